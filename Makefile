@@ -1,0 +1,39 @@
+# Thin convenience wrapper around CMake/CTest. See README.md.
+BUILD_DIR ?= build
+JOBS      ?= $(shell nproc)
+CMAKE_FLAGS ?=
+# OpenMPI refuses to run as root unless told; CI and containers run as root.
+export OMPI_ALLOW_RUN_AS_ROOT=1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_rmaps_base_oversubscribe=1
+export OMP_NUM_THREADS=1
+
+.PHONY: all deps configure build demo test verify bench clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+$(BUILD_DIR)/build.ninja: | deps
+	cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+
+configure: deps $(BUILD_DIR)/build.ninja
+
+build: configure
+	cmake --build $(BUILD_DIR) -j $(JOBS)
+
+demo: build
+	$(BUILD_DIR)/tools/talus-explicit parameter_files/demo/column_collapse_2d.prm
+
+test: build
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE "verify|bench"
+
+verify: build
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L verify
+
+bench: build
+	bash scripts/bench.sh $(BUILD_DIR)
+
+clean:
+	rm -rf $(BUILD_DIR)

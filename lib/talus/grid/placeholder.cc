@@ -1,0 +1,1 @@
+namespace talus { int talus_placeholder = 0; }

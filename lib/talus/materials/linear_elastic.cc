@@ -1,0 +1,69 @@
+#include <talus/base/errors.h>
+#include <talus/materials/linear_elastic.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+namespace talus::materials
+{
+  namespace
+  {
+    void
+    check(const double E, const double nu, const std::string &where)
+    {
+      require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
+      require(nu > -1.0 && nu < 0.5,
+              where + "/poisson ratio",
+              "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+    }
+  } // namespace
+
+  LinearElastic::LinearElastic(const double young, const double poisson)
+    : E(young)
+    , nu(poisson)
+  {
+    check(E, nu, "linear elastic");
+  }
+
+  LinearElastic::LinearElastic(dealii::ParameterHandler &prm, const std::string &where)
+    : E(prm.get_double("young modulus"))
+    , nu(prm.get_double("poisson ratio"))
+  {
+    check(E, nu, where);
+  }
+
+  void
+  LinearElastic::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(), "Young's modulus E [Pa], > 0.");
+    prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(), "Poisson's ratio nu [-], -1 < nu < 0.5.");
+  }
+
+  double
+  LinearElastic::constrained_modulus() const
+  {
+    return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+  }
+
+  void
+  LinearElastic::update_stress(const Strain &d_eps,
+                               const Spin &  d_omega,
+                               const double,
+                               Stress &sigma,
+                               ArrayView<double>) const
+  {
+    const double G      = shear_modulus();
+    const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    sigma               = apply_jaumann_rotation(sigma, d_omega);
+    const double tr     = trace(d_eps);
+    sigma += 2 * G * d_eps;
+    for (unsigned int i = 0; i < 3; ++i)
+      sigma[i][i] += lambda * tr;
+  }
+
+  double
+  LinearElastic::elastic_energy_density(const Stress &s) const
+  {
+    // W = 1/2 sigma : C^-1 : sigma = (1/(2E)) [ (1+nu) s:s - nu tr(s)^2 ]
+    return (1.0 / (2 * E)) * ((1 + nu) * scalar_product(s, s) - nu * trace(s) * trace(s));
+  }
+} // namespace talus::materials

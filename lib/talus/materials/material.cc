@@ -1,0 +1,136 @@
+#include <talus/base/errors.h>
+#include <talus/materials/material.h>
+#include <talus/materials/linear_elastic.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <functional>
+#include <map>
+
+namespace talus::materials
+{
+  Stress
+  apply_jaumann_rotation(const Stress &sigma, const Spin &w)
+  {
+    // Objective integration of the Jaumann rate over one step: sigma <- Q sigma Q^T
+    // with the Cayley (Hughes-Winget) rotation Q = (I - W/2)^-1 (I + W/2). In closed
+    // form, with A = W/2 and a its axial vector: Q = I + 2/(1+|a|^2) (A + A^2).
+    // Q is exactly orthogonal, so stress invariants are preserved to round-off,
+    // and Q sigma Q^T = sigma + W sigma - sigma W + O(|W|^2).
+    const double a0 = 0.5 * w[2][1], a1 = 0.5 * w[0][2], a2 = 0.5 * w[1][0];
+    const double aa = a0 * a0 + a1 * a1 + a2 * a2;
+    if (aa == 0.0)
+      return sigma;
+    dealii::Tensor<2, 3> A;
+    A[0][1] = -a2;
+    A[1][0] = a2;
+    A[0][2] = a1;
+    A[2][0] = -a1;
+    A[1][2] = -a0;
+    A[2][1] = a0;
+    const double         c = 2.0 / (1.0 + aa);
+    dealii::Tensor<2, 3> Q = c * (A + A * A);
+    for (unsigned int i = 0; i < 3; ++i)
+      Q[i][i] += 1.0;
+    const dealii::Tensor<2, 3> S  = sigma;
+    const dealii::Tensor<2, 3> QS = Q * S;
+    Stress                     r;
+    for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int j = i; j < 3; ++j)
+        {
+          double v = 0;
+          for (unsigned int k = 0; k < 3; ++k)
+            v += QS[i][k] * Q[j][k];
+          r[i][j] = v;
+        }
+    return r;
+  }
+
+  double
+  Material::elastic_energy_density(const Stress &) const
+  {
+    return 0.0;
+  }
+
+  namespace
+  {
+    struct ModelEntry
+    {
+      std::function<void(dealii::ParameterHandler &)> declare;
+      std::function<std::unique_ptr<Material>(dealii::ParameterHandler &,
+                                              const std::string &)>
+        create;
+    };
+
+    const std::map<std::string, ModelEntry> &
+    registry()
+    {
+      static const std::map<std::string, ModelEntry> r = {
+        {"linear elastic",
+         {&LinearElastic::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new LinearElastic(prm, where));
+          }}},
+      };
+      return r;
+    }
+
+    std::string
+    model_list()
+    {
+      std::string s;
+      for (const auto &[k, v] : registry())
+        s += (s.empty() ? "" : "|") + k;
+      return s;
+    }
+  } // namespace
+
+  std::vector<std::string>
+  registered_models()
+  {
+    std::vector<std::string> names;
+    for (const auto &[k, v] : registry())
+      names.push_back(k);
+    return names;
+  }
+
+  void
+  declare_material_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("model",
+                      "linear elastic",
+                      dealii::Patterns::Selection(model_list()),
+                      "Constitutive model of this material.");
+    prm.declare_entry("density",
+                      "2000",
+                      dealii::Patterns::Double(0.0),
+                      "Mass density [kg/m^3], > 0.");
+    for (const auto &[k, v] : registry())
+      {
+        prm.enter_subsection(k);
+        v.declare(prm);
+        prm.leave_subsection();
+      }
+  }
+
+  std::unique_ptr<Material>
+  create_material(dealii::ParameterHandler &prm,
+                  const std::string &       where,
+                  const unsigned int        id)
+  {
+    const std::string model = prm.get("model");
+    const auto        it    = registry().find(model);
+    require(it != registry().end(),
+            where,
+            "unknown model '" + model + "'; allowed: " + model_list());
+    const double rho = prm.get_double("density");
+    require(rho > 0, where + "/density", "must be > 0 (got " + std::to_string(rho) + ")");
+    prm.enter_subsection(model);
+    auto m = it->second.create(prm, where + "/" + model);
+    prm.leave_subsection();
+    m->name = where;
+    m->id   = id;
+    m->set_density(rho);
+    return m;
+  }
+} // namespace talus::materials

@@ -1,0 +1,96 @@
+// talus — constitutive model interface shared by the explicit, implicit and
+// semi-implicit drivers. Light on deal.II: tensors only.
+//
+// Conventions
+//  * Stresses are Cauchy stresses, tension positive, always 3x3 (plane strain in 2D
+//    keeps sigma_zz).
+//  * The rate form (explicit driver, seed 000 §7.1) receives the small strain
+//    increment d_eps = sym(grad du) and the spin increment d_omega = skew(grad du)
+//    of one step. The objective (Jaumann) correction of the stress is applied by
+//    the model through apply_jaumann_rotation(), so models with tensorial history
+//    can rotate it as well.
+//  * History variables are plain doubles stored per material point; a model
+//    declares how many it needs and their names (for output).
+#pragma once
+
+#include <deal.II/base/array_view.h>
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/base/tensor.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dealii
+{
+  class ParameterHandler;
+}
+
+namespace talus::materials
+{
+  using dealii::ArrayView;
+  using Stress = dealii::SymmetricTensor<2, 3>;
+  using Strain = dealii::SymmetricTensor<2, 3>;
+  using Spin   = dealii::Tensor<2, 3>;
+
+  /// Jaumann-rate rotation of the stress over one step by the exactly orthogonal
+  /// Cayley (Hughes-Winget) rotation of the spin increment d_omega = skew(grad du).
+  Stress apply_jaumann_rotation(const Stress &sigma, const Spin &d_omega);
+
+  class Material
+  {
+  public:
+    virtual ~Material() = default;
+
+    /// Registry name of the model, e.g. "linear elastic".
+    virtual std::string model_name() const = 0;
+
+    /// Mass density of the material [kg/m^3].
+    double density() const { return rho; }
+    void   set_density(const double r) { rho = r; }
+
+    /// Constrained (P-wave) modulus E_c [Pa] used by the critical time step
+    /// (seed 000 Eq. 4.120). For liquids: the bulk modulus.
+    virtual double constrained_modulus() const = 0;
+
+    /// Number and names of the history variables stored per material point.
+    virtual unsigned int n_history() const { return 0; }
+    virtual std::vector<std::string> history_names() const { return {}; }
+    /// Initialise the history for a point with the given initial stress.
+    virtual void initialize_history(const Stress & /*sigma*/,
+                                    ArrayView<double> /*history*/) const
+    {}
+
+    /// Rate-form stress update (explicit driver): updates sigma (Jaumann rotated
+    /// then integrated over the strain increment) and history in place.
+    virtual void update_stress(const Strain &    d_eps,
+                               const Spin &      d_omega,
+                               const double      dt,
+                               Stress &          sigma,
+                               ArrayView<double> history) const = 0;
+
+    /// Strain energy density increment is computed by the driver from stresses;
+    /// this returns the elastic strain energy density of a stress state (for energy
+    /// diagnostics), W = 1/2 sigma : C^-1 : sigma. Zero when not meaningful.
+    virtual double elastic_energy_density(const Stress &sigma) const;
+
+    std::string name; ///< user-facing name (".prm" subsection), for messages
+    unsigned int id = 0;
+
+  protected:
+    double rho = 0.0;
+  };
+
+  /// Declare the subsection of one material: "model", "density" and every
+  /// model's own subsection.
+  void declare_material_parameters(dealii::ParameterHandler &prm);
+
+  /// Build the material described by the current subsection of prm. `where`
+  /// names the subsection for error messages. Throws talus::InputError.
+  std::unique_ptr<Material> create_material(dealii::ParameterHandler &prm,
+                                            const std::string &       where,
+                                            const unsigned int        id);
+
+  /// Names of all registered models (for error messages and --help).
+  std::vector<std::string> registered_models();
+} // namespace talus::materials
