@@ -46,6 +46,17 @@ namespace talus::materials
     return r;
   }
 
+  void
+  Material::finite_strain_update(const dealii::Tensor<2, 3> &,
+                                 ArrayView<const double>,
+                                 ArrayView<double>,
+                                 Stress &,
+                                 dealii::Tensor<4, 3> *) const
+  {
+    throw InputError("material '" + name + "': model '" + model_name() +
+                     "' has no finite-strain form; choose one of the finite-strain models");
+  }
+
   double
   Material::elastic_energy_density(const Stress &) const
   {

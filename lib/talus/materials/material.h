@@ -69,6 +69,22 @@ namespace talus::materials
                                Stress &          sigma,
                                ArrayView<double> history) const = 0;
 
+    /// ---- Finite-strain form (implicit updated-Lagrangian and semi-implicit
+    /// drivers, seed 001 ch. 3, seed 002 §4.3). Models without it return false.
+    virtual bool has_finite_strain_form() const { return false; }
+
+    /// Given the incremental deformation gradient of the step dF = F_{n+1} F_n^{-1}
+    /// and the history at the start of the step (converged state), compute the
+    /// Kirchhoff stress tau_{n+1}, the updated history, and (if dtau_ddF is not
+    /// null) the consistent tangent d tau_{n+1} / d dF (a full 4th-order tensor,
+    /// dtau_ij / d dF_kl). Models that need the total F keep it in their history.
+    /// Must not modify history_old; history_new may alias nothing else.
+    virtual void finite_strain_update(const dealii::Tensor<2, 3> &dF,
+                                      ArrayView<const double>     history_old,
+                                      ArrayView<double>           history_new,
+                                      Stress &                    tau,
+                                      dealii::Tensor<4, 3> *      dtau_ddF) const;
+
     /// Strain energy density increment is computed by the driver from stresses;
     /// this returns the elastic strain energy density of a stress state (for energy
     /// diagnostics), W = 1/2 sigma : C^-1 : sigma. Zero when not meaningful.
