@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
+#include <talus/materials/neo_hookean.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -77,6 +78,11 @@ namespace talus::materials
     registry()
     {
       static const std::map<std::string, ModelEntry> r = {
+        {"neo hookean",
+         {&NeoHookean::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new NeoHookean(prm, where));
+          }}},
         {"linear elastic",
          {&LinearElastic::declare_parameters,
           [](dealii::ParameterHandler &prm, const std::string &where) {
