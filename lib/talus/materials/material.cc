@@ -2,6 +2,7 @@
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
 #include <talus/materials/neo_hookean.h>
+#include <talus/materials/mohr_coulomb.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -87,6 +88,11 @@ namespace talus::materials
          {&LinearElastic::declare_parameters,
           [](dealii::ParameterHandler &prm, const std::string &where) {
             return std::unique_ptr<Material>(new LinearElastic(prm, where));
+          }}},
+        {"mohr coulomb",
+         {&MohrCoulomb::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new MohrCoulomb(prm, where));
           }}},
       };
       return r;
