@@ -283,3 +283,75 @@ TEST(MohrCoulomb, RejectsBadParameters)
     }
   prm.leave_subsection();
 }
+
+// ---------------------------------------------------------------- Tresca
+#include <talus/materials/tresca.h>
+
+TEST(Tresca, UndrainedTriaxialFailsAtTwiceSu)
+{
+  const double su = 25e3;
+  for (const auto path :
+       {ElementPath::undrained_triaxial_compression, ElementPath::undrained_triaxial_extension,
+        ElementPath::drained_triaxial_compression})
+    {
+      Tresca              m(15e6, 0.45, su);
+      ElementTestSettings set;
+      set.path             = path;
+      set.target_strain    = 0.02;
+      set.n_increments     = 100;
+      set.initial_pressure = 80e3;
+      std::vector<ElementRecord> rec;
+      run_element_test(m, set, [&](const ElementRecord &r) { rec.push_back(r); });
+      const ElementRecord &last = rec.back();
+      EXPECT_NEAR(last.q(), 2 * su, 1e-10 * su);
+      // the deviator is reached, never exceeded
+      for (const auto &r : rec)
+        EXPECT_LE(r.q(), 2 * su * (1 + 1e-12));
+      // elastic start: q = 3 G eps_q (undrained: eps_q = eps_a)
+      if (path == ElementPath::undrained_triaxial_compression)
+        {
+          const double G = 15e6 / (2 * 1.45);
+          EXPECT_NEAR(rec[1].q(), 3 * G * rec[1].eps_axial(), 1e-9 * rec[1].q());
+        }
+      EXPECT_GT(last.history[Tresca::h_plastic_shear_strain], 0.0);
+    }
+}
+
+TEST(Tresca, SimpleShearFailsAtSu)
+{
+  const double        su = 10e3;
+  Tresca              m(5e6, 0.3, su);
+  ElementTestSettings set;
+  set.path             = ElementPath::simple_shear;
+  set.target_strain    = 0.05;
+  set.n_increments     = 500;
+  set.initial_pressure = 50e3;
+  ElementRecord last;
+  run_element_test(m, set, [&](const ElementRecord &r) { last = r; });
+  // pure shear plane stress state: tau_xy -> s_u (no normal stress change)
+  EXPECT_NEAR(std::abs(last.sigma[0][1]), su, 1e-3 * su); // Jaumann spin rotates slightly
+  const auto p = dealii::eigenvalues(last.sigma);
+  EXPECT_NEAR(p[0] - p[2], 2 * su, 1e-10 * su);
+}
+
+TEST(Tresca, EdgeReturn)
+{
+  const double        E = 10e6, nu = 0.3, su = 20e3;
+  Tresca              m(E, nu, su);
+  std::vector<double> h;
+  const Stress        s = one_step(m, strain_for_trial({{-50e3, -52e3, -120e3}}, E, nu), h);
+  const auto          p = principal(s);
+  EXPECT_NEAR(p[0], p[1], 1e-9 * su);
+  EXPECT_NEAR(p[0] - p[2], 2 * su, 1e-9 * su);
+  EXPECT_EQ(h[Tresca::h_yield_state], 2.0);
+  // associated flow is deviatoric: no volume change across the return
+  EXPECT_NEAR(trace(s), -50e3 - 52e3 - 120e3, 1e-9 * su);
+}
+
+TEST(Tresca, RejectsBadParameters)
+{
+  EXPECT_THROW(Tresca(0, 0.3, 1e3), talus::InputError);
+  EXPECT_THROW(Tresca(1e6, 0.5, 1e3), talus::InputError);
+  EXPECT_THROW(Tresca(1e6, 0.3, 0), talus::InputError);
+  EXPECT_NO_THROW(Tresca(1e6, 0.49, 1e3));
+}

@@ -3,6 +3,10 @@
 #include <talus/materials/linear_elastic.h>
 #include <talus/materials/neo_hookean.h>
 #include <talus/materials/mohr_coulomb.h>
+#include <talus/materials/tresca.h>
+#include <talus/materials/newtonian.h>
+#include <talus/materials/bingham.h>
+#include <talus/materials/frictional_fluid.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -93,6 +97,26 @@ namespace talus::materials
          {&MohrCoulomb::declare_parameters,
           [](dealii::ParameterHandler &prm, const std::string &where) {
             return std::unique_ptr<Material>(new MohrCoulomb(prm, where));
+          }}},
+        {"tresca",
+         {&Tresca::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new Tresca(prm, where));
+          }}},
+        {"newtonian",
+         {&Newtonian::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new Newtonian(prm, where));
+          }}},
+        {"bingham",
+         {&Bingham::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new Bingham(prm, where));
+          }}},
+        {"frictional fluid",
+         {&FrictionalFluid::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new FrictionalFluid(prm, where));
           }}},
       };
       return r;

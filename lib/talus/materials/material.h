@@ -53,6 +53,10 @@ namespace talus::materials
     /// (seed 000 Eq. 4.120). For liquids: the bulk modulus.
     virtual double constrained_modulus() const = 0;
 
+    /// Largest dynamic viscosity [Pa s] the model can produce (liquids; 0 for
+    /// solids). Drivers use it for the viscous time-step limit dt <= rho h^2 / (2 mu).
+    virtual double dynamic_viscosity() const { return 0.0; }
+
     /// Number and names of the history variables stored per material point.
     virtual unsigned int n_history() const { return 0; }
     virtual std::vector<std::string> history_names() const { return {}; }

@@ -1,0 +1,86 @@
+#include <talus/materials/frictional_fluid.h>
+#include <talus/materials/liquid_common.h>
+
+namespace talus::materials
+{
+  using namespace internal;
+
+  FrictionalFluid::FrictionalFluid(const double E_, const double nu_, const double K_,
+                                   const double phi_, const double mu_, const double mu_max_,
+                                   const double p_cav_, const std::string &where)
+    : E(E_), nu(nu_), K(K_), phi(phi_), mu(mu_), mu_max(mu_max_), p_cav(p_cav_)
+  {
+    setup(where);
+  }
+
+  FrictionalFluid::FrictionalFluid(dealii::ParameterHandler &prm, const std::string &where)
+    : E(prm.get_double("young modulus"))
+    , nu(prm.get_double("poisson ratio"))
+    , K(prm.get_double("bulk modulus"))
+    , phi(prm.get_double("friction angle"))
+    , mu(prm.get_double("dynamic viscosity"))
+    , mu_max(prm.get_double("maximum viscosity"))
+    , p_cav(prm.get_double("cavitation threshold"))
+  {
+    setup(where);
+  }
+
+  void
+  FrictionalFluid::setup(const std::string &where)
+  {
+    require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
+    require(nu > -1.0 && nu < 0.5,
+            where + "/poisson ratio",
+            "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+    check_liquid_pressure_parameters(K, p_cav, where);
+    require(phi >= 0 && phi < 90,
+            where + "/friction angle",
+            "must satisfy 0 <= phi < 90 degrees (got " + std::to_string(phi) + ")");
+    require(mu >= 0, where + "/dynamic viscosity", "must be >= 0 (got " + std::to_string(mu) + ")");
+    require(mu_max > 0 && mu_max >= mu,
+            where + "/maximum viscosity",
+            "must be > 0 and >= the dynamic viscosity (got " + std::to_string(mu_max) + ")");
+    G       = E / (2 * (1 + nu));
+    sin_phi = std::sin(phi * M_PI / 180.0);
+  }
+
+  void
+  FrictionalFluid::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("young modulus", "1e6", dealii::Patterns::Double(),
+                      "Young's modulus E [Pa], > 0, of the solid-like (unyielded) state.");
+    prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(), "Poisson's ratio nu [-], -1 < nu < 0.5.");
+    declare_liquid_pressure_parameters(prm);
+    prm.declare_entry("friction angle", "30", dealii::Patterns::Double(),
+                      "Friction angle phi [degrees], 0 <= phi < 90: yield stress tau_y = max(p,0) sin(phi).");
+    prm.declare_entry("dynamic viscosity", "1", dealii::Patterns::Double(),
+                      "Viscosity of the flowing state mu [Pa s], >= 0.");
+    prm.declare_entry("maximum viscosity", "1e4", dealii::Patterns::Double(),
+                      "Cap mu_max [Pa s] on the effective viscosity mu + tau_y/gamma_dot, >= mu.");
+  }
+
+  void
+  FrictionalFluid::initialize_history(const Stress &sigma, ArrayView<double> h) const
+  {
+    h[h_volumetric_strain]   = trace(sigma) / (3.0 * K);
+    h[h_effective_viscosity] = 0;
+  }
+
+  void
+  FrictionalFluid::update_stress(const Strain &    d_eps,
+                                 const Spin &      d_omega,
+                                 const double      dt,
+                                 Stress &          sigma,
+                                 ArrayView<double> h) const
+  {
+    const Stress s_old = deviator(apply_jaumann_rotation(sigma, d_omega));
+    h[h_volumetric_strain] += trace(d_eps);
+    const double p     = liquid_pressure(K, h[h_volumetric_strain], p_cav);
+    const double tau_y = std::max(p, 0.0) * sin_phi;
+    double       mu_eff;
+    sigma = viscoplastic_deviator(s_old, d_eps, dt, G, tau_y, mu, mu_max, !(p > p_cav), mu_eff);
+    h[h_effective_viscosity] = mu_eff;
+    for (unsigned int i = 0; i < 3; ++i)
+      sigma[i][i] -= p;
+  }
+} // namespace talus::materials
