@@ -1,0 +1,54 @@
+// talus — the common frame of every command-line tool: MPI start-up, command line
+// (--help, --print-parameters, one .prm file), strict .prm parsing with messages
+// that name the file, line and allowed values, and one clear error per failure
+// with a non-zero exit status.
+#pragma once
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <functional>
+#include <string>
+
+namespace talus
+{
+  /// Exit codes shared by every tool.
+  enum ExitCode : int
+  {
+    exit_ok          = 0,
+    exit_failure     = 1, ///< unexpected internal error
+    exit_input_error = 2, ///< bad command line, .prm, mesh or data file
+    exit_unstable    = 3, ///< the run went unstable and was stopped
+  };
+
+  struct ToolDescription
+  {
+    std::string name;    ///< e.g. "talus-explicit"
+    std::string summary; ///< one paragraph for --help
+    /// Declare every entry. `prm_file` is the file about to be parsed, or empty
+    /// when printing defaults; tools whose entries depend on counts in the file
+    /// (number of bodies, materials) read those with peek_entry().
+    std::function<void(dealii::ParameterHandler &, const std::string &prm_file)> declare;
+    /// Run with the parsed parameters; returns the exit code.
+    std::function<int(dealii::ParameterHandler &, const std::string &prm_file)> run;
+  };
+
+  /// main() of a tool: `return talus::run_tool(argc, argv, description);`
+  int run_tool(int argc, char **argv, const ToolDescription &tool);
+
+  /// Read one entry from a .prm file before the full declaration exists
+  /// (everything else in the file is ignored). `subsection_path` is a list of
+  /// nested subsections separated by '/', empty for the top level. Returns
+  /// `default_value` when the entry is absent.
+  std::string peek_entry(const std::string &prm_file,
+                         const std::string &subsection_path,
+                         const std::string &entry,
+                         const std::string &default_value,
+                         const dealii::Patterns::PatternBase &pattern);
+
+  /// Rank-0 output streams (silent on other ranks).
+  std::ostream &log();
+  std::ostream &err();
+
+  /// Text of a deal.II exception without the backtrace.
+  std::string exception_text(const std::exception &e);
+} // namespace talus

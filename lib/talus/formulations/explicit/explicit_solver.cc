@@ -1,0 +1,1058 @@
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/io/output.h>
+#include <talus/shape/q1.h>
+
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+#include <deal.II/numerics/data_out.h>
+#include <deal.II/particles/data_out.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+namespace talus::explicit_mpm
+{
+  using dealii::Patterns::Anything;
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Integer;
+  using dealii::Patterns::List;
+  using dealii::Patterns::Selection;
+
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+    double
+    seconds_since(const Clock::time_point &t0)
+    {
+      return std::chrono::duration<double>(Clock::now() - t0).count();
+    }
+
+    std::string
+    zeros(const unsigned int dim, const std::string &last = "0")
+    {
+      std::string s;
+      for (unsigned int d = 0; d + 1 < dim; ++d)
+        s += "0, ";
+      return s + last;
+    }
+
+    std::vector<double>
+    parse_doubles(const std::string &text, const std::string &where)
+    {
+      std::vector<double> r;
+      for (const auto &s : dealii::Utilities::split_string_list(text, ','))
+        {
+          try
+            {
+              std::size_t  pos = 0;
+              const double v   = std::stod(s, &pos);
+              if (pos != s.size())
+                throw std::invalid_argument(s);
+              r.push_back(v);
+            }
+          catch (const std::exception &)
+            {
+              throw InputError(where + ": '" + s + "' is not a number (in '" + text + "')");
+            }
+        }
+      return r;
+    }
+
+    template <int dim>
+    dealii::Point<dim>
+    parse_point(const std::string &text, const std::string &where)
+    {
+      const auto v = parse_doubles(text, where);
+      require(v.size() == dim,
+              where,
+              "needs exactly " + std::to_string(dim) + " comma-separated numbers for dimension " +
+                std::to_string(dim) + " (got '" + text + "')");
+      dealii::Point<dim> p;
+      for (unsigned int d = 0; d < dim; ++d)
+        p[d] = v[d];
+      return p;
+    }
+
+    std::vector<unsigned int>
+    parse_ids(const std::string &text, const std::string &where)
+    {
+      std::vector<unsigned int> r;
+      for (const auto &s : dealii::Utilities::split_string_list(text, ','))
+        {
+          const auto v = parse_doubles(s, where);
+          require(v.size() == 1 && v[0] >= 0 && v[0] == std::floor(v[0]) && v[0] < 65535,
+                  where,
+                  "'" + s + "' is not a non-negative integer id");
+          r.push_back(static_cast<unsigned int>(v[0]));
+        }
+      return r;
+    }
+  } // namespace
+
+  // ================================================================ parameters
+  void
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
+  {
+    const unsigned int dim = dealii::Utilities::string_to_int(
+      peek_entry(prm_file, "", "dimension", "2", Selection("2|3")));
+    const unsigned int n_materials = dealii::Utilities::string_to_int(
+      peek_entry(prm_file, "", "number of materials", "1", Integer(1, 64)));
+    const unsigned int n_bodies = dealii::Utilities::string_to_int(
+      peek_entry(prm_file, "", "number of bodies", "1", Integer(1, 64)));
+
+    prm.declare_entry("dimension", "2", Selection("2|3"),
+                      "Spatial dimension: 2 (plane strain, per unit thickness) or 3.");
+    prm.enter_subsection("time");
+    {
+      prm.declare_entry("end time", "1.0", Double(0), "Simulated duration [s].");
+      prm.declare_entry("courant number", "0.5", Double(0, 1),
+                        "Time step as a fraction of the critical time step L_min/c (seed 000 Eq. 4.120), "
+                        "used when 'time step' is 0. Range (0, 1].");
+      prm.declare_entry("time step", "0", Double(0),
+                        "Fixed time step [s]; 0 = courant number x critical time step. A value above the "
+                        "critical time step is refused unless 'force time step' is true.");
+      prm.declare_entry("force time step", "false", Bool(),
+                        "Accept a 'time step' above the critical one (stability studies).");
+      prm.declare_entry("maximum steps", "0", Integer(0), "Stop after this many steps; 0 = no limit.");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("grid");
+    {
+      prm.declare_entry("lower corner", zeros(dim), Anything(),
+                        "Lower corner of the box background grid [m], dim comma-separated numbers.");
+      prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(),
+                        "Upper corner of the box background grid [m].");
+      prm.declare_entry("cells", dim == 2 ? "10, 10" : "10, 10, 10", Anything(),
+                        "Number of cells per direction (dim positive integers). Boundary ids: "
+                        "0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+.");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("boundary conditions");
+    {
+      prm.declare_entry("fixed", "", Anything(),
+                        "Boundary ids (comma-separated) on which every velocity component is zero.");
+      prm.declare_entry("roller", "", Anything(),
+                        "Boundary ids on which the velocity component normal to the boundary is zero.");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("gravity");
+    prm.declare_entry("acceleration", zeros(dim, "-9.81"), Anything(),
+                      "Gravitational acceleration vector [m/s^2].");
+    prm.leave_subsection();
+
+    prm.enter_subsection("stability");
+    prm.declare_entry("energy growth limit", "10", Double(1),
+                      "The run is stopped as unstable when kinetic + strain energy exceed this factor times "
+                      "the energy available (initial kinetic + strain energy + released potential energy + "
+                      "external work), or when any state becomes non-finite.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("output");
+    {
+      prm.declare_entry("directory", "output", Anything(), "Output directory (created if missing).");
+      prm.declare_entry("vtu interval", "0", Double(0),
+                        "Simulated time between particle VTU/PVTU outputs (PVD series); 0 = first and last only.");
+      prm.declare_entry("series interval", "0", Double(0),
+                        "Simulated time between rows of series.csv (energies, momentum, probes); 0 = every step.");
+      prm.declare_entry("write grid", "false", Bool(), "Also write the background grid with nodal mass and velocity.");
+      prm.declare_entry("final particles csv", "false", Bool(),
+                        "Write particles_final.csv (id, position, displacement, velocity, stress, volume), "
+                        "gathered on rank 0 and sorted by id: for tests and comparisons of small runs.");
+      prm.declare_entry("progress", "true", Bool(), "Print progress with an ETA every few seconds.");
+      prm.declare_entry("probes", "", Anything(),
+                        "Points 'x,y[,z]; x,y[,z]; ...': the material point nearest to each at t = 0 is tracked; "
+                        "its displacement and velocity go to series.csv.");
+    }
+    prm.leave_subsection();
+
+    prm.declare_entry("number of materials", "1", Integer(1, 64),
+                      "Number of 'material k' subsections (k = 0..n-1).");
+    for (unsigned int k = 0; k < n_materials; ++k)
+      {
+        prm.enter_subsection("material " + std::to_string(k));
+        materials::declare_material_parameters(prm);
+        prm.leave_subsection();
+      }
+
+    prm.declare_entry("number of bodies", "1", Integer(1, 64), "Number of 'body k' subsections (k = 0..n-1).");
+    for (unsigned int k = 0; k < n_bodies; ++k)
+      {
+        prm.enter_subsection("body " + std::to_string(k));
+        prm.declare_entry("name", "body " + std::to_string(k), Anything(), "Name used in messages.");
+        prm.declare_entry("material", "0", Integer(0), "Material id (index of a 'material k' subsection).");
+        prm.declare_entry("shape", "box", Selection("box|ball|polygon"),
+                          "Region filled with material points: box (lower/upper corner), ball (disk in 2D, "
+                          "sphere in 3D: center, radius) or polygon (2D: vertices).");
+        prm.declare_entry("lower corner", zeros(dim), Anything(), "Box: lower corner [m].");
+        prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(), "Box: upper corner [m].");
+        prm.declare_entry("center", zeros(dim), Anything(), "Ball: center [m].");
+        prm.declare_entry("radius", "0", Double(0), "Ball: radius [m].");
+        prm.declare_entry("vertices", "", Anything(), "Polygon: 'x,y; x,y; ...' [m], at least 3 vertices.");
+        prm.declare_entry("particles per direction", "2", Integer(1, 10),
+                          "Material points per cell and direction (n^dim per filled cell, regular positions).");
+        prm.declare_entry("initial velocity", zeros(dim), Anything(), "Uniform initial velocity [m/s].");
+        prm.declare_entry("initial velocity function", "", Anything(),
+                          "Optional initial velocity field, dim expressions separated by ';' in x, y, z "
+                          "(muparser syntax, e.g. '0.1*sin(pi*x/2); 0'); overrides 'initial velocity'.");
+        prm.declare_entry("function constants", "", Anything(),
+                          "Constants for the function, 'name=value, name=value'.");
+        prm.leave_subsection();
+      }
+  }
+
+  template <int dim>
+  Parameters<dim>
+  parse_parameters(dealii::ParameterHandler &prm)
+  {
+    Parameters<dim> p;
+    prm.enter_subsection("time");
+    p.end_time        = prm.get_double("end time");
+    p.courant         = prm.get_double("courant number");
+    p.time_step       = prm.get_double("time step");
+    p.force_time_step = prm.get_bool("force time step");
+    p.max_steps       = prm.get_integer("maximum steps");
+    require(p.courant > 0, "time/courant number", "must be > 0");
+    require(p.end_time > 0, "time/end time", "must be > 0");
+    prm.leave_subsection();
+
+    prm.enter_subsection("grid");
+    p.grid_lower = parse_point<dim>(prm.get("lower corner"), "grid/lower corner");
+    p.grid_upper = parse_point<dim>(prm.get("upper corner"), "grid/upper corner");
+    p.grid_cells = parse_ids(prm.get("cells"), "grid/cells");
+    require(p.grid_cells.size() == dim, "grid/cells", "needs exactly " + std::to_string(dim) + " integers");
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        require(p.grid_cells[d] > 0, "grid/cells", "every entry must be > 0");
+        require(p.grid_upper[d] > p.grid_lower[d], "grid/upper corner",
+                "must exceed 'lower corner' in every direction");
+      }
+    prm.leave_subsection();
+
+    prm.enter_subsection("boundary conditions");
+    for (const auto id : parse_ids(prm.get("fixed"), "boundary conditions/fixed"))
+      p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::fixed});
+    for (const auto id : parse_ids(prm.get("roller"), "boundary conditions/roller"))
+      p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::roller});
+    prm.leave_subsection();
+
+    prm.enter_subsection("gravity");
+    p.gravity = parse_point<dim>(prm.get("acceleration"), "gravity/acceleration");
+    prm.leave_subsection();
+
+    prm.enter_subsection("stability");
+    p.energy_growth_limit = prm.get_double("energy growth limit");
+    prm.leave_subsection();
+
+    prm.enter_subsection("output");
+    p.output_directory    = prm.get("directory");
+    p.vtu_interval        = prm.get_double("vtu interval");
+    p.series_interval     = prm.get_double("series interval");
+    p.write_grid          = prm.get_bool("write grid");
+    p.final_particles_csv = prm.get_bool("final particles csv");
+    p.progress            = prm.get_bool("progress");
+    require(!p.output_directory.empty(), "output/directory", "must not be empty");
+    for (const auto &s : dealii::Utilities::split_string_list(prm.get("probes"), ';'))
+      p.probes.push_back(parse_point<dim>(s, "output/probes"));
+    prm.leave_subsection();
+
+    const unsigned int n_materials = prm.get_integer("number of materials");
+    for (unsigned int k = 0; k < n_materials; ++k)
+      {
+        const std::string where = "material " + std::to_string(k);
+        prm.enter_subsection(where);
+        p.materials.emplace_back(materials::create_material(prm, where, k));
+        prm.leave_subsection();
+      }
+
+    const unsigned int n_bodies = prm.get_integer("number of bodies");
+    for (unsigned int k = 0; k < n_bodies; ++k)
+      {
+        const std::string where = "body " + std::to_string(k);
+        prm.enter_subsection(where);
+        BodyDescription<dim> b;
+        b.name        = prm.get("name");
+        b.material_id = prm.get_integer("material");
+        require(b.material_id < n_materials, where + "/material",
+                "material " + std::to_string(b.material_id) + " is not defined (number of materials = " +
+                  std::to_string(n_materials) + ", allowed 0.." + std::to_string(n_materials - 1) + ")");
+        const std::string shape = prm.get("shape");
+        if (shape == "box")
+          {
+            b.shape = BodyDescription<dim>::Shape::box;
+            b.lower = parse_point<dim>(prm.get("lower corner"), where + "/lower corner");
+            b.upper = parse_point<dim>(prm.get("upper corner"), where + "/upper corner");
+            for (unsigned int d = 0; d < dim; ++d)
+              require(b.upper[d] > b.lower[d], where + "/upper corner", "must exceed 'lower corner' in every direction");
+          }
+        else if (shape == "ball")
+          {
+            b.shape  = BodyDescription<dim>::Shape::ball;
+            b.center = parse_point<dim>(prm.get("center"), where + "/center");
+            b.radius = prm.get_double("radius");
+            require(b.radius > 0, where + "/radius", "must be > 0 for shape = ball");
+          }
+        else
+          {
+            require(dim == 2, where + "/shape", "polygon bodies exist in 2D only (allowed in 3D: box|ball)");
+            b.shape = BodyDescription<dim>::Shape::polygon;
+            for (const auto &s : dealii::Utilities::split_string_list(prm.get("vertices"), ';'))
+              b.polygon.push_back(parse_point<2>(s, where + "/vertices"));
+            require(b.polygon.size() >= 3, where + "/vertices", "a polygon needs at least 3 vertices");
+          }
+        b.particles_per_direction = prm.get_integer("particles per direction");
+        b.initial_velocity        = parse_point<dim>(prm.get("initial velocity"), where + "/initial velocity");
+        const std::string expr    = prm.get("initial velocity function");
+        if (!expr.empty())
+          {
+            std::map<std::string, double> constants;
+            for (const auto &c : dealii::Utilities::split_string_list(prm.get("function constants"), ','))
+              {
+                const auto kv = dealii::Utilities::split_string_list(c, '=');
+                require(kv.size() == 2, where + "/function constants", "'" + c + "' is not of the form name=value");
+                constants[kv[0]] = parse_doubles(kv[1], where + "/function constants")[0];
+              }
+            auto fp = std::make_shared<dealii::FunctionParser<dim>>(dim);
+            try
+              {
+                fp->initialize(dealii::FunctionParser<dim>::default_variable_names(), expr, constants);
+                fp->value(dealii::Point<dim>(), 0); // force a parse of every component
+                for (unsigned int d = 0; d < dim; ++d)
+                  fp->value(dealii::Point<dim>(), d);
+              }
+            catch (const std::exception &e)
+              {
+                throw InputError(where + "/initial velocity function: cannot parse '" + expr + "' (need " +
+                                 std::to_string(dim) + " expressions separated by ';'): " + exception_text(e));
+              }
+            b.velocity_field = [fp](const dealii::Point<dim> &x) {
+              dealii::Tensor<1, dim> v;
+              for (unsigned int d = 0; d < dim; ++d)
+                v[d] = fp->value(x, d);
+              return v;
+            };
+          }
+        prm.leave_subsection();
+        p.bodies.push_back(b);
+      }
+    return p;
+  }
+
+  // ================================================================ solver
+  template <int dim>
+  Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
+    : prm(p)
+    , comm(c)
+    , grid(c)
+  {}
+
+  template <int dim>
+  double
+  Solver<dim>::critical_time_step() const
+  {
+    // seed 000 Eq. 4.120: dt_cr = L_min / c, c = sqrt(E_c / rho); for quads/hexes
+    // L_min is the smallest cell edge.
+    double c_max = 0;
+    for (const auto &m : prm.materials)
+      c_max = std::max(c_max, std::sqrt(m->constrained_modulus() / m->density()));
+    return grid.min_cell_size() / c_max;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::setup()
+  {
+    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
+    grid.setup();
+    constrained = grid.constrained_dofs(prm.boundary_conditions);
+    grid.reinit_vector(nodal_mass);
+    grid.reinit_vector(nodal_a);
+    grid.reinit_vector(nodal_p);
+
+    unsigned int n_history = 0;
+    for (const auto &m : prm.materials)
+      n_history = std::max(n_history, m->n_history());
+    layout.n_history = n_history;
+    particles.initialize(grid.tria, grid.mapping, layout.n_properties());
+    relocator = std::make_unique<Relocator<dim>>(grid, particles);
+
+    std::vector<double> density;
+    for (const auto &m : prm.materials)
+      density.push_back(m->density());
+    const auto seeded = seed_bodies(grid, prm.bodies, density, layout, particles);
+    for (unsigned int b = 0; b < prm.bodies.size(); ++b)
+      require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
+              "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+
+    // history initialisation
+    for (auto &pt : particles)
+      {
+        auto        P = pt.get_properties();
+        const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
+        if (layout.n_history)
+          m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
+                               dealii::ArrayView<double>(P.data() + layout.history, m.n_history()));
+      }
+
+    const double dt_cr = critical_time_step();
+    if (prm.time_step > 0)
+      {
+        if (prm.time_step > dt_cr && !prm.force_time_step)
+          {
+            std::ostringstream os;
+            os << "time/time step: " << prm.time_step << " s exceeds the critical time step " << dt_cr
+               << " s (L_min = " << grid.min_cell_size()
+               << " m); lower it, or set 'force time step = true' to run anyway";
+            throw InputError(os.str());
+          }
+        dt = prm.time_step;
+      }
+    else
+      dt = prm.courant * dt_cr;
+
+    // probes: nearest particle at t = 0 (ties: lowest id)
+    for (const auto &q : prm.probes)
+      {
+        std::pair<double, dealii::types::particle_index> best{std::numeric_limits<double>::max(), 0};
+        for (const auto &pt : particles)
+          best = std::min(best, std::make_pair(pt.get_location().distance(q), pt.get_id()));
+        const auto all = dealii::Utilities::MPI::all_gather(comm, best);
+        probe_ids.push_back(std::min_element(all.begin(), all.end())->second);
+      }
+    probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
+
+    // energy scale for the instability floor: sum m c^2
+    double local_scale = 0;
+    for (const auto &pt : particles)
+      {
+        const auto  P = pt.get_properties();
+        const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
+        local_scale += P[PropertyLayout<dim>::mass] * m.constrained_modulus() / m.density();
+      }
+    energy_scale     = dealii::Utilities::MPI::sum(local_scale, comm);
+    initial_energies = energies();
+    collect_active_cells();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::collect_active_cells()
+  {
+    active_cells.clear();
+    for (auto it = particles.begin(); it != particles.end();)
+      {
+        const auto cell = it->get_surrounding_cell();
+        active_cells.push_back(cell->active_cell_index());
+        it = particles.particles_in_cell(cell).end();
+      }
+  }
+
+  // ---------------------------------------------------------------- P2G (A)
+  template <int dim>
+  void
+  Solver<dim>::p2g_mass_and_force()
+  {
+    using L                    = PropertyLayout<dim>;
+    constexpr unsigned int nv  = shape::Q1<dim>::n_vertices;
+    double *const          M   = nodal_mass.begin();
+    double *const          F   = nodal_a.begin();
+    const auto             g   = prm.gravity;
+    nodal_mass                 = 0.0;
+    nodal_a                    = 0.0;
+    for (const unsigned int c : active_cells)
+      {
+        const auto &cc = grid.cells[c];
+        double      lm[nv] = {}, lf[nv][dim] = {};
+        for (const auto &pt : particles.particles_in_cell(grid.cell_iterators[c]))
+          {
+            const double *P  = pt.get_properties().data();
+            const auto    xi = pt.get_reference_location();
+            double        N[nv], G[nv][dim];
+            shape::Q1<dim>::values_and_gradients(xi, cc.inv_h, N, G);
+            const double m = P[L::mass], V = P[L::volume];
+            // stress components in the plane (2D: xx, yy, xy) / space
+            double s[dim][dim];
+            s[0][0] = P[L::stress + 0];
+            s[1][1] = P[L::stress + 1];
+            s[0][1] = s[1][0] = P[L::stress + 3];
+            if constexpr (dim == 3)
+              {
+                s[2][2]           = P[L::stress + 2];
+                s[1][2] = s[2][1] = P[L::stress + 4];
+                s[0][2] = s[2][0] = P[L::stress + 5];
+              }
+            for (unsigned int v = 0; v < nv; ++v)
+              {
+                const double mN = m * N[v];
+                lm[v] += mN;
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    double sg = 0;
+                    for (unsigned int e = 0; e < dim; ++e)
+                      sg += s[d][e] * G[v][e];
+                    lf[v][d] += mN * g[d] - V * sg;
+                  }
+              }
+          }
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const unsigned int i = cc.dofs[v * dim + d];
+              M[i] += lm[v];
+              F[i] += lf[v][d];
+            }
+      }
+    nodal_mass.compress(dealii::VectorOperation::add);
+    nodal_a.compress(dealii::VectorOperation::add);
+  }
+
+  // ---------------------------------------------------------------- nodal a
+  template <int dim>
+  void
+  Solver<dim>::nodal_acceleration()
+  {
+    const unsigned int n = nodal_mass.locally_owned_size();
+    const double *     M = nodal_mass.begin();
+    double *           A = nodal_a.begin();
+    for (unsigned int i = 0; i < n; ++i)
+      A[i] = (M[i] > 0 && !constrained[i]) ? A[i] / M[i] : 0.0;
+    nodal_a.update_ghost_values();
+  }
+
+  // ---------------------------------------------------------------- G2P + P2G (B)
+  template <int dim>
+  void
+  Solver<dim>::g2p_velocity_p2g_momentum(const double h)
+  {
+    using L                   = PropertyLayout<dim>;
+    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
+    const double *const    A  = nodal_a.begin();
+    double *const          Pn = nodal_p.begin();
+    nodal_p                   = 0.0;
+    for (const unsigned int c : active_cells)
+      {
+        const auto &cc = grid.cells[c];
+        double      a[nv][dim], lp[nv][dim] = {};
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            a[v][d] = A[cc.dofs[v * dim + d]];
+        for (auto &pt : particles.particles_in_cell(grid.cell_iterators[c]))
+          {
+            double *   P = pt.get_properties().data();
+            double     N[nv];
+            shape::Q1<dim>::values(pt.get_reference_location(), N);
+            double *vel = P + L::velocity;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                double s = 0;
+                for (unsigned int v = 0; v < nv; ++v)
+                  s += N[v] * a[v][d];
+                vel[d] += h * s; // seed 000 Eq. 4.46
+              }
+            const double m = P[L::mass];
+            for (unsigned int v = 0; v < nv; ++v)
+              for (unsigned int d = 0; d < dim; ++d)
+                lp[v][d] += m * N[v] * vel[d]; // Eq. 4.47
+          }
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            Pn[cc.dofs[v * dim + d]] += lp[v][d];
+      }
+    nodal_p.compress(dealii::VectorOperation::add);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::nodal_velocity()
+  {
+    const unsigned int n = nodal_mass.locally_owned_size();
+    const double *     M = nodal_mass.begin();
+    double *           V = nodal_p.begin();
+    for (unsigned int i = 0; i < n; ++i)
+      V[i] = (M[i] > 0 && !constrained[i]) ? V[i] / M[i] : 0.0; // Eq. 4.48
+    nodal_p.update_ghost_values();
+  }
+
+  // ---------------------------------------------------------------- G2P update (C)
+  template <int dim>
+  void
+  Solver<dim>::g2p_update(const double h)
+  {
+    using L                   = PropertyLayout<dim>;
+    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
+    const double *const    Vn = nodal_p.begin();
+    const auto             g  = prm.gravity;
+    Energies               e;
+    bool                   bad = false;
+    const bool             track_probes = !probe_ids.empty();
+    std::fill(probe_values.begin(), probe_values.end(), 0.0);
+    for (const unsigned int c : active_cells)
+      {
+        const auto &cc = grid.cells[c];
+        double      du[nv][dim];
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // Eq. 4.49
+        const auto range = particles.particles_in_cell(grid.cell_iterators[c]);
+        for (auto pt = range.begin(); pt != range.end(); ++pt)
+          {
+            double *     P  = pt->get_properties().data();
+            const auto   xi = pt->get_reference_location();
+            double       N[nv], G[nv][dim];
+            shape::Q1<dim>::values_and_gradients(xi, cc.inv_h, N, G);
+            // displacement increment gradient and position increment
+            double gu[dim][dim] = {}, dx[dim] = {};
+            for (unsigned int v = 0; v < nv; ++v)
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  dx[d] += N[v] * du[v][d];
+                  for (unsigned int k = 0; k < dim; ++k)
+                    gu[d][k] += du[v][d] * G[v][k];
+                }
+            materials::Strain d_eps;
+            materials::Spin   d_omega;
+            for (unsigned int d = 0; d < dim; ++d)
+              for (unsigned int k = 0; k < dim; ++k)
+                {
+                  if (k >= d)
+                    d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
+                  d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
+                }
+            const unsigned int          mat = static_cast<unsigned int>(P[L::material]);
+            const materials::Material &m   = *prm.materials[mat];
+            auto                        sigma = L::get_stress(P);
+            m.update_stress(d_eps, d_omega, h, sigma,
+                            dealii::ArrayView<double>(P + layout.history, m.n_history()));
+            L::set_stress(sigma, P);
+            const double dvol = trace(d_eps);
+            P[L::volume] *= (1.0 + dvol); // Eq. 4.50 (density follows as m / V)
+
+            // position (Eq. 4.51), displacement
+            auto x = pt->get_location();
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                x[d] += dx[d];
+                P[L::displacement + d] += dx[d];
+              }
+            const double mass = P[L::mass];
+            double       v2 = 0, gx = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                v2 += P[L::velocity + d] * P[L::velocity + d];
+                gx += g[d] * x[d];
+              }
+            e.kinetic += 0.5 * mass * v2;
+            e.gravity_potential -= mass * gx;
+            e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+            if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
+                !(P[L::volume] > 0))
+              bad = true;
+
+            if (track_probes)
+              for (unsigned int k = 0; k < probe_ids.size(); ++k)
+                if (pt->get_id() == probe_ids[k])
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      probe_values[k * 2 * dim + d]       = P[L::displacement + d];
+                      probe_values[k * 2 * dim + dim + d] = P[L::velocity + d];
+                    }
+
+            // new reference coordinates: same cell if still inside
+            bool               inside = true;
+            dealii::Point<dim> nxi;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                nxi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
+                inside = inside && nxi[d] >= 0.0 && nxi[d] <= 1.0;
+              }
+            pt->set_location(x);
+            if (inside)
+              pt->set_reference_location(nxi);
+            else
+              relocator->leaving(pt, c);
+          }
+      }
+    local_energies = e;
+    local_bad      = bad;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::step(const double h)
+  {
+    auto t0 = Clock::now();
+    p2g_mass_and_force();
+    timings.p2g += seconds_since(t0);
+    t0 = Clock::now();
+    nodal_acceleration();
+    timings.grid += seconds_since(t0);
+    t0 = Clock::now();
+    g2p_velocity_p2g_momentum(h);
+    timings.p2g += seconds_since(t0);
+    t0 = Clock::now();
+    nodal_velocity();
+    timings.grid += seconds_since(t0);
+    t0 = Clock::now();
+    g2p_update(h);
+    timings.g2p += seconds_since(t0);
+    t0 = Clock::now();
+    relocator->finish(relocation_stats);
+    collect_active_cells();
+    timings.relocation += seconds_since(t0);
+  }
+
+  template <int dim>
+  Energies
+  Solver<dim>::energies() const
+  {
+    using L = PropertyLayout<dim>;
+    Energies e;
+    for (const auto &pt : particles)
+      {
+        const auto  P = pt.get_properties();
+        const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+        double      v2 = 0, gx = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            v2 += P[L::velocity + d] * P[L::velocity + d];
+            gx += prm.gravity[d] * pt.get_location()[d];
+          }
+        e.kinetic += 0.5 * P[L::mass] * v2;
+        e.gravity_potential -= P[L::mass] * gx;
+        e.strain += P[L::volume] * m.elastic_energy_density(L::get_stress(P.data()));
+      }
+    double v[3] = {e.kinetic, e.strain, e.gravity_potential};
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3), comm, dealii::ArrayView<double>(v, 3));
+    return {v[0], v[1], v[2], external_work};
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  Solver<dim>::total_momentum() const
+  {
+    dealii::Tensor<1, dim> p;
+    for (const auto &pt : particles)
+      for (unsigned int d = 0; d < dim; ++d)
+        p[d] += pt.get_properties()[PropertyLayout<dim>::mass] *
+                pt.get_properties()[PropertyLayout<dim>::velocity + d];
+    return dealii::Utilities::MPI::sum(p, comm);
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::total_mass() const
+  {
+    double m = 0;
+    for (const auto &pt : particles)
+      m += pt.get_properties()[PropertyLayout<dim>::mass];
+    return dealii::Utilities::MPI::sum(m, comm);
+  }
+
+  template <int dim>
+  std::pair<double, dealii::Tensor<1, dim>>
+  Solver<dim>::grid_mass_and_momentum()
+  {
+    // P2G of mass and of momentum of the current particle velocities (a = 0)
+    p2g_mass_and_force();
+    nodal_a = 0.0;
+    g2p_velocity_p2g_momentum(0.0);
+    double                 m = 0;
+    dealii::Tensor<1, dim> p;
+    const unsigned int     n = nodal_mass.locally_owned_size();
+    // component of each owned DoF from the cell cache
+    std::vector<int> component(n + grid.partitioner->n_ghost_indices(), -1);
+    for (const auto &cc : grid.cells)
+      for (unsigned int v = 0; v < shape::Q1<dim>::n_vertices; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          if (cc.h[0] > 0) // skip artificial cells (never filled)
+            component[cc.dofs[v * dim + d]] = d;
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        if (component[i] == 0)
+          m += nodal_mass.local_element(i);
+        if (component[i] >= 0)
+          p[component[i]] += nodal_p.local_element(i);
+      }
+    return {dealii::Utilities::MPI::sum(m, comm), dealii::Utilities::MPI::sum(p, comm)};
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::check_stability() const
+  {
+    double v[5] = {local_energies.kinetic, local_energies.strain, local_energies.gravity_potential,
+                   local_bad ? 1.0 : 0.0, 0.0};
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 5), comm, dealii::ArrayView<double>(v, 5));
+    std::ostringstream os;
+    os << std::setprecision(4);
+    if (v[3] > 0 || !std::isfinite(v[0] + v[1] + v[2]))
+      {
+        os << "step " << step_number << " (t = " << time << " s, dt = " << dt
+           << " s): the state became non-finite or a material point volume became non-positive "
+              "(velocity, stress or position). Reduce the time step (courant number) or check the material data.";
+        throw InstabilityError(os.str());
+      }
+    const double available = initial_energies.kinetic + initial_energies.strain +
+                             std::max(0.0, initial_energies.gravity_potential - v[2]) + std::abs(external_work);
+    const double now = v[0] + v[1];
+    if (now > prm.energy_growth_limit * available + 1e-12 * energy_scale)
+      {
+        os << "step " << step_number << " (t = " << time << " s, dt = " << dt
+           << " s): kinetic + strain energy grew to " << now << " J, more than " << prm.energy_growth_limit
+           << " x the energy available (" << available
+           << " J: initial kinetic + strain, released potential, external work). "
+              "The time step is above the stability limit or the material data are inconsistent.";
+        throw InstabilityError(os.str());
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::write_vtu(const unsigned int counter)
+  {
+    dealii::Particles::DataOut<dim> out;
+    out.build_patches(particles, layout.names(), layout.interpretations());
+    const std::string name = out.write_vtu_with_pvtu_record(prm.output_directory + "/", "particles", counter, comm, 4);
+    pvd_records.emplace_back(time, name);
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
+    if (prm.write_grid)
+      {
+        dealii::DataOut<dim> dout;
+        dout.attach_dof_handler(grid.dof_handler);
+        std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interp(
+          dim, dealii::DataComponentInterpretation::component_is_part_of_vector);
+        dout.add_data_vector(nodal_mass, std::vector<std::string>(dim, "nodal_mass"), dealii::DataOut<dim>::type_dof_data, interp);
+        dout.add_data_vector(nodal_p, std::vector<std::string>(dim, "nodal_velocity"), dealii::DataOut<dim>::type_dof_data, interp);
+        dout.build_patches();
+        dout.write_vtu_with_pvtu_record(prm.output_directory + "/", "grid", counter, comm, 4);
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::write_final_particles() const
+  {
+    using L = PropertyLayout<dim>;
+    std::vector<std::vector<double>> rows;
+    for (const auto &pt : particles)
+      {
+        std::vector<double> r = {static_cast<double>(pt.get_id())};
+        for (unsigned int d = 0; d < dim; ++d)
+          r.push_back(pt.get_location()[d]);
+        const auto P = pt.get_properties();
+        for (unsigned int d = 0; d < dim; ++d)
+          r.push_back(P[L::displacement + d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          r.push_back(P[L::velocity + d]);
+        for (unsigned int k = 0; k < L::n_stress; ++k)
+          r.push_back(P[L::stress + k]);
+        r.push_back(P[L::volume]);
+        rows.push_back(r);
+      }
+    const auto all = dealii::Utilities::MPI::gather(comm, rows, 0);
+    if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    std::vector<std::vector<double>> merged;
+    for (const auto &r : all)
+      merged.insert(merged.end(), r.begin(), r.end());
+    std::sort(merged.begin(), merged.end());
+    std::vector<std::string> header = {"id"};
+    const char *             ax[]   = {"x", "y", "z"};
+    for (unsigned int d = 0; d < dim; ++d)
+      header.push_back(std::string("pos_") + ax[d]);
+    for (unsigned int d = 0; d < dim; ++d)
+      header.push_back(std::string("u_") + ax[d]);
+    for (unsigned int d = 0; d < dim; ++d)
+      header.push_back(std::string("v_") + ax[d]);
+    const auto names = layout.names();
+    for (unsigned int k = 0; k < L::n_stress; ++k)
+      header.push_back(names[L::stress + k]);
+    header.push_back("volume");
+    io::AtomicFile f(prm.output_directory + "/particles_final.csv");
+    for (unsigned int k = 0; k < header.size(); ++k)
+      f.stream() << (k ? "," : "") << header[k];
+    f.stream() << "\n" << std::setprecision(17);
+    for (const auto &r : merged)
+      {
+        f.stream() << static_cast<unsigned long long>(r[0]);
+        for (unsigned int k = 1; k < r.size(); ++k)
+          f.stream() << "," << r[k];
+        f.stream() << "\n";
+      }
+    f.commit();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::run()
+  {
+    const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
+    if (root)
+      std::filesystem::create_directories(prm.output_directory);
+    MPI_Barrier(comm);
+    const double dt_cr = critical_time_step();
+    log() << "talus-explicit: " << dim << "D, " << grid.tria.n_global_active_cells() << " cells, "
+          << grid.dof_handler.n_dofs() << " DoFs, " << n_particles() << " material points, "
+          << dealii::Utilities::MPI::n_mpi_processes(comm) << " rank(s)\n"
+          << "  critical time step " << dt_cr << " s (L_min " << grid.min_cell_size() << " m), dt = " << dt
+          << " s (" << dt / dt_cr << " x critical), end time " << prm.end_time << " s\n";
+
+    // series CSV: written as .part while running, renamed when the run ends
+    std::unique_ptr<io::AtomicFile> series;
+    const char *                    ax[] = {"x", "y", "z"};
+    if (root)
+      {
+        series = std::make_unique<io::AtomicFile>(prm.output_directory + "/series.csv");
+        auto &s = series->stream();
+        s << "time,step,kinetic_energy,strain_energy,gravity_potential_energy,external_work,total_energy";
+        for (unsigned int d = 0; d < dim; ++d)
+          s << ",momentum_" << ax[d];
+        s << ",n_particles,lost_particles";
+        for (unsigned int k = 0; k < probe_ids.size(); ++k)
+          {
+            for (unsigned int d = 0; d < dim; ++d)
+              s << ",probe" << k << "_u" << ax[d];
+            for (unsigned int d = 0; d < dim; ++d)
+              s << ",probe" << k << "_v" << ax[d];
+          }
+        s << "\n" << std::setprecision(12);
+      }
+    const auto write_series_row = [&]() {
+      const Energies e = energies();
+      const auto     p = total_momentum();
+      std::vector<double> probes(probe_values.size());
+      if (!probe_values.empty())
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
+                                    dealii::ArrayView<double>(probes));
+      if (!root)
+        return;
+      auto &s = series->stream();
+      s << time << "," << step_number << "," << e.kinetic << "," << e.strain << "," << e.gravity_potential << ","
+        << e.external_work << "," << e.total();
+      for (unsigned int d = 0; d < dim; ++d)
+        s << "," << p[d];
+      s << "," << n_particles() << "," << relocation_stats.lost;
+      for (const double v : probes)
+        s << "," << v;
+      s << "\n";
+    };
+    // probe values at t = 0
+    if (!probe_ids.empty())
+      for (const auto &pt : particles)
+        for (unsigned int k = 0; k < probe_ids.size(); ++k)
+          if (pt.get_id() == probe_ids[k])
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                probe_values[k * 2 * dim + d]       = pt.get_properties()[PropertyLayout<dim>::displacement + d];
+                probe_values[k * 2 * dim + dim + d] = pt.get_properties()[PropertyLayout<dim>::velocity + d];
+              }
+
+    unsigned int vtu_counter = 0;
+    write_series_row();
+    write_vtu(vtu_counter++);
+    double next_series = prm.series_interval, next_vtu = prm.vtu_interval;
+
+    const auto   t_start   = Clock::now();
+    auto         t_report  = t_start;
+    const double eps_t     = 1e-9 * dt;
+    bool         unstable  = false;
+    std::string  instability;
+    while (time < prm.end_time - eps_t && (prm.max_steps == 0 || step_number < prm.max_steps))
+      {
+        const double h = std::min(dt, prm.end_time - time);
+        step(h);
+        time += h;
+        ++step_number;
+        try
+          {
+            check_stability();
+          }
+        catch (const InstabilityError &e)
+          {
+            unstable    = true;
+            instability = e.what();
+            break;
+          }
+        const bool last = !(time < prm.end_time - eps_t) || (prm.max_steps && step_number >= prm.max_steps);
+        auto       t0   = Clock::now();
+        if (prm.series_interval == 0 || time >= next_series - eps_t || last)
+          {
+            write_series_row();
+            while (next_series <= time + eps_t)
+              next_series += prm.series_interval > 0 ? prm.series_interval : dt;
+          }
+        if ((prm.vtu_interval > 0 && time >= next_vtu - eps_t) || last)
+          {
+            write_vtu(vtu_counter++);
+            while (prm.vtu_interval > 0 && next_vtu <= time + eps_t)
+              next_vtu += prm.vtu_interval;
+          }
+        timings.output += seconds_since(t0);
+        if (prm.progress && seconds_since(t_report) > 2.0)
+          {
+            t_report            = Clock::now();
+            const double el     = seconds_since(t_start);
+            const double frac   = time / prm.end_time;
+            log() << "  step " << step_number << "  t = " << std::setprecision(4) << time << " s  ("
+                  << std::setprecision(3) << 100 * frac << " %)  elapsed " << el << " s  ETA "
+                  << el * (1 - frac) / std::max(frac, 1e-12) << " s" << std::endl;
+          }
+      }
+    timings.total = seconds_since(t_start);
+    if (root)
+      series->commit();
+    if (unstable)
+      throw InstabilityError(instability + " Output up to the last stable step is in " + prm.output_directory + ".");
+    if (prm.final_particles_csv)
+      write_final_particles();
+
+    const double ns = 1e9 * timings.total / std::max(1.0, double(step_number) * double(n_particles()));
+    log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid
+          << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << ", output "
+          << timings.output << "; particles moved cell " << relocation_stats.moved_locally << ", full sorts "
+          << relocation_stats.global_sorts << ", lost " << relocation_stats.lost << "\n";
+    log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "
+          << timings.total << " s, " << std::setprecision(3) << ns << " ns/particle-step, output in "
+          << prm.output_directory << "/ (particles.pvd, series.csv)" << std::endl;
+  }
+
+  int
+  run(dealii::ParameterHandler &prm, const std::string &)
+  {
+    const unsigned int dim = prm.get_integer("dimension");
+    if (dim == 2)
+      {
+        auto       p = parse_parameters<2>(prm);
+        Solver<2>  s(p, MPI_COMM_WORLD);
+        s.setup();
+        s.run();
+      }
+    else
+      {
+        auto       p = parse_parameters<3>(prm);
+        Solver<3>  s(p, MPI_COMM_WORLD);
+        s.setup();
+        s.run();
+      }
+    return exit_ok;
+  }
+
+  template struct Parameters<2>;
+  template struct Parameters<3>;
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  template class Solver<2>;
+  template class Solver<3>;
+} // namespace talus::explicit_mpm

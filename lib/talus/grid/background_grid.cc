@@ -1,0 +1,180 @@
+#include <talus/base/errors.h>
+#include <talus/grid/background_grid.h>
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/grid_tools.h>
+
+#include <cmath>
+#include <set>
+
+namespace talus
+{
+  template <int dim>
+  BackgroundGrid<dim>::BackgroundGrid(MPI_Comm comm_)
+    : comm(comm_)
+    , tria(comm_)
+    , fe(dealii::FE_Q<dim>(1), dim)
+    , dof_handler(tria)
+  {}
+
+  template <int dim>
+  void
+  BackgroundGrid<dim>::make_box(const dealii::Point<dim> &       lower,
+                                const dealii::Point<dim> &       upper,
+                                const std::vector<unsigned int> &n_cells)
+  {
+    require(n_cells.size() == dim, "grid/cells", "needs " + std::to_string(dim) + " entries");
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        require(upper[d] > lower[d], "grid", "upper corner must exceed lower corner in every direction");
+        require(n_cells[d] > 0, "grid/cells", "every entry must be > 0");
+      }
+    dealii::GridGenerator::subdivided_hyper_rectangle(tria, n_cells, lower, upper, true);
+  }
+
+  template <int dim>
+  void
+  BackgroundGrid<dim>::setup()
+  {
+    dof_handler.distribute_dofs(fe);
+    owned_dofs = dof_handler.locally_owned_dofs();
+    dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant_dofs);
+    partitioner = std::make_shared<dealii::Utilities::MPI::Partitioner>(owned_dofs, relevant_dofs, comm);
+
+    constexpr unsigned int nv = CellCache<dim>::n_vertices;
+    cells.assign(tria.n_active_cells(), CellCache<dim>());
+    cell_iterators.assign(tria.n_active_cells(), tria.end());
+    std::vector<dealii::types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
+    double                                       min_h = std::numeric_limits<double>::max();
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        if (cell->is_artificial())
+          continue;
+        const unsigned int c = cell->active_cell_index();
+        cell_iterators[c]    = cell;
+        auto &cc             = cells[c];
+        cc.locally_owned     = cell->is_locally_owned();
+        const auto p0        = cell->vertex(0);
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            cc.lower[d] = p0[d];
+            cc.h[d]     = cell->vertex(nv - 1)[d] - p0[d];
+            cc.inv_h[d] = 1.0 / cc.h[d];
+            if (cc.locally_owned)
+              min_h = std::min(min_h, cc.h[d]);
+          }
+        // every vertex must sit at its box corner
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double expected = p0[d] + (((v >> d) & 1u) ? cc.h[d] : 0.0);
+              if (std::abs(cell->vertex(v)[d] - expected) > 1e-10 * std::abs(cc.h[d]) || !(cc.h[d] > 0))
+                throw InputError("grid: cell " + cell->id().to_string() + " at " +
+                                 std::to_string(p0[0]) + ",... is not an axis-aligned box; "
+                                 "the background grid must consist of axis-aligned quads/hexes");
+            }
+        cell->get_dof_indices(dof_indices);
+        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+          {
+            const auto [comp, base] = fe.system_to_component_index(i);
+            const unsigned int v    = base; // Q1: base index == vertex
+            cc.dofs[v * dim + comp] = partitioner->global_to_local(dof_indices[i]);
+          }
+      }
+    global_min_h = dealii::Utilities::MPI::min(min_h, comm);
+
+    // vertex neighbours of every non-artificial cell (including itself)
+    const auto vertex_to_cell = dealii::GridTools::vertex_to_cell_map(tria);
+    neighbours.clear();
+    for (unsigned int c = 0; c < cells.size(); ++c)
+      {
+        if (cell_iterators[c] == tria.end())
+          continue;
+        std::set<unsigned int> nb;
+        for (unsigned int v = 0; v < nv; ++v)
+          for (const auto &ncell : vertex_to_cell[cell_iterators[c]->vertex_index(v)])
+            if (!ncell->is_artificial() && ncell->is_active())
+              nb.insert(ncell->active_cell_index());
+        cells[c].neighbours_begin = neighbours.size();
+        neighbours.push_back(c); // itself first
+        for (const auto n : nb)
+          if (n != c)
+            neighbours.push_back(n);
+        cells[c].neighbours_end = neighbours.size();
+      }
+  }
+
+  template <int dim>
+  std::vector<unsigned char>
+  BackgroundGrid<dim>::constrained_dofs(const std::vector<BoundaryCondition> &bcs) const
+  {
+    std::vector<unsigned char> flag(partitioner->locally_owned_size() + partitioner->n_ghost_indices(), 0);
+    std::set<dealii::types::boundary_id> used;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        if (cell->is_artificial())
+          continue;
+        for (const unsigned int f : cell->face_indices())
+          {
+            if (!cell->face(f)->at_boundary())
+              continue;
+            const auto bid = cell->face(f)->boundary_id();
+            for (const auto &bc : bcs)
+              if (bc.id == bid)
+                {
+                  used.insert(bid);
+                  const unsigned int normal_dir = f / 2; // box: faces 2d, 2d+1 normal to d
+                  for (unsigned int v = 0; v < dealii::GeometryInfo<dim>::vertices_per_face; ++v)
+                    for (unsigned int comp = 0; comp < dim; ++comp)
+                      if (bc.kind == BoundaryCondition::Kind::fixed || comp == normal_dir)
+                        {
+                          const auto gi = cell->face(f)->vertex_dof_index(v, comp);
+                          flag[partitioner->global_to_local(gi)] = 1;
+                        }
+                }
+          }
+      }
+    // every boundary id named must exist somewhere in the grid
+    std::vector<dealii::types::boundary_id> all_ids = tria.get_boundary_ids();
+    for (const auto &bc : bcs)
+      if (std::find(all_ids.begin(), all_ids.end(), bc.id) == all_ids.end())
+        {
+          std::string ids;
+          for (const auto i : all_ids)
+            ids += (ids.empty() ? "" : ", ") + std::to_string(i);
+          throw InputError("boundary conditions: boundary id " + std::to_string(bc.id) +
+                           " does not exist in the grid (ids present: " + ids + ")");
+        }
+    return flag;
+  }
+
+  template <int dim>
+  unsigned int
+  BackgroundGrid<dim>::find_owned_cell_near(const unsigned int        c,
+                                            const dealii::Point<dim> &x,
+                                            dealii::Point<dim> &      xi) const
+  {
+    const auto &cc = cells[c];
+    for (unsigned int k = cc.neighbours_begin; k < cc.neighbours_end; ++k)
+      {
+        const unsigned int n  = neighbours[k];
+        const auto &       nc = cells[n];
+        bool               in = true;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double r = (x[d] - nc.lower[d]) * nc.inv_h[d];
+            in             = in && (r >= 0.0) && (r <= 1.0);
+            xi[d]          = r;
+          }
+        if (in)
+          return nc.locally_owned ? n : dealii::numbers::invalid_unsigned_int;
+      }
+    return dealii::numbers::invalid_unsigned_int;
+  }
+
+  template class BackgroundGrid<2>;
+  template class BackgroundGrid<3>;
+} // namespace talus

@@ -1,0 +1,111 @@
+// talus — the background grid: a distributed quad/hex triangulation, the vector
+// Q1 DoFHandler on it, and a flat per-cell cache (box geometry, local DoF indices,
+// vertex neighbours) that the particle loops read instead of deal.II iterators.
+#pragma once
+
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/partitioner.h>
+#include <deal.II/base/point.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/mapping_cartesian.h>
+#include <deal.II/lac/la_parallel_vector.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace talus
+{
+  using Vector = dealii::LinearAlgebra::distributed::Vector<double>;
+
+  /// Kinematic boundary condition on every node of a boundary id (seed 000 §5.1):
+  /// applied to all nodes of that boundary, active or not, so nodes that become
+  /// active later are constrained too.
+  struct BoundaryCondition
+  {
+    enum class Kind
+    {
+      fixed, ///< all velocity components zero
+      roller ///< the component normal to the boundary zero
+    };
+    dealii::types::boundary_id id;
+    Kind                       kind;
+  };
+
+  template <int dim>
+  struct CellCache
+  {
+    static constexpr unsigned int n_vertices = 1u << dim;
+    double                        lower[dim];
+    double                        h[dim];
+    double                        inv_h[dim];
+    /// Local (owned + ghost) index of DoF (vertex v, component c) at [v*dim + c].
+    unsigned int dofs[n_vertices * dim];
+    /// Range of this cell's vertex neighbours in BackgroundGrid::neighbours.
+    unsigned int neighbours_begin = 0, neighbours_end = 0;
+    bool         locally_owned    = false;
+  };
+
+  template <int dim>
+  class BackgroundGrid
+  {
+  public:
+    explicit BackgroundGrid(MPI_Comm comm);
+
+    /// Axis-aligned box with n_cells[d] cells per direction; boundary ids
+    /// 0..2dim-1 for the faces x-, x+, y-, y+, z-, z+.
+    void make_box(const dealii::Point<dim> &       lower,
+                  const dealii::Point<dim> &       upper,
+                  const std::vector<unsigned int> &n_cells);
+
+    /// Distribute DoFs and build the cell cache. Throws InputError if a cell is
+    /// not an axis-aligned box (the Q1 kernel and MappingCartesian need boxes).
+    void setup();
+
+    /// Per local DoF (owned + ghost) a flag: 1 if its velocity component is
+    /// prescribed zero by one of the conditions.
+    std::vector<unsigned char>
+    constrained_dofs(const std::vector<BoundaryCondition> &bcs) const;
+
+    void reinit_vector(Vector &v) const { v.reinit(partitioner); }
+
+    /// Index of the cell (owned, containing x) among cell `c` and its vertex
+    /// neighbours; on success also writes the reference coordinates. Returns
+    /// numbers::invalid_unsigned_int if x is in none of them or the containing
+    /// cell is not locally owned.
+    unsigned int find_owned_cell_near(const unsigned int        c,
+                                      const dealii::Point<dim> &x,
+                                      dealii::Point<dim> &      xi) const;
+
+    /// Reference coordinates of x in cell c (box map).
+    dealii::Point<dim> reference_point(const unsigned int c, const dealii::Point<dim> &x) const
+    {
+      const auto &  cc = cells[c];
+      dealii::Point<dim> xi;
+      for (unsigned int d = 0; d < dim; ++d)
+        xi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
+      return xi;
+    }
+
+    /// Smallest cell edge over the whole grid (all ranks).
+    double min_cell_size() const { return global_min_h; }
+
+    MPI_Comm                                           comm;
+    dealii::parallel::distributed::Triangulation<dim> tria;
+    dealii::FESystem<dim>                              fe;
+    dealii::DoFHandler<dim>                            dof_handler;
+    dealii::MappingCartesian<dim>                      mapping;
+    dealii::IndexSet                                   owned_dofs, relevant_dofs;
+    std::shared_ptr<const dealii::Utilities::MPI::Partitioner> partitioner;
+
+    /// Indexed by active_cell_index().
+    std::vector<CellCache<dim>>                                             cells;
+    std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_iterators;
+    std::vector<unsigned int>                                               neighbours;
+
+  private:
+    double global_min_h = 0;
+  };
+} // namespace talus

@@ -1,1 +1,0 @@
-namespace talus { int talus_placeholder = 0; }

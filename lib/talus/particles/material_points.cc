@@ -1,0 +1,276 @@
+#include <talus/base/errors.h>
+#include <talus/particles/material_points.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace talus
+{
+  // ------------------------------------------------------------ layout
+  template <int dim>
+  std::vector<std::string>
+  PropertyLayout<dim>::names() const
+  {
+    std::vector<std::string> n = {"mass", "volume", "material_id", "body_id"};
+    for (unsigned int d = 0; d < dim; ++d)
+      n.emplace_back("velocity");
+    for (unsigned int d = 0; d < dim; ++d)
+      n.emplace_back("displacement");
+    const char *s2[] = {"stress_xx", "stress_yy", "stress_zz", "stress_xy"};
+    const char *s3[] = {"stress_xx", "stress_yy", "stress_zz", "stress_xy", "stress_yz", "stress_xz"};
+    for (unsigned int i = 0; i < n_stress; ++i)
+      n.emplace_back(dim == 2 ? s2[i] : s3[i]);
+    for (unsigned int i = 0; i < n_history; ++i)
+      n.emplace_back("history_" + std::to_string(i));
+    return n;
+  }
+
+  template <int dim>
+  std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+  PropertyLayout<dim>::interpretations() const
+  {
+    using namespace dealii::DataComponentInterpretation;
+    std::vector<DataComponentInterpretation> r(n_properties(), component_is_scalar);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        r[velocity + d]     = component_is_part_of_vector;
+        r[displacement + d] = component_is_part_of_vector;
+      }
+    return r;
+  }
+
+  template <int dim>
+  dealii::SymmetricTensor<2, 3>
+  PropertyLayout<dim>::get_stress(const double *p)
+  {
+    dealii::SymmetricTensor<2, 3> s;
+    s[0][0] = p[stress + 0];
+    s[1][1] = p[stress + 1];
+    s[2][2] = p[stress + 2];
+    s[0][1] = p[stress + 3];
+    if constexpr (dim == 3)
+      {
+        s[1][2] = p[stress + 4];
+        s[0][2] = p[stress + 5];
+      }
+    return s;
+  }
+
+  template <int dim>
+  void
+  PropertyLayout<dim>::set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p)
+  {
+    p[stress + 0] = s[0][0];
+    p[stress + 1] = s[1][1];
+    p[stress + 2] = s[2][2];
+    p[stress + 3] = s[0][1];
+    if constexpr (dim == 3)
+      {
+        p[stress + 4] = s[1][2];
+        p[stress + 5] = s[0][2];
+      }
+  }
+
+  // ------------------------------------------------------------ bodies
+  template <int dim>
+  bool
+  BodyDescription<dim>::contains(const dealii::Point<dim> &x) const
+  {
+    switch (shape)
+      {
+        case Shape::box:
+          for (unsigned int d = 0; d < dim; ++d)
+            if (x[d] < lower[d] || x[d] > upper[d])
+              return false;
+          return true;
+        case Shape::ball:
+          return x.distance_square(center) <= radius * radius;
+        case Shape::polygon:
+          {
+            // even-odd rule in the x-y plane (2D bodies only)
+            bool               inside = false;
+            const std::size_t  n      = polygon.size();
+            for (std::size_t i = 0, j = n - 1; i < n; j = i++)
+              {
+                const auto &a = polygon[i], &b = polygon[j];
+                if (((a[1] > x[1]) != (b[1] > x[1])) &&
+                    (x[0] < (b[0] - a[0]) * (x[1] - a[1]) / (b[1] - a[1]) + a[0]))
+                  inside = !inside;
+              }
+            return inside;
+          }
+      }
+    return false;
+  }
+
+  template <int dim>
+  SeedingResult
+  seed_bodies(const BackgroundGrid<dim> &               grid,
+              const std::vector<BodyDescription<dim>> & bodies,
+              const std::vector<double> &               density_of_material,
+              const PropertyLayout<dim> &               layout,
+              dealii::Particles::ParticleHandler<dim> & particles)
+  {
+    struct NewPoint
+    {
+      dealii::Point<dim> x, xi;
+      unsigned int       cell, body;
+      double             volume;
+    };
+    std::vector<NewPoint> points;
+    SeedingResult         result;
+    result.volume_per_body.assign(bodies.size(), 0.0);
+
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      {
+        const auto &cc = grid.cells[c];
+        if (!cc.locally_owned)
+          continue;
+        double cell_volume = 1.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          cell_volume *= cc.h[d];
+        for (unsigned int b = 0; b < bodies.size(); ++b)
+          {
+            const unsigned int n     = bodies[b].particles_per_direction;
+            unsigned int       total = 1;
+            for (unsigned int d = 0; d < dim; ++d)
+              total *= n;
+            for (unsigned int k = 0; k < total; ++k)
+              {
+                dealii::Point<dim> xi, x;
+                unsigned int       r = k;
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    xi[d] = (r % n + 0.5) / n;
+                    r /= n;
+                    x[d] = cc.lower[d] + xi[d] * cc.h[d];
+                  }
+                if (!bodies[b].contains(x))
+                  continue;
+                // first body wins: skip if an earlier body claims this point
+                bool claimed = false;
+                for (unsigned int e = 0; e < b && !claimed; ++e)
+                  claimed = bodies[e].contains(x);
+                if (claimed)
+                  continue;
+                points.push_back({x, xi, c, b, cell_volume / total});
+              }
+          }
+      }
+
+    const unsigned long long n_local = points.size();
+    unsigned long long       offset  = 0;
+    MPI_Exscan(&n_local, &offset, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, grid.comm);
+    if (dealii::Utilities::MPI::this_mpi_process(grid.comm) == 0)
+      offset = 0;
+
+    particles.reserve(points.size());
+    std::vector<double> props(layout.n_properties(), 0.0);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      {
+        const auto &p    = points[i];
+        const auto &body = bodies[p.body];
+        std::fill(props.begin(), props.end(), 0.0);
+        props[layout.mass]     = density_of_material[body.material_id] * p.volume;
+        props[layout.volume]   = p.volume;
+        props[layout.material] = body.material_id;
+        props[layout.body]     = p.body;
+        const dealii::Tensor<1, dim> v =
+          body.velocity_field ? body.velocity_field(p.x) : body.initial_velocity;
+        for (unsigned int d = 0; d < dim; ++d)
+          props[layout.velocity + d] = v[d];
+        result.volume_per_body[p.body] += p.volume;
+        particles.insert_particle(p.x,
+                                  p.xi,
+                                  offset + i,
+                                  grid.cell_iterators[p.cell],
+                                  dealii::ArrayView<const double>(props.data(), props.size()));
+      }
+    particles.update_cached_numbers();
+    result.n_particles = dealii::Utilities::MPI::sum(n_local, grid.comm);
+    for (auto &v : result.volume_per_body)
+      v = dealii::Utilities::MPI::sum(v, grid.comm);
+    return result;
+  }
+
+  // ------------------------------------------------------------ relocation
+  template <int dim>
+  Relocator<dim>::Relocator(const BackgroundGrid<dim> &g, dealii::Particles::ParticleHandler<dim> &p)
+    : grid(g)
+    , particles(p)
+  {
+    particles.signals.particle_lost.connect(
+      [this](const typename dealii::Particles::ParticleIterator<dim> &,
+             const typename dealii::Triangulation<dim>::active_cell_iterator &) { ++lost_counter; });
+  }
+
+  template <int dim>
+  void
+  Relocator<dim>::finish(RelocationStats &stats)
+  {
+    struct Move
+    {
+      dealii::Point<dim>            x, xi;
+      dealii::types::particle_index id;
+      unsigned int                  cell;
+      unsigned int                  prop_offset;
+    };
+    std::vector<Move>   moves;
+    std::vector<double> props;
+    std::vector<std::size_t> to_remove;
+    moves.reserve(pending.size());
+    const unsigned int n_props = particles.n_properties_per_particle();
+    bool               need_sort = false;
+    for (std::size_t k = 0; k < pending.size(); ++k)
+      {
+        const auto &       it = pending[k].it;
+        dealii::Point<dim> xi;
+        const auto         x = it->get_location();
+        const unsigned int n = grid.find_owned_cell_near(pending[k].cell, x, xi);
+        if (n == dealii::numbers::invalid_unsigned_int)
+          {
+            need_sort = true;
+            continue;
+          }
+        const auto p = it->get_properties();
+        moves.push_back({x, xi, it->get_id(), n, static_cast<unsigned int>(props.size())});
+        props.insert(props.end(), p.begin(), p.end());
+        to_remove.push_back(k);
+      }
+    // remove backwards: pending is in ascending order within each cell, and
+    // deal.II removes by moving the cell's last particle into the hole
+    for (auto k = to_remove.rbegin(); k != to_remove.rend(); ++k)
+      particles.remove_particle(pending[*k].it);
+    for (const auto &m : moves)
+      particles.insert_particle(m.x,
+                                m.xi,
+                                m.id,
+                                grid.cell_iterators[m.cell],
+                                dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
+    stats.moved_locally += moves.size();
+    pending.clear();
+
+    if (dealii::Utilities::MPI::logical_or(need_sort, grid.comm))
+      {
+        const unsigned long long lost_before = lost_counter;
+        particles.sort_particles_into_subdomains_and_cells();
+        ++stats.global_sorts;
+        stats.lost += dealii::Utilities::MPI::sum(lost_counter - lost_before, grid.comm);
+      }
+  }
+
+  template struct PropertyLayout<2>;
+  template struct PropertyLayout<3>;
+  template struct BodyDescription<2>;
+  template struct BodyDescription<3>;
+  template class Relocator<2>;
+  template class Relocator<3>;
+  template SeedingResult seed_bodies(const BackgroundGrid<2> &, const std::vector<BodyDescription<2>> &,
+                                     const std::vector<double> &, const PropertyLayout<2> &,
+                                     dealii::Particles::ParticleHandler<2> &);
+  template SeedingResult seed_bodies(const BackgroundGrid<3> &, const std::vector<BodyDescription<3>> &,
+                                     const std::vector<double> &, const PropertyLayout<3> &,
+                                     dealii::Particles::ParticleHandler<3> &);
+} // namespace talus

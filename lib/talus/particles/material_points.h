@@ -1,0 +1,142 @@
+// talus — material points: the property layout stored in deal.II's
+// ParticleHandler, seeding from geometric primitives, and relocation to new
+// cells whose cost follows the particles that actually changed cell.
+#pragma once
+
+#include <talus/grid/background_grid.h>
+
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/numerics/data_component_interpretation.h>
+#include <deal.II/particles/particle_handler.h>
+
+#include <functional>
+
+#include <string>
+#include <vector>
+
+namespace talus
+{
+  /// Layout of the double-valued properties of one material point.
+  ///
+  ///  offset            size      quantity
+  ///  mass              1         mass m_p [kg] (per unit thickness in 2D)
+  ///  volume            1         current volume V_p [m^3] (area in 2D)
+  ///  material          1         material id (integer stored as double)
+  ///  body              1         body id
+  ///  velocity          dim       v_p [m/s]
+  ///  displacement      dim       u_p = x_p - X_p [m]
+  ///  stress            n_stress  Cauchy stress, tension positive [Pa]:
+  ///                              2D xx,yy,zz,xy; 3D xx,yy,zz,xy,yz,xz
+  ///  history           n_history constitutive history variables (per model)
+  template <int dim>
+  struct PropertyLayout
+  {
+    static constexpr unsigned int n_stress     = dim == 2 ? 4 : 6;
+    static constexpr unsigned int mass         = 0;
+    static constexpr unsigned int volume       = 1;
+    static constexpr unsigned int material     = 2;
+    static constexpr unsigned int body         = 3;
+    static constexpr unsigned int velocity     = 4;
+    static constexpr unsigned int displacement = velocity + dim;
+    static constexpr unsigned int stress       = displacement + dim;
+    static constexpr unsigned int history      = stress + n_stress;
+
+    unsigned int n_history = 0;
+    unsigned int n_properties() const { return history + n_history; }
+
+    /// Names for output (vectors get dim identical names for ParaView).
+    std::vector<std::string> names() const;
+    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+    interpretations() const;
+
+    static dealii::SymmetricTensor<2, 3> get_stress(const double *p);
+    static void set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p);
+  };
+
+  /// A body made of material points: a primitive region filled with regular
+  /// points in every grid cell it covers (seed 000 §4.3.2: equal shares of the
+  /// cell volume).
+  template <int dim>
+  struct BodyDescription
+  {
+    enum class Shape
+    {
+      box,
+      ball, ///< disk in 2D, sphere in 3D
+      polygon
+    };
+    Shape                          shape = Shape::box;
+    dealii::Point<dim>             lower, upper;    // box
+    dealii::Point<dim>             center;          // ball
+    double                         radius = 0;      // ball
+    std::vector<dealii::Point<2>>  polygon;         // polygon (2D)
+    unsigned int                   material_id = 0;
+    unsigned int                   particles_per_direction = 2;
+    dealii::Tensor<1, dim>         initial_velocity;
+    /// optional velocity field v(x) overriding initial_velocity (empty: none)
+    std::function<dealii::Tensor<1, dim>(const dealii::Point<dim> &)> velocity_field;
+    std::string                    name;
+
+    bool contains(const dealii::Point<dim> &x) const;
+  };
+
+  struct SeedingResult
+  {
+    unsigned long long n_particles = 0;
+    std::vector<double> volume_per_body;
+  };
+
+  /// Fill every locally owned cell with n^dim regular points (cell-centred
+  /// sub-cells) of each body that contains them (first body wins). Volumes are
+  /// equal shares of the cell volume, masses = density * volume. Particle ids
+  /// are global and contiguous. Collective.
+  template <int dim>
+  SeedingResult seed_bodies(const BackgroundGrid<dim> &                 grid,
+                            const std::vector<BodyDescription<dim>> &   bodies,
+                            const std::vector<double> &                 density_of_material,
+                            const PropertyLayout<dim> &                 layout,
+                            dealii::Particles::ParticleHandler<dim> &   particles);
+
+  struct RelocationStats
+  {
+    unsigned long long moved_locally = 0; ///< changed cell, found among neighbours
+    unsigned long long global_sorts  = 0; ///< full deal.II sorts needed
+    unsigned long long lost          = 0; ///< left the grid (removed)
+  };
+
+  /// Relocator: after positions were updated, each particle still inside its
+  /// cell only gets new reference coordinates (done by the caller in its loop);
+  /// particles that left their cell are handed here. Those that landed in a
+  /// locally owned vertex neighbour are moved directly; if any rank has a
+  /// particle it cannot place (other rank, jumped past the neighbours, left
+  /// the grid), everyone falls back to deal.II's collective sort.
+  template <int dim>
+  class Relocator
+  {
+  public:
+    Relocator(const BackgroundGrid<dim> &grid, dealii::Particles::ParticleHandler<dim> &particles);
+
+    /// Called from the particle loop for a particle whose new position x left
+    /// cell c (its location is already updated).
+    void
+    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
+            const unsigned int c)
+    {
+      pending.push_back({it, c});
+    }
+
+    /// Apply all moves. Collective.
+    void finish(RelocationStats &stats);
+
+  private:
+    struct Pending
+    {
+      typename dealii::Particles::ParticleHandler<dim>::particle_iterator it;
+      unsigned int                                                        cell;
+    };
+    const BackgroundGrid<dim> &              grid;
+    dealii::Particles::ParticleHandler<dim> &particles;
+    std::vector<Pending>                     pending;
+    unsigned long long                       lost_counter = 0;
+  };
+} // namespace talus
