@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
+#include <talus/materials/j2_plasticity.h>
 #include <talus/materials/neo_hookean.h>
 #include <talus/materials/mohr_coulomb.h>
 #include <talus/materials/tresca.h>
@@ -83,6 +84,11 @@ namespace talus::materials
     registry()
     {
       static const std::map<std::string, ModelEntry> r = {
+        {"j2 plasticity",
+         {&J2Plasticity::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new J2Plasticity(prm, where));
+          }}},
         {"neo hookean",
          {&NeoHookean::declare_parameters,
           [](dealii::ParameterHandler &prm, const std::string &where) {
