@@ -1,13 +1,14 @@
 #include <talus/base/errors.h>
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
-#include <talus/materials/j2_plasticity.h>
 #include <talus/materials/neo_hookean.h>
+#include <talus/materials/j2_plasticity.h>
 #include <talus/materials/mohr_coulomb.h>
 #include <talus/materials/tresca.h>
 #include <talus/materials/newtonian.h>
 #include <talus/materials/bingham.h>
 #include <talus/materials/frictional_fluid.h>
+#include <talus/materials/modified_cam_clay.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -123,6 +124,11 @@ namespace talus::materials
          {&FrictionalFluid::declare_parameters,
           [](dealii::ParameterHandler &prm, const std::string &where) {
             return std::unique_ptr<Material>(new FrictionalFluid(prm, where));
+          }}},
+        {"modified cam clay",
+         {&ModifiedCamClay::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new ModifiedCamClay(prm, where));
           }}},
       };
       return r;
