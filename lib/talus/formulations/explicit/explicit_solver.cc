@@ -316,7 +316,7 @@ namespace talus::explicit_mpm
         const std::string expr    = prm.get("initial velocity function");
         if (!expr.empty())
           {
-            std::map<std::string, double> constants;
+            std::map<std::string, double> constants = {{"pi", M_PI}, {"Pi", M_PI}};
             for (const auto &c : dealii::Utilities::split_string_list(prm.get("function constants"), ','))
               {
                 const auto kv = dealii::Utilities::split_string_list(c, '=');

@@ -1,0 +1,30 @@
+# Verification of the explicit 1-phase solid MPM (issue 2). Label "fast": run by
+# `make test` / CI. Each case runs talus-explicit through a Python checker that
+# compares with an analytic or published reference and a stated tolerance.
+set(_v ${CMAKE_CURRENT_SOURCE_DIR}/verification)
+set(_w ${CMAKE_BINARY_DIR}/tests/verification)
+set(_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1;PYTHONPATH=${_v}")
+
+function(talus_verification name script prm)
+  add_test(NAME verification.${name}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/${script} ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/${prm} ${_w}/${name})
+  set_tests_properties(verification.${name} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+endfunction()
+
+talus_verification(explicit_bar_vibration check_bar.py verification/bar_vibration.prm)
+talus_verification(explicit_disks_collision_np1_np2 check_disks.py verification/disks_collision.prm)
+talus_verification(explicit_elastic_column_gravity check_column.py verification/elastic_column_gravity.prm)
+talus_verification(explicit_stability check_stability.py verification/bar_vibration.prm)
+talus_verification(explicit_bad_input check_bad_input.py verification/bar_vibration.prm)
+set_tests_properties(verification.explicit_disks_collision_np1_np2 PROPERTIES PROCESSORS 2)
+
+add_test(NAME demo.column_collapse_2d
+         COMMAND ${TALUS_TOOLS_DIR}/talus-explicit ${TALUS_PRM_DIR}/demo/column_collapse_2d.prm
+         WORKING_DIRECTORY ${_w})
+set_tests_properties(demo.column_collapse_2d PROPERTIES LABELS "fast" TIMEOUT 900)
+
+# the transfer/relocation unit tests again on 2 ranks (particles cross ranks)
+add_test(NAME unit.test_explicit_transfer_np2
+         COMMAND mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_explicit_transfer)
+set_tests_properties(unit.test_explicit_transfer_np2 PROPERTIES LABELS "unit" ENVIRONMENT "${_env}" PROCESSORS 2 TIMEOUT 600)

@@ -1,0 +1,103 @@
+"""Helpers for talus verification cases: edit .prm entries, run tools, read CSVs.
+
+Only the Python standard library is used so that the checks run anywhere.
+"""
+import csv
+import os
+import re
+import subprocess
+import sys
+
+
+def prm_set(text, path, value):
+    """Set entry `path` ("sub/sub/entry" or "entry") in a .prm text.
+
+    Replaces the entry where it is; otherwise adds it to the (innermost existing)
+    subsection, creating the missing subsections at the end of the text.
+    """
+    parts = path.split("/")
+    subs, key = parts[:-1], parts[-1]
+    lines = text.splitlines()
+    stack = []
+    for i, line in enumerate(lines):
+        s = line.split("#", 1)[0].strip()
+        m = re.match(r"subsection\s+(.*)$", s)
+        if m:
+            stack.append(m.group(1).strip())
+            continue
+        if s == "end":
+            stack.pop()
+            continue
+        m = re.match(r"set\s+(.*?)\s*=\s*(.*)$", s)
+        if m and m.group(1) == key and stack == subs:
+            indent = line[: len(line) - len(line.lstrip())]
+            lines[i] = f"{indent}set {key} = {value}"
+            return "\n".join(lines) + "\n"
+    # not found: append a block (deal.II accepts a subsection opened twice)
+    block = [f"subsection {x}" for x in subs] + [f"set {key} = {value}"] + ["end"] * len(subs)
+    return "\n".join(lines + block) + "\n"
+
+
+def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None):
+    """Write <workdir>/<name>.prm, run the tool (under mpirun if np > 1).
+
+    Returns (returncode, stdout, stderr). Fails the test if the return code is
+    not expect_rc (None: accept anything).
+    """
+    os.makedirs(workdir, exist_ok=True)
+    prm = os.path.join(workdir, name + ".prm")
+    with open(prm, "w") as f:
+        f.write(prm_text)
+    cmd = [os.path.abspath(tool), os.path.abspath(prm)]
+    if np > 1:
+        cmd = ["mpirun", "--oversubscribe", "-np", str(np)] + cmd
+    env = dict(os.environ)
+    env.update({"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1", "OMP_NUM_THREADS": "1"})
+    if extra_env:
+        env.update(extra_env)
+    p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=3000)
+    if expect_rc is not None and p.returncode != expect_rc:
+        sys.stdout.write(p.stdout)
+        sys.stderr.write(p.stderr)
+        fail(f"{name}: exit code {p.returncode}, expected {expect_rc}")
+    return p.returncode, p.stdout, p.stderr
+
+
+def read_csv(path):
+    """Columns of a CSV file as a dict name -> list of floats."""
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    header, data = rows[0], rows[1:]
+    return {h: [float(r[i]) for r in data] for i, h in enumerate(header)}
+
+
+def zero_crossings(t, y, direction=0):
+    """Times where y crosses 0 (linear interpolation). direction: +1 up, -1 down, 0 both."""
+    out = []
+    for i in range(1, len(y)):
+        a, b = y[i - 1], y[i]
+        if (a < 0 <= b and direction >= 0) or (a > 0 >= b and direction <= 0):
+            if a != b:
+                out.append(t[i - 1] + (t[i] - t[i - 1]) * (-a) / (b - a))
+    return out
+
+
+_failures = []
+
+
+def check(cond, message):
+    print(("PASS: " if cond else "FAIL: ") + message)
+    if not cond:
+        _failures.append(message)
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def finish():
+    if _failures:
+        print(f"{len(_failures)} check(s) failed")
+        sys.exit(1)
+    print("all checks passed")
