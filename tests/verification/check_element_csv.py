@@ -38,7 +38,7 @@ def main():
     csv_path = os.path.join(a.workdir, a.csv)
     if os.path.exists(csv_path):
         os.remove(csv_path)
-    r = subprocess.run([a.tool, os.path.abspath(a.prm)], cwd=a.workdir,
+    r = subprocess.run([os.path.abspath(a.tool), os.path.abspath(a.prm)], cwd=a.workdir,
                        capture_output=True, text=True)
     print(r.stdout, r.stderr)
 
