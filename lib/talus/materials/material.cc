@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
+#include <talus/materials/nor_sand.h>
 #include <talus/materials/hencky_mohr_coulomb.h>
 #include <talus/materials/neo_hookean.h>
 #include <talus/materials/j2_plasticity.h>
@@ -86,6 +87,11 @@ namespace talus::materials
     registry()
     {
       static const std::map<std::string, ModelEntry> r = {
+        {"nor sand",
+         {&NorSand::declare_parameters,
+          [](dealii::ParameterHandler &prm, const std::string &where) {
+            return std::unique_ptr<Material>(new NorSand(prm, where));
+          }}},
         {"hencky mohr coulomb",
          {&HenckyMohrCoulomb::declare_parameters,
           [](dealii::ParameterHandler &prm, const std::string &where) {
