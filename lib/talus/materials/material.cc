@@ -1,9 +1,9 @@
 #include <talus/base/errors.h>
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
+#include <talus/materials/neo_hookean.h>
 #include <talus/materials/nor_sand.h>
 #include <talus/materials/hencky_mohr_coulomb.h>
-#include <talus/materials/neo_hookean.h>
 #include <talus/materials/j2_plasticity.h>
 #include <talus/materials/mohr_coulomb.h>
 #include <talus/materials/tresca.h>
