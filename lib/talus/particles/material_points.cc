@@ -208,7 +208,9 @@ namespace talus
 
   template <int dim>
   void
-  Relocator<dim>::finish(RelocationStats &stats)
+  Relocator<dim>::finish(
+    RelocationStats &stats,
+    const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved)
   {
     struct Move
     {
@@ -244,19 +246,34 @@ namespace talus
     for (auto k = to_remove.rbegin(); k != to_remove.rend(); ++k)
       particles.remove_particle(pending[*k].it);
     for (const auto &m : moves)
-      particles.insert_particle(m.x,
+      {
+        if (moved)
+          moved(m.cell, m.xi, props.data() + m.prop_offset);
+        particles.insert_particle(m.x,
                                 m.xi,
                                 m.id,
                                 grid.cell_iterators[m.cell],
                                 dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
+      }
     stats.moved_locally += moves.size();
+    moved_since_sort += moves.size();
     pending.clear();
 
-    if (dealii::Utilities::MPI::logical_or(need_sort, grid.comm))
+    // one reduction decides both: a needed sort and a memory-order sort
+    double flags[3] = {need_sort ? 1.0 : 0.0, double(moved_since_sort),
+                       double(particles.n_locally_owned_particles())};
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(flags, 3), grid.comm,
+                                dealii::ArrayView<double>(flags, 3));
+    const bool reorder = flags[1] > resort_fraction * flags[2];
+    if (flags[0] > 0 || reorder)
       {
         const unsigned long long lost_before = lost_counter;
         particles.sort_particles_into_subdomains_and_cells();
-        ++stats.global_sorts;
+        if (flags[0] > 0)
+          ++stats.global_sorts;
+        else
+          ++stats.storage_sorts;
+        moved_since_sort = 0;
         stats.lost += dealii::Utilities::MPI::sum(lost_counter - lost_before, grid.comm);
       }
   }

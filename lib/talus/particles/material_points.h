@@ -102,6 +102,7 @@ namespace talus
     unsigned long long moved_locally = 0; ///< changed cell, found among neighbours
     unsigned long long global_sorts  = 0; ///< full deal.II sorts needed
     unsigned long long lost          = 0; ///< left the grid (removed)
+    unsigned long long storage_sorts = 0; ///< sorts done to restore memory order
   };
 
   /// Relocator: after positions were updated, each particle still inside its
@@ -125,8 +126,16 @@ namespace talus
       pending.push_back({it, c});
     }
 
-    /// Apply all moves. Collective.
-    void finish(RelocationStats &stats);
+    /// Apply all moves. Collective. Moved particles get new storage slots
+    /// scattered in memory; once the particles moved since the last full sort
+    /// exceed `resort_fraction` of all particles, a full deal.II sort restores
+    /// the cell-by-cell memory order (it calls PropertyPool::sort_memory_slots).
+    /// `moved(c, xi, properties)` is called for every particle moved to a
+    /// neighbour cell c (not for those handled by a full sort).
+    void finish(RelocationStats &stats,
+                const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved = {});
+
+    double resort_fraction = 0.5;
 
   private:
     struct Pending
@@ -138,5 +147,6 @@ namespace talus
     dealii::Particles::ParticleHandler<dim> &particles;
     std::vector<Pending>                     pending;
     unsigned long long                       lost_counter = 0;
+    unsigned long long                       moved_since_sort = 0;
   };
 } // namespace talus

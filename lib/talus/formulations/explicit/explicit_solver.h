@@ -103,12 +103,22 @@ namespace talus::explicit_mpm
     std::unique_ptr<Relocator<dim>>               relocator;
     std::vector<unsigned char>                    constrained;
     Vector                                        nodal_mass, nodal_a, nodal_p;
-    std::vector<unsigned int>                     active_cells;
+    /// Cells with particles in the storage order of the ParticleHandler, with
+    /// their particle counts: the loops walk one particle iterator along this
+    /// list and never look cells up in the triangulation.
+    struct ActiveCell
+    {
+      unsigned int cell, n_particles;
+    };
+    std::vector<ActiveCell>                       active_cells;
     RelocationStats                               relocation_stats;
     Timings                                       timings;
     double                                        time = 0, dt = 0;
     unsigned int                                  step_number = 0;
     Energies                                      initial_energies;
+    /// Strain energy is summed in the update pass only when a series row or a
+    /// stability check needs it (set by the time loop).
+    bool                                          need_strain_energy = true;
     double                                        energy_scale = 0;
 
   private:
@@ -122,6 +132,7 @@ namespace talus::explicit_mpm
     void write_vtu(unsigned int counter);
     void write_final_particles() const;
 
+    bool p2g_ready = false; ///< nodal mass/force of the current state accumulated
     // local energy/stability sums from the last update pass
     Energies local_energies;
     bool     local_bad = false;
