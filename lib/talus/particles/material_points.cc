@@ -4,6 +4,7 @@
 #include <deal.II/base/mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace talus
@@ -212,17 +213,13 @@ namespace talus
     RelocationStats &stats,
     const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved)
   {
-    struct Move
-    {
-      dealii::Point<dim>            x, xi;
-      dealii::types::particle_index id;
-      unsigned int                  cell;
-      unsigned int                  prop_offset;
-    };
-    std::vector<Move>   moves;
-    std::vector<double> props;
-    std::vector<std::size_t> to_remove;
-    moves.reserve(pending.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    moves.clear();
+    props.clear();
+    to_remove.clear();
+    removed_from.clear();
+    inserted_into.clear();
+    sorted_last = false;
     const unsigned int n_props = particles.n_properties_per_particle();
     bool               need_sort = false;
     for (std::size_t k = 0; k < pending.size(); ++k)
@@ -244,11 +241,15 @@ namespace talus
     // remove backwards: pending is in ascending order within each cell, and
     // deal.II removes by moving the cell's last particle into the hole
     for (auto k = to_remove.rbegin(); k != to_remove.rend(); ++k)
-      particles.remove_particle(pending[*k].it);
+      {
+        removed_from.push_back(pending[*k].cell);
+        particles.remove_particle(pending[*k].it);
+      }
     for (const auto &m : moves)
       {
         if (moved)
           moved(m.cell, m.xi, props.data() + m.prop_offset);
+        inserted_into.push_back(m.cell);
         particles.insert_particle(m.x,
                                 m.xi,
                                 m.id,
@@ -265,6 +266,8 @@ namespace talus
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(flags, 3), grid.comm,
                                 dealii::ArrayView<double>(flags, 3));
     const bool reorder = flags[1] > resort_fraction * flags[2];
+    const auto t1      = std::chrono::steady_clock::now();
+    stats.seconds_moves += std::chrono::duration<double>(t1 - t0).count();
     if (flags[0] > 0 || reorder)
       {
         const unsigned long long lost_before = lost_counter;
@@ -274,7 +277,9 @@ namespace talus
         else
           ++stats.storage_sorts;
         moved_since_sort = 0;
+        sorted_last      = true;
         stats.lost += dealii::Utilities::MPI::sum(lost_counter - lost_before, grid.comm);
+        stats.seconds_sorts += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       }
   }
 

@@ -91,6 +91,13 @@ namespace talus::explicit_mpm
     double                    total_mass() const;
     unsigned long long        n_particles() const { return particles.n_global_particles(); }
 
+    /// For tests: after step(), the mass/force accumulated by the fused update
+    /// pass and the relocation must equal a fresh P2G of the new state, and the
+    /// incrementally kept (cell, count) list must equal one read from storage.
+    /// Returns the largest relative difference of mass and force (entries of
+    /// the active DoFs and ghosts) and whether the cell lists agree.
+    std::pair<double, bool> check_incremental_state();
+
     /// Nodal lumped mass and momentum after a P2G of the current particle state
     /// (for tests): returns global sums sum_i m_i and sum_i p_i.
     std::pair<double, dealii::Tensor<1, dim>> grid_mass_and_momentum();
@@ -111,6 +118,9 @@ namespace talus::explicit_mpm
       unsigned int cell, n_particles;
     };
     std::vector<ActiveCell>                       active_cells;
+    /// Locally owned DoFs (local indices) of the active cells plus those other
+    /// ranks contribute to: the only nodes the grid update visits.
+    std::vector<unsigned int>                     active_dofs;
     RelocationStats                               relocation_stats;
     Timings                                       timings;
     double                                        time = 0, dt = 0;
@@ -123,6 +133,16 @@ namespace talus::explicit_mpm
 
   private:
     void collect_active_cells();
+    void update_active_cells();
+    void collect_active_dofs();
+    std::vector<unsigned int>  particles_in_cell_count; // by active cell index
+    std::vector<unsigned char> cell_erased;
+
+    void zero_on_active(Vector &v) const;
+    std::vector<unsigned char> dof_marker;
+    /// particles the loops prefetch ahead (8 measured best: 317 -> 227 ns per
+    /// particle-step on a 164k-point 3D scene vs no prefetch)
+    unsigned int prefetch_distance = 8;
     void p2g_mass_and_force();
     void nodal_acceleration();
     void g2p_velocity_p2g_momentum(const double dt);
