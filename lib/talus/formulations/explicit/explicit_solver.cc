@@ -761,6 +761,9 @@ namespace talus::explicit_mpm
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)
             du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // Eq. 4.49
+        double cell_volume = 1.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          cell_volume *= cc.h[d];
         using QF = shape::Q1Factorised<dim>;
         double D[dim][QF::npairs][dim];
         QF::differences(du, D);
@@ -794,6 +797,13 @@ namespace talus::explicit_mpm
             L::set_stress(sigma, P);
             const double dvol = trace(d_eps);
             P[L::volume] *= (1.0 + dvol); // Eq. 4.50 (density follows as m / V)
+            // A point never integrates more than the volume of its cell. Without
+            // this bound, points that separate from the mass at a free surface
+            // (cohesionless material at the apex, sigma = 0) dilate without limit
+            // under the grid's velocity gradient (1e6 x measured in the demo
+            // column collapse) and blow the run up when they land again.
+            if (P[L::volume] > cell_volume)
+              P[L::volume] = cell_volume;
 
             // position (Eq. 4.51), displacement
             auto x = pt->get_location();
