@@ -19,10 +19,7 @@ talus_verification(explicit_stability check_stability.py verification/bar_vibrat
 talus_verification(explicit_bad_input check_bad_input.py verification/bar_vibration.prm)
 set_tests_properties(verification.explicit_disks_collision_np1_np2 PROPERTIES PROCESSORS 2)
 
-add_test(NAME demo.column_collapse_2d
-         COMMAND ${TALUS_TOOLS_DIR}/talus-explicit ${TALUS_PRM_DIR}/demo/column_collapse_2d.prm
-         WORKING_DIRECTORY ${_w})
-set_tests_properties(demo.column_collapse_2d PROPERTIES LABELS "fast" TIMEOUT 900)
+talus_verification(demo_column_collapse_2d check_demo.py demo/column_collapse_2d.prm)
 
 # the transfer/relocation unit tests again on 2 ranks (particles cross ranks)
 add_test(NAME unit.test_explicit_transfer_np2
