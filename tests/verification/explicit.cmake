@@ -25,3 +25,5 @@ talus_verification(demo_column_collapse_2d check_demo.py demo/column_collapse_2d
 add_test(NAME unit.test_explicit_transfer_np2
          COMMAND mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_explicit_transfer)
 set_tests_properties(unit.test_explicit_transfer_np2 PROPERTIES LABELS "unit" ENVIRONMENT "${_env}" PROCESSORS 2 TIMEOUT 600)
+
+talus_verification(explicit_lost_particles check_lost.py verification/block_leaving_grid.prm)

@@ -26,6 +26,16 @@ namespace talus
     {}
   };
 
+  /// The run met a condition the .prm says must stop it (e.g. material points
+  /// leaving the grid with 'lost particles = stop'). Exit code 3 like instability.
+  class RunStopped : public std::runtime_error
+  {
+  public:
+    explicit RunStopped(const std::string &what)
+      : std::runtime_error(what)
+    {}
+  };
+
   /// Throw InputError with `where: message` when cond is false.
   inline void
   require(const bool cond, const std::string &where, const std::string &message)

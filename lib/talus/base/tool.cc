@@ -191,6 +191,11 @@ namespace talus
         err() << tool.name << ": UNSTABLE: " << e.what() << "\n";
         return exit_unstable;
       }
+    catch (const RunStopped &e)
+      {
+        err() << tool.name << ": stopped: " << e.what() << "\n";
+        return exit_unstable;
+      }
     catch (const std::exception &e)
       {
         err() << tool.name << ": internal error: " << exception_text(e) << "\n";

@@ -22,6 +22,8 @@ namespace talus::materials
     , nu(poisson)
   {
     check(E, nu, "linear elastic");
+    two_G       = E / (1 + nu);
+    lame_lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   }
 
   LinearElastic::LinearElastic(dealii::ParameterHandler &prm, const std::string &where)
@@ -29,6 +31,8 @@ namespace talus::materials
     , nu(prm.get_double("poisson ratio"))
   {
     check(E, nu, where);
+    two_G       = E / (1 + nu);
+    lame_lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   }
 
   void
@@ -51,8 +55,8 @@ namespace talus::materials
                                Stress &sigma,
                                ArrayView<double>) const
   {
-    const double G      = shear_modulus();
-    const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    const double G      = 0.5 * two_G;
+    const double lambda = lame_lambda;
     sigma               = apply_jaumann_rotation(sigma, d_omega);
     const double tr     = trace(d_eps);
     sigma += 2 * G * d_eps;

@@ -29,5 +29,6 @@ namespace talus::materials
 
   private:
     double E, nu;
+    double two_G = 0, lame_lambda = 0; // precomputed: the update runs per point and step
   };
 } // namespace talus::materials

@@ -157,6 +157,9 @@ namespace talus::explicit_mpm
                       "The run is stopped as unstable when kinetic + strain energy exceed this factor times "
                       "the energy available (initial kinetic + strain energy + released potential energy + "
                       "external work), or when any state becomes non-finite.");
+    prm.declare_entry("lost particles", "remove", Selection("remove|stop"),
+                      "Material points that leave the grid: 'remove' them (counted in the log and in "
+                      "series.csv, column lost_particles) and go on, or 'stop' the run with an error (exit 3).");
     prm.leave_subsection();
 
     prm.enter_subsection("output");
@@ -252,7 +255,8 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     prm.enter_subsection("stability");
-    p.energy_growth_limit = prm.get_double("energy growth limit");
+    p.energy_growth_limit    = prm.get_double("energy growth limit");
+    p.stop_on_lost_particles = prm.get("lost particles") == "stop";
     prm.leave_subsection();
 
     prm.enter_subsection("output");
@@ -1183,7 +1187,8 @@ namespace talus::explicit_mpm
                 probe_values[k * 2 * dim + dim + d] = pt.get_properties()[PropertyLayout<dim>::velocity + d];
               }
 
-    unsigned int vtu_counter = 0;
+    unsigned int       vtu_counter   = 0;
+    unsigned long long lost_reported = 0;
     write_series_row();
     write_vtu(vtu_counter++);
     double next_series = prm.series_interval, next_vtu = prm.vtu_interval;
@@ -1191,7 +1196,7 @@ namespace talus::explicit_mpm
     const auto   t_start   = Clock::now();
     auto         t_report  = t_start;
     const double eps_t     = 1e-9 * dt;
-    bool         unstable  = false;
+    bool         unstable  = false, stopped = false;
     std::string  instability;
     while (time < prm.end_time - eps_t && (prm.max_steps == 0 || step_number < prm.max_steps))
       {
@@ -1203,10 +1208,28 @@ namespace talus::explicit_mpm
         try
           {
             check_stability();
+            if (relocation_stats.lost > lost_reported)
+              {
+                std::ostringstream os;
+                os << "step " << step_number << " (t = " << time << " s): "
+                   << relocation_stats.lost - lost_reported << " material point(s) left the grid ("
+                   << relocation_stats.lost << " in total)";
+                lost_reported = relocation_stats.lost;
+                if (prm.stop_on_lost_particles)
+                  throw RunStopped(os.str() + "; 'stability/lost particles = stop'. Enlarge the grid or "
+                                                    "add boundary conditions.");
+                log() << "  warning: " << os.str() << "; removed" << std::endl;
+              }
           }
         catch (const InstabilityError &e)
           {
             unstable    = true;
+            instability = e.what();
+            break;
+          }
+        catch (const RunStopped &e)
+          {
+            stopped     = true;
             instability = e.what();
             break;
           }
@@ -1241,6 +1264,8 @@ namespace talus::explicit_mpm
       series->commit();
     if (unstable)
       throw InstabilityError(instability + " Output up to the last stable step is in " + prm.output_directory + ".");
+    if (stopped)
+      throw RunStopped(instability + " Output up to the previous step is in " + prm.output_directory + ".");
     if (prm.final_particles_csv)
       write_final_particles();
 

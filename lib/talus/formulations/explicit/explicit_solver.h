@@ -33,6 +33,7 @@ namespace talus::explicit_mpm
     dealii::Tensor<1, dim>    gravity;
     // stability
     double energy_growth_limit = 10.0;
+    bool   stop_on_lost_particles = false; ///< else: remove them, count, go on
     // output
     std::string                     output_directory = "output";
     double                          vtu_interval     = 0.0; ///< simulated time, 0: off
