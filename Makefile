@@ -30,7 +30,7 @@ test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE "verify|bench"
 
 verify: build
-	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L verify
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L "fast|verify"
 
 bench: build
 	bash scripts/bench.sh $(BUILD_DIR)
