@@ -179,18 +179,13 @@ namespace talus::materials
                               Stress &          sigma,
                               ArrayView<double> history) const
   {
-    double old[8];
-    for (unsigned int i = 0; i < 8; ++i)
-      old[i] = history[i];
-    Stress tau;
-    finite_strain_update(fs::incremental_deformation_gradient(d_eps, d_omega),
-                         ArrayView<const double>(old, 8), history, tau, nullptr);
+    const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
     sigma = tau / history[6];
   }
 
   double
   J2Plasticity::elastic_energy_density(const Stress &s) const
   {
-    return (1.0 / (2 * E)) * ((1 + nu) * scalar_product(s, s) - nu * trace(s) * trace(s));
+    return isotropic_elastic_energy_density(E, nu, s);
   }
 } // namespace talus::materials

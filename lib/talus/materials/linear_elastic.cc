@@ -67,7 +67,6 @@ namespace talus::materials
   double
   LinearElastic::elastic_energy_density(const Stress &s) const
   {
-    // W = 1/2 sigma : C^-1 : sigma = (1/(2E)) [ (1+nu) s:s - nu tr(s)^2 ]
-    return (1.0 / (2 * E)) * ((1 + nu) * scalar_product(s, s) - nu * trace(s) * trace(s));
+    return isotropic_elastic_energy_density(E, nu, s);
   }
 } // namespace talus::materials

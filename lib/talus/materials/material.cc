@@ -1,4 +1,5 @@
 #include <talus/base/errors.h>
+#include <talus/materials/finite_strain_tools.h>
 #include <talus/materials/material.h>
 #include <talus/materials/linear_elastic.h>
 #include <talus/materials/neo_hookean.h>
@@ -67,6 +68,26 @@ namespace talus::materials
   {
     throw InputError("material '" + name + "': model '" + model_name() +
                      "' has no finite-strain form; choose one of the finite-strain models");
+  }
+
+  Stress
+  Material::finite_strain_rate_update(const Strain &d_eps, const Spin &d_omega, ArrayView<double> history) const
+  {
+    constexpr unsigned int max_history = 64;
+    AssertThrow(history.size() <= max_history, dealii::ExcMessage("history too long for the rate form"));
+    double old[max_history];
+    std::copy(history.begin(), history.end(), old);
+    Stress tau;
+    finite_strain_update(fs::incremental_deformation_gradient(d_eps, d_omega),
+                         ArrayView<const double>(old, history.size()), history, tau, nullptr);
+    return tau;
+  }
+
+  double
+  isotropic_elastic_energy_density(const double E, const double nu, const Stress &s)
+  {
+    // W = 1/2 sigma : C^-1 : sigma = (1/(2E)) [ (1+nu) s:s - nu tr(s)^2 ]
+    return (1.0 / (2 * E)) * ((1 + nu) * scalar_product(s, s) - nu * trace(s) * trace(s));
   }
 
   double

@@ -98,8 +98,17 @@ namespace talus::materials
     unsigned int id = 0;
 
   protected:
+    /// Rate form of a finite-strain model (explicit driver): dF = I + d_eps +
+    /// d_omega, finite_strain_update() from a copy of the history (updated in
+    /// place). Returns the Kirchhoff stress; the caller divides by its J.
+    Stress finite_strain_rate_update(const Strain &d_eps, const Spin &d_omega, ArrayView<double> history) const;
+
     double rho = 0.0;
   };
+
+  /// Elastic strain energy density 1/2 s : C^-1 : s of isotropic linear
+  /// elasticity with Young's modulus E and Poisson's ratio nu.
+  double isotropic_elastic_energy_density(const double E, const double nu, const Stress &s);
 
   /// Declare the subsection of one material: "model", "density" and every
   /// model's own subsection.

@@ -275,12 +275,7 @@ namespace talus::materials
                             Stress &          sigma,
                             ArrayView<double> history) const
   {
-    double old[6];
-    for (unsigned int i = 0; i < 6; ++i)
-      old[i] = history[i];
-    Stress tau;
-    finite_strain_update(fs::incremental_deformation_gradient(d_eps, d_omega),
-                         ArrayView<const double>(old, 6), history, tau, nullptr);
+    const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
     const double J = std::sqrt(determinant(fs::load_sym(history, 0)));
     sigma          = tau / J;
   }
@@ -289,6 +284,6 @@ namespace talus::materials
   NeoHookean::elastic_energy_density(const Stress &s) const
   {
     // small-strain estimate, W = 1/2 sigma : C^-1 : sigma
-    return (1.0 / (2 * E)) * ((1 + nu) * scalar_product(s, s) - nu * trace(s) * trace(s));
+    return isotropic_elastic_energy_density(E, nu, s);
   }
 } // namespace talus::materials

@@ -414,12 +414,7 @@ namespace talus::materials
                          Stress &          sigma,
                          ArrayView<double> history) const
   {
-    double old[13];
-    for (unsigned int i = 0; i < 13; ++i)
-      old[i] = history[i];
-    Stress tau;
-    finite_strain_update(fs::incremental_deformation_gradient(d_eps, d_omega),
-                         ArrayView<const double>(old, 13), history, tau, nullptr);
+    const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
     sigma = tau / history[6];
   }
 } // namespace talus::materials

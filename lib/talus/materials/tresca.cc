@@ -115,6 +115,6 @@ namespace talus::materials
   double
   Tresca::elastic_energy_density(const Stress &s) const
   {
-    return (1.0 / (2 * E)) * ((1 + nu) * scalar_product(s, s) - nu * trace(s) * trace(s));
+    return isotropic_elastic_energy_density(E, nu, s);
   }
 } // namespace talus::materials
