@@ -1064,7 +1064,11 @@ namespace talus::explicit_mpm
         dout.add_data_vector(nodal_mass, std::vector<std::string>(dim, "nodal_mass"), dealii::DataOut<dim>::type_dof_data, interp);
         dout.add_data_vector(nodal_p, std::vector<std::string>(dim, "nodal_velocity"), dealii::DataOut<dim>::type_dof_data, interp);
         dout.build_patches();
-        dout.write_vtu_with_pvtu_record(prm.output_directory + "/", "grid", counter, comm, 4);
+        const std::string gname =
+          dout.write_vtu_with_pvtu_record(prm.output_directory + "/", "grid", counter, comm, 4);
+        grid_pvd_records.emplace_back(time, gname);
+        if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+          io::write_pvd(prm.output_directory + "/grid.pvd", grid_pvd_records);
       }
   }
 

@@ -159,7 +159,7 @@ namespace talus::explicit_mpm
     bool     local_bad = false;
     std::string bad_what;
     double   external_work = 0;
-    std::vector<std::pair<double, std::string>> pvd_records;
+    std::vector<std::pair<double, std::string>> pvd_records, grid_pvd_records;
     std::vector<dealii::types::particle_index>  probe_ids;
     std::vector<double>                         probe_values; // local, (u, v) per probe
   };
