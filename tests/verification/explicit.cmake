@@ -27,3 +27,9 @@ add_test(NAME unit.test_explicit_transfer_np2
 set_tests_properties(unit.test_explicit_transfer_np2 PROPERTIES LABELS "unit" ENVIRONMENT "${_env}" PROCESSORS 2 TIMEOUT 600)
 
 talus_verification(explicit_lost_particles check_lost.py verification/block_leaving_grid.prm)
+
+# talus-critical-dt (formula + measured limit by bisection) on the bar
+add_test(NAME verification.critical_dt_bar
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_critical_dt.py ${TALUS_TOOLS_DIR}/talus-critical-dt
+                 ${TALUS_PRM_DIR}/verification/bar_vibration.prm ${_w}/critical_dt_bar)
+set_tests_properties(verification.critical_dt_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

@@ -68,7 +68,14 @@ def read_csv(path):
     with open(path) as f:
         rows = list(csv.reader(f))
     header, data = rows[0], rows[1:]
-    return {h: [float(r[i]) for r in data] for i, h in enumerate(header)}
+
+    def value(x):
+        try:
+            return float(x)
+        except ValueError:
+            return x  # text columns (names) stay strings
+
+    return {h: [value(r[i]) for r in data] for i, h in enumerate(header)}
 
 
 def zero_crossings(t, y, direction=0):

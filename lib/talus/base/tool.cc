@@ -4,6 +4,7 @@
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -40,6 +41,35 @@ namespace talus
       return s.substr(b, e - b + 1);
     }
   } // namespace
+
+  namespace
+  {
+    std::vector<std::string> given_options;
+  }
+
+  const std::vector<std::string> &
+  tool_options()
+  {
+    return given_options;
+  }
+
+  std::string
+  tool_option_value(const std::string &name, const std::string &fallback)
+  {
+    for (const auto &o : given_options)
+      if (o.rfind(name + "=", 0) == 0)
+        return o.substr(name.size() + 1);
+    return fallback;
+  }
+
+  bool
+  tool_option_given(const std::string &name)
+  {
+    for (const auto &o : given_options)
+      if (o == name || o.rfind(name + "=", 0) == 0)
+        return true;
+    return false;
+  }
 
   std::ostream &
   log()
@@ -119,7 +149,10 @@ namespace talus
          << "       mpirun -np N " << tool.name << " FILE.prm\n\n"
          << tool.summary << "\n\n"
          << "  --help               this text\n"
-         << "  --print-parameters   print a complete, documented default .prm and exit\n"
+         << "  --print-parameters   print a complete, documented default .prm and exit\n";
+      for (const auto &[o, d] : tool.options)
+        os << "  " << o << (o.back() == '=' ? "VALUE" : "") << std::string(o.size() + 5 < 21 ? 21 - o.size() - (o.back() == '=' ? 5 : 0) : 1, ' ') << d << "\n";
+      os
          << "Exit status: 0 ok, 1 internal error, 2 bad input, 3 run went unstable.\n";
     };
 
@@ -134,10 +167,17 @@ namespace talus
           }
         else if (a == "--print-parameters")
           print = true;
+        else if (!a.empty() && a[0] == '-' &&
+                 std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
+                   return o.first.back() == '=' ? a.rfind(o.first, 0) == 0 : a == o.first;
+                 }))
+          given_options.push_back(a);
         else if (!a.empty() && a[0] == '-')
           {
-            err() << tool.name << ": error: unknown option '" << a
-                  << "' (allowed: --help, --print-parameters)\n";
+            std::string allowed = "--help, --print-parameters";
+            for (const auto &[o, d] : tool.options)
+              allowed += ", " + o + (o.back() == '=' ? "VALUE" : "");
+            err() << tool.name << ": error: unknown option '" << a << "' (allowed: " << allowed << ")\n";
             return exit_input_error;
           }
         else if (prm_file.empty())

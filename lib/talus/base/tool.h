@@ -8,6 +8,8 @@
 
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace talus
 {
@@ -30,7 +32,19 @@ namespace talus
     std::function<void(dealii::ParameterHandler &, const std::string &prm_file)> declare;
     /// Run with the parsed parameters; returns the exit code.
     std::function<int(dealii::ParameterHandler &, const std::string &prm_file)> run;
+    /// Extra command-line options this tool accepts besides --help and
+    /// --print-parameters, with a one-line description each. An option written
+    /// "--name=" takes a value ("--name=VALUE").
+    std::vector<std::pair<std::string, std::string>> options;
   };
+
+  /// The extra options given on the command line (as written, e.g. "--probe",
+  /// "--csv=out.csv"), valid while run_tool() runs.
+  const std::vector<std::string> &tool_options();
+
+  /// Value of "--name=VALUE" among tool_options(), or `fallback`.
+  std::string tool_option_value(const std::string &name, const std::string &fallback);
+  bool        tool_option_given(const std::string &name);
 
   /// main() of a tool: `return talus::run_tool(argc, argv, description);`
   int run_tool(int argc, char **argv, const ToolDescription &tool);

@@ -902,6 +902,20 @@ namespace talus::explicit_mpm
   }
 
   template <int dim>
+  void
+  Solver<dim>::advance(const unsigned int n_steps)
+  {
+    for (unsigned int i = 0; i < n_steps; ++i)
+      {
+        need_strain_energy = step_number % 10 == 0;
+        step(dt);
+        time += dt;
+        ++step_number;
+        check_stability();
+      }
+  }
+
+  template <int dim>
   Energies
   Solver<dim>::energies() const
   {

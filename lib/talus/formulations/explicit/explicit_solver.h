@@ -81,6 +81,9 @@ namespace talus::explicit_mpm
     void run();
     /// One explicit step of size dt (§4.3.7). Collective.
     void step(const double dt);
+    /// n steps of the current time step with the stability check after each
+    /// (throws InstabilityError), no output. For probes and tests.
+    void advance(const unsigned int n_steps);
 
     /// Critical time step of §4.6.1 over all materials and the smallest cell.
     double critical_time_step() const;
