@@ -49,4 +49,21 @@ for col in a:
     worst = max(worst, d)
     print(f"  {col:12s} max |np1 - np2| / max|np1| = {d:.2e}")
 tv.check(worst <= 1e-10, f"1 vs 2 ranks agree to 1e-10 relative (worst {worst:.2e})")
+
+# atomic output: no temporary file left, every PVTU piece and PVD entry exists
+import glob
+import os
+import re
+out2 = f"{work}/out_np2"
+tv.check(not glob.glob(out2 + "/*.part"), "no temporary .part file left behind")
+missing = []
+for pvtu in glob.glob(out2 + "/*.pvtu"):
+    for piece in re.findall(r'Source="([^"]+)"', open(pvtu).read()):
+        if not os.path.exists(os.path.join(out2, piece)):
+            missing.append(piece)
+for f in re.findall(r'file="([^"]+)"', open(out2 + "/particles.pvd").read()):
+    if not os.path.exists(os.path.join(out2, f)):
+        missing.append(f)
+n_pvtu = len(glob.glob(out2 + "/*.pvtu"))
+tv.check(n_pvtu >= 13 and not missing, f"{n_pvtu} PVTU records on 2 ranks, all pieces present {missing}")
 tv.finish()

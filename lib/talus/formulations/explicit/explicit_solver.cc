@@ -1055,6 +1055,40 @@ namespace talus::explicit_mpm
       }
   }
 
+  namespace
+  {
+    /// VTU piece per rank plus the PVTU record, each written under a temporary
+    /// name and renamed when complete: a killed run never leaves a truncated
+    /// VTU/PVTU. Same file names as DataOutInterface::write_vtu_with_pvtu_record.
+    template <typename DataOutType>
+    std::string
+    write_vtu_atomic(const DataOutType &out,
+                     const std::string &directory,
+                     const std::string &base,
+                     const unsigned int counter,
+                     MPI_Comm           comm)
+    {
+      const unsigned int rank   = dealii::Utilities::MPI::this_mpi_process(comm);
+      const unsigned int n_rank = dealii::Utilities::MPI::n_mpi_processes(comm);
+      const std::string  stem   = base + "_" + dealii::Utilities::int_to_string(counter, 4);
+      {
+        io::AtomicFile f(directory + "/" + stem + "." + std::to_string(rank) + ".vtu");
+        out.write_vtu(f.stream());
+        f.commit();
+      }
+      if (rank == 0)
+        {
+          std::vector<std::string> pieces;
+          for (unsigned int r = 0; r < n_rank; ++r)
+            pieces.push_back(stem + "." + std::to_string(r) + ".vtu");
+          io::AtomicFile f(directory + "/" + stem + ".pvtu");
+          out.write_pvtu_record(f.stream(), pieces);
+          f.commit();
+        }
+      return stem + ".pvtu";
+    }
+  } // namespace
+
   template <int dim>
   void
   Solver<dim>::write_vtu(const unsigned int counter)
@@ -1065,7 +1099,7 @@ namespace talus::explicit_mpm
     flags.time              = time;
     flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
     out.set_flags(flags);
-    const std::string name = out.write_vtu_with_pvtu_record(prm.output_directory + "/", "particles", counter, comm, 4);
+    const std::string name = write_vtu_atomic(out, prm.output_directory, "particles", counter, comm);
     pvd_records.emplace_back(time, name);
     if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
@@ -1078,8 +1112,7 @@ namespace talus::explicit_mpm
         dout.add_data_vector(nodal_mass, std::vector<std::string>(dim, "nodal_mass"), dealii::DataOut<dim>::type_dof_data, interp);
         dout.add_data_vector(nodal_p, std::vector<std::string>(dim, "nodal_velocity"), dealii::DataOut<dim>::type_dof_data, interp);
         dout.build_patches();
-        const std::string gname =
-          dout.write_vtu_with_pvtu_record(prm.output_directory + "/", "grid", counter, comm, 4);
+        const std::string gname = write_vtu_atomic(dout, prm.output_directory, "grid", counter, comm);
         grid_pvd_records.emplace_back(time, gname);
         if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
           io::write_pvd(prm.output_directory + "/grid.pvd", grid_pvd_records);
