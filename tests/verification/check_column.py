@@ -1,4 +1,4 @@
-"""Elastic column under gravity — issue 2 verification.
+"""Elastic column under gravity (2D and 3D) — issue 2 verification.
 
 Released stress-free, the column oscillates about the static settlement
 u_s = rho g H^2 / (2 E_c). The time average of the top probe displacement over
@@ -14,7 +14,8 @@ tool, prm_path, work = sys.argv[1:4]
 text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 tv.run_tool(tool, text, work, "column")
 s = tv.read_csv(f"{work}/out/series.csv")
-t, u = s["time"], s["probe0_uy"]
+t = s["time"]
+u = s["probe0_uz"] if "probe0_uz" in s else s["probe0_uy"]  # vertical: y in 2D, z in 3D
 E, nu, rho, g, H = 1e6, 0.3, 2000.0, 9.81, 1.0
 Ec = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 u_static = -rho * g * H * H / (2 * Ec)
