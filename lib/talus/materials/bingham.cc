@@ -28,10 +28,7 @@ namespace talus::materials
   void
   Bingham::setup(const std::string &where)
   {
-    require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-    require(nu > -1.0 && nu < 0.5,
-            where + "/poisson ratio",
-            "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+    check_isotropic_elasticity(E, nu, where);
     check_liquid_pressure_parameters(K, p_cav, where);
     require(tau_y >= 0, where + "/yield stress", "must be >= 0 (got " + std::to_string(tau_y) + ")");
     require(mu >= 0, where + "/dynamic viscosity", "must be >= 0 (got " + std::to_string(mu) + ")");

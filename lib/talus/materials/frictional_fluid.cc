@@ -28,10 +28,7 @@ namespace talus::materials
   void
   FrictionalFluid::setup(const std::string &where)
   {
-    require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-    require(nu > -1.0 && nu < 0.5,
-            where + "/poisson ratio",
-            "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+    check_isotropic_elasticity(E, nu, where);
     check_liquid_pressure_parameters(K, p_cav, where);
     require(phi >= 0 && phi < 90,
             where + "/friction angle",

@@ -45,9 +45,7 @@ namespace talus::materials
   void
   HenckyMohrCoulomb::setup(const std::string &where)
   {
-    require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-    require(nu > -1.0 && nu < 0.5, where + "/poisson ratio",
-            "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+    check_isotropic_elasticity(E, nu, where);
     require(c >= 0, where + "/cohesion", "must be >= 0 (got " + std::to_string(c) + ")");
     require(phi > 0 && phi < M_PI / 2, where + "/friction angle",
             "must satisfy 0 < phi < 90 degrees (got " + std::to_string(phi * 180 / M_PI) + ")");
@@ -174,10 +172,7 @@ namespace talus::materials
                                           Stress &                    tau,
                                           dealii::Tensor<4, 3> *      dtau_ddF) const
   {
-    const double detf = determinant(dF);
-    if (!(detf > 0))
-      throw InstabilityError("material '" + name + "' (hencky mohr coulomb): det dF = " +
-                             std::to_string(detf) + " <= 0");
+    const double detf = checked_increment_jacobian(dF, *this);
     const Stress     b_n  = fs::load_sym(h_old, 0);
     const Stress     b_tr = symmetrize(dF * dealii::Tensor<2, 3>(b_n) * transpose(dF));
     const fs::Spectral sp = fs::spectral_decomposition(b_tr);

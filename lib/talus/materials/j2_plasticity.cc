@@ -13,10 +13,7 @@ namespace talus::materials
     void
     check(const double E, const double nu, const double sy, const double H, const std::string &where)
     {
-      require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-      require(nu > -1.0 && nu < 0.5,
-              where + "/poisson ratio",
-              "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+      check_isotropic_elasticity(E, nu, where);
       require(sy > 0, where + "/yield stress", "must be > 0 (got " + std::to_string(sy) + ")");
       require(H >= 0, where + "/hardening modulus", "must be >= 0 (got " + std::to_string(H) + ")");
     }
@@ -104,10 +101,7 @@ namespace talus::materials
                                      Stress &                    tau,
                                      dealii::Tensor<4, 3> *      dtau_ddF) const
   {
-    const double detf = determinant(dF);
-    if (!(detf > 0))
-      throw InstabilityError("material '" + name + "' (j2 plasticity): det dF = " +
-                             std::to_string(detf) + " <= 0");
+    const double detf = checked_increment_jacobian(dF, *this);
     const Stress bbar_n  = fs::load_sym(h_old, 0);
     const double J       = h_old[6] * detf;
     const double alpha_n = h_old[7];

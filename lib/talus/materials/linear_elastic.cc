@@ -5,23 +5,11 @@
 
 namespace talus::materials
 {
-  namespace
-  {
-    void
-    check(const double E, const double nu, const std::string &where)
-    {
-      require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-      require(nu > -1.0 && nu < 0.5,
-              where + "/poisson ratio",
-              "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
-    }
-  } // namespace
-
   LinearElastic::LinearElastic(const double young, const double poisson)
     : E(young)
     , nu(poisson)
   {
-    check(E, nu, "linear elastic");
+    check_isotropic_elasticity(E, nu, "linear elastic");
     two_G       = E / (1 + nu);
     lame_lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   }
@@ -30,7 +18,7 @@ namespace talus::materials
     : E(prm.get_double("young modulus"))
     , nu(prm.get_double("poisson ratio"))
   {
-    check(E, nu, where);
+    check_isotropic_elasticity(E, nu, where);
     two_G       = E / (1 + nu);
     lame_lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   }

@@ -83,6 +83,24 @@ namespace talus::materials
     return tau;
   }
 
+  void
+  check_isotropic_elasticity(const double E, const double nu, const std::string &where)
+  {
+    require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
+    require(nu > -1.0 && nu < 0.5, where + "/poisson ratio",
+            "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+  }
+
+  double
+  checked_increment_jacobian(const dealii::Tensor<2, 3> &dF, const Material &m)
+  {
+    const double detf = determinant(dF);
+    if (!(detf > 0))
+      throw InstabilityError("material '" + m.name + "' (" + m.model_name() + "): det dF = " +
+                             std::to_string(detf) + " <= 0");
+    return detf;
+  }
+
   double
   isotropic_elastic_energy_density(const double E, const double nu, const Stress &s)
   {

@@ -110,6 +110,14 @@ namespace talus::materials
   /// elasticity with Young's modulus E and Poisson's ratio nu.
   double isotropic_elastic_energy_density(const double E, const double nu, const Stress &s);
 
+  /// Validate isotropic elastic constants: E > 0 and -1 < nu < 0.5; throws
+  /// InputError naming `where`/young modulus or `where`/poisson ratio.
+  void check_isotropic_elasticity(const double E, const double nu, const std::string &where);
+
+  /// det(dF) of an incremental deformation gradient, or InstabilityError naming
+  /// the material and model when it is not positive (inverted point).
+  double checked_increment_jacobian(const dealii::Tensor<2, 3> &dF, const Material &m);
+
   /// Declare the subsection of one material: "model", "density" and every
   /// model's own subsection.
   void declare_material_parameters(dealii::ParameterHandler &prm);

@@ -10,15 +10,6 @@ namespace talus::materials
 {
   namespace
   {
-    void
-    check(const double E, const double nu, const std::string &where)
-    {
-      require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-      require(nu > -1.0 && nu < 0.5,
-              where + "/poisson ratio",
-              "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
-    }
-
     NeoHookean::Energy
     parse_energy(const std::string &s, const std::string &where)
     {
@@ -56,7 +47,7 @@ namespace talus::materials
     , nu(poisson)
     , energy_form(energy)
   {
-    check(E, nu, "neo hookean");
+    check_isotropic_elasticity(E, nu, "neo hookean");
     lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
     mu     = E / (2 * (1 + nu));
   }
@@ -66,7 +57,7 @@ namespace talus::materials
     , nu(prm.get_double("poisson ratio"))
     , energy_form(parse_energy(prm.get("volumetric energy"), where))
   {
-    check(E, nu, where);
+    check_isotropic_elasticity(E, nu, where);
     lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
     mu     = E / (2 * (1 + nu));
   }
@@ -204,10 +195,7 @@ namespace talus::materials
                            double &                    J,
                            dealii::Tensor<4, 3> *      dtau_dev_ddF) const
   {
-    const double detf = determinant(dF);
-    if (!(detf > 0))
-      throw InstabilityError("material '" + name + "' (neo hookean): det dF = " +
-                             std::to_string(detf) + " <= 0");
+    const double detf = checked_increment_jacobian(dF, *this);
     const Stress b_n = fs::load_sym(history_old, 0);
     const Stress b   = symmetrize(dF * dealii::Tensor<2, 3>(b_n) * transpose(dF));
     fs::store_sym(b, history_new, 0);
@@ -224,10 +212,7 @@ namespace talus::materials
                                    Stress &                    tau,
                                    dealii::Tensor<4, 3> *      dtau_ddF) const
   {
-    const double detf = determinant(dF);
-    if (!(detf > 0))
-      throw InstabilityError("material '" + name + "' (neo hookean): det dF = " +
-                             std::to_string(detf) + " <= 0");
+    const double detf = checked_increment_jacobian(dF, *this);
     const Stress b_n = fs::load_sym(history_old, 0);
     const Stress b   = symmetrize(dF * dealii::Tensor<2, 3>(b_n) * transpose(dF));
     fs::store_sym(b, history_new, 0);

@@ -352,9 +352,7 @@ namespace talus::materials
                                 Stress &                    tau,
                                 dealii::Tensor<4, 3> *      dtau_ddF) const
   {
-    const double detf = determinant(dF);
-    if (!(detf > 0))
-      throw InstabilityError("material '" + name + "' (nor sand): det dF = " + std::to_string(detf) + " <= 0");
+    const double detf = checked_increment_jacobian(dF, *this);
     for (unsigned int i = 0; i < 13; ++i)
       h_new[i] = h_old[i];
     h_new[6] = h_old[6] * detf;

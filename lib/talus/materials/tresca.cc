@@ -29,10 +29,7 @@ namespace talus::materials
   void
   Tresca::setup(const std::string &where)
   {
-    require(E > 0, where + "/young modulus", "must be > 0 (got " + std::to_string(E) + ")");
-    require(nu > -1.0 && nu < 0.5,
-            where + "/poisson ratio",
-            "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
+    check_isotropic_elasticity(E, nu, where);
     require(su > 0, where + "/undrained shear strength", "must be > 0 (got " + std::to_string(su) + ")");
     G      = E / (2 * (1 + nu));
     K      = E / (3 * (1 - 2 * nu));
