@@ -741,6 +741,7 @@ namespace talus::explicit_mpm
     const double *const    Vn = nodal_p.begin();
     const auto             g  = prm.gravity;
     Energies               e;
+    dealii::Tensor<1, dim> momentum;
     bool                   bad = false;
     const bool             track_probes = !probe_ids.empty();
     std::fill(probe_values.begin(), probe_values.end(), 0.0);
@@ -824,6 +825,8 @@ namespace talus::explicit_mpm
                 gx += g[d] * x[d];
               }
             e.kinetic += 0.5 * mass * v2;
+            for (unsigned int d = 0; d < dim; ++d)
+              momentum[d] += mass * P[L::velocity + d];
             e.gravity_potential -= mass * gx;
             if (need_strain_energy)
               e.strain += P[L::volume] * m.elastic_energy_density(sigma);
@@ -860,6 +863,7 @@ namespace talus::explicit_mpm
         acc.scatter(cc, g, M, F);
       }
     local_energies = e;
+    local_momentum = momentum;
     local_bad      = bad;
   }
 
@@ -1208,9 +1212,29 @@ namespace talus::explicit_mpm
           }
         s << "\n" << std::setprecision(12);
       }
-    const auto write_series_row = [&]() {
-      const Energies e = energies();
-      const auto     p = total_momentum();
+    // After a step, the update pass has already summed the energies and the
+    // momentum of the new state (strain energy when need_strain_energy was
+    // set); only at t = 0 and after a deal.II sort (points may have been lost)
+    // are they summed by separate passes.
+    const auto write_series_row = [&](const bool from_update_pass) {
+      Energies               e;
+      dealii::Tensor<1, dim> p;
+      if (from_update_pass)
+        {
+          double v[3 + dim] = {local_energies.kinetic, local_energies.strain, local_energies.gravity_potential};
+          for (unsigned int d = 0; d < dim; ++d)
+            v[3 + d] = local_momentum[d];
+          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3 + dim), comm,
+                                      dealii::ArrayView<double>(v, 3 + dim));
+          e = {v[0], v[1], v[2], external_work};
+          for (unsigned int d = 0; d < dim; ++d)
+            p[d] = v[3 + d];
+        }
+      else
+        {
+          e = energies();
+          p = total_momentum();
+        }
       std::vector<double> probes(probe_values.size());
       if (!probe_values.empty())
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
@@ -1240,7 +1264,7 @@ namespace talus::explicit_mpm
 
     unsigned int       vtu_counter   = 0;
     unsigned long long lost_reported = 0;
-    write_series_row();
+    write_series_row(false);
     write_vtu(vtu_counter++);
     double next_series = prm.series_interval, next_vtu = prm.vtu_interval;
 
@@ -1251,8 +1275,13 @@ namespace talus::explicit_mpm
     std::string  instability;
     while (time < prm.end_time - eps_t && (prm.max_steps == 0 || step_number < prm.max_steps))
       {
-        const double h     = std::min(dt, prm.end_time - time);
-        need_strain_energy = step_number % 10 == 0; // the stability check uses KE (+ SE when summed)
+        const double h = std::min(dt, prm.end_time - time);
+        const bool   last_step =
+          !(time + h < prm.end_time - eps_t) || (prm.max_steps && step_number + 1 >= prm.max_steps);
+        const bool series_due =
+          prm.series_interval == 0 || time + h >= next_series - eps_t || last_step;
+        // the stability check uses KE (+ SE when summed), a series row needs SE
+        need_strain_energy = series_due || step_number % 10 == 0;
         step(h);
         time += h;
         ++step_number;
@@ -1284,15 +1313,14 @@ namespace talus::explicit_mpm
             instability = e.what();
             break;
           }
-        const bool last = !(time < prm.end_time - eps_t) || (prm.max_steps && step_number >= prm.max_steps);
-        auto       t0   = Clock::now();
-        if (prm.series_interval == 0 || time >= next_series - eps_t || last)
+        auto t0 = Clock::now();
+        if (series_due)
           {
-            write_series_row();
+            write_series_row(!relocator->sorted_last);
             while (next_series <= time + eps_t)
               next_series += prm.series_interval > 0 ? prm.series_interval : dt;
           }
-        if ((prm.vtu_interval > 0 && time >= next_vtu - eps_t) || last)
+        if ((prm.vtu_interval > 0 && time >= next_vtu - eps_t) || last_step)
           {
             write_vtu(vtu_counter++);
             while (prm.vtu_interval > 0 && next_vtu <= time + eps_t)

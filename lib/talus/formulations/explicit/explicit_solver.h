@@ -158,7 +158,8 @@ namespace talus::explicit_mpm
 
     bool p2g_ready = false; ///< nodal mass/force of the current state accumulated
     // local energy/stability sums from the last update pass
-    Energies local_energies;
+    Energies               local_energies;
+    dealii::Tensor<1, dim> local_momentum;
     bool     local_bad = false;
     std::string bad_what;
     double   external_work = 0;
