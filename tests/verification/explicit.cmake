@@ -34,3 +34,7 @@ add_test(NAME verification.critical_dt_bar
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_critical_dt.py ${TALUS_TOOLS_DIR}/talus-critical-dt
                  ${TALUS_PRM_DIR}/verification/bar_vibration.prm ${_w}/critical_dt_bar)
 set_tests_properties(verification.critical_dt_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# loads, damping, convergence, mass scaling, friction, K0, stages (issue 5)
+talus_verification(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
+talus_verification(explicit_block_friction check_block_friction.py verification/block_friction.prm)

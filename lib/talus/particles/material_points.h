@@ -28,6 +28,7 @@ namespace talus
   ///  stress            n_stress  Cauchy stress, tension positive [Pa]:
   ///                              2D xx,yy,zz,xy; 3D xx,yy,zz,xy,yz,xz
   ///  history           n_history constitutive history variables (per model)
+  ///  point_forces()    dim x n_point_force_slots  traction force per unit time factor [N]
   template <int dim>
   struct PropertyLayout
   {
@@ -42,7 +43,11 @@ namespace talus
     static constexpr unsigned int history      = stress + n_stress;
 
     unsigned int n_history = 0;
-    unsigned int n_properties() const { return history + n_history; }
+    /// traction point forces (seed 000 Eq. 4.29): dim doubles per traction
+    /// slot after the history, only when tractions exist (loads/load_control.h)
+    unsigned int n_point_force_slots = 0;
+    unsigned int point_forces() const { return history + n_history; }
+    unsigned int n_properties() const { return history + n_history + dim * n_point_force_slots; }
 
     /// Names for output (vectors get dim identical names for ParaView).
     std::vector<std::string> names() const;

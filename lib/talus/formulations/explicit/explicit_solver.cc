@@ -2,6 +2,7 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/io/output.h>
+#include <talus/loads/load_control.h>
 #include <talus/shape/q1.h>
 
 #include <deal.II/base/function_parser.h>
@@ -190,6 +191,7 @@ namespace talus::explicit_mpm
       }
 
     prm.declare_entry("number of bodies", "1", Integer(1, 64), "Number of 'body k' subsections (k = 0..n-1).");
+    loads::declare_parameters(prm, prm_file, dim, n_bodies);
     for (unsigned int k = 0; k < n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
@@ -350,6 +352,13 @@ namespace talus::explicit_mpm
         prm.leave_subsection();
         p.bodies.push_back(b);
       }
+    p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
+    if (p.loads.staged)
+      {
+        p.end_time = 0; // the sum of the stage durations
+        for (const auto &st : p.loads.stages)
+          p.end_time += st.duration;
+      }
     return p;
   }
 
@@ -359,7 +368,11 @@ namespace talus::explicit_mpm
     : prm(p)
     , comm(c)
     , grid(c)
+    , gravity(p.gravity)
   {}
+
+  template <int dim>
+  Solver<dim>::~Solver() = default;
 
   template <int dim>
   double
@@ -370,7 +383,8 @@ namespace talus::explicit_mpm
     double c_max = 0;
     for (const auto &m : prm.materials)
       c_max = std::max(c_max, std::sqrt(m->constrained_modulus() / m->density()));
-    return grid.min_cell_size() / c_max;
+    // mass scaling (Eq. 6.31): dt_cr grows by sqrt(beta)
+    return std::sqrt(mass_scaling) * grid.min_cell_size() / c_max;
   }
 
   template <int dim>
@@ -388,6 +402,11 @@ namespace talus::explicit_mpm
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
     layout.n_history = n_history;
+    if (prm.loads.active())
+      {
+        control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
+        layout.n_point_force_slots = control->n_point_force_slots();
+      }
     particles.initialize(grid.tria, grid.mapping, layout.n_properties());
     relocator = std::make_unique<Relocator<dim>>(grid, particles);
 
@@ -398,6 +417,9 @@ namespace talus::explicit_mpm
     for (unsigned int b = 0; b < prm.bodies.size(); ++b)
       require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
               "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+
+    if (control)
+      control->initial_state(*this); // K0 stresses, stage 0 (gravity, boundaries, mass scaling)
 
     // history initialisation
     for (auto &pt : particles)
@@ -657,7 +679,7 @@ namespace talus::explicit_mpm
         CellForce<dim> acc;
         for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(false))
           acc.add(pt->get_reference_location(), pt->get_properties().data());
-        acc.scatter(grid.cells[c], prm.gravity, M, F);
+        acc.scatter(grid.cells[c], gravity, M, F);
       }
     p2g_ready = true;
   }
@@ -669,10 +691,14 @@ namespace talus::explicit_mpm
   {
     nodal_mass.compress(dealii::VectorOperation::add);
     nodal_a.compress(dealii::VectorOperation::add);
+    if (control)
+      control->nodal_forces(*this); // tractions, convergence ratios, damping, mass scaling
     const double *M = nodal_mass.begin();
     double *      A = nodal_a.begin();
     for (const unsigned int i : active_dofs)
       A[i] = (M[i] > 0 && !constrained[i]) ? A[i] / M[i] : 0.0;
+    if (control)
+      control->nodal_accelerations(*this); // prescribed velocities, boundary friction
     nodal_a.update_ghost_values();
   }
 
@@ -728,6 +754,8 @@ namespace talus::explicit_mpm
     double *      V = nodal_p.begin();
     for (const unsigned int i : active_dofs)
       V[i] = (M[i] > 0 && !constrained[i]) ? V[i] / M[i] : 0.0; // Eq. 4.48
+    if (control)
+      control->nodal_velocities(*this);
     nodal_p.update_ghost_values();
   }
 
@@ -739,7 +767,7 @@ namespace talus::explicit_mpm
     using L                   = PropertyLayout<dim>;
     constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     const double *const    Vn = nodal_p.begin();
-    const auto             g  = prm.gravity;
+    const auto             g  = gravity;
     Energies               e;
     dealii::Tensor<1, dim> momentum;
     bool                   bad = false;
@@ -874,12 +902,16 @@ namespace talus::explicit_mpm
     auto t0 = Clock::now();
     if (!p2g_ready)
       p2g_mass_and_force();
+    if (control)
+      control->before_nodal_solve(*this, h); // traction point forces, nodal v^t
     timings.p2g += seconds_since(t0);
     t0 = Clock::now();
     nodal_acceleration();
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
     g2p_velocity_p2g_momentum(h);
+    if (control)
+      control->particle_velocities(*this); // prescribed material point velocities
     timings.p2g += seconds_since(t0);
     t0 = Clock::now();
     nodal_velocity();
@@ -896,7 +928,7 @@ namespace talus::explicit_mpm
                         const auto &   cc = grid.cells[c];
                         CellForce<dim> acc;
                         acc.add(xi, P);
-                        acc.scatter(cc, prm.gravity, M, F);
+                        acc.scatter(cc, gravity, M, F);
                       });
     // a deal.II sort recomputes reference locations and may move particles to
     // other ranks: the fused P2G is then redone from scratch
@@ -933,7 +965,7 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           {
             v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += prm.gravity[d] * pt.get_location()[d];
+            gx += gravity[d] * pt.get_location()[d];
           }
         e.kinetic += 0.5 * P[L::mass] * v2;
         e.gravity_potential -= P[L::mass] * gx;
@@ -1199,10 +1231,12 @@ namespace talus::explicit_mpm
       {
         series = std::make_unique<io::AtomicFile>(prm.output_directory + "/series.csv");
         auto &s = series->stream();
-        s << "time,step,kinetic_energy,strain_energy,gravity_potential_energy,external_work,total_energy";
+        s << "time,step,stage,kinetic_energy,strain_energy,gravity_potential_energy,external_work,total_energy";
         for (unsigned int d = 0; d < dim; ++d)
           s << ",momentum_" << ax[d];
         s << ",n_particles,lost_particles";
+        if (control && control->has_convergence())
+          s << ",force_ratio,energy_ratio";
         for (unsigned int k = 0; k < probe_ids.size(); ++k)
           {
             for (unsigned int d = 0; d < dim; ++d)
@@ -1242,11 +1276,13 @@ namespace talus::explicit_mpm
       if (!root)
         return;
       auto &s = series->stream();
-      s << time << "," << step_number << "," << e.kinetic << "," << e.strain << "," << e.gravity_potential << ","
+      s << time << "," << step_number << "," << current_stage << "," << e.kinetic << "," << e.strain << "," << e.gravity_potential << ","
         << e.external_work << "," << e.total();
       for (unsigned int d = 0; d < dim; ++d)
         s << "," << p[d];
       s << "," << n_particles() << "," << relocation_stats.lost;
+      if (control && control->has_convergence())
+        s << "," << control->force_ratio << "," << control->energy_ratio;
       for (const double v : probes)
         s << "," << v;
       s << "\n";
@@ -1270,15 +1306,29 @@ namespace talus::explicit_mpm
 
     const auto   t_start   = Clock::now();
     auto         t_report  = t_start;
-    const double eps_t     = 1e-9 * dt;
     bool         unstable  = false, stopped = false;
     std::string  instability;
-    while (time < prm.end_time - eps_t && (prm.max_steps == 0 || step_number < prm.max_steps))
+    // stages (one without a staged .prm); a restarted run resumes in current_stage
+    const unsigned int n_stages    = control ? control->n_stages() : 1;
+    const bool         resumed     = time > 0;
+    bool               run_stopped = false;
+    bool               first_stage = true;
+    for (; current_stage < n_stages && !unstable && !stopped && !run_stopped; ++current_stage)
       {
-        const double h = std::min(dt, prm.end_time - time);
-        const bool   last_step =
-          !(time + h < prm.end_time - eps_t) || (prm.max_steps && step_number + 1 >= prm.max_steps);
-        const bool series_due =
+    double end_time = prm.end_time;
+    if (control) // stage 0 was begun by setup()
+      end_time = (first_stage && !resumed && current_stage == 0)
+                   ? stage_start_time + control->stage(0).duration
+                   : control->begin_stage(*this, current_stage, resumed && first_stage);
+    first_stage = false;
+    const double eps_t      = 1e-9 * dt;
+    bool         stage_done = false;
+    while (!stage_done && time < end_time - eps_t && (prm.max_steps == 0 || step_number < prm.max_steps))
+      {
+        const double h = std::min(dt, end_time - time);
+        bool         last_step =
+          !(time + h < end_time - eps_t) || (prm.max_steps && step_number + 1 >= prm.max_steps);
+        bool series_due =
           prm.series_interval == 0 || time + h >= next_series - eps_t || last_step;
         // the stability check uses KE (+ SE when summed), a series row needs SE
         need_strain_energy = series_due || step_number % 10 == 0;
@@ -1313,6 +1363,13 @@ namespace talus::explicit_mpm
             instability = e.what();
             break;
           }
+        if (control && control->stage_converged())
+          {
+            stage_done = last_step = series_due = true;
+            log() << std::setprecision(6) << "  stage " << current_stage << " converged at step " << step_number
+                  << " (t = " << time << " s): force ratio " << control->force_ratio << ", energy ratio "
+                  << control->energy_ratio << std::endl;
+          }
         auto t0 = Clock::now();
         if (series_due)
           {
@@ -1338,6 +1395,11 @@ namespace talus::explicit_mpm
                   << el * (1 - frac) / std::max(frac, 1e-12) << " s" << std::endl;
           }
       }
+    if (prm.max_steps && step_number >= prm.max_steps)
+      run_stopped = true;
+      }
+    if (current_stage >= n_stages)
+      current_stage = n_stages - 1; // the last stage stays the current one after the run
     timings.total = seconds_since(t_start);
     if (root)
       series->commit();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <talus/grid/background_grid.h>
+#include <talus/loads/settings.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
 
@@ -14,6 +15,12 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+namespace talus::loads
+{
+  template <int dim>
+  class LoadControl;
+}
 
 namespace talus::explicit_mpm
 {
@@ -45,6 +52,8 @@ namespace talus::explicit_mpm
     // scene
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                        bodies;
+    // loads, friction, damping, convergence, mass scaling, K0, stages
+    loads::Settings<dim> loads;
   };
 
   /// Declare the complete .prm of talus-explicit. `prm_file` (may be empty)
@@ -74,6 +83,7 @@ namespace talus::explicit_mpm
   {
   public:
     Solver(const Parameters<dim> &prm, MPI_Comm comm);
+    ~Solver();
 
     /// Grid, DoFs, boundary conditions, particles, time step. Collective.
     void setup();
@@ -134,8 +144,20 @@ namespace talus::explicit_mpm
     /// stability check needs it (set by the time loop).
     bool                                          need_strain_energy = true;
     double                                        energy_scale = 0;
+    /// Gravity of the running stage (prm.gravity without stages).
+    dealii::Tensor<1, dim>                        gravity;
+    /// Mass scaling factor beta of the running stage (seed 000 §6.5): nodal
+    /// accelerations f / (beta m); critical_time_step() includes sqrt(beta).
+    double                                        mass_scaling = 1.0;
+    /// Staged calculation state (part of the solver state for restarts): the
+    /// running stage and the simulated time at which it started.
+    unsigned int                                  current_stage    = 0;
+    double                                        stage_start_time = 0;
+    /// Loads/friction/damping/convergence/K0/stages; null when none is used.
+    std::unique_ptr<loads::LoadControl<dim>>      control;
 
   private:
+    friend class loads::LoadControl<dim>;
     void collect_active_cells();
     void update_active_cells();
     void collect_active_dofs();

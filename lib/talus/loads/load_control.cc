@@ -1,0 +1,659 @@
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/loads/load_control.h>
+#include <talus/loads/local_damping.h>
+#include <talus/shape/q1.h>
+
+#include <deal.II/base/geometry_info.h>
+#include <deal.II/base/mpi.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+namespace talus::loads
+{
+  template <int dim>
+  LoadControl<dim>::LoadControl(const Settings<dim> &s)
+    : settings(s)
+  {}
+
+  template <int dim>
+  bool
+  LoadControl<dim>::has_convergence() const
+  {
+    for (const auto &st : settings.stages)
+      if (st.convergence.enabled)
+        return true;
+    return false;
+  }
+
+  // ---------------------------------------------------------------- K0
+  template <int dim>
+  void
+  LoadControl<dim>::initial_state(Solver &s)
+  {
+    using L = PropertyLayout<dim>;
+    const auto             g  = settings.stages[0].gravity;
+    const double           gn = g.norm();
+    dealii::Tensor<1, dim> e; // up: against gravity
+    if (gn > 0)
+      e = -g / gn;
+    unsigned int up_axis = 0;
+    for (unsigned int d = 1; d < dim; ++d)
+      if (std::abs(e[d]) > std::abs(e[up_axis]))
+        up_axis = d;
+    const unsigned int n_bodies = settings.k0.size();
+    // top of every body along e (material point + half its spacing)
+    std::vector<double> top(n_bodies, -std::numeric_limits<double>::max());
+    for (const auto &pt : s.particles)
+      {
+        const auto         P = pt.get_properties();
+        const unsigned int b = static_cast<unsigned int>(P[L::body]);
+        if (b >= n_bodies || !settings.k0[b].enabled)
+          continue;
+        const auto  &cc = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+        const double z  = pt.get_location() * e;
+        top[b] = std::max(top[b], z + 0.5 * cc.h[up_axis] / s.prm.bodies[b].particles_per_direction);
+      }
+    {
+      std::vector<double> all(top.size());
+      dealii::Utilities::MPI::max(dealii::ArrayView<const double>(top), s.comm, dealii::ArrayView<double>(all));
+      top = all;
+    }
+    for (auto &pt : s.particles)
+      {
+        auto               P = pt.get_properties();
+        const unsigned int b = static_cast<unsigned int>(P[L::body]);
+        if (b >= n_bodies || !settings.k0[b].enabled)
+          continue;
+        const auto &k      = settings.k0[b];
+        const double level = std::isnan(k.surface_level) ? top[b] : k.surface_level;
+        const double rho   = P[L::mass] / P[L::volume];
+        const double depth = std::max(0.0, level - pt.get_location() * e);
+        const double sv    = -(rho * gn * depth + k.surcharge);
+        const double sh    = k.K0 * sv;
+        dealii::SymmetricTensor<2, 3> sigma;
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = i; j < 3; ++j)
+            {
+              const double ei = i < dim ? e[i] : 0.0, ej = j < dim ? e[j] : 0.0;
+              sigma[i][j]     = (i == j ? sh : 0.0) + (sv - sh) * ei * ej;
+            }
+        L::set_stress(sigma, P.data());
+      }
+    begin_stage(s, 0, false);
+  }
+
+  // ---------------------------------------------------------------- stages
+  template <int dim>
+  void
+  LoadControl<dim>::set_time_step(Solver &s)
+  {
+    const double dt_cr = s.critical_time_step();
+    if (s.prm.time_step > 0)
+      {
+        if (s.prm.time_step > dt_cr && !s.prm.force_time_step)
+          {
+            std::ostringstream os;
+            os << "time/time step: " << s.prm.time_step << " s exceeds the critical time step " << dt_cr
+               << " s of stage '" << current->name << "' (mass scaling " << current->mass_scaling
+               << "); lower it, or set 'force time step = true' to run anyway";
+            throw InputError(os.str());
+          }
+        s.dt = s.prm.time_step;
+      }
+    else
+      s.dt = s.prm.courant * dt_cr;
+  }
+
+  template <int dim>
+  double
+  LoadControl<dim>::begin_stage(Solver &s, const unsigned int k, const bool resume)
+  {
+    AssertThrow(k < settings.stages.size(), dealii::ExcInternalError());
+    current       = &settings.stages[k];
+    stage_index   = k;
+    s.current_stage = k;
+    if (!resume)
+      s.stage_start_time = s.time;
+    stage_t0     = s.stage_start_time;
+    stage_step0  = s.step_number;
+    converged    = false;
+    force_ratio  = energy_ratio = std::numeric_limits<double>::quiet_NaN();
+    s.gravity      = current->gravity;
+    s.mass_scaling = current->mass_scaling;
+    s.constrained  = s.grid.constrained_dofs(current->boundary_conditions);
+    s.p2g_ready    = false; // gravity may have changed: redo the mass/force P2G
+    set_time_step(s);
+
+    settle_time = 0;
+    for (unsigned int j = 0; j < current->tractions.size(); ++j)
+      {
+        const bool glob = j < current->n_global_tractions;
+        settle_time     = std::max(settle_time, current->tractions[j].function.settle_time() - (glob ? stage_t0 : 0.0));
+      }
+    for (unsigned int j = 0; j < current->velocities.size(); ++j)
+      {
+        const bool glob = j < current->n_global_velocities;
+        settle_time = std::max(settle_time, current->velocities[j].function.settle_time() - (glob ? stage_t0 : 0.0));
+      }
+
+    if (s.layout.n_point_force_slots > 0)
+      assign_tractions(s);
+    build_node_lists(s);
+    s.initial_energies = s.energies();
+    potential0         = s.initial_energies.gravity_potential;
+    work_loads         = s.external_work;
+
+    std::ostringstream os;
+    os << "  stage " << k << " '" << current->name << "': t = " << s.time << " s, duration " << current->duration
+       << " s, dt = " << s.dt << " s";
+    if (current->mass_scaling != 1.0)
+      os << " (mass scaling " << current->mass_scaling << ")";
+    if (current->damping > 0)
+      os << ", local damping " << current->damping;
+    if (!current->tractions.empty())
+      os << ", " << current->tractions.size() << " traction(s)";
+    if (!current->velocities.empty())
+      os << ", " << current->velocities.size() << " velocity condition(s)";
+    if (!current->friction_ids.empty())
+      os << ", friction mu = " << current->friction_coefficient << " on " << friction_nodes.size()
+         << " node(s) of this rank";
+    if (current->convergence.enabled)
+      os << ", convergence F < " << current->convergence.force_tolerance << ", E < "
+         << current->convergence.energy_tolerance;
+    log() << os.str() << std::endl;
+    return stage_t0 + current->duration;
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::assign_tractions(Solver &s)
+  {
+    // Boundary material points of each traction, selected by their initial
+    // position X = x - u: the outermost layer of a box body on the face, or
+    // the points in a region. Each point gets the share A_p of the loaded area
+    // proportional to V_p / spacing normal to the face (regular seeding: the
+    // area of its sub-cell face); for a body face the shares are normalised to
+    // the face area of the box, so the total force is exactly traction x area
+    // (seed 000 Eq. 4.29: f_p = tau S_e / n_ebMP).
+    using L                   = PropertyLayout<dim>;
+    const unsigned int off    = s.layout.point_forces();
+    const unsigned int nslots = s.layout.n_point_force_slots;
+    for (auto &pt : s.particles)
+      {
+        auto P = pt.get_properties();
+        for (unsigned int i = 0; i < nslots * dim; ++i)
+          P[off + i] = 0.0;
+      }
+    have_tractions = !current->tractions.empty();
+    for (unsigned int j = 0; j < current->tractions.size(); ++j)
+      {
+        const auto &t = current->tractions[j];
+        const auto initial = [&](const auto &pt) {
+          auto X = pt.get_location();
+          for (unsigned int d = 0; d < dim; ++d)
+            X[d] -= pt.get_properties()[L::displacement + d];
+          return X;
+        };
+        const auto spacing = [&](const auto &pt) {
+          const auto &       cc = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+          const unsigned int b  = static_cast<unsigned int>(pt.get_properties()[L::body]);
+          return cc.h[t.axis] / s.prm.bodies[b].particles_per_direction;
+        };
+        double extreme = -std::numeric_limits<double>::max();
+        if (t.target == Traction<dim>::Target::body_face)
+          {
+            for (const auto &pt : s.particles)
+              if (static_cast<unsigned int>(pt.get_properties()[L::body]) == t.body)
+                extreme = std::max(extreme, t.side * initial(pt)[t.axis]);
+            extreme = dealii::Utilities::MPI::max(extreme, s.comm);
+          }
+        const auto selected = [&](const auto &pt) {
+          const auto X = initial(pt);
+          if (t.target == Traction<dim>::Target::body_face)
+            return static_cast<unsigned int>(pt.get_properties()[L::body]) == t.body &&
+                   t.side * X[t.axis] > extreme - 0.5 * spacing(pt);
+          for (unsigned int d = 0; d < dim; ++d)
+            if (X[d] < t.lower[d] || X[d] > t.upper[d])
+              return false;
+          return true;
+        };
+        double       area_sum = 0;
+        unsigned int n_sel    = 0;
+        for (const auto &pt : s.particles)
+          if (selected(pt))
+            {
+              area_sum += pt.get_properties()[L::volume] / spacing(pt);
+              ++n_sel;
+            }
+        area_sum          = dealii::Utilities::MPI::sum(area_sum, s.comm);
+        const auto n_all  = dealii::Utilities::MPI::sum(n_sel, s.comm);
+        require(n_all > 0, t.where, "selects no material point (check the body/face or the region)");
+        double scale = 1.0;
+        if (t.target == Traction<dim>::Target::body_face)
+          {
+            const auto &b    = s.prm.bodies[t.body];
+            double      area = 1.0;
+            for (unsigned int d = 0; d < dim; ++d)
+              if (d != t.axis)
+                area *= b.upper[d] - b.lower[d];
+            scale = area / area_sum;
+          }
+        for (auto &pt : s.particles)
+          if (selected(pt))
+            {
+              auto         P  = pt.get_properties();
+              const double Ap = scale * P[L::volume] / spacing(pt);
+              for (unsigned int d = 0; d < dim; ++d)
+                P[off + j * dim + d] = t.traction[d] * Ap;
+            }
+        log() << "  " << t.where << ": " << n_all << " boundary material points, loaded area "
+              << area_sum * scale << (dim == 2 ? " m (per unit thickness)" : " m^2") << ", f(t) = "
+              << t.function.text() << std::endl;
+      }
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::build_node_lists(Solver &s)
+  {
+    const unsigned int n_owned = s.nodal_mass.locally_owned_size();
+    const unsigned int n_local = n_owned + s.grid.partitioner->n_ghost_indices();
+    component.assign(n_local, -1);
+    for (const auto &cc : s.grid.cells)
+      if (cc.h[0] > 0)
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            component[cc.dofs[v * dim + d]] = d;
+    excluded.assign(n_local, 0);
+    for (unsigned int i = 0; i < n_local; ++i)
+      excluded[i] = s.constrained[i];
+
+    // friction nodes: vertices of boundary faces with a friction id (owned
+    // DoFs; faces of ghost cells add their area share to owned nodes)
+    friction_nodes.clear();
+    std::map<unsigned int, unsigned int> node_of; // first DoF -> index
+    for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
+      {
+        const auto &cc = s.grid.cells[c];
+        if (!(cc.h[0] > 0) || current->friction_ids.empty())
+          continue;
+        const auto &cell = s.grid.cell_iterators[c];
+        for (unsigned int f = 0; f < dealii::GeometryInfo<dim>::faces_per_cell; ++f)
+          {
+            if (!cell->face(f)->at_boundary())
+              continue;
+            const auto id = cell->face(f)->boundary_id();
+            if (std::find(current->friction_ids.begin(), current->friction_ids.end(), id) ==
+                current->friction_ids.end())
+              continue;
+            const unsigned int axis = f / 2;
+            double             area = 1.0;
+            for (unsigned int d = 0; d < dim; ++d)
+              if (d != axis)
+                area *= cc.h[d];
+            for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
+              {
+                const unsigned int v = dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i);
+                if (cc.dofs[v * dim] >= n_owned)
+                  continue;
+                const unsigned int key = cc.dofs[v * dim] * 8 + f; // a node may sit on two boundaries
+                auto               it  = node_of.find(key);
+                if (it == node_of.end())
+                  {
+                    FrictionNode n;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      n.dofs[d] = cc.dofs[v * dim + d];
+                    n.axis  = axis;
+                    n.side  = (f % 2) ? +1 : -1;
+                    n.area  = 0;
+                    n.state = 0;
+                    it      = node_of.emplace(key, friction_nodes.size()).first;
+                    friction_nodes.push_back(n);
+                  }
+                friction_nodes[it->second].area += area / dealii::GeometryInfo<dim>::vertices_per_face;
+              }
+          }
+      }
+    for (const auto &n : friction_nodes)
+      for (unsigned int d = 0; d < dim; ++d)
+        excluded[n.dofs[d]] = 1;
+
+    // prescribed nodal velocities
+    prescribed_dofs.clear();
+    particle_conditions.clear();
+    std::vector<unsigned char> seen(n_owned, 0);
+    for (unsigned int j = 0; j < current->velocities.size(); ++j)
+      {
+        const auto &pv = current->velocities[j];
+        if (pv.target == PrescribedVelocity<dim>::Target::body)
+          {
+            particle_conditions.push_back(j);
+            continue;
+          }
+        std::fill(seen.begin(), seen.end(), 0);
+        for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
+          {
+            const auto &cc = s.grid.cells[c];
+            if (!(cc.h[0] > 0))
+              continue;
+            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+              {
+                const unsigned int i0 = cc.dofs[v * dim];
+                if (i0 >= n_owned || seen[i0])
+                  continue;
+                bool hit = false;
+                if (pv.target == PrescribedVelocity<dim>::Target::region)
+                  {
+                    hit = true;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        const double x   = cc.lower[d] + ((v >> d) & 1u) * cc.h[d];
+                        const double tol = 1e-9 * cc.h[d];
+                        hit              = hit && x >= pv.lower[d] - tol && x <= pv.upper[d] + tol;
+                      }
+                  }
+                else
+                  {
+                    const auto &cell = s.grid.cell_iterators[c];
+                    for (unsigned int f = 0; f < dealii::GeometryInfo<dim>::faces_per_cell && !hit; ++f)
+                      if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == pv.boundary)
+                        for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
+                          hit = hit || dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i) == v;
+                  }
+                if (!hit)
+                  continue;
+                seen[i0] = 1;
+                for (unsigned int d = 0; d < dim; ++d)
+                  if (pv.component[d])
+                    {
+                      prescribed_dofs.push_back({cc.dofs[v * dim + d], j, d});
+                      excluded[cc.dofs[v * dim + d]] = 1;
+                    }
+              }
+          }
+      }
+    need_vt = !friction_nodes.empty() || !prescribed_dofs.empty() || current->damping > 0 ||
+              dealii::Utilities::MPI::logical_or(!friction_nodes.empty() || !prescribed_dofs.empty(), s.comm);
+    if (need_vt && vt.size() == 0)
+      s.grid.reinit_vector(vt);
+    if (have_tractions && trac.size() == 0)
+      s.grid.reinit_vector(trac);
+  }
+
+  // ---------------------------------------------------------------- step hooks
+  template <int dim>
+  void
+  LoadControl<dim>::before_nodal_solve(Solver &s, const double step)
+  {
+    using L                   = PropertyLayout<dim>;
+    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
+    h                         = step;
+    if (!have_tractions && !need_vt)
+      return;
+    double *const T   = have_tractions ? trac.begin() : nullptr;
+    double *const Pm  = need_vt ? vt.begin() : nullptr;
+    if (have_tractions)
+      s.zero_on_active(trac);
+    if (need_vt)
+      s.zero_on_active(vt);
+    // time factors of the tractions at t
+    const unsigned int  nt = current->tractions.size();
+    std::vector<double> factor(nt);
+    for (unsigned int j = 0; j < nt; ++j)
+      factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
+    const unsigned int off = s.layout.point_forces();
+    double             work = 0;
+    auto               pt   = s.particles.begin();
+    for (const auto [c, n_in_cell] : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[c];
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          {
+            const double *P = pt->get_properties().data();
+            double        N[nv];
+            bool          have_N = false;
+            if (have_tractions)
+              {
+                double f[dim] = {};
+                bool   any    = false;
+                for (unsigned int j = 0; j < nt; ++j)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    if (P[off + j * dim + d] != 0.0)
+                      {
+                        f[d] += factor[j] * P[off + j * dim + d];
+                        any = true;
+                      }
+                if (any)
+                  {
+                    shape::Q1<dim>::values(pt->get_reference_location(), N);
+                    have_N = true;
+                    for (unsigned int v = 0; v < nv; ++v)
+                      for (unsigned int d = 0; d < dim; ++d)
+                        T[cc.dofs[v * dim + d]] += N[v] * f[d]; // Eq. 5.3
+                    for (unsigned int d = 0; d < dim; ++d)
+                      work += f[d] * P[L::velocity + d] * h;
+                  }
+              }
+            if (need_vt)
+              {
+                if (!have_N)
+                  shape::Q1<dim>::values(pt->get_reference_location(), N);
+                const double m = P[L::mass];
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    Pm[cc.dofs[v * dim + d]] += m * N[v] * P[L::velocity + d];
+              }
+          }
+      }
+    if (have_tractions)
+      {
+        trac.compress(dealii::VectorOperation::add);
+        s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+      }
+    if (need_vt)
+      vt.compress(dealii::VectorOperation::add);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::nodal_forces(Solver &s)
+  {
+    double *const       F = s.nodal_a.begin();
+    const double *const M = s.nodal_mass.begin();
+    if (have_tractions)
+      {
+        const double *T = trac.begin();
+        for (const unsigned int i : s.active_dofs)
+          F[i] += T[i];
+      }
+    // quasi-static convergence (seed 000 §6.4), on the unbalanced force before damping
+    const auto &conv = current->convergence;
+    if (conv.enabled && s.step_number > stage_step0 && (s.step_number - stage_step0) % conv.interval == 0)
+      {
+        const double *T  = have_tractions ? trac.begin() : nullptr;
+        double        v[4] = {0, 0, 0, 0};
+        for (const unsigned int i : s.active_dofs)
+          if (!excluded[i] && component[i] >= 0)
+            {
+              const double fext = M[i] * s.gravity[component[i]] + (T ? T[i] : 0.0);
+              v[0] += F[i] * F[i];
+              v[1] += fext * fext;
+            }
+        v[2] = s.local_energies.kinetic;
+        v[3] = s.local_energies.gravity_potential;
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 4), s.comm, dealii::ArrayView<double>(v, 4));
+        const double w_ext = (potential0 - v[3]) + (s.external_work - work_loads) + 0.0;
+        force_ratio        = std::sqrt(v[0]) / std::max(std::sqrt(v[1]), 1e-300);
+        const double ke    = current->mass_scaling * v[2]; // kinetic energy of the scaled inertia
+        energy_ratio       = w_ext > 0 ? ke / w_ext : (ke > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+        const double t_stage = s.time - stage_t0;
+        if (conv.end_stage && t_stage >= settle_time - 1e-9 * s.dt && force_ratio < conv.force_tolerance &&
+            energy_ratio < conv.energy_tolerance)
+          converged = true;
+      }
+    // local damping (Eq. 6.23) with the nodal velocity at t
+    if (current->damping > 0)
+      {
+        const double *Pm = vt.begin();
+        const double  a  = current->damping;
+        for (const unsigned int i : s.active_dofs)
+          if (M[i] > 0)
+            F[i] += local_damping_force(a, F[i], Pm[i]); // sign(p) = sign(v)
+      }
+    // mass scaling (Eq. 6.31): inertia beta m, forces unchanged
+    if (current->mass_scaling != 1.0)
+      {
+        const double inv = 1.0 / current->mass_scaling;
+        for (const unsigned int i : s.active_dofs)
+          F[i] *= inv;
+      }
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::nodal_accelerations(Solver &s)
+  {
+    if (friction_nodes.empty() && prescribed_dofs.empty())
+      return;
+    double *const       A  = s.nodal_a.begin();
+    const double *const M  = s.nodal_mass.begin();
+    const double *const Pm = vt.begin();
+    const double        beta = current->mass_scaling;
+    // frictional contact with a rigid fixed boundary: seed 000 Eqs. 6.4-6.21
+    // with the other body at rest (v = 0): predicted v* = v^t + dt a; if it
+    // moves into the wall, the normal component is removed and the tangential
+    // one is reduced by mu |v*_n| + a A dt / m (stick if that stops it).
+    const double mu = current->friction_coefficient, adh = current->adhesion;
+    for (auto &n : friction_nodes)
+      {
+        const double m = M[n.dofs[0]];
+        n.state        = 0;
+        if (!(m > 0))
+          continue;
+        double v0[dim], vs[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const bool fixed = s.constrained[n.dofs[d]];
+            v0[d]            = fixed ? 0.0 : Pm[n.dofs[d]] / m;
+            vs[d]            = fixed ? 0.0 : v0[d] + h * A[n.dofs[d]];
+          }
+        const double vn = n.side * vs[n.axis];
+        if (!(vn > 0))
+          continue; // separating: no correction
+        vs[n.axis]  = 0;
+        double vt2  = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          vt2 += vs[d] * vs[d];
+        const double vtan   = std::sqrt(vt2);
+        const double budget = mu * vn + adh * n.area * h / (beta * m);
+        if (vtan <= budget)
+          {
+            n.state = 1; // stick
+            for (unsigned int d = 0; d < dim; ++d)
+              vs[d] = 0;
+          }
+        else
+          {
+            n.state         = 2; // slip
+            const double fr = 1.0 - budget / vtan;
+            for (unsigned int d = 0; d < dim; ++d)
+              vs[d] *= fr;
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          if (!s.constrained[n.dofs[d]])
+            A[n.dofs[d]] = (vs[d] - v0[d]) / h;
+      }
+    // prescribed nodal velocities: a = (vbar(t + dt) - v^t) / dt; the work of
+    // the reaction goes to the external work
+    double work = 0;
+    for (const auto &p : prescribed_dofs)
+      {
+        const double m = M[p.dof];
+        if (!(m > 0))
+          continue;
+        const auto & pv   = current->velocities[p.condition];
+        const double t    = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
+        const double vbar = pv.velocity[p.component] * pv.function.value(t);
+        const double anew = (vbar - Pm[p.dof] / m) / h;
+        work += beta * m * (anew - A[p.dof]) * vbar * h;
+        A[p.dof] = anew;
+      }
+    if (!prescribed_dofs.empty() || settings.staged)
+      s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::particle_velocities(Solver &s)
+  {
+    if (particle_conditions.empty())
+      return;
+    using L                   = PropertyLayout<dim>;
+    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
+    double *const          Pn = s.nodal_p.begin();
+    double                 work = 0;
+    auto                   pt   = s.particles.begin();
+    for (const auto [c, n_in_cell] : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[c];
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          {
+            double *           P = pt->get_properties().data();
+            const unsigned int b = static_cast<unsigned int>(P[L::body]);
+            for (const unsigned int j : particle_conditions)
+              {
+                const auto &pv = current->velocities[j];
+                if (pv.body != b)
+                  continue;
+                const double t = (j < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
+                const double f = pv.function.value(t);
+                double       dv[dim];
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    dv[d] = pv.component[d] ? pv.velocity[d] * f - P[L::velocity + d] : 0.0;
+                    P[L::velocity + d] += dv[d];
+                    work += P[L::mass] * dv[d] * P[L::velocity + d];
+                  }
+                double N[nv];
+                shape::Q1<dim>::values(pt->get_reference_location(), N);
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    Pn[cc.dofs[v * dim + d]] += P[L::mass] * N[v] * dv[d];
+              }
+          }
+      }
+    s.nodal_p.compress(dealii::VectorOperation::add);
+    s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::nodal_velocities(Solver &s)
+  {
+    double *const V = s.nodal_p.begin();
+    for (const auto &n : friction_nodes)
+      if (n.state != 0)
+        {
+          if (n.side * V[n.dofs[n.axis]] > 0)
+            V[n.dofs[n.axis]] = 0; // no penetration
+          if (n.state == 1)
+            for (unsigned int d = 0; d < dim; ++d)
+              V[n.dofs[d]] = 0; // stick
+        }
+    for (const auto &p : prescribed_dofs)
+      {
+        const auto & pv = current->velocities[p.condition];
+        const double t  = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
+        V[p.dof]        = pv.velocity[p.component] * pv.function.value(t);
+      }
+  }
+
+  template class LoadControl<2>;
+  template class LoadControl<3>;
+} // namespace talus::loads

@@ -1,0 +1,113 @@
+// talus — run-time side of loads, boundary friction, prescribed velocities,
+// local damping, quasi-static convergence, mass scaling, K0 stresses and stages
+// for the explicit solver. The solver calls the hooks below only when the
+// controller exists (Settings::active()), so none of this costs anything when
+// the features are off.
+//
+// Step with the controller (seed 000 §4.3.7 with §5.2, §6.2-§6.5):
+//   P2G mass/force (fused, solver)
+//   before_nodal_solve   traction point forces -> nodal f_trac (Eq. 5.3); nodal
+//                        momentum at t when friction/prescribed/damping need v_i^t
+//   nodal_forces         f = f_grav + f_trac - f_int; convergence ratios (6.29,
+//                        6.30) every 'check interval' steps; local damping
+//                        f += -alpha |f| sign(v^t) (6.23); f /= beta (6.31)
+//   a = f / m (solver)
+//   nodal_accelerations  prescribed node velocities a = (vbar - v^t)/dt;
+//                        friction nodes: predictor v* = v^t + dt a, rigid-wall
+//                        form of Eqs. 6.4-6.21, a = (v~ - v^t)/dt
+//   G2P velocity, P2G momentum (solver)
+//   particle_velocities  prescribed material point velocities (momentum corrected)
+//   v = p / m (solver)
+//   nodal_velocities     prescribed values, no penetration / stick at friction nodes
+#pragma once
+
+#include <talus/grid/background_grid.h>
+#include <talus/loads/settings.h>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace talus::explicit_mpm
+{
+  template <int dim>
+  class Solver;
+}
+
+namespace talus::loads
+{
+  template <int dim>
+  class LoadControl
+  {
+  public:
+    using Solver = explicit_mpm::Solver<dim>;
+    explicit LoadControl(const Settings<dim> &settings);
+
+    unsigned int n_stages() const { return settings.stages.size(); }
+    unsigned int n_point_force_slots() const { return settings.max_tractions; }
+    const Stage<dim> &stage(const unsigned int k) const { return settings.stages[k]; }
+    bool has_convergence() const;
+
+    /// After seeding, before the history initialisation: K0 stresses, and
+    /// stage 0 applied (gravity, boundaries, mass scaling, time step).
+    void initial_state(Solver &s);
+    /// Apply stage k: gravity, boundary conditions, friction and prescribed
+    /// nodes, traction point forces, mass scaling and the time step, baselines
+    /// of the convergence ratios. `resume`: keep the solver's stage start time
+    /// (restart inside a stage). Returns the absolute end time of the stage.
+    double begin_stage(Solver &s, const unsigned int k, const bool resume);
+
+    void before_nodal_solve(Solver &s, const double h);
+    void nodal_forces(Solver &s);
+    void nodal_accelerations(Solver &s);
+    void particle_velocities(Solver &s);
+    void nodal_velocities(Solver &s);
+
+    /// The convergence criterion of the stage was met (and ends the stage).
+    bool stage_converged() const { return converged; }
+    /// Last evaluated ratios (NaN before the first evaluation of the stage).
+    double force_ratio  = std::numeric_limits<double>::quiet_NaN();
+    double energy_ratio = std::numeric_limits<double>::quiet_NaN();
+
+  private:
+    const Settings<dim> &settings;
+    const Stage<dim> *   current = nullptr;
+    unsigned int         stage_index = 0;
+    double               h = 0; ///< size of the running step
+    double               stage_t0 = 0;
+    unsigned int         stage_step0 = 0;
+    double               settle_time = 0; ///< stage time after which all loads are constant
+    bool                 converged = false;
+    double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
+
+    bool need_vt = false, have_tractions = false;
+    Vector trac, vt;
+    std::vector<int> component; ///< of each local DoF (-1: none)
+    std::vector<unsigned char> excluded; ///< DoFs left out of the force ratio
+
+    struct FrictionNode
+    {
+      unsigned int  dofs[dim];
+      unsigned int  axis;
+      int           side;
+      double        area;
+      unsigned char state; ///< 0 free/separating, 1 stick, 2 slip
+    };
+    std::vector<FrictionNode> friction_nodes;
+    struct PrescribedDof
+    {
+      unsigned int dof, condition, component;
+    };
+    std::vector<PrescribedDof> prescribed_dofs;
+    std::vector<unsigned int>  particle_conditions; ///< indices of body velocity conditions
+
+    double load_time(const unsigned int index, const bool global, const double t_abs) const
+    {
+      (void)index;
+      return global ? t_abs : t_abs - stage_t0;
+    }
+    void assign_tractions(Solver &s);
+    void build_node_lists(Solver &s);
+    void set_time_step(Solver &s);
+  };
+} // namespace talus::loads

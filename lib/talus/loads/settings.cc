@@ -1,0 +1,495 @@
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/loads/settings.h>
+
+#include <deal.II/base/utilities.h>
+
+#include <cmath>
+
+namespace talus::loads
+{
+  using dealii::Patterns::Anything;
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Integer;
+  using dealii::Patterns::Selection;
+
+  namespace
+  {
+    std::string
+    zeros(const unsigned int dim)
+    {
+      return dim == 2 ? "0, 0" : "0, 0, 0";
+    }
+
+    std::vector<double>
+    doubles(const std::string &text, const std::string &where)
+    {
+      std::vector<double> r;
+      for (const auto &s : dealii::Utilities::split_string_list(text, ','))
+        {
+          try
+            {
+              std::size_t  pos = 0;
+              const double v   = std::stod(s, &pos);
+              if (pos != s.size() || !std::isfinite(v))
+                throw std::invalid_argument(s);
+              r.push_back(v);
+            }
+          catch (const std::exception &)
+            {
+              throw InputError(where + ": '" + s + "' is not a number (in '" + text + "')");
+            }
+        }
+      return r;
+    }
+
+    template <int dim>
+    dealii::Point<dim>
+    point(const std::string &text, const std::string &where)
+    {
+      const auto v = doubles(text, where);
+      require(v.size() == dim, where,
+              "needs exactly " + std::to_string(dim) + " comma-separated numbers (got '" + text + "')");
+      dealii::Point<dim> p;
+      for (unsigned int d = 0; d < dim; ++d)
+        p[d] = v[d];
+      return p;
+    }
+
+    std::vector<dealii::types::boundary_id>
+    ids(const std::string &text, const std::string &where, const unsigned int dim)
+    {
+      std::vector<dealii::types::boundary_id> r;
+      if (text == "none")
+        return r;
+      for (const auto &x : doubles(text, where))
+        {
+          require(x >= 0 && x == std::floor(x) && x < 2 * dim, where,
+                  "boundary id " + std::to_string(x) + " does not exist (box grid ids 0.." +
+                    std::to_string(2 * dim - 1) + ")");
+          r.push_back(static_cast<dealii::types::boundary_id>(x));
+        }
+      return r;
+    }
+
+    const char *face_names = "x-|x+|y-|y+|z-|z+";
+
+    void
+    declare_loads(dealii::ParameterHandler &prm, const std::string &prm_file, const std::string &path,
+                  const unsigned int dim)
+    {
+      const unsigned int n_tr = dealii::Utilities::string_to_int(
+        peek_entry(prm_file, path, "number of tractions", "0", Integer(0, 16)));
+      const unsigned int n_v = dealii::Utilities::string_to_int(
+        peek_entry(prm_file, path, "number of velocity conditions", "0", Integer(0, 16)));
+      prm.enter_subsection("loads");
+      prm.declare_entry("number of tractions", "0", Integer(0, 16),
+                        "Number of 'traction k' subsections: surface tractions carried by boundary material "
+                        "points (seed 000 §4.3.2, §5.2).");
+      prm.declare_entry("number of velocity conditions", "0", Integer(0, 16),
+                        "Number of 'velocity k' subsections: prescribed velocities on grid nodes or material points.");
+      for (unsigned int k = 0; k < n_tr; ++k)
+        {
+          prm.enter_subsection("traction " + std::to_string(k));
+          prm.declare_entry("apply to", "body face", Selection("body face|region"),
+                            "'body face': the outermost layer of material points of a box body on 'face'; "
+                            "'region': the points whose initial position lies in the region box, loaded on the "
+                            "face normal to the axis of 'face'.");
+          prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body face).");
+          prm.declare_entry("face", dim == 2 ? "y+" : "z+", Selection(face_names),
+                            "Loaded face: its outward normal axis and side.");
+          prm.declare_entry("region lower corner", zeros(dim), Anything(), "Region: lower corner [m].");
+          prm.declare_entry("region upper corner", zeros(dim), Anything(), "Region: upper corner [m].");
+          prm.declare_entry("traction", zeros(dim), Anything(),
+                            "Traction vector [Pa], force per unit initial area of the face (e.g. 0, -1e4 pushes down); direction and size do not follow the deformation (seed 000 §5.2).");
+          prm.declare_entry("time function", "constant", Anything(),
+                            "Factor f(t): constant | step T | ramp T1 | ramp T0 T1 | table t0:f0, t1:f1, ... | "
+                            "table file NAME.csv (time of the stage for stage loads).");
+          prm.leave_subsection();
+        }
+      for (unsigned int k = 0; k < n_v; ++k)
+        {
+          prm.enter_subsection("velocity " + std::to_string(k));
+          prm.declare_entry("apply to", "boundary", Selection("boundary|region|body"),
+                            "'boundary': every grid node of 'boundary id'; 'region': the grid nodes inside the "
+                            "region box; 'body': the material points of 'body'.");
+          prm.declare_entry("boundary id", "0", Integer(0), "Boundary id (apply to = boundary).");
+          prm.declare_entry("region lower corner", zeros(dim), Anything(), "Region: lower corner [m].");
+          prm.declare_entry("region upper corner", zeros(dim), Anything(), "Region: upper corner [m].");
+          prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body).");
+          prm.declare_entry("components", "all", Anything(),
+                            "Prescribed components: 'all' or a list of x, y, z.");
+          prm.declare_entry("velocity", zeros(dim), Anything(), "Velocity vector [m/s] (unprescribed components ignored).");
+          prm.declare_entry("time function", "constant", Anything(), "Factor f(t), as for tractions.");
+          prm.leave_subsection();
+        }
+      prm.leave_subsection();
+    }
+
+    template <int dim>
+    void
+    parse_loads(dealii::ParameterHandler &prm, const std::string &path, const std::vector<BodyDescription<dim>> &bodies,
+                std::vector<Traction<dim>> &tractions, std::vector<PrescribedVelocity<dim>> &velocities)
+    {
+      prm.enter_subsection("loads");
+      const std::string  base = path.empty() ? "loads" : path + "/loads";
+      const unsigned int n_tr = prm.get_integer("number of tractions");
+      const unsigned int n_v  = prm.get_integer("number of velocity conditions");
+      for (unsigned int k = 0; k < n_tr; ++k)
+        {
+          const std::string where = base + "/traction " + std::to_string(k);
+          prm.enter_subsection("traction " + std::to_string(k));
+          Traction<dim>     t;
+          t.where            = where;
+          const std::string f = prm.get("face");
+          t.axis              = static_cast<unsigned int>(f[0] - 'x');
+          t.side              = f[1] == '+' ? +1 : -1;
+          require(t.axis < dim, where + "/face", "'" + f + "' does not exist in " + std::to_string(dim) + "D");
+          t.target = prm.get("apply to") == "region" ? Traction<dim>::Target::region : Traction<dim>::Target::body_face;
+          if (t.target == Traction<dim>::Target::body_face)
+            {
+              t.body = prm.get_integer("body");
+              require(t.body < bodies.size(), where + "/body",
+                      "body " + std::to_string(t.body) + " is not defined (number of bodies = " +
+                        std::to_string(bodies.size()) + ")");
+              require(bodies[t.body].shape == BodyDescription<dim>::Shape::box, where + "/apply to",
+                      "'body face' needs a box body (body " + std::to_string(t.body) +
+                        " is not a box); use 'region'");
+            }
+          else
+            {
+              t.lower = point<dim>(prm.get("region lower corner"), where + "/region lower corner");
+              t.upper = point<dim>(prm.get("region upper corner"), where + "/region upper corner");
+              for (unsigned int d = 0; d < dim; ++d)
+                require(t.upper[d] > t.lower[d], where + "/region upper corner",
+                        "must exceed 'region lower corner' in every direction");
+            }
+          t.traction = point<dim>(prm.get("traction"), where + "/traction");
+          t.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
+          prm.leave_subsection();
+          tractions.push_back(t);
+        }
+      for (unsigned int k = 0; k < n_v; ++k)
+        {
+          const std::string where = base + "/velocity " + std::to_string(k);
+          prm.enter_subsection("velocity " + std::to_string(k));
+          PrescribedVelocity<dim> v;
+          v.where             = where;
+          const std::string a = prm.get("apply to");
+          if (a == "boundary")
+            {
+              v.target                = PrescribedVelocity<dim>::Target::boundary;
+              const unsigned int b    = prm.get_integer("boundary id");
+              require(b < 2 * dim, where + "/boundary id",
+                      "boundary id " + std::to_string(b) + " does not exist (box grid ids 0.." +
+                        std::to_string(2 * dim - 1) + ")");
+              v.boundary = static_cast<dealii::types::boundary_id>(b);
+            }
+          else if (a == "region")
+            {
+              v.target = PrescribedVelocity<dim>::Target::region;
+              v.lower  = point<dim>(prm.get("region lower corner"), where + "/region lower corner");
+              v.upper  = point<dim>(prm.get("region upper corner"), where + "/region upper corner");
+              for (unsigned int d = 0; d < dim; ++d)
+                require(v.upper[d] >= v.lower[d], where + "/region upper corner",
+                        "must not be below 'region lower corner'");
+            }
+          else
+            {
+              v.target = PrescribedVelocity<dim>::Target::body;
+              v.body   = prm.get_integer("body");
+              require(v.body < bodies.size(), where + "/body",
+                      "body " + std::to_string(v.body) + " is not defined (number of bodies = " +
+                        std::to_string(bodies.size()) + ")");
+            }
+          const std::string comps = prm.get("components");
+          for (unsigned int d = 0; d < dim; ++d)
+            v.component[d] = comps == "all";
+          if (comps != "all")
+            for (const auto &c : dealii::Utilities::split_string_list(comps, ','))
+              {
+                require(c.size() == 1 && c[0] >= 'x' && c[0] < 'x' + dim, where + "/components",
+                        "'" + c + "' is not a component (allowed: all, or a list of " +
+                          std::string(dim == 2 ? "x, y" : "x, y, z") + ")");
+                v.component[c[0] - 'x'] = true;
+              }
+          v.velocity = point<dim>(prm.get("velocity"), where + "/velocity");
+          v.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
+          prm.leave_subsection();
+          velocities.push_back(v);
+        }
+      prm.leave_subsection();
+    }
+
+    /// the per-stage switches; `stage` true: defaults mean "inherit"
+    void
+    declare_switches(dealii::ParameterHandler &prm, const bool stage)
+    {
+      prm.enter_subsection("damping");
+      prm.declare_entry("local damping", stage ? "-1" : "0", Double(stage ? -1 : 0, 1),
+                        "Local damping factor alpha of seed 000 §6.3 (Eq. 6.23): nodal f_damp = -alpha |f| sign(v); "
+                        "0 = off; 0.7-0.8 for quasi-static runs." +
+                          std::string(stage ? " -1: as the top-level 'damping'." : ""));
+      prm.leave_subsection();
+      prm.enter_subsection("mass scaling");
+      prm.declare_entry("factor", stage ? "-1" : "1", Double(stage ? -1 : 0),
+                        "Mass scaling factor beta of seed 000 §6.5: inertia beta m (gravity keeps m); the critical "
+                        "time step grows by sqrt(beta) (Eq. 6.31). 1 = off." +
+                          std::string(stage ? " -1: as the top-level 'mass scaling'." : ""));
+      prm.leave_subsection();
+      prm.enter_subsection("convergence");
+      prm.declare_entry("enabled", stage ? "inherit" : "false", stage ? Selection("inherit|true|false") : Selection("true|false"),
+                        "Evaluate the quasi-static convergence ratios of seed 000 §6.4: force ratio "
+                        "|f_ext - f_int| / |f_ext| over the free DoFs (Eq. 6.29) and energy ratio KE / W_ext "
+                        "(Eq. 6.30, W_ext = work of gravity and loads since the stage start).");
+      prm.declare_entry("force ratio tolerance", stage ? "-1" : "1e-3", Double(-1), "Tolerance of the force ratio.");
+      prm.declare_entry("energy ratio tolerance", stage ? "-1" : "1e-5", Double(-1), "Tolerance of the energy ratio.");
+      prm.declare_entry("check interval", stage ? "0" : "10", Integer(0),
+                        "Steps between evaluations (an MPI reduction each)." +
+                          std::string(stage ? " 0: inherit." : ""));
+      prm.declare_entry("end stage", stage ? "inherit" : "true", stage ? Selection("inherit|true|false") : Selection("true|false"),
+                        "End the stage (the run, if it is the last) once both ratios are below their tolerances "
+                        "and every load of the stage has reached its final value.");
+      prm.leave_subsection();
+    }
+
+    template <int dim>
+    void
+    parse_switches(dealii::ParameterHandler &prm, const std::string &path, Stage<dim> &s, const Stage<dim> *base)
+    {
+      const std::string pre = path.empty() ? "" : path + "/";
+      prm.enter_subsection("damping");
+      const double a = prm.get_double("local damping");
+      s.damping      = (a < 0 && base) ? base->damping : a;
+      require(s.damping >= 0 && s.damping < 1, pre + "damping/local damping", "must be in [0, 1)");
+      prm.leave_subsection();
+      prm.enter_subsection("mass scaling");
+      const double b = prm.get_double("factor");
+      s.mass_scaling = (b < 0 && base) ? base->mass_scaling : b;
+      require(s.mass_scaling > 0, pre + "mass scaling/factor", "must be > 0 (1 = no mass scaling)");
+      prm.leave_subsection();
+      prm.enter_subsection("convergence");
+      const auto pick = [&](const std::string &e, const bool inherited) {
+        const std::string v = prm.get(e);
+        return v == "inherit" ? inherited : v == "true";
+      };
+      const Convergence c0 = base ? base->convergence : Convergence();
+      s.convergence.enabled   = pick("enabled", c0.enabled);
+      s.convergence.end_stage = pick("end stage", c0.end_stage);
+      const double ft = prm.get_double("force ratio tolerance"), et = prm.get_double("energy ratio tolerance");
+      s.convergence.force_tolerance  = (ft < 0 && base) ? c0.force_tolerance : ft;
+      s.convergence.energy_tolerance = (et < 0 && base) ? c0.energy_tolerance : et;
+      const unsigned int n           = prm.get_integer("check interval");
+      s.convergence.interval         = (n == 0 && base) ? c0.interval : n;
+      require(s.convergence.force_tolerance > 0, pre + "convergence/force ratio tolerance", "must be > 0");
+      require(s.convergence.energy_tolerance > 0, pre + "convergence/energy ratio tolerance", "must be > 0");
+      require(s.convergence.interval > 0, pre + "convergence/check interval", "must be > 0");
+      prm.leave_subsection();
+    }
+  } // namespace
+
+  template <int dim>
+  bool
+  Settings<dim>::active() const
+  {
+    if (staged)
+      return true;
+    for (const auto &k : k0)
+      if (k.enabled)
+        return true;
+    for (const auto &s : stages)
+      if (!s.friction_ids.empty() || !s.tractions.empty() || !s.velocities.empty() || s.damping > 0 ||
+          s.mass_scaling != 1.0 || s.convergence.enabled)
+        return true;
+    return false;
+  }
+
+  void
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim,
+                     const unsigned int n_bodies)
+  {
+    prm.enter_subsection("boundary conditions");
+    prm.declare_entry("friction", "", Anything(),
+                      "Boundary ids with frictional contact (seed 000 §6.2 against a rigid fixed boundary): "
+                      "no penetration, free separation, Coulomb friction on the tangential velocity.");
+    prm.declare_entry("friction coefficient", "0", Double(0), "Coulomb friction coefficient mu of the 'friction' boundaries.");
+    prm.declare_entry("adhesion", "0", Double(0), "Adhesion a [Pa] of the 'friction' boundaries (Eq. 6.19: f_adh = a A_k).");
+    prm.leave_subsection();
+    declare_loads(prm, prm_file, "loads", dim);
+    declare_switches(prm, false);
+
+    for (unsigned int k = 0; k < n_bodies; ++k)
+      {
+        prm.enter_subsection("body " + std::to_string(k));
+        prm.enter_subsection("initial stress");
+        prm.declare_entry("K0 procedure", "false", Bool(),
+                          "Initial geostatic stresses at setup: sigma_v = -(rho |g| (surface level - z) + surcharge) "
+                          "along the gravity direction, sigma_h = K0 sigma_v (all other normal components).");
+        prm.declare_entry("K0", "auto", Anything(),
+                          "Lateral stress ratio; 'auto' = 1 - sin(phi) for Mohr-Coulomb materials (error otherwise).");
+        prm.declare_entry("surface level", "", Anything(),
+                          "Level of the free surface along -g [m]; empty = top of this body.");
+        prm.declare_entry("surcharge", "0", Double(0), "Vertical pressure on the surface [Pa] (overburden of layers above).");
+        prm.leave_subsection();
+        prm.leave_subsection();
+      }
+
+    const unsigned int n_stages =
+      dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of stages", "0", Integer(0, 32)));
+    prm.declare_entry("number of stages", "0", Integer(0, 32),
+                      "Staged calculation: number of 'stage k' subsections run one after the other (0 = one stage "
+                      "from the top-level entries and time/end time).");
+    for (unsigned int k = 0; k < n_stages; ++k)
+      {
+        const std::string name = "stage " + std::to_string(k);
+        prm.enter_subsection(name);
+        prm.declare_entry("name", name, Anything(), "Name used in messages.");
+        prm.declare_entry("duration", "1", Double(0), "Simulated duration of the stage [s] (it may end earlier by convergence).");
+        prm.enter_subsection("gravity");
+        prm.declare_entry("acceleration", "", Anything(), "Gravity of the stage; empty = the top-level gravity.");
+        prm.leave_subsection();
+        prm.enter_subsection("boundary conditions");
+        for (const char *e : {"fixed", "roller", "friction"})
+          prm.declare_entry(e, "inherit", Anything(),
+                            std::string("Boundary ids of the stage, 'none', or 'inherit' (top-level ") + e + ").");
+        prm.declare_entry("friction coefficient", "-1", Double(-1), "-1: the top-level value.");
+        prm.declare_entry("adhesion", "-1", Double(-1), "-1: the top-level value.");
+        prm.leave_subsection();
+        declare_loads(prm, prm_file, name + "/loads", dim);
+        declare_switches(prm, true);
+        prm.leave_subsection();
+      }
+  }
+
+  template <int dim>
+  Settings<dim>
+  parse_parameters(dealii::ParameterHandler &               prm,
+                   const double                             end_time,
+                   const dealii::Tensor<1, dim> &           gravity,
+                   const std::vector<BoundaryCondition> &   boundary_conditions,
+                   const std::vector<BodyDescription<dim>> &bodies)
+  {
+    Settings<dim> s;
+    Stage<dim>    top;
+    top.name                = "main";
+    top.duration            = end_time;
+    top.gravity             = gravity;
+    top.boundary_conditions = boundary_conditions;
+    prm.enter_subsection("boundary conditions");
+    top.friction_ids         = ids(prm.get("friction"), "boundary conditions/friction", dim);
+    top.friction_coefficient = prm.get_double("friction coefficient");
+    top.adhesion             = prm.get_double("adhesion");
+    for (const auto id : top.friction_ids)
+      for (const auto &bc : boundary_conditions)
+        require(bc.id != id, "boundary conditions/friction",
+                "boundary " + std::to_string(id) + " is also fixed/roller; give each boundary one condition");
+    prm.leave_subsection();
+    parse_loads<dim>(prm, "", bodies, top.tractions, top.velocities);
+    top.n_global_tractions  = top.tractions.size();
+    top.n_global_velocities = top.velocities.size();
+    parse_switches<dim>(prm, "", top, nullptr);
+
+    // K0 per body
+    for (unsigned int k = 0; k < bodies.size(); ++k)
+      {
+        const std::string where = "body " + std::to_string(k) + "/initial stress";
+        prm.enter_subsection("body " + std::to_string(k));
+        prm.enter_subsection("initial stress");
+        K0Stress  z;
+        z.enabled = prm.get_bool("K0 procedure");
+        const std::string k0 = prm.get("K0"), level = prm.get("surface level");
+        z.surcharge          = prm.get_double("surcharge");
+        if (!level.empty())
+          z.surface_level = doubles(level, where + "/surface level").at(0);
+        prm.leave_subsection();
+        prm.leave_subsection();
+        if (z.enabled)
+          {
+            require(gravity.norm() > 0, where, "the K0 procedure needs a non-zero gravity/acceleration");
+            if (k0 == "auto")
+              {
+                const std::string mat = "material " + std::to_string(bodies[k].material_id);
+                prm.enter_subsection(mat);
+                const std::string model = prm.get("model");
+                double            phi   = -1;
+                if (model == "mohr coulomb" || model == "hencky mohr coulomb")
+                  {
+                    prm.enter_subsection(model);
+                    phi = prm.get_double("friction angle");
+                    prm.leave_subsection();
+                  }
+                prm.leave_subsection();
+                require(phi >= 0, where + "/K0",
+                        "'auto' (1 - sin phi) needs a Mohr-Coulomb material; " + mat + " is '" + model +
+                          "': give K0 as a number");
+                z.K0 = 1.0 - std::sin(phi * M_PI / 180.0);
+              }
+            else
+              z.K0 = doubles(k0, where + "/K0").at(0);
+            require(z.K0 >= 0, where + "/K0", "must be >= 0");
+          }
+        s.k0.push_back(z);
+      }
+
+    const unsigned int n_stages = prm.get_integer("number of stages");
+    s.staged                    = n_stages > 0;
+    if (!s.staged)
+      s.stages.push_back(top);
+    for (unsigned int k = 0; k < n_stages; ++k)
+      {
+        const std::string where = "stage " + std::to_string(k);
+        prm.enter_subsection(where);
+        Stage<dim> st;
+        st.name     = prm.get("name");
+        st.duration = prm.get_double("duration");
+        require(st.duration > 0, where + "/duration", "must be > 0");
+        prm.enter_subsection("gravity");
+        const std::string g = prm.get("acceleration");
+        st.gravity          = g.empty() ? top.gravity : dealii::Tensor<1, dim>(point<dim>(g, where + "/gravity/acceleration"));
+        prm.leave_subsection();
+        prm.enter_subsection("boundary conditions");
+        const auto list = [&](const char *e, const std::vector<dealii::types::boundary_id> &inherited) {
+          const std::string v = prm.get(e);
+          return v == "inherit" ? inherited : ids(v, where + "/boundary conditions/" + e, dim);
+        };
+        std::vector<dealii::types::boundary_id> top_fixed, top_roller;
+        for (const auto &bc : top.boundary_conditions)
+          (bc.kind == BoundaryCondition::Kind::fixed ? top_fixed : top_roller).push_back(bc.id);
+        for (const auto id : list("fixed", top_fixed))
+          st.boundary_conditions.push_back({id, BoundaryCondition::Kind::fixed});
+        for (const auto id : list("roller", top_roller))
+          st.boundary_conditions.push_back({id, BoundaryCondition::Kind::roller});
+        st.friction_ids         = list("friction", top.friction_ids);
+        const double mu         = prm.get_double("friction coefficient");
+        const double ad         = prm.get_double("adhesion");
+        st.friction_coefficient = mu < 0 ? top.friction_coefficient : mu;
+        st.adhesion             = ad < 0 ? top.adhesion : ad;
+        for (const auto id : st.friction_ids)
+          for (const auto &bc : st.boundary_conditions)
+            require(bc.id != id, where + "/boundary conditions/friction",
+                    "boundary " + std::to_string(id) + " is also fixed/roller in this stage");
+        prm.leave_subsection();
+        st.tractions           = top.tractions;
+        st.velocities          = top.velocities;
+        st.n_global_tractions  = top.tractions.size();
+        st.n_global_velocities = top.velocities.size();
+        parse_loads<dim>(prm, where, bodies, st.tractions, st.velocities);
+        parse_switches<dim>(prm, where, st, &top);
+        prm.leave_subsection();
+        s.stages.push_back(st);
+      }
+    for (const auto &st : s.stages)
+      s.max_tractions = std::max<unsigned int>(s.max_tractions, st.tractions.size());
+    return s;
+  }
+
+  template struct Settings<2>;
+  template struct Settings<3>;
+  template Settings<2> parse_parameters<2>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 2> &,
+                                           const std::vector<BoundaryCondition> &,
+                                           const std::vector<BodyDescription<2>> &);
+  template Settings<3> parse_parameters<3>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 3> &,
+                                           const std::vector<BoundaryCondition> &,
+                                           const std::vector<BodyDescription<3>> &);
+} // namespace talus::loads

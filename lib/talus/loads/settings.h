@@ -1,0 +1,125 @@
+// talus — .prm settings of loads, boundary friction, prescribed velocities,
+// local damping, quasi-static convergence, mass scaling, K0 initial stresses
+// and staged calculations of the explicit solver (seed 000 §4.3.2, §5.2, §6.2,
+// §6.3-§6.5). Pure data plus declaration/parsing; the run-time logic is in
+// load_control.h.
+#pragma once
+
+#include <talus/grid/background_grid.h>
+#include <talus/loads/time_function.h>
+#include <talus/particles/material_points.h>
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace talus::loads
+{
+  /// A surface traction carried by the boundary material points of a face
+  /// (seed 000 Eqs. 4.28-4.29, 5.1-5.3).
+  template <int dim>
+  struct Traction
+  {
+    enum class Target
+    {
+      body_face, ///< the outermost layer of points of a box body on one face
+      region     ///< the points whose initial position lies in a box region
+    };
+    Target                 target = Target::body_face;
+    unsigned int           body   = 0;
+    unsigned int           axis   = dim - 1; ///< normal axis of the face
+    int                    side   = +1;      ///< +1: upper face, -1: lower face
+    dealii::Point<dim>     lower, upper;     ///< region
+    dealii::Tensor<1, dim> traction;         ///< [Pa] (force per area)
+    TimeFunction           function;
+    std::string            where;
+  };
+
+  /// Prescribed velocity on grid nodes (boundary id or region) or on the
+  /// material points of a body, per component.
+  template <int dim>
+  struct PrescribedVelocity
+  {
+    enum class Target
+    {
+      boundary,
+      region,
+      body
+    };
+    Target                     target   = Target::boundary;
+    dealii::types::boundary_id boundary = 0;
+    dealii::Point<dim>         lower, upper;
+    unsigned int               body = 0;
+    bool                       component[dim];
+    dealii::Tensor<1, dim>     velocity;
+    TimeFunction               function;
+    std::string                where;
+  };
+
+  struct Convergence
+  {
+    bool         enabled            = false;
+    double       force_tolerance    = 1e-3; ///< F = |f_ext - f_int| / |f_ext| (Eq. 6.29)
+    double       energy_tolerance   = 1e-5; ///< E = KE / W_ext (Eq. 6.30)
+    unsigned int interval           = 10;   ///< steps between evaluations
+    bool         end_stage          = true;
+  };
+
+  template <int dim>
+  struct Stage
+  {
+    std::string                              name;
+    double                                   duration = 1.0;
+    dealii::Tensor<1, dim>                   gravity;
+    std::vector<BoundaryCondition>           boundary_conditions;
+    std::vector<dealii::types::boundary_id>  friction_ids;
+    double                                   friction_coefficient = 0, adhesion = 0;
+    std::vector<Traction<dim>>               tractions;   ///< stage loads (stage time)
+    std::vector<PrescribedVelocity<dim>>     velocities;
+    double                                   damping      = 0; ///< local damping alpha
+    double                                   mass_scaling = 1; ///< beta
+    Convergence                              convergence;
+    /// number of leading tractions/velocities that are global loads (top-level
+    /// 'loads', evaluated at the absolute time); the rest use the stage time
+    unsigned int n_global_tractions = 0, n_global_velocities = 0;
+  };
+
+  struct K0Stress
+  {
+    bool   enabled       = false;
+    double K0            = 0.5;
+    double surface_level = std::numeric_limits<double>::quiet_NaN(); ///< NaN: top of the body
+    double surcharge     = 0; ///< vertical pressure at the surface [Pa], compression positive
+  };
+
+  template <int dim>
+  struct Settings
+  {
+    bool                    staged = false;
+    std::vector<Stage<dim>> stages; ///< at least one
+    std::vector<K0Stress>   k0;     ///< per body
+    unsigned int            max_tractions = 0; ///< point-force slots needed per material point
+
+    /// Whether the run needs the load controller (false: the solver runs its
+    /// plain single-stage loop and nothing here costs anything).
+    bool active() const;
+  };
+
+  /// Declare the entries (loads, damping, mass scaling, convergence, friction
+  /// in 'boundary conditions', 'initial stress' in every body, stages).
+  void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
+                          unsigned int n_bodies);
+
+  /// Parse after the solver has read its own entries (end time, gravity, the
+  /// fixed/roller boundaries and the bodies, which are passed in).
+  template <int dim>
+  Settings<dim> parse_parameters(dealii::ParameterHandler &               prm,
+                                 const double                             end_time,
+                                 const dealii::Tensor<1, dim> &           gravity,
+                                 const std::vector<BoundaryCondition> &   boundary_conditions,
+                                 const std::vector<BodyDescription<dim>> &bodies);
+} // namespace talus::loads
