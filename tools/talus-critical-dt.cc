@@ -34,7 +34,8 @@ namespace
     for (const auto &m : p.materials)
       {
         const double c = std::sqrt(m->constrained_modulus() / m->density());
-        rows.push_back({m->name, m->model_name(), c, L_min / c});
+        // mass scaling (seed 000 Eq. 6.31): c = sqrt(E_c / (beta rho)), dt_cr x sqrt(beta)
+        rows.push_back({m->name, m->model_name(), c / std::sqrt(s.mass_scaling), std::sqrt(s.mass_scaling) * L_min / c});
       }
     std::size_t ctrl = 0;
     for (std::size_t i = 1; i < rows.size(); ++i)
@@ -46,6 +47,9 @@ namespace
     log() << std::setprecision(6) << "talus-critical-dt: explicit 1-phase solid (seed 000 Eq. 4.120, dt_cr = L_min / c,"
           << " c = sqrt(E_c / rho))\n"
           << "  L_min = " << L_min << " m (smallest cell edge of the grid)\n";
+    if (s.mass_scaling != 1.0)
+      log() << "  mass scaling factor " << s.mass_scaling << " (first stage): wave speeds and critical time steps "
+            << "below are scaled (Eq. 6.31, dt_cr x sqrt(beta))\n";
     for (const auto &r : rows)
       log() << "  " << r.material << " (" << r.model << "): c = " << r.c << " m/s, dt_cr = " << r.dt_cr << " s\n";
     log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s\n"

@@ -38,3 +38,5 @@ set_tests_properties(verification.critical_dt_bar PROPERTIES LABELS "fast" ENVIR
 # loads, damping, convergence, mass scaling, friction, K0, stages (issue 5)
 talus_verification(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
 talus_verification(explicit_block_friction check_block_friction.py verification/block_friction.prm)
+talus_verification(explicit_staged_column check_stages.py verification/staged_column.prm)
+talus_verification(explicit_k0_column check_k0.py verification/k0_column.prm)

@@ -380,7 +380,7 @@ namespace talus::loads
       }
     need_vt = !friction_nodes.empty() || !prescribed_dofs.empty() || current->damping > 0 ||
               dealii::Utilities::MPI::logical_or(!friction_nodes.empty() || !prescribed_dofs.empty(), s.comm);
-    if (need_vt && vt.size() == 0)
+    if ((need_vt || current->convergence.enabled) && vt.size() == 0)
       s.grid.reinit_vector(vt);
     if (have_tractions && trac.size() == 0)
       s.grid.reinit_vector(trac);
@@ -388,19 +388,28 @@ namespace talus::loads
 
   // ---------------------------------------------------------------- step hooks
   template <int dim>
+  bool
+  LoadControl<dim>::check_step(const Solver &s) const
+  {
+    const auto &conv = current->convergence;
+    return conv.enabled && s.step_number > stage_step0 && (s.step_number - stage_step0) % conv.interval == 0;
+  }
+
+  template <int dim>
   void
   LoadControl<dim>::before_nodal_solve(Solver &s, const double step)
   {
     using L                   = PropertyLayout<dim>;
     constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     h                         = step;
-    if (!have_tractions && !need_vt)
+    const bool vt_now         = need_vt || check_step(s);
+    if (!have_tractions && !vt_now)
       return;
     double *const T   = have_tractions ? trac.begin() : nullptr;
-    double *const Pm  = need_vt ? vt.begin() : nullptr;
+    double *const Pm  = vt_now ? vt.begin() : nullptr;
     if (have_tractions)
       s.zero_on_active(trac);
-    if (need_vt)
+    if (vt_now)
       s.zero_on_active(vt);
     // time factors of the tractions at t
     const unsigned int  nt = current->tractions.size();
@@ -440,7 +449,7 @@ namespace talus::loads
                       work += f[d] * P[L::velocity + d] * h;
                   }
               }
-            if (need_vt)
+            if (vt_now)
               {
                 if (!have_N)
                   shape::Q1<dim>::values(pt->get_reference_location(), N);
@@ -456,7 +465,7 @@ namespace talus::loads
         trac.compress(dealii::VectorOperation::add);
         s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
       }
-    if (need_vt)
+    if (vt_now)
       vt.compress(dealii::VectorOperation::add);
   }
 
@@ -474,7 +483,7 @@ namespace talus::loads
       }
     // quasi-static convergence (seed 000 §6.4), on the unbalanced force before damping
     const auto &conv = current->convergence;
-    if (conv.enabled && s.step_number > stage_step0 && (s.step_number - stage_step0) % conv.interval == 0)
+    if (check_step(s))
       {
         const double *T  = have_tractions ? trac.begin() : nullptr;
         double        v[4] = {0, 0, 0, 0};
@@ -485,12 +494,19 @@ namespace talus::loads
               v[0] += F[i] * F[i];
               v[1] += fext * fext;
             }
-        v[2] = s.local_energies.kinetic;
+        // kinetic energy of the grid motion, 1/2 sum p_i^2 / m_i: velocity
+        // fields of the points that project to zero nodal momentum (the MPM
+        // null space) carry energy that no force acts on, and must not block
+        // convergence
+        const double *Pm = vt.begin();
+        for (const unsigned int i : s.active_dofs)
+          if (M[i] > 0)
+            v[2] += 0.5 * Pm[i] * Pm[i] / M[i];
         v[3] = s.local_energies.gravity_potential;
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 4), s.comm, dealii::ArrayView<double>(v, 4));
         const double w_ext = (potential0 - v[3]) + (s.external_work - work_loads) + 0.0;
         force_ratio        = std::sqrt(v[0]) / std::max(std::sqrt(v[1]), 1e-300);
-        const double ke    = current->mass_scaling * v[2]; // kinetic energy of the scaled inertia
+        const double ke    = current->mass_scaling * v[2]; // of the scaled inertia
         energy_ratio       = w_ext > 0 ? ke / w_ext : (ke > 0 ? std::numeric_limits<double>::infinity() : 0.0);
         const double t_stage = s.time - stage_t0;
         if (conv.end_stage && t_stage >= settle_time - 1e-9 * s.dt && force_ratio < conv.force_tolerance &&

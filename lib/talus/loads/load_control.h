@@ -109,5 +109,7 @@ namespace talus::loads
     void assign_tractions(Solver &s);
     void build_node_lists(Solver &s);
     void set_time_step(Solver &s);
+    /// the convergence ratios are evaluated in this step
+    bool check_step(const Solver &s) const;
   };
 } // namespace talus::loads
