@@ -74,6 +74,13 @@ fs = [f for f, t in zip(s["free_surface_points"], T) if t >= 1.9]
 tv.check(s["free_surface_points"][0] == 0 and min(fs) > 0,
          f"free-surface points: none on the grid-aligned initial column, {int(min(fs))} to {int(max(fs))} "
          f"(of 1600) in every row with T >= 1.9")
+# cavitation threshold 0 (no tension): no point below it, and the liquid does
+# stretch (points held at the threshold) in the thin front
+f = tv.read_csv(f"{work}/out/particles_final.csv")
+pres = [-(a + b + c) / 3 for a, b, c in zip(f["stress_xx"], f["stress_yy"], f["stress_zz"])]
+n_cav = sum(1 for x in pres if x == 0.0)
+tv.check(min(pres) >= 0.0 and n_cav > 0,
+         f"cavitation threshold 0 honoured: min pressure {min(pres):.3g} Pa, {n_cav} points held at p = 0")
 vtus = sorted(glob.glob(f"{work}/out/particles_*.0.vtu"))
 tv.check(len(vtus) > 1 and 'Name="free_surface"' in open(vtus[-1], errors="ignore").read(),
          "VTU output carries the free_surface field")

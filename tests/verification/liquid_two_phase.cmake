@@ -14,10 +14,6 @@ endfunction()
 
 talus_liquid_case(liquid_hydrostatic_newtonian fast check_hydrostatic.py
                   verification/hydrostatic_water_1phase.prm liquid newtonian)
-talus_liquid_case(liquid_hydrostatic_bingham verify check_hydrostatic.py
-                  verification/hydrostatic_water_1phase.prm liquid bingham)
-talus_liquid_case(liquid_hydrostatic_frictional_fluid verify check_hydrostatic.py
-                  verification/hydrostatic_water_1phase.prm liquid "frictional fluid")
 talus_liquid_case(liquid_dam_break fast check_dam_break.py verification/dam_break.prm)
 talus_liquid_case(two_phase_hydrostatic fast check_hydrostatic.py verification/hydrostatic_2phase.prm two-phase)
 talus_liquid_case(two_phase_terzaghi_fast fast check_terzaghi.py verification/terzaghi_consolidation.prm fast)
@@ -25,3 +21,5 @@ talus_liquid_case(two_phase_terzaghi verify check_terzaghi.py verification/terza
 talus_liquid_case(two_phase_stability fast check_stability_two_phase.py verification/terzaghi_consolidation.prm)
 talus_liquid_case(undrained_column fast check_undrained.py verification/elastic_column_gravity.prm)
 talus_liquid_case(two_phase_bad_input fast check_bad_input_two_phase.py verification/terzaghi_consolidation.prm)
+talus_liquid_case(two_phase_np1_np2 fast check_two_phase_ranks.py verification/terzaghi_consolidation.prm)
+set_tests_properties(verification.two_phase_np1_np2 PROPERTIES PROCESSORS 2)
