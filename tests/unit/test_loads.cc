@@ -158,8 +158,9 @@ TEST(Loads, TractionForcesSumToTractionTimesArea)
 {
   with_solver("", [](explicit_mpm::Solver<2> &s) {
     using L            = PropertyLayout<2>;
-    const unsigned off = s.layout.point_forces();
-    ASSERT_EQ(s.layout.n_point_force_slots, 1u);
+    ASSERT_TRUE(s.control);
+    ASSERT_EQ(s.control->n_point_force_slots(), 1u);
+    const unsigned off = s.control->point_force_offset();
     double fx = 0, fy = 0;
     unsigned int n = 0;
     for (const auto &pt : s.particles)

@@ -22,6 +22,18 @@ namespace talus::loads
   {}
 
   template <int dim>
+  void
+  LoadControl<dim>::extend_layout(PropertyLayout<dim> &layout)
+  {
+    for (unsigned int j = 0; j < settings.max_tractions; ++j)
+      {
+        const unsigned int o = layout.add_extra("point_force_" + std::to_string(j), dim, true);
+        if (j == 0)
+          force_offset = o;
+      }
+  }
+
+  template <int dim>
   bool
   LoadControl<dim>::has_convergence() const
   {
@@ -142,7 +154,7 @@ namespace talus::loads
         settle_time = std::max(settle_time, current->velocities[j].function.settle_time() - (glob ? stage_t0 : 0.0));
       }
 
-    if (s.layout.n_point_force_slots > 0)
+    if (settings.max_tractions > 0)
       assign_tractions(s);
     build_node_lists(s);
     s.initial_energies = s.energies();
@@ -182,8 +194,8 @@ namespace talus::loads
     // the face area of the box, so the total force is exactly traction x area
     // (seed 000 Eq. 4.29: f_p = tau S_e / n_ebMP).
     using L                   = PropertyLayout<dim>;
-    const unsigned int off    = s.layout.point_forces();
-    const unsigned int nslots = s.layout.n_point_force_slots;
+    const unsigned int off    = force_offset;
+    const unsigned int nslots = settings.max_tractions;
     for (auto &pt : s.particles)
       {
         auto P = pt.get_properties();
@@ -416,7 +428,7 @@ namespace talus::loads
     std::vector<double> factor(nt);
     for (unsigned int j = 0; j < nt; ++j)
       factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
-    const unsigned int off = s.layout.point_forces();
+    const unsigned int off = force_offset;
     double             work = 0;
     auto               pt   = s.particles.begin();
     for (const auto [c, n_in_cell] : s.active_cells)

@@ -45,6 +45,11 @@ namespace talus::loads
 
     unsigned int n_stages() const { return settings.stages.size(); }
     unsigned int n_point_force_slots() const { return settings.max_tractions; }
+    /// Add the traction point-force blocks (dim doubles per traction slot) to
+    /// the property layout; before the ParticleHandler is initialised.
+    void extend_layout(PropertyLayout<dim> &layout);
+    /// Offset of the first point-force block (slot j at + j dim).
+    unsigned int point_force_offset() const { return force_offset; }
     const Stage<dim> &stage(const unsigned int k) const { return settings.stages[k]; }
     bool has_convergence() const;
 
@@ -71,6 +76,7 @@ namespace talus::loads
 
   private:
     const Settings<dim> &settings;
+    unsigned int         force_offset = 0;
     const Stage<dim> *   current = nullptr;
     unsigned int         stage_index = 0;
     double               h = 0; ///< size of the running step

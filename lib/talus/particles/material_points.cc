@@ -25,9 +25,9 @@ namespace talus
       n.emplace_back(dim == 2 ? s2[i] : s3[i]);
     for (unsigned int i = 0; i < n_history; ++i)
       n.emplace_back("history_" + std::to_string(i));
-    for (unsigned int j = 0; j < n_point_force_slots; ++j)
-      for (unsigned int d = 0; d < dim; ++d)
-        n.emplace_back("point_force_" + std::to_string(j));
+    for (const auto &e : extras)
+      for (unsigned int i = 0; i < e.size; ++i)
+        n.emplace_back(e.vector || e.size == 1 ? e.name : e.name + "_" + std::to_string(i));
     return n;
   }
 
@@ -42,8 +42,10 @@ namespace talus
         r[velocity + d]     = component_is_part_of_vector;
         r[displacement + d] = component_is_part_of_vector;
       }
-    for (unsigned int i = 0; i < dim * n_point_force_slots; ++i)
-      r[point_forces() + i] = component_is_part_of_vector;
+    for (const auto &e : extras)
+      if (e.vector)
+        for (unsigned int i = 0; i < e.size; ++i)
+          r[e.offset + i] = component_is_part_of_vector;
     return r;
   }
 

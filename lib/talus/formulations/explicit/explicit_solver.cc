@@ -181,12 +181,15 @@ namespace talus::explicit_mpm
     }
     prm.leave_subsection();
 
+    declare_liquid_output(prm);
+
     prm.declare_entry("number of materials", "1", Integer(1, 64),
                       "Number of 'material k' subsections (k = 0..n-1).");
     for (unsigned int k = 0; k < n_materials; ++k)
       {
         prm.enter_subsection("material " + std::to_string(k));
         materials::declare_material_parameters(prm);
+        declare_pore_liquid(prm);
         prm.leave_subsection();
       }
 
@@ -213,6 +216,7 @@ namespace talus::explicit_mpm
                           "(muparser syntax, e.g. '0.1*sin(pi*x/2); 0'); overrides 'initial velocity'.");
         prm.declare_entry("function constants", "", Anything(),
                           "Constants for the function, 'name=value, name=value'.");
+        declare_body_traction(prm, dim);
         prm.leave_subsection();
       }
   }
@@ -273,12 +277,16 @@ namespace talus::explicit_mpm
       p.probes.push_back(parse_point<dim>(s, "output/probes"));
     prm.leave_subsection();
 
+    parse_liquid_output(prm, p.liquid);
+
     const unsigned int n_materials = prm.get_integer("number of materials");
     for (unsigned int k = 0; k < n_materials; ++k)
       {
         const std::string where = "material " + std::to_string(k);
         prm.enter_subsection(where);
-        p.materials.emplace_back(materials::create_material(prm, where, k));
+        std::shared_ptr<const materials::Material> m = materials::create_material(prm, where, k);
+        p.liquid.pore_liquid.push_back(parse_pore_liquid(prm, where, m));
+        p.materials.push_back(m);
         prm.leave_subsection();
       }
 
@@ -349,6 +357,7 @@ namespace talus::explicit_mpm
               return v;
             };
           }
+        p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
         prm.leave_subsection();
         p.bodies.push_back(b);
       }
@@ -378,13 +387,31 @@ namespace talus::explicit_mpm
   double
   Solver<dim>::critical_time_step() const
   {
-    // seed 000 Eq. 4.120: dt_cr = L_min / c, c = sqrt(E_c / rho); for quads/hexes
-    // L_min is the smallest cell edge.
-    double c_max = 0;
-    for (const auto &m : prm.materials)
-      c_max = std::max(c_max, std::sqrt(m->constrained_modulus() / m->density()));
-    // mass scaling (Eq. 6.31): dt_cr grows by sqrt(beta)
-    return std::sqrt(mass_scaling) * grid.min_cell_size() / c_max;
+    // seed 000 Eq. 4.120 (solids), 4.121 (liquids, with the viscous limit), 4.129
+    // (coupled 2-phase); for quads/hexes L_min is the smallest cell edge.
+    double dt_min = std::numeric_limits<double>::max();
+    for (const auto &c : critical_time_steps())
+      dt_min = std::min(dt_min, c.dt);
+    return dt_min;
+  }
+
+  template <int dim>
+  std::vector<CriticalStep>
+  Solver<dim>::critical_time_steps() const
+  {
+    auto r = explicit_mpm::critical_time_steps(prm.materials, prm.liquid.pore_liquid, grid.min_cell_size());
+    // mass scaling (seed 000 Eq. 6.31, 1-phase solid): c / sqrt(beta), dt_cr x sqrt(beta)
+    if (mass_scaling != 1.0)
+      for (auto &c : r)
+        {
+          const double f = std::sqrt(mass_scaling);
+          c.wave_speed /= f;
+          c.dt *= f;
+          c.dt_wave *= f;
+          c.dt_other *= f;
+          c.dt_4_122 *= f;
+        }
+    return r;
   }
 
   template <int dim>
@@ -405,7 +432,18 @@ namespace talus::explicit_mpm
     if (prm.loads.active())
       {
         control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
-        layout.n_point_force_slots = control->n_point_force_slots();
+        control->extend_layout(layout);
+      }
+    // 2-phase / traction properties and the free-surface flag: only when used
+    if (prm.liquid.any_coupled() || prm.liquid.any_traction())
+      {
+        two_phase = std::make_unique<TwoPhase<dim>>(*this);
+        two_phase->extend_layout(layout);
+      }
+    if (prm.liquid.free_surface_factor > 0)
+      {
+        free_surface = std::make_unique<FreeSurface<dim>>(*this, prm.liquid.free_surface_factor);
+        free_surface->extend_layout(layout);
       }
     particles.initialize(grid.tria, grid.mapping, layout.n_properties());
     relocator = std::make_unique<Relocator<dim>>(grid, particles);
@@ -430,6 +468,8 @@ namespace talus::explicit_mpm
           m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
                                dealii::ArrayView<double>(P.data() + layout.history, m.n_history()));
       }
+    if (two_phase)
+      two_phase->initialize_particles();
 
     const double dt_cr = critical_time_step();
     if (prm.time_step > 0)
@@ -899,6 +939,11 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::step(const double h)
   {
+    if (two_phase)
+      {
+        two_phase->step(h); // separate passes (explicit_two_phase.cc)
+        return;
+      }
     auto t0 = Clock::now();
     if (!p2g_ready)
       p2g_mass_and_force();
@@ -955,6 +1000,8 @@ namespace talus::explicit_mpm
   Energies
   Solver<dim>::energies() const
   {
+    if (two_phase)
+      return two_phase->energies();
     using L = PropertyLayout<dim>;
     Energies e;
     for (const auto &pt : particles)
@@ -1129,6 +1176,8 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::write_vtu(const unsigned int counter)
   {
+    if (free_surface)
+      free_surface->update();
     dealii::Particles::DataOut<dim> out;
     out.build_patches(particles, layout.names(), layout.interpretations());
     dealii::DataOutBase::VtkFlags flags;
@@ -1174,6 +1223,9 @@ namespace talus::explicit_mpm
         for (unsigned int k = 0; k < L::n_stress; ++k)
           r.push_back(P[L::stress + k]);
         r.push_back(P[L::volume]);
+        for (const auto &e : layout.extras)
+          for (unsigned int i = 0; i < e.size; ++i)
+            r.push_back(P[e.offset + i]);
         rows.push_back(r);
       }
     const auto all = dealii::Utilities::MPI::gather(comm, rows, 0);
@@ -1195,6 +1247,9 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < L::n_stress; ++k)
       header.push_back(names[L::stress + k]);
     header.push_back("volume");
+    for (const auto &e : layout.extras)
+      for (unsigned int i = 0; i < e.size; ++i)
+        header.push_back(e.size == 1 ? e.name : e.name + "_" + std::string(ax[i < 3 ? i : 0]));
     io::AtomicFile f(prm.output_directory + "/particles_final.csv");
     for (unsigned int k = 0; k < header.size(); ++k)
       f.stream() << (k ? "," : "") << header[k];
@@ -1237,6 +1292,12 @@ namespace talus::explicit_mpm
         s << ",n_particles,lost_particles";
         if (control && control->has_convergence())
           s << ",force_ratio,energy_ratio";
+        if (free_surface)
+          {
+            s << ",free_surface_points";
+            for (unsigned int d = 0; d < dim; ++d)
+              s << ",extent_" << ax[d] << "_min,extent_" << ax[d] << "_max";
+          }
         for (unsigned int k = 0; k < probe_ids.size(); ++k)
           {
             for (unsigned int d = 0; d < dim; ++d)
@@ -1269,6 +1330,8 @@ namespace talus::explicit_mpm
           e = energies();
           p = total_momentum();
         }
+      if (free_surface)
+        free_surface->update();
       std::vector<double> probes(probe_values.size());
       if (!probe_values.empty())
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
@@ -1283,6 +1346,12 @@ namespace talus::explicit_mpm
       s << "," << n_particles() << "," << relocation_stats.lost;
       if (control && control->has_convergence())
         s << "," << control->force_ratio << "," << control->energy_ratio;
+      if (free_surface)
+        {
+          s << "," << free_surface->count;
+          for (const double x : free_surface->extent)
+            s << "," << x;
+        }
       for (const double v : probes)
         s << "," << v;
       s << "\n";
