@@ -4,6 +4,7 @@
 // scales the critical time step by sqrt(beta).
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/loads/load_control.h>
 #include <talus/loads/time_function.h>
 
 #include <deal.II/base/mpi.h>
