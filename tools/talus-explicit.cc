@@ -13,5 +13,6 @@ main(int argc, char **argv)
                  "Writes particles.pvd (+ VTU/PVTU), series.csv (energies, momentum, probes).";
   tool.declare = &talus::explicit_mpm::declare_parameters;
   tool.run     = &talus::explicit_mpm::run;
+  tool.options = {{"--restart", "resume from the newest valid checkpoint (same as 'checkpoint/restart = true')"}};
   return talus::run_tool(argc, argv, tool);
 }

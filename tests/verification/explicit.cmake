@@ -40,3 +40,8 @@ talus_verification(explicit_oedometer_traction check_oedometer.py verification/o
 talus_verification(explicit_block_friction check_block_friction.py verification/block_friction.prm)
 talus_verification(explicit_staged_column check_stages.py verification/staged_column.prm)
 talus_verification(explicit_k0_column check_k0.py verification/k0_column.prm)
+
+# checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
+# 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
+talus_verification(explicit_checkpoint_restart check_restart.py demo/column_collapse_2d.prm)
+set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESSORS 2)

@@ -140,7 +140,8 @@ namespace talus::loads
     s.mass_scaling = current->mass_scaling;
     s.constrained  = s.grid.constrained_dofs(current->boundary_conditions);
     s.p2g_ready    = false; // gravity may have changed: redo the mass/force P2G
-    set_time_step(s);
+    if (!resume)
+      set_time_step(s); // a restart continues with the checkpointed step
 
     settle_time = 0;
     for (unsigned int j = 0; j < current->tractions.size(); ++j)
@@ -157,8 +158,9 @@ namespace talus::loads
     if (settings.max_tractions > 0)
       assign_tractions(s);
     build_node_lists(s);
-    s.initial_energies = s.energies();
-    potential0         = s.initial_energies.gravity_potential;
+    if (!resume)
+      s.initial_energies = s.energies(); // baseline of the stability check (restored on restart)
+    potential0 = s.energies().gravity_potential;
     work_loads         = s.external_work;
 
     std::ostringstream os;
