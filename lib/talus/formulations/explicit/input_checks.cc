@@ -1,5 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/formulations/explicit/input_checks.h>
 
 #include <algorithm>
@@ -55,10 +56,10 @@ namespace talus::explicit_mpm
     double h = std::numeric_limits<double>::max();
     for (unsigned int d = 0; d < dim; ++d)
       h = std::min(h, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
-    double c_max = 0;
-    for (const auto &m : p.materials)
-      c_max = std::max(c_max, std::sqrt(m->constrained_modulus() / m->density()));
-    return c_max > 0 ? h / c_max : std::numeric_limits<double>::infinity();
+    double dt = std::numeric_limits<double>::infinity();
+    for (const auto &c : critical_time_steps(p.materials, p.liquid.pore_liquid, h))
+      dt = std::min(dt, c.dt);
+    return dt;
   }
 
   template <int dim>
@@ -134,6 +135,12 @@ namespace talus::explicit_mpm
                     "contains no material point: it is thinner than one sub-cell (cell size / particles per "
                     "direction) in direction " +
                       std::to_string(d) + " and holds no seeding position");
+        if (k < p.liquid.tractions.size() && p.liquid.tractions[k].face >= 0)
+          require(b.shape == BodyDescription<dim>::Shape::box,
+                  "body " + std::to_string(k) + "/traction face",
+                  "tractions are supported on box bodies only (this body is a " +
+                    std::string(b.shape == BodyDescription<dim>::Shape::ball ? "ball" : "polygon") +
+                    "; allowed here: none)");
         n_points += overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
       }
     require(n_points <= max_material_points,
@@ -144,10 +151,10 @@ namespace talus::explicit_mpm
     if (p.time_step > 0 && !p.force_time_step)
       {
         const double dt_cr = critical_time_step_of(p);
-        if (p.time_step > dt_cr)
+        if (p.time_step > dt_cr * (1 + 1e-12))
           throw InputError("time/time step: " + fmt(p.time_step) + " s exceeds the critical time step " +
                            fmt(dt_cr) +
-                           " s (seed 000 Eq. 4.120, smallest cell edge / fastest wave speed); lower it, or set "
+                           " s (seed 000 §4.6, smallest cell edge over the fastest wave speed); lower it, or set "
                            "'force time step = true' to run anyway");
       }
   }
