@@ -15,5 +15,6 @@ main(int argc, char **argv)
   tool.declare = &talus::explicit_mpm::declare_parameters;
   tool.check   = &talus::explicit_mpm::check_scene;
   tool.run     = &talus::explicit_mpm::run;
+  tool.options = {{"--restart", "resume from the newest valid checkpoint (same as 'checkpoint/restart = true')"}};
   return talus::run_tool(argc, argv, tool);
 }

@@ -28,6 +28,20 @@ base = tv.prm_set(base, "output/series interval", "0")
 base = tv.prm_set(base, "output/final particles csv", "false")
 
 
+def eq_4_129(k, L=0.025, n=0.3, rS=2650.0, rL=1000.0, KL=2.2e9, Ec=1e7, g=9.81):
+    """Seed 000 Eqs. 4.122-4.132 computed independently (L^2 and L^4 in b and c,
+    see docs/explicit-liquid-two-phase.md)."""
+    rho = (1 - n) * rS + n * rL
+    c1 = ((Ec + KL / n) / rho) ** 0.5
+    rt = rho + (1 / n - 2) * rL
+    dt1, dt2 = L / c1, 2 * rt * k / (rL * g)
+    a = n * rho * g / ((1 - n) * rS * k)
+    b = 4 * (n * rho * KL + (1 - 2 * n) * rL * KL + n * rL * Ec) / (n * (1 - n) * rS * rL * L * L)
+    c = 16 * Ec * KL / ((1 - n) * rS * rL * L ** 4)
+    s = b + (b * b - 4 * c) ** 0.5
+    return (-2 * a + (4 * a * a + 8 * s) ** 0.5) / s, min(dt1, dt2)
+
+
 def formula_dt(text, name):
     os.makedirs(work, exist_ok=True)
     prm = os.path.join(work, name + ".prm")
@@ -39,6 +53,11 @@ def formula_dt(text, name):
     tv.check(p.returncode == 0, f"{name}: talus-critical-dt --probe exit code {p.returncode}")
     r = tv.read_csv(csv)
     tv.check(r["phase"][0] == "coupled" and r["formula"][0] == "Eq. 4.129", f"{name}: coupled phase, Eq. 4.129 reported")
+    k = float(text.split("hydraulic conductivity =")[1].split()[0])
+    ref, ref122 = eq_4_129(k)
+    tv.check(abs(r["dt_critical_formula"][0] - ref) <= 1e-9 * ref and abs(r["dt_eq_4_122"][0] - ref122) <= 1e-9 * ref122,
+             f"{name}: Eq. 4.129 {r['dt_critical_formula'][0]:.9g} s and Eq. 4.122 {r['dt_eq_4_122'][0]:.9g} s equal "
+             f"the independent evaluation ({ref:.9g}, {ref122:.9g} s)")
     return r["dt_critical_formula"][0], r["probe_stable_factor"][0], r["probe_unstable_factor"][0]
 
 

@@ -8,8 +8,9 @@ from the initial position of the point; terms up to i = 200):
   T_v = c_v t / H^2,  c_v = k E_c / (rho_w g).
 Check: the L2 error sqrt(mean((p - p_an)^2)) / q < 3 % at each T_v (the relative
 L2 error ||p - p_an|| / ||p_an|| is reported too).
-Usage: check_terzaghi.py TOOL PRM WORKDIR [fast]
-  fast: a column one cell (0.025 m) wide instead of 0.1 m (1-D anyway).
+Usage: check_terzaghi.py TOOL PRM WORKDIR [fast|3d]
+  fast: a column one cell (0.025 m) wide instead of 0.1 m (1-D anyway);
+  3d:   the same column in 3D, 1 x 1 x 41 hexes, rollers on the four sides and the base.
 """
 import math
 import sys
@@ -17,7 +18,8 @@ import sys
 import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1:4]
-fast = len(sys.argv) > 4 and sys.argv[4] == "fast"
+mode = sys.argv[4] if len(sys.argv) > 4 else ""
+fast = mode == "fast"
 H, q, k, E, rho_w, g = 1.0, 1e4, 1e-3, 1e7, 1000.0, 9.81
 cv = k * E / (rho_w * g)
 
@@ -35,13 +37,22 @@ if fast:
     base = tv.prm_set(base, "grid/upper corner", "0.025, 1.025")
     base = tv.prm_set(base, "grid/cells", "1, 41")
     base = tv.prm_set(base, "body 0/upper corner", "0.025, 1")
+vert = "y"
+if mode == "3d":
+    vert = "z"
+    for k, v in [("dimension", "3"), ("grid/lower corner", "0, 0, 0"), ("grid/upper corner", "0.025, 0.025, 1.025"),
+                 ("grid/cells", "1, 1, 41"), ("boundary conditions/roller", "0, 1, 2, 3, 4"),
+                 ("gravity/acceleration", "0, 0, 0"), ("body 0/lower corner", "0, 0, 0"),
+                 ("body 0/upper corner", "0.025, 0.025, 1"), ("body 0/traction face", "z+"),
+                 ("body 0/traction", "0, 0, -10000")]:
+        base = tv.prm_set(base, k, v)
 for Tv in (0.05, 0.2, 0.5):
     t = Tv * H * H / cv
     text = tv.prm_set(base, "output/directory", f"out_{Tv}")
     text = tv.prm_set(text, "time/end time", f"{t:.10g}")
     tv.run_tool(tool, text, work, f"terzaghi_{Tv}")
     p = tv.read_csv(f"{work}/out_{Tv}/particles_final.csv")
-    z = [H - (y - u) for y, u in zip(p["pos_y"], p["u_y"])]
+    z = [H - (y - u) for y, u in zip(p["pos_" + vert], p["u_" + vert])]
     num = [x / q for x in p["pore_pressure"]]
     ref = [analytic(zz, Tv) for zz in z]
     n = len(num)

@@ -504,24 +504,31 @@ namespace talus::explicit_mpm
     {
       const auto & con   = s.constrained;
       const double alpha = s.prm.liquid.local_damping;
-      // local damping (§6.3): f <- f - alpha |f| sign(v), per phase and component
-      const auto damp = [alpha](const double f, const double v) {
-        return alpha > 0 && v != 0 ? f - alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : f;
+      // local damping, 2-phase form of §6.3.2 (Eqs. 6.24-6.28): water
+      // f_w^damp = -alpha |f_w| sign(v_L) with f_w its unbalanced force (traction,
+      // gravity, internal; no drag); solid f_s^damp = -alpha |f - n f_w| sign(v_S);
+      // the mixture receives f_s^damp + n f_w^damp (the liquid equation here is the
+      // one divided by n, so its forces enter the mixture with the nodal n = Mbar_L / M_L)
+      const auto damping = [alpha](const double f, const double v) {
+        return (alpha > 0 && v != 0) ? -alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : 0.0;
       };
       for (const unsigned int i : s.active_dofs)
         {
-          double       aL = 0;
+          double       aL = 0, n_i = 0, dL = 0;
           const double vS = MS[i] > 0 ? PS[i] / MS[i] : 0.0;
           if (coupled)
             {
               if (mLt_[i] > 0 && !con[i])
                 {
                   const double vL = PL_[i] / mLn_[i];
-                  aL              = damp(FL_[i] - Q_[i] * (vL - vS), vL) / mLt_[i];
+                  n_i             = mLn_[i] / mLt_[i];
+                  dL              = damping(FL_[i], vL);
+                  aL              = (FL_[i] - Q_[i] * (vL - vS) + dL) / mLt_[i];
                 }
               AL_[i] = aL;
             }
-          FS[i] = (MS[i] > 0 && !con[i]) ? damp(FS[i] - (coupled ? mLn_[i] * aL : 0.0), vS) / MS[i] : 0.0;
+          const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS);
+          FS[i] = (MS[i] > 0 && !con[i]) ? (FS[i] - (coupled ? mLn_[i] * aL : 0.0) + dS + n_i * dL) / MS[i] : 0.0;
         }
       FSv.update_ghost_values();
       if (coupled)
