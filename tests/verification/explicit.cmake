@@ -34,3 +34,8 @@ add_test(NAME verification.critical_dt_bar
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_critical_dt.py ${TALUS_TOOLS_DIR}/talus-critical-dt
                  ${TALUS_PRM_DIR}/verification/bar_vibration.prm ${_w}/critical_dt_bar)
 set_tests_properties(verification.critical_dt_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
+# 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
+talus_verification(explicit_checkpoint_restart check_restart.py demo/column_collapse_2d.prm)
+set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESSORS 2)
