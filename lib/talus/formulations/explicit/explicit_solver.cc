@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/input_checks.h>
 #include <talus/io/output.h>
 #include <talus/shape/q1.h>
 
@@ -55,13 +56,13 @@ namespace talus::explicit_mpm
             {
               std::size_t  pos = 0;
               const double v   = std::stod(s, &pos);
-              if (pos != s.size())
+              if (pos != s.size() || !std::isfinite(v))
                 throw std::invalid_argument(s);
               r.push_back(v);
             }
           catch (const std::exception &)
             {
-              throw InputError(where + ": '" + s + "' is not a number (in '" + text + "')");
+              throw InputError(where + ": '" + s + "' is not a finite number (in '" + text + "')");
             }
         }
       return r;
@@ -113,7 +114,7 @@ namespace talus::explicit_mpm
                       "Spatial dimension: 2 (plane strain, per unit thickness) or 3.");
     prm.enter_subsection("time");
     {
-      prm.declare_entry("end time", "1.0", Double(0), "Simulated duration [s].");
+      prm.declare_entry("end time", "1.0", Double(0), "Simulated duration [s], > 0 (must be set).", /*has_to_be_set=*/true);
       prm.declare_entry("courant number", "0.5", Double(0, 1),
                         "Time step as a fraction of the critical time step L_min/c (seed 000 Eq. 4.120), "
                         "used when 'time step' is 0. Range (0, 1].");
@@ -361,8 +362,9 @@ namespace talus::explicit_mpm
             for (const auto &c : dealii::Utilities::split_string_list(prm.get("function constants"), ','))
               {
                 const auto kv = dealii::Utilities::split_string_list(c, '=');
-                require(kv.size() == 2, where + "/function constants", "'" + c + "' is not of the form name=value");
-                constants[kv[0]] = parse_doubles(kv[1], where + "/function constants")[0];
+                const auto v = kv.size() == 2 ? parse_doubles(kv[1], where + "/function constants") : std::vector<double>();
+                require(v.size() == 1, where + "/function constants", "'" + c + "' is not of the form name=value");
+                constants[kv[0]] = v[0];
               }
             auto fp = std::make_shared<dealii::FunctionParser<dim>>(dim);
             try
@@ -388,6 +390,7 @@ namespace talus::explicit_mpm
         prm.leave_subsection();
         p.bodies.push_back(b);
       }
+    check_consistency(p);
     return p;
   }
 
