@@ -34,3 +34,10 @@ add_test(NAME verification.critical_dt_bar
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_critical_dt.py ${TALUS_TOOLS_DIR}/talus-critical-dt
                  ${TALUS_PRM_DIR}/verification/bar_vibration.prm ${_w}/critical_dt_bar)
 set_tests_properties(verification.critical_dt_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# chapter 6 numerics (issue 5): contact (§6.2)
+add_test(NAME verification.explicit_contact
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                 ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact)
+set_tests_properties(verification.explicit_contact PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)

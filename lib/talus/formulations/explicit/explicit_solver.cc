@@ -180,6 +180,8 @@ namespace talus::explicit_mpm
     }
     prm.leave_subsection();
 
+    declare_numerics_parameters(prm);
+
     prm.declare_entry("number of materials", "1", Integer(1, 64),
                       "Number of 'material k' subsections (k = 0..n-1).");
     for (unsigned int k = 0; k < n_materials; ++k)
@@ -350,6 +352,7 @@ namespace talus::explicit_mpm
         prm.leave_subsection();
         p.bodies.push_back(b);
       }
+    p.numerics = parse_numerics_parameters(prm, n_bodies);
     return p;
   }
 
@@ -390,6 +393,10 @@ namespace talus::explicit_mpm
     layout.n_history = n_history;
     particles.initialize(grid.tria, grid.mapping, layout.n_properties());
     relocator = std::make_unique<Relocator<dim>>(grid, particles);
+    if (prm.numerics.contact())
+      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size());
+    if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
+      smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
     std::vector<double> density;
     for (const auto &m : prm.materials)
@@ -646,6 +653,12 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::p2g_mass_and_force()
   {
+    if (prm.numerics.extended_p2g())
+      {
+        p2g_extended(*this); // MPM-MIXED and/or per-body contact fields
+        p2g_ready = true;
+        return;
+      }
     double *const M = nodal_mass.begin();
     double *const F = nodal_a.begin();
     zero_on_active(nodal_mass);
@@ -751,6 +764,7 @@ namespace talus::explicit_mpm
     // relocation, and any deal.II sort falls back to a full P2G pass.
     double *const M = nodal_mass.begin();
     double *const F = nodal_a.begin();
+    const bool    fuse = !prm.numerics.extended_p2g(); // else a full P2G pass follows
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
     // Every non-zero entry of the mass/force vectors belongs to a cell that
@@ -781,10 +795,23 @@ namespace talus::explicit_mpm
             QF::weights(xi, N, w);
             // displacement increment gradient and position increment
             double gu[dim][dim], dx[dim] = {};
-            QF::gradient(D, w, cc.inv_h, gu);
-            for (unsigned int v = 0; v < nv; ++v)
-              for (unsigned int d = 0; d < dim; ++d)
-                dx[d] += N[v] * du[v][d];
+            if (contact) // the body's own nodal velocities (§6.2)
+              {
+                double dub[nv][dim], Db[dim][QF::npairs][dim];
+                contact->body_increments(cc, static_cast<unsigned int>(P[L::body]), h, dub);
+                QF::differences(dub, Db);
+                QF::gradient(Db, w, cc.inv_h, gu);
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    dx[d] += N[v] * dub[v][d];
+              }
+            else
+              {
+                QF::gradient(D, w, cc.inv_h, gu);
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    dx[d] += N[v] * du[v][d];
+              }
             materials::Strain d_eps;
             materials::Spin   d_omega;
             for (unsigned int d = 0; d < dim; ++d)
@@ -794,6 +821,8 @@ namespace talus::explicit_mpm
                     d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
                   d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
                 }
+            if (smoothing) // §6.7.1: smoothed volumetric part
+              smoothing->apply(c, d_eps);
             const unsigned int          mat = static_cast<unsigned int>(P[L::material]);
             const materials::Material &m   = *prm.materials[mat];
             auto                        sigma = L::get_stress(P);
@@ -855,12 +884,14 @@ namespace talus::explicit_mpm
             if (inside)
               {
                 pt->set_reference_location(nxi);
-                acc.add(nxi, P);
+                if (fuse)
+                  acc.add(nxi, P);
               }
             else
               relocator->leaving(pt, c);
           }
-        acc.scatter(cc, g, M, F);
+        if (fuse)
+          acc.scatter(cc, g, M, F);
       }
     local_energies = e;
     local_momentum = momentum;
@@ -877,12 +908,21 @@ namespace talus::explicit_mpm
     timings.p2g += seconds_since(t0);
     t0 = Clock::now();
     nodal_acceleration();
+    if (contact)
+      contact->correct_accelerations(*this, h);
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
-    g2p_velocity_p2g_momentum(h);
+    if (contact)
+      contact->g2p_velocity_p2g_momentum(*this, h);
+    else
+      g2p_velocity_p2g_momentum(h);
     timings.p2g += seconds_since(t0);
     t0 = Clock::now();
     nodal_velocity();
+    if (contact)
+      contact->correct_velocities(*this, h);
+    if (smoothing)
+      smoothing->compute(*this, h);
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
     g2p_update(h);
@@ -900,7 +940,8 @@ namespace talus::explicit_mpm
                       });
     // a deal.II sort recomputes reference locations and may move particles to
     // other ranks: the fused P2G is then redone from scratch
-    p2g_ready = relocation_stats.global_sorts + relocation_stats.storage_sorts == sorts_before;
+    p2g_ready = relocation_stats.global_sorts + relocation_stats.storage_sorts == sorts_before &&
+                !prm.numerics.extended_p2g();
     update_active_cells();
     timings.relocation += seconds_since(t0);
   }

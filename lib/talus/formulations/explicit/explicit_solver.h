@@ -3,6 +3,7 @@
 // update), Jaumann-rate stress update, volume update, relocation.
 #pragma once
 
+#include <talus/formulations/explicit/numerics.h>
 #include <talus/grid/background_grid.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
@@ -45,6 +46,8 @@ namespace talus::explicit_mpm
     // scene
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                        bodies;
+    // MPM-MIXED, strain smoothing, contact (seed 000 chapter 6; numerics.h)
+    NumericsOptions numerics;
   };
 
   /// Declare the complete .prm of talus-explicit. `prm_file` (may be empty)
@@ -134,6 +137,9 @@ namespace talus::explicit_mpm
     /// stability check needs it (set by the time loop).
     bool                                          need_strain_energy = true;
     double                                        energy_scale = 0;
+    /// chapter-6 numerics, null when switched off (numerics.h)
+    std::unique_ptr<Contact<dim>>                 contact;
+    std::unique_ptr<StrainSmoothing<dim>>         smoothing;
 
   private:
     void collect_active_cells();
