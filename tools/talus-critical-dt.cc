@@ -25,29 +25,31 @@ namespace
     s.setup();
     const double L_min = s.grid.min_cell_size();
 
-    struct Row
-    {
-      std::string material, model;
-      double      c, dt_cr;
-    };
-    std::vector<Row> rows;
-    for (const auto &m : p.materials)
-      {
-        const double c = std::sqrt(m->constrained_modulus() / m->density());
-        rows.push_back({m->name, m->model_name(), c, L_min / c});
-      }
+    // per material: phase, formula, wave speed and step (seed 000 §4.6)
+    const auto  rows = s.critical_time_steps();
     std::size_t ctrl = 0;
     for (std::size_t i = 1; i < rows.size(); ++i)
-      if (rows[i].dt_cr < rows[ctrl].dt_cr)
+      if (rows[i].dt < rows[ctrl].dt)
         ctrl = i;
-    const double dt_cr = rows[ctrl].dt_cr;
+    const double dt_cr = rows[ctrl].dt;
     const double dt    = s.time_step();
 
-    log() << std::setprecision(6) << "talus-critical-dt: explicit 1-phase solid (seed 000 Eq. 4.120, dt_cr = L_min / c,"
-          << " c = sqrt(E_c / rho))\n"
+    log() << std::setprecision(6)
+          << "talus-critical-dt: explicit MPM (seed 000 §4.6: 1-phase solid Eq. 4.120, dt_cr = L_min / c, "
+             "c = sqrt(E_c / rho); 1-phase liquid Eq. 4.121 and the viscous limit rho L^2 / (2 mu); "
+             "2-phase coupled Eqs. 4.122 and 4.129)\n"
           << "  L_min = " << L_min << " m (smallest cell edge of the grid)\n";
     for (const auto &r : rows)
-      log() << "  " << r.material << " (" << r.model << "): c = " << r.c << " m/s, dt_cr = " << r.dt_cr << " s\n";
+      {
+        log() << "  " << r.material << " (" << r.model << ", " << r.phase << "): c = " << r.wave_speed
+              << " m/s, dt_cr = " << r.dt << " s (" << r.formula << ")";
+        if (r.phase == "coupled")
+          log() << "; Eq. 4.123 L/c_1 = " << r.dt_wave << " s, Eq. 4.124 = " << r.dt_other
+                << " s, Eq. 4.122 min = " << r.dt_4_122 << " s";
+        else if (r.phase == "liquid" && r.dt_other > 0)
+          log() << "; L/c = " << r.dt_wave << " s, viscous = " << r.dt_other << " s";
+        log() << "\n";
+      }
     log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s\n"
           << "  time step in use: " << dt << " s = " << dt / dt_cr << " x critical\n";
 
@@ -101,11 +103,12 @@ namespace
       {
         io::AtomicFile f(csv);
         f.stream() << std::setprecision(10)
-                   << "material,model,wave_speed,L_min,dt_critical_formula,controlling,dt_in_use,courant_in_use,"
-                      "dt_measured,probe_stable_factor,probe_unstable_factor\n";
+                   << "material,model,phase,formula,wave_speed,L_min,dt_critical_formula,dt_wave,dt_other,dt_eq_4_122,"
+                      "controlling,dt_in_use,courant_in_use,dt_measured,probe_stable_factor,probe_unstable_factor\n";
         for (std::size_t i = 0; i < rows.size(); ++i)
-          f.stream() << rows[i].material << "," << rows[i].model << "," << rows[i].c << "," << L_min << ","
-                     << rows[i].dt_cr << "," << (i == ctrl ? 1 : 0) << "," << dt << "," << dt / dt_cr << ","
+          f.stream() << rows[i].material << "," << rows[i].model << "," << rows[i].phase << ",\"" << rows[i].formula
+                     << "\"," << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << rows[i].dt_wave << ","
+                     << rows[i].dt_other << "," << rows[i].dt_4_122 << "," << (i == ctrl ? 1 : 0) << "," << dt << "," << dt / dt_cr << ","
                      << (probe && i == ctrl ? measured : 0.0) << "," << (probe && i == ctrl ? probe_lo : 0.0) << ","
                      << (probe && i == ctrl ? probe_hi : 0.0) << "\n";
         f.commit();
@@ -119,8 +122,10 @@ main(int argc, char **argv)
 {
   talus::ToolDescription tool;
   tool.name    = "talus-critical-dt";
-  tool.summary = "Critical time step of an explicit scene (the talus-explicit .prm): per material the wave\n"
-                 "speed and L_min/c (seed 000 Eq. 4.120), the controlling material, the time step in use.\n"
+  tool.summary = "Critical time step of an explicit scene (the talus-explicit .prm): per material the phase\n"
+                 "(solid, liquid, undrained, coupled), the wave speed and the formula of seed 000 §4.6\n"
+                 "(Eq. 4.120, 4.121 + viscous limit, 4.122 and 4.129), the controlling material and the\n"
+                 "time step in use.\n"
                  "With --probe, the real limit is measured by bisection on short forced runs whose\n"
                  "instability check (energy growth, non-finite state) decides stable / unstable.";
   tool.declare = &talus::explicit_mpm::declare_parameters;

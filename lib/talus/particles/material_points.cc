@@ -25,6 +25,9 @@ namespace talus
       n.emplace_back(dim == 2 ? s2[i] : s3[i]);
     for (unsigned int i = 0; i < n_history; ++i)
       n.emplace_back("history_" + std::to_string(i));
+    for (const auto &e : extras)
+      for (unsigned int i = 0; i < e.size; ++i)
+        n.emplace_back(e.vector || e.size == 1 ? e.name : e.name + "_" + std::to_string(i));
     return n;
   }
 
@@ -39,6 +42,10 @@ namespace talus
         r[velocity + d]     = component_is_part_of_vector;
         r[displacement + d] = component_is_part_of_vector;
       }
+    for (const auto &e : extras)
+      if (e.vector)
+        for (unsigned int i = 0; i < e.size; ++i)
+          r[e.offset + i] = component_is_part_of_vector;
     return r;
   }
 

@@ -28,6 +28,9 @@ namespace talus
   ///  stress            n_stress  Cauchy stress, tension positive [Pa]:
   ///                              2D xx,yy,zz,xy; 3D xx,yy,zz,xy,yz,xz
   ///  history           n_history constitutive history variables (per model)
+  ///  extras            optional named blocks added by features that need them
+  ///                    (2-phase: porosity, pore pressure, liquid velocity, ...;
+  ///                    liquids: free-surface flag), allocated only when used
   template <int dim>
   struct PropertyLayout
   {
@@ -42,7 +45,25 @@ namespace talus
     static constexpr unsigned int history      = stress + n_stress;
 
     unsigned int n_history = 0;
-    unsigned int n_properties() const { return history + n_history; }
+    unsigned int n_properties() const { return history + n_history + n_extra; }
+
+    /// Optional named block after the history; call after n_history is final
+    /// and before the ParticleHandler is initialised. Returns its offset.
+    /// `vector`: a dim-sized block shown as a vector in the VTU output.
+    unsigned int add_extra(const std::string &name, const unsigned int size, const bool vector = false)
+    {
+      extras.push_back({name, history + n_history + n_extra, size, vector});
+      n_extra += size;
+      return extras.back().offset;
+    }
+    struct Extra
+    {
+      std::string  name;
+      unsigned int offset, size;
+      bool         vector;
+    };
+    std::vector<Extra> extras;
+    unsigned int       n_extra = 0;
 
     /// Names for output (vectors get dim identical names for ParaView).
     std::vector<std::string> names() const;

@@ -181,6 +181,7 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     declare_numerics_parameters(prm);
+    declare_liquid_output(prm);
 
     prm.declare_entry("number of materials", "1", Integer(1, 64),
                       "Number of 'material k' subsections (k = 0..n-1).");
@@ -188,6 +189,7 @@ namespace talus::explicit_mpm
       {
         prm.enter_subsection("material " + std::to_string(k));
         materials::declare_material_parameters(prm);
+        declare_pore_liquid(prm);
         prm.leave_subsection();
       }
 
@@ -213,6 +215,7 @@ namespace talus::explicit_mpm
                           "(muparser syntax, e.g. '0.1*sin(pi*x/2); 0'); overrides 'initial velocity'.");
         prm.declare_entry("function constants", "", Anything(),
                           "Constants for the function, 'name=value, name=value'.");
+        declare_body_traction(prm, dim);
         prm.leave_subsection();
       }
   }
@@ -273,12 +276,16 @@ namespace talus::explicit_mpm
       p.probes.push_back(parse_point<dim>(s, "output/probes"));
     prm.leave_subsection();
 
+    parse_liquid_output(prm, p.liquid);
+
     const unsigned int n_materials = prm.get_integer("number of materials");
     for (unsigned int k = 0; k < n_materials; ++k)
       {
         const std::string where = "material " + std::to_string(k);
         prm.enter_subsection(where);
-        p.materials.emplace_back(materials::create_material(prm, where, k));
+        std::shared_ptr<const materials::Material> m = materials::create_material(prm, where, k);
+        p.liquid.pore_liquid.push_back(parse_pore_liquid(prm, where, m));
+        p.materials.push_back(m);
         prm.leave_subsection();
       }
 
@@ -349,6 +356,7 @@ namespace talus::explicit_mpm
               return v;
             };
           }
+        p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
         prm.leave_subsection();
         p.bodies.push_back(b);
       }
@@ -368,12 +376,19 @@ namespace talus::explicit_mpm
   double
   Solver<dim>::critical_time_step() const
   {
-    // seed 000 Eq. 4.120: dt_cr = L_min / c, c = sqrt(E_c / rho); for quads/hexes
-    // L_min is the smallest cell edge.
-    double c_max = 0;
-    for (const auto &m : prm.materials)
-      c_max = std::max(c_max, std::sqrt(m->constrained_modulus() / m->density()));
-    return grid.min_cell_size() / c_max;
+    // seed 000 Eq. 4.120 (solids), 4.121 (liquids, with the viscous limit), 4.129
+    // (coupled 2-phase); for quads/hexes L_min is the smallest cell edge.
+    double dt_min = std::numeric_limits<double>::max();
+    for (const auto &c : critical_time_steps())
+      dt_min = std::min(dt_min, c.dt);
+    return dt_min;
+  }
+
+  template <int dim>
+  std::vector<CriticalStep>
+  Solver<dim>::critical_time_steps() const
+  {
+    return explicit_mpm::critical_time_steps(prm.materials, prm.liquid.pore_liquid, grid.min_cell_size());
   }
 
   template <int dim>
@@ -391,8 +406,23 @@ namespace talus::explicit_mpm
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
     layout.n_history = n_history;
+    // 2-phase / traction properties and the free-surface flag: only when used
+    if (prm.liquid.any_coupled() || prm.liquid.any_traction())
+      {
+        two_phase = std::make_unique<TwoPhase<dim>>(*this);
+        two_phase->extend_layout(layout);
+      }
+    if (prm.liquid.free_surface_factor > 0)
+      {
+        free_surface = std::make_unique<FreeSurface<dim>>(*this, prm.liquid.free_surface_factor);
+        free_surface->extend_layout(layout);
+      }
     particles.initialize(grid.tria, grid.mapping, layout.n_properties());
     relocator = std::make_unique<Relocator<dim>>(grid, particles);
+    require(!two_phase || (!prm.numerics.extended_p2g() && prm.numerics.smoothing == NumericsOptions::Smoothing::none),
+            "numerics/integration, numerics/strain smoothing, contact/pairs",
+            "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
+            "2-phase materials or tractions); use integration = mpm, strain smoothing = none, no contact pairs");
     if (prm.numerics.contact())
       contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size());
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
@@ -415,6 +445,8 @@ namespace talus::explicit_mpm
           m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
                                dealii::ArrayView<double>(P.data() + layout.history, m.n_history()));
       }
+    if (two_phase)
+      two_phase->initialize_particles();
 
     const double dt_cr = critical_time_step();
     if (prm.time_step > 0)
@@ -902,6 +934,11 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::step(const double h)
   {
+    if (two_phase)
+      {
+        two_phase->step(h); // separate passes (explicit_two_phase.cc)
+        return;
+      }
     auto t0 = Clock::now();
     if (!p2g_ready)
       p2g_mass_and_force();
@@ -964,6 +1001,8 @@ namespace talus::explicit_mpm
   Energies
   Solver<dim>::energies() const
   {
+    if (two_phase)
+      return two_phase->energies();
     using L = PropertyLayout<dim>;
     Energies e;
     for (const auto &pt : particles)
@@ -1138,6 +1177,8 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::write_vtu(const unsigned int counter)
   {
+    if (free_surface)
+      free_surface->update();
     dealii::Particles::DataOut<dim> out;
     out.build_patches(particles, layout.names(), layout.interpretations());
     dealii::DataOutBase::VtkFlags flags;
@@ -1183,6 +1224,9 @@ namespace talus::explicit_mpm
         for (unsigned int k = 0; k < L::n_stress; ++k)
           r.push_back(P[L::stress + k]);
         r.push_back(P[L::volume]);
+        for (const auto &e : layout.extras)
+          for (unsigned int i = 0; i < e.size; ++i)
+            r.push_back(P[e.offset + i]);
         rows.push_back(r);
       }
     const auto all = dealii::Utilities::MPI::gather(comm, rows, 0);
@@ -1204,6 +1248,9 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < L::n_stress; ++k)
       header.push_back(names[L::stress + k]);
     header.push_back("volume");
+    for (const auto &e : layout.extras)
+      for (unsigned int i = 0; i < e.size; ++i)
+        header.push_back(e.size == 1 ? e.name : e.name + "_" + std::string(ax[i < 3 ? i : 0]));
     io::AtomicFile f(prm.output_directory + "/particles_final.csv");
     for (unsigned int k = 0; k < header.size(); ++k)
       f.stream() << (k ? "," : "") << header[k];
@@ -1244,6 +1291,12 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           s << ",momentum_" << ax[d];
         s << ",n_particles,lost_particles";
+        if (free_surface)
+          {
+            s << ",free_surface_points";
+            for (unsigned int d = 0; d < dim; ++d)
+              s << ",extent_" << ax[d] << "_min,extent_" << ax[d] << "_max";
+          }
         for (unsigned int k = 0; k < probe_ids.size(); ++k)
           {
             for (unsigned int d = 0; d < dim; ++d)
@@ -1276,6 +1329,8 @@ namespace talus::explicit_mpm
           e = energies();
           p = total_momentum();
         }
+      if (free_surface)
+        free_surface->update();
       std::vector<double> probes(probe_values.size());
       if (!probe_values.empty())
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
@@ -1288,6 +1343,12 @@ namespace talus::explicit_mpm
       for (unsigned int d = 0; d < dim; ++d)
         s << "," << p[d];
       s << "," << n_particles() << "," << relocation_stats.lost;
+      if (free_surface)
+        {
+          s << "," << free_surface->count;
+          for (const double x : free_surface->extent)
+            s << "," << x;
+        }
       for (const double v : probes)
         s << "," << v;
       s << "\n";

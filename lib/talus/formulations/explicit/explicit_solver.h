@@ -4,6 +4,7 @@
 #pragma once
 
 #include <talus/formulations/explicit/numerics.h>
+#include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/grid/background_grid.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
@@ -48,6 +49,9 @@ namespace talus::explicit_mpm
     std::vector<BodyDescription<dim>>                        bodies;
     // MPM-MIXED, strain smoothing, contact (seed 000 chapter 6; numerics.h)
     NumericsOptions numerics;
+    // pore liquid per material, tractions per body, free-surface detection
+    // (explicit_two_phase.h)
+    LiquidParameters<dim> liquid;
   };
 
   /// Declare the complete .prm of talus-explicit. `prm_file` (may be empty)
@@ -88,8 +92,11 @@ namespace talus::explicit_mpm
     /// (throws InstabilityError), no output. For probes and tests.
     void advance(const unsigned int n_steps);
 
-    /// Critical time step of §4.6.1 over all materials and the smallest cell.
+    /// Critical time step of §4.6 over all materials and the smallest cell
+    /// (the smallest of critical_time_steps()).
     double critical_time_step() const;
+    /// Per material: phase, formula and step (seed 000 §4.6.1-4.6.3).
+    std::vector<CriticalStep> critical_time_steps() const;
     double time_step() const { return dt; }
 
     /// Global sums over particles (collective).
@@ -140,8 +147,14 @@ namespace talus::explicit_mpm
     /// chapter-6 numerics, null when switched off (numerics.h)
     std::unique_ptr<Contact<dim>>                 contact;
     std::unique_ptr<StrainSmoothing<dim>>         smoothing;
+    /// 2-phase / traction step (separate passes; null: the fused 1-phase step)
+    std::unique_ptr<TwoPhase<dim>>                two_phase;
+    /// free-surface detection at output times (null: off)
+    std::unique_ptr<FreeSurface<dim>>             free_surface;
 
   private:
+    friend class TwoPhase<dim>;
+    friend class FreeSurface<dim>;
     void collect_active_cells();
     void update_active_cells();
     void collect_active_dofs();

@@ -1,0 +1,824 @@
+#include <talus/base/errors.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/explicit_two_phase.h>
+#include <talus/shape/q1.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace talus::explicit_mpm
+{
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Selection;
+
+  bool
+  any_of_drainage(const std::vector<PoreLiquid> &v, const Drainage d)
+  {
+    for (const auto &p : v)
+      if (p.drainage == d)
+        return true;
+    return false;
+  }
+
+  template <int dim>
+  bool
+  LiquidParameters<dim>::any_coupled() const
+  {
+    return any_of_drainage(pore_liquid, Drainage::coupled);
+  }
+
+  template <int dim>
+  bool
+  LiquidParameters<dim>::any_traction() const
+  {
+    for (const auto &t : tractions)
+      if (t.face >= 0)
+        return true;
+    return false;
+  }
+
+  // ================================================================ undrained wrapper
+  namespace
+  {
+    /// Undrained effective-stress analysis (seed 000 §4.3.8): the skeleton model
+    /// integrates the effective stress, the excess pore pressure (compression
+    /// positive, history 0) follows the volumetric strain, dp = -(K_L / n) tr(d eps)
+    /// (Eq. 4.52 with the equivalent bulk modulus of the pore liquid K_L / n for
+    /// incompressible grains: the undrained limit v_L = v_S of the storage equation
+    /// 3.23). The stress carried by the point is the total stress sigma' - p I.
+    class UndrainedEffectiveStress : public materials::Material
+    {
+    public:
+      UndrainedEffectiveStress(std::shared_ptr<const materials::Material> s, const double K_L, const double n)
+        : skeleton(std::move(s))
+        , K_eq(K_L / n)
+      {
+        name = skeleton->name;
+        id   = skeleton->id;
+        set_density(skeleton->density());
+      }
+      std::string model_name() const override { return skeleton->model_name() + " (undrained)"; }
+      double constrained_modulus() const override { return skeleton->constrained_modulus() + K_eq; }
+      double dynamic_viscosity() const override { return skeleton->dynamic_viscosity(); }
+      unsigned int n_history() const override { return 1 + skeleton->n_history(); }
+      std::vector<std::string> history_names() const override
+      {
+        std::vector<std::string> n = {"excess pore pressure"};
+        for (const auto &s : skeleton->history_names())
+          n.push_back(s);
+        return n;
+      }
+      void initialize_history(const materials::Stress &sigma, materials::ArrayView<double> h) const override
+      {
+        h[0] = 0.0; // the initial stress is effective, no excess pore pressure
+        skeleton->initialize_history(sigma, materials::ArrayView<double>(h.data() + 1, h.size() - 1));
+      }
+      void update_stress(const materials::Strain &d_eps, const materials::Spin &d_omega, const double dt,
+                         materials::Stress &sigma, materials::ArrayView<double> h) const override
+      {
+        materials::Stress eff = sigma;
+        for (unsigned int i = 0; i < 3; ++i)
+          eff[i][i] += h[0];
+        skeleton->update_stress(d_eps, d_omega, dt, eff,
+                                materials::ArrayView<double>(h.data() + 1, h.size() - 1));
+        h[0] -= K_eq * trace(d_eps);
+        sigma = eff;
+        for (unsigned int i = 0; i < 3; ++i)
+          sigma[i][i] -= h[0];
+      }
+      double elastic_energy_density(const materials::Stress &sigma) const override
+      {
+        // the split into sigma' and p is not known from sigma alone: the skeleton's
+        // energy of the total stress (a diagnostic only)
+        return skeleton->elastic_energy_density(sigma);
+      }
+
+    private:
+      std::shared_ptr<const materials::Material> skeleton;
+      double                                     K_eq;
+    };
+
+    bool
+    is_liquid_model(const materials::Material &m)
+    {
+      const std::string n = m.model_name();
+      return n == "newtonian" || n == "bingham" || n == "frictional fluid";
+    }
+  } // namespace
+
+  // ================================================================ parameters
+  void
+  declare_pore_liquid(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("pore liquid");
+    prm.declare_entry("drainage", "drained", Selection("drained|undrained|coupled"),
+                      "Pore liquid of this material (seed 000 §4.3.8, §4.5): 'drained' (1-phase, no pore "
+                      "pressure; 'density' is the bulk density), 'undrained' (1-phase effective-stress "
+                      "analysis: excess pore pressure dp = -(K_L/n) tr(d eps), total stress = effective - p I; "
+                      "'density' is the saturated bulk density), 'coupled' (2-phase single point, §4.5: "
+                      "'density' is the density of the solid grains rho_S).");
+    prm.declare_entry("porosity", "0.3", Double(0), "Initial porosity n_0, 0 < n_0 < 1 (undrained, coupled).");
+    prm.declare_entry("liquid density", "1000", Double(0), "Density of the pore liquid rho_L [kg/m^3] (coupled).");
+    prm.declare_entry("liquid bulk modulus", "2.2e9", Double(0),
+                      "Bulk modulus of the pore liquid K_L [Pa] (undrained, coupled).");
+    prm.declare_entry("liquid viscosity", "1e-3", Double(0), "Dynamic viscosity of the pore liquid mu_d [Pa s] (coupled).");
+    prm.declare_entry("intrinsic permeability", "1e-10", Double(0),
+                      "Intrinsic permeability kappa [m^2] (coupled); the Darcy permeability is "
+                      "k = kappa rho_L g / mu_d (Eq. 3.25).");
+    prm.declare_entry("hydraulic conductivity", "0", Double(0),
+                      "Alternative to 'intrinsic permeability': the Darcy permeability k [m/s]; when > 0, "
+                      "kappa = k mu_d / (rho_L g).");
+    prm.declare_entry("permeability gravity", "9.81", Double(0),
+                      "g of Eq. 3.25 [m/s^2], independent of the gravity vector (a consolidation test "
+                      "without body force still has k = kappa rho_L g / mu_d).");
+    prm.leave_subsection();
+  }
+
+  PoreLiquid
+  parse_pore_liquid(dealii::ParameterHandler &prm, const std::string &where_m,
+                    std::shared_ptr<const materials::Material> &material)
+  {
+    prm.enter_subsection("pore liquid");
+    const std::string where = where_m + "/pore liquid";
+    PoreLiquid        p;
+    const std::string d = prm.get("drainage");
+    p.drainage = d == "coupled" ? Drainage::coupled : d == "undrained" ? Drainage::undrained : Drainage::drained;
+    p.porosity               = prm.get_double("porosity");
+    p.density                = prm.get_double("liquid density");
+    p.bulk_modulus           = prm.get_double("liquid bulk modulus");
+    p.viscosity              = prm.get_double("liquid viscosity");
+    p.intrinsic_permeability = prm.get_double("intrinsic permeability");
+    p.gravity                = prm.get_double("permeability gravity");
+    const double k           = prm.get_double("hydraulic conductivity");
+    prm.leave_subsection();
+    if (p.drainage == Drainage::drained)
+      return p;
+    require(!is_liquid_model(*material), where + "/drainage",
+            "'" + d + "' needs a soil skeleton model; model '" + material->model_name() +
+              "' is a liquid (allowed for liquids: drained)");
+    require(p.porosity > 0 && p.porosity < 1, where + "/porosity", "must satisfy 0 < n < 1");
+    require(p.bulk_modulus > 0, where + "/liquid bulk modulus", "must be > 0");
+    if (p.drainage == Drainage::undrained)
+      {
+        material = std::make_shared<UndrainedEffectiveStress>(material, p.bulk_modulus, p.porosity);
+        return p;
+      }
+    require(p.density > 0, where + "/liquid density", "must be > 0");
+    require(p.viscosity > 0, where + "/liquid viscosity", "must be > 0");
+    require(p.gravity > 0, where + "/permeability gravity", "must be > 0");
+    if (k > 0)
+      p.intrinsic_permeability = k * p.viscosity / (p.density * p.gravity);
+    require(p.intrinsic_permeability > 0, where + "/intrinsic permeability",
+            "must be > 0 (or give 'hydraulic conductivity' > 0)");
+    return p;
+  }
+
+  void
+  declare_body_traction(dealii::ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.declare_entry("traction face", "none", Selection(dim == 2 ? "none|x-|x+|y-|y+" : "none|x-|x+|y-|y+|z-|z+"),
+                      "Box bodies: face whose outermost layer of material points carries 'traction' "
+                      "(seed 000 §4.3.2: each point carries traction x its share of the face), constant in "
+                      "time. Honoured by the separate (unfused) step used for 2-phase scenes.");
+    prm.declare_entry("traction", dim == 2 ? "0, 0" : "0, 0, 0", dealii::Patterns::Anything(),
+                      "Traction vector [Pa] on 'traction face' (e.g. '0, -10000' presses a top face down).");
+  }
+
+  template <int dim>
+  BodyTraction<dim>
+  parse_body_traction(dealii::ParameterHandler &prm, const std::string &where)
+  {
+    BodyTraction<dim> t;
+    const std::string f = prm.get("traction face");
+    if (f == "none")
+      return t;
+    t.face = 2 * (f[0] - 'x') + (f[1] == '+' ? 1 : 0);
+    const auto v = dealii::Utilities::split_string_list(prm.get("traction"), ',');
+    require(v.size() == dim, where + "/traction", "needs exactly " + std::to_string(dim) + " numbers");
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        try
+          {
+            t.traction[d] = std::stod(v[d]);
+          }
+        catch (const std::exception &)
+          {
+            throw InputError(where + "/traction: '" + v[d] + "' is not a number");
+          }
+      }
+    return t;
+  }
+
+  void
+  declare_liquid_output(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("liquid");
+    prm.declare_entry("free surface factor", "0", Double(0, 1),
+                      "Free-surface detection (seed 000 §6.8, Eq. 6.40): a material point is on the free "
+                      "surface when the density interpolated from the nodal density of the non-empty cells "
+                      "is <= factor x its material density. 0 = off; suggested 0.7 (mesh dependent, < 1). "
+                      "When on: particle field 'free_surface' (1/0) in the VTU output, columns "
+                      "free_surface_points and the particle extent (min/max per axis) in series.csv.");
+    prm.leave_subsection();
+    prm.enter_subsection("two phase");
+    prm.declare_entry("local damping", "0", Double(0, 1),
+                      "Minimal local damping of the separate 2-phase step (seed 000 §6.3): the nodal "
+                      "unbalanced force of each phase is reduced by alpha |f| sign(v), 0 <= alpha < 1. "
+                      "For quasi-static states (hydrostatic columns); 0 = off.");
+    prm.leave_subsection();
+  }
+
+  template <int dim>
+  void
+  parse_liquid_output(dealii::ParameterHandler &prm, LiquidParameters<dim> &p)
+  {
+    prm.enter_subsection("liquid");
+    p.free_surface_factor = prm.get_double("free surface factor");
+    prm.leave_subsection();
+    require(p.free_surface_factor < 1, "liquid/free surface factor", "must be < 1 (0 = off)");
+    prm.enter_subsection("two phase");
+    p.local_damping = prm.get_double("local damping");
+    prm.leave_subsection();
+    require(p.local_damping < 1, "two phase/local damping", "must satisfy 0 <= alpha < 1");
+  }
+
+  // ================================================================ critical time steps
+  std::vector<CriticalStep>
+  critical_time_steps(const std::vector<std::shared_ptr<const materials::Material>> &materials,
+                      const std::vector<PoreLiquid> &pore_liquid, const double L)
+  {
+    std::vector<CriticalStep> r;
+    for (std::size_t k = 0; k < materials.size(); ++k)
+      {
+        const auto &      m  = *materials[k];
+        const PoreLiquid  pl = k < pore_liquid.size() ? pore_liquid[k] : PoreLiquid();
+        CriticalStep      c;
+        c.material = m.name;
+        c.model    = m.model_name();
+        if (pl.drainage == Drainage::coupled)
+          {
+            // seed 000 §4.6.3. rho_S = 'density', E_c of the skeleton.
+            const double n = pl.porosity, rS = m.density(), rL = pl.density, KL = pl.bulk_modulus;
+            const double Ec = m.constrained_modulus(), g = pl.gravity, k_d = pl.darcy_permeability();
+            const double rho = (1 - n) * rS + n * rL;                       // Eq. 4.127
+            const double Ecu = Ec + KL / n;                                 // Eq. 4.126
+            c.wave_speed     = std::sqrt(Ecu / rho);                        // Eq. 4.125
+            c.dt_wave        = L / c.wave_speed;                            // Eq. 4.123 (m = 1)
+            const double rt  = rho + (1.0 / n - 2.0) * rL;                  // Eq. 4.128
+            c.dt_other       = 2 * rt * k_d / (rL * g);                     // Eq. 4.124
+            c.dt_4_122       = std::min(c.dt_wave, c.dt_other);             // Eq. 4.122
+            // Eq. 4.129-4.132. The manual prints L_min in b and c; the dimensions
+            // (b in 1/s^2, c in 1/s^4) and the limit k -> infinity (dt -> 2/omega_max
+            // with omega_max = 2 c / L for E_c -> 0) need L_min^2 and L_min^4.
+            const double a = n * rho * g / ((1 - n) * rS * k_d);
+            const double b = 4 * (n * rho * KL + (1 - 2 * n) * rL * KL + n * rL * Ec) / (n * (1 - n) * rS * rL * L * L);
+            const double cc = 16 * Ec * KL / ((1 - n) * rS * rL * L * L * L * L);
+            const double s  = b + std::sqrt(std::max(0.0, b * b - 4 * cc));
+            c.dt            = (-2 * a + std::sqrt(4 * a * a + 8 * s)) / s;
+            c.phase         = "coupled";
+            c.formula       = "Eq. 4.129";
+          }
+        else
+          {
+            c.wave_speed = std::sqrt(m.constrained_modulus() / m.density());
+            c.dt_wave    = L / c.wave_speed; // Eq. 4.120 / 4.121
+            c.dt         = c.dt_wave;
+            const double mu = m.dynamic_viscosity();
+            if (is_liquid_model(m))
+              {
+                c.phase   = "liquid";
+                c.formula = "Eq. 4.121";
+                if (mu > 0)
+                  {
+                    // explicit viscous stress: diffusion limit rho L^2 / (2 mu)
+                    c.dt_other = m.density() * L * L / (2 * mu);
+                    if (c.dt_other < c.dt)
+                      {
+                        c.dt      = c.dt_other;
+                        c.formula = "viscous limit rho L^2 / (2 mu)";
+                      }
+                  }
+              }
+            else
+              {
+                c.phase   = pl.drainage == Drainage::undrained ? "undrained" : "solid";
+                c.formula = pl.drainage == Drainage::undrained ? "Eq. 4.120 with E_c + K_L/n" : "Eq. 4.120";
+              }
+          }
+        r.push_back(c);
+      }
+    return r;
+  }
+
+  // ================================================================ 2-phase
+  template <int dim>
+  TwoPhase<dim>::TwoPhase(Solver<dim> &solver)
+    : s(solver)
+  {
+    coupled   = s.prm.liquid.any_coupled();
+    tractions = s.prm.liquid.any_traction();
+  }
+
+  template <int dim>
+  void
+  TwoPhase<dim>::extend_layout(PropertyLayout<dim> &layout)
+  {
+    if (coupled)
+      {
+        porosity        = layout.add_extra("porosity", 1);
+        pore_pressure   = layout.add_extra("pore_pressure", 1);
+        liquid_velocity = layout.add_extra("liquid_velocity", dim, true);
+        s.grid.reinit_vector(m_liquid);
+        s.grid.reinit_vector(m_liquid_n);
+        s.grid.reinit_vector(drag);
+        s.grid.reinit_vector(f_liquid);
+        s.grid.reinit_vector(p_liquid);
+        s.grid.reinit_vector(a_liquid);
+      }
+    if (tractions)
+      external_force = layout.add_extra("external_force", dim, true);
+  }
+
+  template <int dim>
+  void
+  TwoPhase<dim>::initialize_particles()
+  {
+    using L          = PropertyLayout<dim>;
+    const auto &pl   = s.prm.liquid.pore_liquid;
+    for (auto &pt : s.particles)
+      {
+        double *           P   = pt.get_properties().data();
+        const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+        if (coupled && pl[mat].drainage == Drainage::coupled)
+          {
+            const double n = pl[mat].porosity;
+            P[porosity]    = n;
+            P[L::mass]     = (1 - n) * s.prm.materials[mat]->density() * P[L::volume]; // solid mass
+            for (unsigned int d = 0; d < dim; ++d)
+              P[liquid_velocity + d] = P[L::velocity + d];
+          }
+        if (tractions)
+          {
+            const unsigned int b = static_cast<unsigned int>(P[L::body]);
+            const auto &       t = s.prm.liquid.tractions[b];
+            if (t.face < 0)
+              continue;
+            const auto &body = s.prm.bodies[b];
+            require(body.shape == BodyDescription<dim>::Shape::box, "body " + std::to_string(b) + "/traction face",
+                    "tractions are supported on box bodies only");
+            const unsigned int axis = t.face / 2;
+            const auto &       cc   = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+            const double       sp   = cc.h[axis] / body.particles_per_direction; // point spacing
+            const double       xf   = (t.face % 2) ? body.upper[axis] : body.lower[axis];
+            if (std::abs(pt.get_location()[axis] - xf) < 0.5 * sp * (1 + 1e-9) + 1e-12)
+              for (unsigned int d = 0; d < dim; ++d)
+                P[external_force + d] = t.traction[d] * P[L::volume] / sp;
+          }
+      }
+  }
+
+  template <int dim>
+  Energies
+  TwoPhase<dim>::energies() const
+  {
+    using L        = PropertyLayout<dim>;
+    const auto &pl = s.prm.liquid.pore_liquid;
+    Energies    e;
+    for (const auto &pt : s.particles)
+      {
+        const auto         P   = pt.get_properties();
+        const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+        const auto &       m   = *s.prm.materials[mat];
+        double             v2 = 0, gx = 0, vl2 = 0, mL = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            v2 += P[L::velocity + d] * P[L::velocity + d];
+            gx += s.prm.gravity[d] * pt.get_location()[d];
+          }
+        e.strain += P[L::volume] * m.elastic_energy_density(L::get_stress(P.data()));
+        if (coupled && pl[mat].drainage == Drainage::coupled)
+          {
+            const double n = P[porosity];
+            mL             = n * pl[mat].density * P[L::volume];
+            for (unsigned int d = 0; d < dim; ++d)
+              vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
+            e.strain += P[L::volume] * n * P[pore_pressure] * P[pore_pressure] / (2 * pl[mat].bulk_modulus);
+          }
+        e.kinetic += 0.5 * P[L::mass] * v2 + 0.5 * mL * vl2;
+        e.gravity_potential -= (P[L::mass] + mL) * gx;
+      }
+    double v[3] = {e.kinetic, e.strain, e.gravity_potential};
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3), s.comm, dealii::ArrayView<double>(v, 3));
+    return {v[0], v[1], v[2], s.external_work};
+  }
+
+  template <int dim>
+  void
+  TwoPhase<dim>::step(const double h)
+  {
+    using L                   = PropertyLayout<dim>;
+    using Q                   = shape::Q1<dim>;
+    constexpr unsigned int nv = Q::n_vertices;
+    const auto &           pl = s.prm.liquid.pore_liquid;
+    const auto             g  = s.prm.gravity;
+    const auto             t0 = std::chrono::steady_clock::now();
+
+    // ---- 1. P2G at time t: masses, drag, forces, momenta of both phases
+    Vector &MSv = s.nodal_mass, &FSv = s.nodal_a, &PSv = s.nodal_p;
+    // local (owned + ghost) indices, as in the cell cache
+    double *const MS = MSv.begin(), *const FS = FSv.begin(), *const PS = PSv.begin();
+    double *const mLt_ = coupled ? m_liquid.begin() : nullptr, *const mLn_ = coupled ? m_liquid_n.begin() : nullptr;
+    double *const Q_ = coupled ? drag.begin() : nullptr, *const FL_ = coupled ? f_liquid.begin() : nullptr;
+    double *const PL_ = coupled ? p_liquid.begin() : nullptr, *const AL_ = coupled ? a_liquid.begin() : nullptr;
+    s.zero_on_active(MSv);
+    s.zero_on_active(FSv);
+    s.zero_on_active(PSv);
+    if (coupled)
+      for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
+        s.zero_on_active(*v);
+    {
+      auto pt = s.particles.begin();
+      for (const auto [c, n_in_cell] : s.active_cells)
+        {
+          const auto &cc = s.grid.cells[c];
+          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+            {
+              const double *     P   = pt->get_properties().data();
+              const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+              double             N[nv], G[nv][dim];
+              Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
+              const double mS = P[L::mass], V = P[L::volume];
+              auto         sig = L::get_stress(P);
+              const bool   cp  = coupled && pl[mat].drainage == Drainage::coupled;
+              double       mL = 0, mLt = 0, q = 0, p = 0;
+              if (cp)
+                {
+                  const double n = P[porosity];
+                  mLt            = pl[mat].density * V;
+                  mL             = n * mLt;
+                  q              = n * pl[mat].viscosity / pl[mat].intrinsic_permeability * V; // n rho_L g / k V
+                  p              = P[pore_pressure];
+                  for (unsigned int i = 0; i < 3; ++i)
+                    sig[i][i] -= p; // total stress (Eq. 4.117)
+                }
+              double fe[dim] = {};
+              if (tractions)
+                for (unsigned int d = 0; d < dim; ++d)
+                  fe[d] = P[external_force + d];
+              for (unsigned int v = 0; v < nv; ++v)
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    const unsigned int i  = cc.dofs[v * dim + d];
+                    double             fi = 0;
+                    for (unsigned int e = 0; e < dim; ++e)
+                      fi -= V * sig[d][e] * G[v][e];
+                    MS[i] += mS * N[v];
+                    FS[i] += fi + (mS + mL) * N[v] * g[d] + N[v] * fe[d];
+                    PS[i] += mS * N[v] * P[L::velocity + d];
+                    if (cp)
+                      {
+                        mLt_[i] += mLt * N[v];
+                        mLn_[i] += mL * N[v];
+                        Q_[i] += q * N[v];
+                        FL_[i] += V * p * G[v][d] + mLt * N[v] * g[d];
+                        PL_[i] += mL * N[v] * P[liquid_velocity + d];
+                      }
+                  }
+            }
+        }
+    }
+    for (Vector *v : {&MSv, &FSv, &PSv})
+      v->compress(dealii::VectorOperation::add);
+    if (coupled)
+      for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
+        v->compress(dealii::VectorOperation::add);
+
+    // ---- 2-3. nodal accelerations: liquid (Eq. 4.106), then solid (4.107)
+    {
+      const auto & con   = s.constrained;
+      const double alpha = s.prm.liquid.local_damping;
+      // local damping, 2-phase form of §6.3.2 (Eqs. 6.24-6.28): water
+      // f_w^damp = -alpha |f_w| sign(v_L) with f_w its unbalanced force (traction,
+      // gravity, internal; no drag); solid f_s^damp = -alpha |f - n f_w| sign(v_S);
+      // the mixture receives f_s^damp + n f_w^damp (the liquid equation here is the
+      // one divided by n, so its forces enter the mixture with the nodal n = Mbar_L / M_L)
+      const auto damping = [alpha](const double f, const double v) {
+        return (alpha > 0 && v != 0) ? -alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : 0.0;
+      };
+      for (const unsigned int i : s.active_dofs)
+        {
+          double       aL = 0, n_i = 0, dL = 0;
+          const double vS = MS[i] > 0 ? PS[i] / MS[i] : 0.0;
+          if (coupled)
+            {
+              if (mLt_[i] > 0 && !con[i])
+                {
+                  const double vL = PL_[i] / mLn_[i];
+                  n_i             = mLn_[i] / mLt_[i];
+                  dL              = damping(FL_[i], vL);
+                  aL              = (FL_[i] - Q_[i] * (vL - vS) + dL) / mLt_[i];
+                }
+              AL_[i] = aL;
+            }
+          const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS);
+          FS[i] = (MS[i] > 0 && !con[i]) ? (FS[i] - (coupled ? mLn_[i] * aL : 0.0) + dS + n_i * dL) / MS[i] : 0.0;
+        }
+      FSv.update_ghost_values();
+      if (coupled)
+        a_liquid.update_ghost_values();
+    }
+
+    // ---- 4-5. point velocities (4.108-4.109), nodal momenta (4.110-4.111)
+    s.zero_on_active(PSv);
+    if (coupled)
+      s.zero_on_active(p_liquid);
+    {
+      auto pt = s.particles.begin();
+      for (const auto [c, n_in_cell] : s.active_cells)
+        {
+          const auto &cc = s.grid.cells[c];
+          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+            {
+              double *           P   = pt->get_properties().data();
+              const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+              const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
+              double             N[nv];
+              Q::values(pt->get_reference_location(), N);
+              const double mL = cp ? P[porosity] * pl[mat].density * P[L::volume] : 0.0;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  double aS = 0, aL = 0;
+                  for (unsigned int v = 0; v < nv; ++v)
+                    {
+                      aS += N[v] * FS[cc.dofs[v * dim + d]];
+                      if (cp)
+                        aL += N[v] * AL_[cc.dofs[v * dim + d]];
+                    }
+                  P[L::velocity + d] += h * aS;
+                  if (cp)
+                    P[liquid_velocity + d] += h * aL;
+                  for (unsigned int v = 0; v < nv; ++v)
+                    {
+                      const unsigned int i = cc.dofs[v * dim + d];
+                      PS[i] += P[L::mass] * N[v] * P[L::velocity + d];
+                      if (cp)
+                        PL_[i] += mL * N[v] * P[liquid_velocity + d];
+                    }
+                }
+            }
+        }
+    }
+    PSv.compress(dealii::VectorOperation::add);
+    if (coupled)
+      p_liquid.compress(dealii::VectorOperation::add);
+    for (const unsigned int i : s.active_dofs)
+      {
+        const bool free = !s.constrained[i];
+        PS[i]           = (MS[i] > 0 && free) ? PS[i] / MS[i] : 0.0;
+        if (coupled)
+          PL_[i] = (mLn_[i] > 0 && free) ? PL_[i] / mLn_[i] : 0.0;
+      }
+    PSv.update_ghost_values();
+    if (coupled)
+      p_liquid.update_ghost_values();
+    s.timings.p2g += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    // ---- 6-11. strains, effective stress, pore pressure, volume, porosity, positions
+    const auto t1 = std::chrono::steady_clock::now();
+    Energies               e;
+    dealii::Tensor<1, dim> momentum;
+    bool                   bad  = false;
+    double                 work = 0; // of the tractions over this step
+    std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
+    {
+      auto pt = s.particles.begin();
+      for (const auto [c, n_in_cell] : s.active_cells)
+        {
+          const auto &cc          = s.grid.cells[c];
+          double      cell_volume = 1.0;
+          for (unsigned int d = 0; d < dim; ++d)
+            cell_volume *= cc.h[d];
+          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+            {
+              double *           P   = pt->get_properties().data();
+              const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+              const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
+              double             N[nv], G[nv][dim];
+              Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
+              double gu[dim][dim] = {}, dx[dim] = {}, div_uL = 0;
+              for (unsigned int v = 0; v < nv; ++v)
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    const unsigned int i  = cc.dofs[v * dim + d];
+                    const double       du = h * PS[i]; // Eq. 4.112
+                    dx[d] += N[v] * du;
+                    for (unsigned int e2 = 0; e2 < dim; ++e2)
+                      gu[d][e2] += du * G[v][e2];
+                    if (cp)
+                      div_uL += h * PL_[i] * G[v][d]; // Eq. 4.113 (volumetric part)
+                  }
+              materials::Strain d_eps;
+              materials::Spin   d_omega;
+              for (unsigned int d = 0; d < dim; ++d)
+                for (unsigned int k2 = 0; k2 < dim; ++k2)
+                  {
+                    if (k2 >= d)
+                      d_eps[d][k2] = 0.5 * (gu[d][k2] + gu[k2][d]);
+                    d_omega[d][k2] = 0.5 * (gu[d][k2] - gu[k2][d]);
+                  }
+              const materials::Material &m     = *s.prm.materials[mat];
+              auto                       sigma = L::get_stress(P);
+              m.update_stress(d_eps, d_omega, h, sigma,
+                              dealii::ArrayView<double>(P + s.layout.history, m.n_history()));
+              L::set_stress(sigma, P);
+              const double dvS = trace(d_eps);
+              double       mL = 0, vl2 = 0;
+              if (cp)
+                {
+                  // storage equation (Eqs. 4.115-4.116), pore pressure compression positive
+                  const double n = P[porosity];
+                  P[pore_pressure] -= pl[mat].bulk_modulus / n * ((1 - n) * dvS + n * div_uL);
+                  // solid mass conservation (1 - n) V = const (Eq. 3.19)
+                  P[porosity] = 1.0 - (1.0 - n) / (1.0 + dvS);
+                  mL          = P[porosity] * pl[mat].density * P[L::volume] * (1.0 + dvS);
+                  for (unsigned int d = 0; d < dim; ++d)
+                    vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
+                  if (s.need_strain_energy)
+                    e.strain += P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
+                                (2 * pl[mat].bulk_modulus);
+                  if (!std::isfinite(P[pore_pressure] + vl2) || !(P[porosity] > 0 && P[porosity] < 1))
+                    bad = true;
+                }
+              P[L::volume] *= (1.0 + dvS); // Eq. 4.118
+              if (P[L::volume] > cell_volume)
+                P[L::volume] = cell_volume;
+
+              if (tractions)
+                for (unsigned int d = 0; d < dim; ++d)
+                  work += P[external_force + d] * dx[d];
+              auto x = pt->get_location();
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  x[d] += dx[d]; // Eq. 4.119
+                  P[L::displacement + d] += dx[d];
+                }
+              const double mS = P[L::mass];
+              double       v2 = 0, gx = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  v2 += P[L::velocity + d] * P[L::velocity + d];
+                  gx += g[d] * x[d];
+                  momentum[d] += mS * P[L::velocity + d] + (cp ? mL * P[liquid_velocity + d] : 0.0);
+                }
+              e.kinetic += 0.5 * mS * v2 + 0.5 * mL * vl2;
+              e.gravity_potential -= (mS + mL) * gx;
+              if (s.need_strain_energy)
+                e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+              if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
+                  !(P[L::volume] > 0))
+                bad = true;
+              for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
+                if (pt->get_id() == s.probe_ids[k2])
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
+                      s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
+                    }
+              bool               inside = true;
+              dealii::Point<dim> nxi;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  nxi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
+                  inside = inside && nxi[d] >= 0.0 && nxi[d] <= 1.0;
+                }
+              pt->set_location(x);
+              if (inside)
+                pt->set_reference_location(nxi);
+              else
+                s.relocator->leaving(pt, c);
+            }
+        }
+    }
+    s.local_energies = e;
+    s.local_momentum = momentum;
+    s.local_bad      = bad;
+    if (tractions)
+      s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+    s.timings.g2p += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+
+    const auto t2 = std::chrono::steady_clock::now();
+    s.relocator->finish(s.relocation_stats);
+    s.p2g_ready = false;
+    s.update_active_cells();
+    s.timings.relocation += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+  }
+
+  // ================================================================ free surface
+  template <int dim>
+  FreeSurface<dim>::FreeSurface(Solver<dim> &solver, const double f)
+    : s(solver)
+    , factor(f)
+  {}
+
+  template <int dim>
+  void
+  FreeSurface<dim>::extend_layout(PropertyLayout<dim> &layout)
+  {
+    flag = layout.add_extra("free_surface", 1);
+    s.grid.reinit_vector(mass);
+    s.grid.reinit_vector(volume);
+  }
+
+  template <int dim>
+  void
+  FreeSurface<dim>::update()
+  {
+    using L                   = PropertyLayout<dim>;
+    using Q                   = shape::Q1<dim>;
+    constexpr unsigned int nv = Q::n_vertices;
+    // nodal density (Eq. 6.38) on the x-component DoFs: mass share over the
+    // volume share of the non-empty cells around the node
+    mass   = 0.0;
+    volume = 0.0;
+    double *const Mn = mass.begin(), *const Vn = volume.begin();
+    {
+      auto pt = s.particles.begin();
+      for (const auto [c, n_in_cell] : s.active_cells)
+        {
+          const auto &cc   = s.grid.cells[c];
+          double      vol = 1.0;
+          for (unsigned int d = 0; d < dim; ++d)
+            vol *= cc.h[d];
+          for (unsigned int v = 0; v < nv; ++v)
+            Vn[cc.dofs[v * dim]] += vol / nv;
+          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+            {
+              double N[nv];
+              Q::values(pt->get_reference_location(), N);
+              const double m = pt->get_properties()[L::mass];
+              for (unsigned int v = 0; v < nv; ++v)
+                Mn[cc.dofs[v * dim]] += m * N[v];
+            }
+        }
+    }
+    mass.compress(dealii::VectorOperation::add);
+    volume.compress(dealii::VectorOperation::add);
+    for (unsigned int i = 0; i < mass.locally_owned_size(); ++i)
+      mass.local_element(i) = volume.local_element(i) > 0 ? mass.local_element(i) / volume.local_element(i) : 0.0;
+    mass.update_ghost_values();
+
+    unsigned long long  n_flagged = 0;
+    std::vector<double> lo(dim, std::numeric_limits<double>::max()), hi(dim, -std::numeric_limits<double>::max());
+    auto                pt = s.particles.begin();
+    for (const auto [c, n_in_cell] : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[c];
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          {
+            double N[nv];
+            Q::values(pt->get_reference_location(), N);
+            double rho = 0;
+            for (unsigned int v = 0; v < nv; ++v)
+              rho += N[v] * Mn[cc.dofs[v * dim]]; // Eq. 6.39
+            double *           P   = pt->get_properties().data();
+            const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+            // reference density: that of the material, or of the solid mass per
+            // volume of a coupled point (its P[mass] is the solid mass)
+            double rho0 = s.prm.materials[mat]->density();
+            if (s.two_phase && s.two_phase->coupled &&
+                s.prm.liquid.pore_liquid[mat].drainage == Drainage::coupled)
+              rho0 *= 1 - s.prm.liquid.pore_liquid[mat].porosity;
+            const bool on = rho <= factor * rho0; // Eq. 6.40
+            P[flag]       = on ? 1.0 : 0.0;
+            n_flagged += on;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                lo[d] = std::min(lo[d], pt->get_location()[d]);
+                hi[d] = std::max(hi[d], pt->get_location()[d]);
+              }
+          }
+      }
+    count = dealii::Utilities::MPI::sum(n_flagged, s.comm);
+    extent.assign(2 * dim, 0.0);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        extent[2 * d]     = dealii::Utilities::MPI::min(lo[d], s.comm);
+        extent[2 * d + 1] = dealii::Utilities::MPI::max(hi[d], s.comm);
+      }
+  }
+
+  template struct LiquidParameters<2>;
+  template struct LiquidParameters<3>;
+  template void parse_liquid_output<2>(dealii::ParameterHandler &, LiquidParameters<2> &);
+  template void parse_liquid_output<3>(dealii::ParameterHandler &, LiquidParameters<3> &);
+  template BodyTraction<2> parse_body_traction<2>(dealii::ParameterHandler &, const std::string &);
+  template BodyTraction<3> parse_body_traction<3>(dealii::ParameterHandler &, const std::string &);
+  template class TwoPhase<2>;
+  template class TwoPhase<3>;
+  template class FreeSurface<2>;
+  template class FreeSurface<3>;
+} // namespace talus::explicit_mpm

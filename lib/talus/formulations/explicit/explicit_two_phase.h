@@ -1,0 +1,150 @@
+// talus — explicit MPM: pore liquid of a material (drained | undrained effective
+// stress | coupled 2-phase, seed 000 §3.4, §4.3.8, §4.5), the 2-phase single-point
+// time step (§4.5.6-4.5.7), tractions carried by boundary material points
+// (minimal, §4.3.2), the critical time steps of every phase (§4.6, Eqs. 4.120-4.129)
+// and the liquid free-surface detection (§6.8).
+//
+// The 1-phase solver (explicit_solver.cc) keeps its fused hot loop; a scene with a
+// coupled material or a traction switches Solver::step() to TwoPhase::step(), a
+// separate set of unfused passes. An undrained material is a 1-phase material (a
+// wrapper adding the pore pressure of Eq. 4.52) and costs the hot loop nothing.
+#pragma once
+
+#include <talus/materials/material.h>
+#include <talus/particles/material_points.h>
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/tensor.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace talus::explicit_mpm
+{
+  template <int dim>
+  class Solver;
+  struct Energies;
+
+  enum class Drainage
+  {
+    drained,   ///< 1-phase, no pore pressure (dry, or drained with zero excess pressure)
+    undrained, ///< 1-phase effective-stress analysis, Eq. 4.52 (pore pressure from the volumetric strain)
+    coupled    ///< 2-phase, single material point (§3.4, §4.5)
+  };
+
+  /// Pore liquid of one material ("material k/pore liquid" in the .prm).
+  struct PoreLiquid
+  {
+    Drainage drainage               = Drainage::drained;
+    double   porosity               = 0.3;    ///< n_0 [-]
+    double   density                = 1000;   ///< rho_L [kg/m^3]
+    double   bulk_modulus           = 2.2e9;  ///< K_L [Pa]
+    double   viscosity              = 1e-3;   ///< mu_d [Pa s]
+    double   intrinsic_permeability = 1e-10;  ///< kappa [m^2]
+    double   gravity                = 9.81;   ///< g of Eq. 3.25 [m/s^2]
+    /// Darcy permeability k = kappa rho_L g / mu_d (Eq. 3.25) [m/s]
+    double darcy_permeability() const { return intrinsic_permeability * density * gravity / viscosity; }
+  };
+
+  /// Traction carried by the boundary material points of a box body
+  /// ("body k/traction face", "body k/traction"): the points of the outermost
+  /// layer at that face carry traction x their share of the face (§4.3.2).
+  template <int dim>
+  struct BodyTraction
+  {
+    int                    face = -1; ///< -1 none; 2 axis + (0 lower, 1 upper)
+    dealii::Tensor<1, dim> traction;  ///< [Pa]
+  };
+
+  template <int dim>
+  struct LiquidParameters
+  {
+    std::vector<PoreLiquid>        pore_liquid; ///< per material
+    std::vector<BodyTraction<dim>> tractions;   ///< per body
+    double                         free_surface_factor = 0; ///< F_FreeSurf of Eq. 6.40; 0: off
+    double                         local_damping       = 0; ///< alpha of §6.3 in the 2-phase step
+    bool                           any_coupled() const;
+    bool                           any_traction() const;
+  };
+
+  /// .prm declarations: inside a "material k" subsection, inside a "body k"
+  /// subsection, and the top-level "liquid" subsection.
+  void declare_pore_liquid(dealii::ParameterHandler &prm);
+  void declare_body_traction(dealii::ParameterHandler &prm, const unsigned int dim);
+  void declare_liquid_output(dealii::ParameterHandler &prm);
+
+  /// Read "pore liquid" of the current material subsection. For undrained
+  /// materials `material` is replaced by the effective-stress wrapper.
+  PoreLiquid parse_pore_liquid(dealii::ParameterHandler &                  prm,
+                               const std::string &                         where,
+                               std::shared_ptr<const materials::Material> &material);
+  template <int dim>
+  BodyTraction<dim> parse_body_traction(dealii::ParameterHandler &prm, const std::string &where);
+  /// "liquid/free surface factor" and "two phase/local damping"
+  template <int dim>
+  void parse_liquid_output(dealii::ParameterHandler &prm, LiquidParameters<dim> &p);
+
+  /// Critical time step of one material (seed 000 §4.6).
+  struct CriticalStep
+  {
+    std::string material, model, phase; ///< phase: solid | liquid | undrained | coupled
+    std::string formula;                ///< the equation used
+    double      wave_speed = 0;         ///< c (c_1 of Eq. 4.125 for coupled) [m/s]
+    double      dt         = 0;         ///< the step used [s]
+    double      dt_wave = 0, dt_other = 0; ///< L/c; viscous (liquids) or Eq. 4.124 (coupled)
+    double      dt_4_122 = 0;           ///< coupled: min(4.123, 4.124)
+  };
+
+  /// Per material, for the smallest cell edge L_min.
+  std::vector<CriticalStep>
+  critical_time_steps(const std::vector<std::shared_ptr<const materials::Material>> &materials,
+                      const std::vector<PoreLiquid> &pore_liquid, const double L_min);
+
+  /// 2-phase single-point formulation: properties, time step, energies.
+  template <int dim>
+  class TwoPhase
+  {
+  public:
+    explicit TwoPhase(Solver<dim> &s);
+    /// porosity, pore pressure, liquid velocity (coupled), external force (tractions)
+    void extend_layout(PropertyLayout<dim> &layout);
+    /// after seeding: solid masses (1-n) rho_S V, porosity, liquid velocity,
+    /// traction forces of the boundary points
+    void initialize_particles();
+    /// One step of §4.5.7. Collective.
+    void step(const double dt);
+    Energies energies() const;
+
+    unsigned int porosity = 0, pore_pressure = 0, liquid_velocity = 0, external_force = 0;
+    bool         coupled = false, tractions = false;
+
+  private:
+    Solver<dim> &s;
+    // lumped nodal quantities: liquid mass without / with porosity, drag,
+    // liquid force and momentum (solid: the solver's nodal_mass, nodal_a, nodal_p)
+    Vector m_liquid, m_liquid_n, drag, f_liquid, p_liquid, a_liquid;
+  };
+
+  /// Liquid free-surface detection (§6.8): nodal density of the non-empty
+  /// cells (Eq. 6.38), interpolated to the points (6.39), flagged when below
+  /// F rho_0 (6.40). Computed only when an output needs it.
+  template <int dim>
+  class FreeSurface
+  {
+  public:
+    FreeSurface(Solver<dim> &s, const double factor);
+    void extend_layout(PropertyLayout<dim> &layout);
+    /// Flags the points (property "free_surface") and sums the count and the
+    /// extent of the particles (collective). Returns {count, extent (min, max per axis)}.
+    void update();
+    unsigned long long  count = 0;
+    std::vector<double> extent; ///< x_min, x_max, y_min, y_max (, z_min, z_max)
+    unsigned int        flag = 0;
+
+  private:
+    Solver<dim> &s;
+    double       factor;
+    Vector       mass, volume;
+  };
+} // namespace talus::explicit_mpm

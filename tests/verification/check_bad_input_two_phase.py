@@ -1,0 +1,32 @@
+"""Bad input of the liquid / 2-phase entries (issue 5): each case must exit with
+code 2 before any output, naming the entry.
+Usage: check_bad_input_two_phase.py TOOL PRM WORKDIR   (PRM: the Terzaghi case)
+"""
+import os
+import sys
+
+import talus_verify as tv
+
+tool, prm_path, work = sys.argv[1:4]
+base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+cases = [
+    ("porosity", [("material 0/pore liquid/porosity", "1.2")], "pore liquid/porosity"),
+    ("zero permeability", [("material 0/pore liquid/hydraulic conductivity", "0"),
+                           ("material 0/pore liquid/intrinsic permeability", "0")], "intrinsic permeability"),
+    ("liquid as skeleton", [("material 0/model", "newtonian")], "pore liquid/drainage"),
+    ("bad drainage", [("material 0/pore liquid/drainage", "partial")], "drainage"),
+    ("traction size", [("body 0/traction", "0, 1, 2")], "body 0/traction"),
+    ("traction on a ball", [("body 0/shape", "ball"), ("body 0/center", "0.05, 0.5"), ("body 0/radius", "0.04")],
+     "traction face"),
+    ("free surface factor", [("liquid/free surface factor", "1")], "free surface factor"),
+    ("damping", [("two phase/local damping", "1")], "local damping"),
+]
+for name, edits, needle in cases:
+    text = base
+    for k, v in edits:
+        text = tv.prm_set(text, k, v)
+    rc, out, err = tv.run_tool(tool, text, os.path.join(work, name.replace(" ", "_")), "case", expect_rc=None)
+    msg = (out + err).strip().splitlines()
+    tv.check(rc == 2 and needle in (out + err) and not os.path.exists(os.path.join(work, name.replace(" ", "_"), "out", "series.csv")),
+             f"{name}: exit {rc}, message names '{needle}': {msg[-1] if msg else ''}")
+tv.finish()

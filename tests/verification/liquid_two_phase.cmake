@@ -1,0 +1,27 @@
+# Verification of the 1-phase liquid and the 2-phase coupled formulation of the
+# explicit solver (issue 5, items 1-3). Label "fast": make test / CI; "verify":
+# the full versions (make verify).
+set(_v ${CMAKE_CURRENT_SOURCE_DIR}/verification)
+set(_w ${CMAKE_BINARY_DIR}/tests/verification)
+set(_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1;PYTHONPATH=${_v}")
+
+function(talus_liquid_case name label script prm)
+  add_test(NAME verification.${name}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/${script} ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/${prm} ${_w}/${name} ${ARGN})
+  set_tests_properties(verification.${name} PROPERTIES LABELS "${label}" ENVIRONMENT "${_env}" TIMEOUT 1800)
+endfunction()
+
+talus_liquid_case(liquid_hydrostatic_newtonian fast check_hydrostatic.py
+                  verification/hydrostatic_water_1phase.prm liquid newtonian)
+talus_liquid_case(liquid_dam_break fast check_dam_break.py verification/dam_break.prm)
+talus_liquid_case(two_phase_hydrostatic fast check_hydrostatic.py verification/hydrostatic_2phase.prm two-phase)
+talus_liquid_case(two_phase_terzaghi_fast fast check_terzaghi.py verification/terzaghi_consolidation.prm fast)
+talus_liquid_case(two_phase_terzaghi verify check_terzaghi.py verification/terzaghi_consolidation.prm)
+talus_liquid_case(two_phase_stability fast check_stability_two_phase.py verification/terzaghi_consolidation.prm)
+talus_liquid_case(undrained_column fast check_undrained.py verification/elastic_column_gravity.prm)
+talus_liquid_case(two_phase_bad_input fast check_bad_input_two_phase.py verification/terzaghi_consolidation.prm)
+talus_liquid_case(two_phase_np1_np2 fast check_two_phase_ranks.py verification/terzaghi_consolidation.prm)
+set_tests_properties(verification.two_phase_np1_np2 PROPERTIES PROCESSORS 2)
+talus_liquid_case(two_phase_terzaghi_3d verify check_terzaghi.py verification/terzaghi_consolidation.prm 3d)
+talus_liquid_case(two_phase_local_damping fast check_local_damping.py verification/elastic_column_gravity.prm)
