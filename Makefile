@@ -1,5 +1,8 @@
 # Thin convenience wrapper around CMake/CTest. See README.md.
 BUILD_DIR ?= build
+# sanitizer build (AddressSanitizer + UndefinedBehaviorSanitizer): its own tree
+SAN_BUILD_DIR ?= build-asan
+SAN_JOBS ?= $(JOBS)
 JOBS      ?= $(shell nproc)
 CMAKE_FLAGS ?=
 # OpenMPI refuses to run as root unless told; CI and containers run as root.
@@ -8,7 +11,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export OMP_NUM_THREADS=1
 
-.PHONY: all deps configure build demo test verify bench clean
+.PHONY: all deps configure build demo test verify sanitize bench clean
 
 all: build
 
@@ -29,11 +32,18 @@ demo: build
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE "verify|bench"
 
-verify: build
+verify: build sanitize
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L "fast|verify"
+
+# Unit tests and short runs of every tool (plus the fast .prm fuzz subset) built
+# with -DTALUS_SANITIZE=ON in $(SAN_BUILD_DIR); any ASan/UBSan report fails.
+sanitize: deps
+	cmake -S . -B $(SAN_BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release -DTALUS_SANITIZE=ON $(CMAKE_FLAGS)
+	cmake --build $(SAN_BUILD_DIR) -j $(SAN_JOBS)
+	cd $(SAN_BUILD_DIR) && ctest --output-on-failure -j $(SAN_JOBS) -L "unit|sanitize"
 
 bench: build
 	bash scripts/bench.sh $(BUILD_DIR)
 
 clean:
-	rm -rf $(BUILD_DIR)
+	rm -rf $(BUILD_DIR) $(SAN_BUILD_DIR)

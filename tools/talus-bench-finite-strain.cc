@@ -1,6 +1,7 @@
 // talus-bench-finite-strain: ns per finite_strain_update() of the finite-strain
 // models (with and without the consistent tangent; elastic and plastic steps).
-// Micro-benchmark, not a test. Usage: talus-bench-finite-strain [n_updates]
+// Micro-benchmark, not a test. Usage: talus-bench-finite-strain [--updates=N]
+#include <talus/base/tool.h>
 #include <talus/materials/hencky_mohr_coulomb.h>
 #include <talus/materials/j2_plasticity.h>
 #include <talus/materials/neo_hookean.h>
@@ -65,12 +66,10 @@ namespace
     const double b = ns_per_update(m, dF, h, true, n);
     std::printf("| %-40s | %10.0f | %10.0f |\n", name, a, b);
   }
-} // namespace
 
-int
-main(int argc, char **argv)
-{
-  const int n = argc > 1 ? std::atoi(argv[1]) : 200000;
+  int
+  bench(const int n)
+  {
   std::printf("| model, step                              | stress [ns] | +tangent [ns] |\n");
   std::printf("|---|---|---|\n");
   NeoHookean nh(1e7, 0.3);
@@ -94,4 +93,23 @@ main(int argc, char **argv)
   row("nor sand, elastic step", ns, diag(1.00001, 1.0, 1.0), hns, n);
   row("nor sand, plastic step (3x3 Newton)", ns, diag(0.999, 1.0005, 1.0005, 3e-4), hns, n);
   return sink == 12345.0;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  talus::ToolDescription tool;
+  tool.name      = "talus-bench-finite-strain";
+  tool.summary   = "Micro-benchmark: ns per finite_strain_update() of the finite-strain models, with and\n"
+                   "without the consistent tangent, elastic and plastic steps. Reads no parameter file.";
+  tool.reads_prm = false;
+  tool.options   = {{"--updates=", "updates per timed row (default 200000, 1..10^9)"}};
+  tool.check     = [](dealii::ParameterHandler &, const std::string &) {
+    talus::tool_option_uint("--updates", 200000, 1, 1000000000);
+  };
+  tool.run = [](dealii::ParameterHandler &, const std::string &) {
+    return bench(static_cast<int>(talus::tool_option_uint("--updates", 200000, 1, 1000000000)));
+  };
+  return talus::run_tool(argc, argv, tool);
 }

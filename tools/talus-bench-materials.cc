@@ -1,7 +1,7 @@
 // talus-bench-materials — micro-benchmark of the constitutive models: ns per
 // stress update for every registered model with its default parameters.
 //
-//   talus-bench-materials [--points N] [--steps S]
+//   talus-bench-materials [--points=N] [--steps=S]   (also "--points N")
 //
 // Each of N material points (own stress and history, initial stress -100 kPa
 // isotropic) follows S strain increments d_eps_k = a (B1 + sin(0.3 k + phase) B2)
@@ -12,6 +12,7 @@
 // with dF = I + a (B1 + sin(...) B2 + spin), without and with the consistent tangent.
 // Prints a Markdown table (docs/materials.md).
 #include <talus/base/errors.h>
+#include <talus/base/tool.h>
 #include <talus/materials/material.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -117,23 +118,11 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+namespace
 {
-  unsigned int N = 1000, S = 200;
-  for (int i = 1; i < argc; ++i)
-    {
-      const std::string a = argv[i];
-      if (a == "--points" && i + 1 < argc)
-        N = std::atoi(argv[++i]);
-      else if (a == "--steps" && i + 1 < argc)
-        S = std::atoi(argv[++i]);
-      else
-        {
-          std::cerr << "usage: talus-bench-materials [--points N] [--steps S]\n";
-          return a == "--help" ? 0 : 2;
-        }
-    }
+  int
+  bench(const unsigned int N, const unsigned int S)
+  {
   std::cout << "| model | small strain, elastic [ns] | small strain, loading [ns] | "
                "finite strain [ns] | finite strain + tangent [ns] |\n"
                "|---|---:|---:|---:|---:|\n";
@@ -171,4 +160,27 @@ main(int argc, char **argv)
   if (sink == 12345.678)
     std::cout << sink;
   return 0;
+}
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  talus::ToolDescription tool;
+  tool.name      = "talus-bench-materials";
+  tool.summary   = "Micro-benchmark of the constitutive models: ns per stress update of every registered model\n"
+                   "with its default parameters (small strain elastic and loading, finite strain with and\n"
+                   "without the consistent tangent). Prints a Markdown table. Reads no parameter file.";
+  tool.reads_prm = false;
+  tool.options   = {{"--points=", "material points per model (default 1000, 1..10^7)"},
+                    {"--steps=", "strain increments per point (default 200, 1..10^7)"}};
+  tool.check     = [](dealii::ParameterHandler &, const std::string &) {
+    talus::tool_option_uint("--points", 1000, 1, 10000000);
+    talus::tool_option_uint("--steps", 200, 1, 10000000);
+  };
+  tool.run = [](dealii::ParameterHandler &, const std::string &) {
+    return bench(talus::tool_option_uint("--points", 1000, 1, 10000000),
+                 talus::tool_option_uint("--steps", 200, 1, 10000000));
+  };
+  return talus::run_tool(argc, argv, tool);
 }

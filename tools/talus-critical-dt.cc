@@ -57,7 +57,7 @@ namespace
     const bool probe = tool_option_given("--probe");
     if (probe)
       {
-        const unsigned int n_steps = std::stoul(tool_option_value("--probe-steps", "400"));
+        const unsigned int n_steps = tool_option_uint("--probe-steps", 400, 1, 1000000);
         // stable(f): n_steps at f x dt_cr without the instability check firing
         const auto stable = [&](const double f) {
           auto q            = p;
@@ -132,6 +132,15 @@ main(int argc, char **argv)
   tool.options = {{"--probe", "measure the limit by bisection on f x dt_cr, f in [0.5, 4]"},
                   {"--probe-steps=", "steps per probe run (default 400)"},
                   {"--csv=", "also write the results to this CSV file"}};
+  tool.check   = [](dealii::ParameterHandler &prm, const std::string &) {
+    if (prm.get_integer("dimension") == 2)
+      talus::explicit_mpm::parse_parameters<2>(prm);
+    else
+      talus::explicit_mpm::parse_parameters<3>(prm);
+    talus::tool_option_uint("--probe-steps", 400, 1, 1000000);
+    if (talus::tool_option_given("--csv"))
+      talus::require_output_file(talus::tool_option_value("--csv", ""), "option --csv");
+  };
   tool.run     = [](dealii::ParameterHandler &prm, const std::string &) {
     return prm.get_integer("dimension") == 2 ? run<2>(prm) : run<3>(prm);
   };

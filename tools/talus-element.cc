@@ -8,6 +8,7 @@
 // Exit status: 0 ok, 1 internal error, 2 bad input, 3 the path could not be
 // followed (non-converged mixed control, non-finite stress).
 #include <talus/base/errors.h>
+#include <talus/base/tool.h>
 #include <talus/materials/material.h>
 #include <talus/materials/single_element.h>
 
@@ -42,10 +43,11 @@ namespace
     prm.declare_entry("path",
                       "drained triaxial compression",
                       dealii::Patterns::Selection(element_path_names()),
-                      "Loading path. Triaxial and oedometer: axial strain along x controlled; "
+                      "Loading path (must be set). Triaxial and oedometer: axial strain along x controlled; "
                       "drained triaxial: lateral stresses held at their initial value (Newton "
                       "loop on the lateral strains); undrained: isochoric; simple shear: "
-                      "grad u = gamma e_x (x) e_y (with its spin).");
+                      "grad u = gamma e_x (x) e_y (with its spin).",
+                      /*has_to_be_set=*/true);
     prm.declare_entry("strain form",
                       "small",
                       dealii::Patterns::Selection("small|finite"),
@@ -112,23 +114,6 @@ namespace
       if (c == ' ' || c == ',' || c == '-')
         c = '_';
     return s;
-  }
-
-  std::string
-  exception_text(const dealii::ExceptionBase &e)
-  {
-    std::ostringstream os;
-    e.print_info(os);
-    std::string s = os.str(), out;
-    std::istringstream is(s);
-    std::string        line;
-    while (std::getline(is, line))
-      {
-        const auto b = line.find_first_not_of(" \t");
-        if (b != std::string::npos)
-          out += (out.empty() ? "" : "\n  ") + line.substr(b);
-      }
-    return out.empty() ? std::string(e.get_exc_name()) : out;
   }
 
   bool
@@ -202,10 +187,22 @@ namespace
     std::filesystem::remove(script + ".log");
   }
 
-  int
-  run(dealii::ParameterHandler &prm)
+  /// Everything the run needs, read and validated from the parsed .prm
+  /// (no file is touched).
+  struct Setup
   {
-    ElementTestSettings set;
+    ElementTestSettings       set;
+    std::string               path_name;
+    std::filesystem::path     csv;
+    bool                      plots = true;
+    std::unique_ptr<Material> m;
+  };
+
+  Setup
+  parse(dealii::ParameterHandler &prm)
+  {
+    Setup u;
+    auto &set = u.set;
     prm.enter_subsection("test");
     set.path                  = element_path_from_name(prm.get("path"));
     set.finite_strain         = prm.get("strain form") == "finite";
@@ -216,18 +213,39 @@ namespace
     set.k0                    = prm.get_double("initial stress ratio");
     set.newton_tolerance      = prm.get_double("newton tolerance");
     set.max_newton_iterations = prm.get_integer("max newton iterations");
-    const std::string path_name = prm.get("path");
+    u.path_name               = prm.get("path");
     prm.leave_subsection();
+    require(set.target_strain > 0, "test/target strain", "must be > 0 (got " + std::to_string(set.target_strain) + ")");
+    require(set.time_increment > 0, "test/time increment",
+            "must be > 0 (got " + std::to_string(set.time_increment) + ")");
+    require(set.k0 > 0, "test/initial stress ratio", "must be > 0 (got " + std::to_string(set.k0) + ")");
+    require(set.newton_tolerance > 0, "test/newton tolerance",
+            "must be > 0 (got " + std::to_string(set.newton_tolerance) + ")");
 
     prm.enter_subsection("output");
-    const std::filesystem::path csv   = prm.get("csv file");
-    const bool                  plots = prm.get_bool("plots");
+    u.csv   = prm.get("csv file");
+    u.plots = prm.get_bool("plots");
     prm.leave_subsection();
-    require(!csv.empty(), "output/csv file", "must not be empty");
+    require_output_file(u.csv.string(), "output/csv file");
 
     prm.enter_subsection("material");
-    const std::unique_ptr<Material> m = create_material(prm, "material", 0);
+    u.m = create_material(prm, "material", 0);
     prm.leave_subsection();
+    require(!set.finite_strain || u.m->has_finite_strain_form(),
+            "test/strain form",
+            "model '" + u.m->model_name() + "' has no finite-strain form (allowed for it: small)");
+    return u;
+  }
+
+  int
+  run(dealii::ParameterHandler &prm)
+  {
+    const Setup u = parse(prm);
+    const auto &set       = u.set;
+    const auto &csv       = u.csv;
+    const auto &plots     = u.plots;
+    const auto &m         = u.m;
+    const auto &path_name = u.path_name;
 
     if (!csv.parent_path().empty())
       std::filesystem::create_directories(csv.parent_path());
@@ -281,89 +299,16 @@ namespace
 int
 main(int argc, char **argv)
 {
-  const std::string name = "talus-element";
-  auto              usage = [&](std::ostream &os) {
-    os << "Usage: " << name << " [--help] [--print-parameters] FILE.prm\n\n"
-       << summary << "\n\n"
-       << "  --help               this text\n"
-       << "  --print-parameters   print a complete, documented default .prm and exit\n"
-       << "Models: ";
-    for (const auto &n : registered_models())
-      os << "'" << n << "' ";
-    os << "\nExit status: 0 ok, 1 internal error, 2 bad input, 3 path could not be followed.\n";
-  };
-  std::string prm_file;
-  bool        print = false;
-  for (int i = 1; i < argc; ++i)
-    {
-      const std::string a = argv[i];
-      if (a == "--help" || a == "-h")
-        {
-          usage(std::cout);
-          return 0;
-        }
-      else if (a == "--print-parameters")
-        print = true;
-      else if (!a.empty() && a[0] == '-')
-        {
-          std::cerr << name << ": error: unknown option '" << a
-                    << "' (allowed: --help, --print-parameters)\n";
-          return 2;
-        }
-      else if (prm_file.empty())
-        prm_file = a;
-      else
-        {
-          std::cerr << name << ": error: more than one parameter file ('" << prm_file << "', '"
-                    << a << "')\n";
-          return 2;
-        }
-    }
-  try
-    {
-      dealii::ParameterHandler prm;
-      declare(prm);
-      if (print)
-        {
-          prm.print_parameters(std::cout, dealii::ParameterHandler::OutputStyle::PRM);
-          return 0;
-        }
-      if (prm_file.empty())
-        {
-          std::cerr << name << ": error: no parameter file given\n\n";
-          usage(std::cerr);
-          return 2;
-        }
-      if (!std::filesystem::is_regular_file(prm_file))
-        throw InputError("parameter file '" + prm_file + "' does not exist or is not a file");
-      try
-        {
-          prm.parse_input(prm_file, "", /*skip_undefined=*/false, /*assert_mandatory=*/true);
-        }
-      catch (const dealii::ExceptionBase &e)
-        {
-          throw InputError("in '" + prm_file + "':\n  " + exception_text(e));
-        }
-      return run(prm);
-    }
-  catch (const InputError &e)
-    {
-      std::cerr << name << ": error: " << e.what() << "\n";
-      return 2;
-    }
-  catch (const InstabilityError &e)
-    {
-      std::cerr << name << ": error: " << e.what() << "\n";
-      return 3;
-    }
-  catch (const dealii::ExceptionBase &e)
-    {
-      std::cerr << name << ": error: " << exception_text(e) << "\n";
-      return 1;
-    }
-  catch (const std::exception &e)
-    {
-      std::cerr << name << ": internal error: " << e.what() << "\n";
-      return 1;
-    }
+  std::string models;
+  for (const auto &n : registered_models())
+    models += (models.empty() ? "'" : ", '") + n + "'";
+  talus::ToolDescription tool;
+  tool.name    = "talus-element";
+  tool.summary = std::string(summary) + "\nModels: " + models +
+                 ".\nExit status 3 here: the path could not be followed (non-converged mixed control, "
+                 "non-finite stress).";
+  tool.declare = [](dealii::ParameterHandler &prm, const std::string &) { declare(prm); };
+  tool.check   = [](dealii::ParameterHandler &prm, const std::string &) { parse(prm); };
+  tool.run     = [](dealii::ParameterHandler &prm, const std::string &) { return run(prm); };
+  return talus::run_tool(argc, argv, tool);
 }

@@ -1,6 +1,7 @@
 // talus-explicit: explicit dynamic MPM (Anura3D-style), driven by a .prm file.
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/input_checks.h>
 
 int
 main(int argc, char **argv)
@@ -12,6 +13,8 @@ main(int argc, char **argv)
                  "axis-aligned quads/hexes, material points seeded in box/ball/polygon bodies.\n"
                  "Writes particles.pvd (+ VTU/PVTU), series.csv (energies, momentum, probes).";
   tool.declare = &talus::explicit_mpm::declare_parameters;
+  tool.check   = &talus::explicit_mpm::check_scene;
   tool.run     = &talus::explicit_mpm::run;
+  tool.options = {{"--restart", "resume from the newest valid checkpoint (same as 'checkpoint/restart = true')"}};
   return talus::run_tool(argc, argv, tool);
 }

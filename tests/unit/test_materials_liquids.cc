@@ -61,6 +61,7 @@ TEST(Newtonian, CavitationThreshold)
 {
   const double K = 2e9, p_cav = -50e3, mu = 1e-3;
   Newtonian    m(K, mu, p_cav);
+  m.incremental_cavitation = false; // the density form (Eqs. 7.30-7.32)
   Stress       s;
   s[0][0] = s[1][1] = s[2][2] = -100e3; // p0 = 100 kPa
   std::vector<double> h(1);
@@ -101,6 +102,30 @@ TEST(Newtonian, CavitationThreshold)
   m.update_stress(g, Spin(), 1e-3, sc, ArrayView<double>(hc.data(), 1));
   EXPECT_DOUBLE_EQ(sc[0][1], 0.0);
   EXPECT_DOUBLE_EQ(-trace(sc) / 3, p_cav);
+}
+
+TEST(Newtonian, CavitationIncrementalRecovery)
+{
+  // seed 000 Eq. 7.33 (the default): the same path as above, but the pressure
+  // rises again at the first compression after cavitation
+  const double K = 2e9, p_cav = -50e3, mu = 1e-3;
+  Newtonian    m(K, mu, p_cav);
+  EXPECT_TRUE(m.incremental_cavitation);
+  Stress s;
+  s[0][0] = s[1][1] = s[2][2] = -100e3;
+  std::vector<double> h(1);
+  m.initialize_history(s, ArrayView<double>(h.data(), 1));
+  Strain d;
+  for (unsigned int i = 0; i < 3; ++i)
+    d[i][i] = 1e-5 / 3; // dp = -20 kPa per step
+  for (int k = 0; k < 12; ++k)
+    m.update_stress(d, Spin(), 1e-3, s, ArrayView<double>(h.data(), 1));
+  EXPECT_DOUBLE_EQ(-trace(s) / 3, p_cav);
+  const Strain dc = -d;
+  m.update_stress(dc, Spin(), 1e-3, s, ArrayView<double>(h.data(), 1));
+  EXPECT_NEAR(-trace(s) / 3, p_cav + 20e3, 1e-6);
+  m.update_stress(dc, Spin(), 1e-3, s, ArrayView<double>(h.data(), 1));
+  EXPECT_NEAR(-trace(s) / 3, p_cav + 40e3, 1e-6);
 }
 
 TEST(Bingham, ShearStressVsShearRate)

@@ -15,8 +15,10 @@ T = 1.19 with a/20 cells, 18 % with a/40: the gap does not close with the grid; 
 experiment is known to lag by the finite gate-removal time), so
   * the front speed dZ/dT between the points T = 0.84 and 2.32 within 10 % of the
     experimental one (independent of the time origin),
-  * |Z_sim - Z_exp| / Z_exp <= 10 % for the points with 1.9 <= T <= 2.5,
-  * |Z_sim - Z_exp| / Z_exp <= 20 % at every point with T <= 2.5.
+  * with the experiment's time origin shifted by the best fit (searched in
+    0 <= dT <= 0.3, i.e. at most 0.3 sqrt(a / (2 g)) = 16 ms for their a = 2.25 in),
+    |Z_sim - Z_exp| / Z_exp <= 10 % at every point with T <= 2.5,
+  * without a shift, |Z_sim - Z_exp| / Z_exp <= 20 % at every point with T <= 2.5.
 Also checked: free-surface points are counted in series.csv and the
 VTU output carries the free_surface field.
 Usage: check_dam_break.py TOOL PRM WORKDIR
@@ -46,26 +48,31 @@ def interp(x, xs, ys):
     return float("nan")
 
 
-worst, worst_late = 0.0, 0.0
-for Te, Ze in MM:
-    Zs = interp(Te, T, Z)
-    err = abs(Zs - Ze) / Ze
-    if not err == err:
-        err = float("inf")
-    worst = max(worst, err)
-    if Te >= 1.9:
-        worst_late = max(worst_late, err)
-    print(f"T = {Te:.2f}: Z = {Zs:.3f} (Martin & Moyce {Ze:.2f}), error {100 * err:.1f} %")
+def errors(shift):
+    out = []
+    for Te, Ze in MM:
+        e = abs(interp(Te - shift, T, Z) - Ze) / Ze
+        out.append(e if e == e else float("inf"))
+    return out
+
+
+worst = max(errors(0.0))
+for (Te, Ze), e in zip(MM, errors(0.0)):
+    print(f"T = {Te:.2f}: Z = {interp(Te, T, Z):.3f} (Martin & Moyce {Ze:.2f}), error {100 * e:.1f} %")
 (T0, Z0), (T1, Z1) = MM[1], MM[-1]
 speed_exp = (Z1 - Z0) / (T1 - T0)
 speed_sim = (interp(T1, T, Z) - interp(T0, T, Z)) / (T1 - T0)
-shifts = [k * 0.005 for k in range(0, 81)]
-best = min(shifts, key=lambda d: sum((interp(Te - d, T, Z) - Ze) ** 2 for Te, Ze in MM))
+shifts = [k * 0.005 for k in range(0, 61)]
+best = min(shifts, key=lambda d: sum(e * e for e in errors(d)))
+worst_shifted = max(errors(best))
+print("with the best-fit shift: " + ", ".join(f"{100 * e:.1f} %" for e in errors(best)))
 print(f"front speed dZ/dT over T = {T0}..{T1}: {speed_sim:.4f} (Martin & Moyce {speed_exp:.4f}); "
       f"time shift of the experiment that fits best: {best:.3f}")
 tv.check(abs(speed_sim - speed_exp) <= 0.10 * speed_exp,
          f"front speed within 10 % of Martin & Moyce (error {100 * abs(speed_sim / speed_exp - 1):.1f} %)")
-tv.check(worst_late <= 0.10, f"front within 10 % of Martin & Moyce for 1.9 <= T <= 2.5 (worst {100 * worst_late:.1f} %)")
+tv.check(worst_shifted <= 0.10,
+         f"front within 10 % of Martin & Moyce for T <= 2.5 with the best-fit time origin dT = {best:.3f} "
+         f"(worst {100 * worst_shifted:.1f} %)")
 tv.check(worst <= 0.20, f"front within 20 % of Martin & Moyce for T <= 2.5 (worst {100 * worst:.1f} %)")
 # Eq. 6.38 divides by the volume of the non-empty cells only, so a surface lying
 # on grid lines (the initial square column) has the full density: detection starts

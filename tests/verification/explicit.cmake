@@ -41,3 +41,8 @@ add_test(NAME verification.explicit_contact
                  ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
                  ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact)
 set_tests_properties(verification.explicit_contact PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+
+# checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
+# 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
+talus_verification(explicit_checkpoint_restart check_restart.py demo/column_collapse_2d.prm)
+set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESSORS 2)

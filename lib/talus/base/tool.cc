@@ -4,7 +4,11 @@
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -40,11 +44,129 @@ namespace talus
       const auto e = s.find_last_not_of(" \t\n\r");
       return s.substr(b, e - b + 1);
     }
+
+    /// deal.II's message for entries declared with has_to_be_set shows their
+    /// mangled paths ("time.end_20time"); turn it into "'time/end time'".
+    std::string
+    readable_mandatory_message(const std::string &text)
+    {
+      const std::string a = "The following parameters ", b = " have not been set";
+      const auto        i = text.find(a), j = text.find(b);
+      if (text.find("has_to_be_set") == std::string::npos || i == std::string::npos || j == std::string::npos ||
+          j < i)
+        return text;
+      std::istringstream is(text.substr(i + a.size(), j - i - a.size()));
+      std::string        token, list;
+      while (is >> token)
+        {
+          while (!token.empty() && token.back() == ',')
+            token.pop_back();
+          std::string out;
+          for (std::size_t k = 0; k < token.size(); ++k)
+            if (token[k] == '_' && k + 2 < token.size() + 0 && std::isxdigit(token[k + 1]) &&
+                std::isxdigit(token[k + 2]))
+              {
+                out += static_cast<char>(std::stoi(token.substr(k + 1, 2), nullptr, 16));
+                k += 2;
+              }
+            else
+              out += token[k] == '.' ? '/' : token[k];
+          list += (list.empty() ? "'" : ", '") + out + "'";
+        }
+      return "entry " + list + " must be set (no usable default); see --print-parameters";
+    }
   } // namespace
 
   namespace
   {
     std::vector<std::string> given_options;
+    bool                     check_flag = false;
+  } // namespace
+
+  bool
+  check_only()
+  {
+    return check_flag;
+  }
+
+  unsigned long
+  tool_option_uint(const std::string &name, const unsigned long fallback, const unsigned long min,
+                   const unsigned long max)
+  {
+    if (!tool_option_given(name))
+      return fallback;
+    const std::string v       = tool_option_value(name, "");
+    const std::string allowed = "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+    const bool digits = !v.empty() && v.size() < 19 && std::all_of(v.begin(), v.end(), [](const char c) {
+      return c >= '0' && c <= '9';
+    });
+    if (!digits)
+      throw InputError("option " + name + ": '" + v + "' is not " + allowed);
+    const unsigned long n = std::stoul(v);
+    if (n < min || n > max)
+      throw InputError("option " + name + ": " + v + " is out of range (allowed: " + allowed + ")");
+    return n;
+  }
+
+  void
+  require_finite(const double x, const std::string &where)
+  {
+    if (!std::isfinite(x))
+      throw InputError(where + ": the value must be a finite number (got " + std::to_string(x) + ")");
+  }
+
+  void
+  require_input_file(const std::string &path, const std::string &where)
+  {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (path.empty())
+      throw InputError(where + ": no file given (the entry is empty)");
+    if (!fs::exists(path, ec))
+      throw InputError(where + ": file '" + path + "' does not exist");
+    if (!fs::is_regular_file(path, ec))
+      throw InputError(where + ": '" + path + "' is not a regular file");
+    if (::access(path.c_str(), R_OK) != 0)
+      throw InputError(where + ": file '" + path + "' is not readable");
+  }
+
+  void
+  require_output_directory(const std::string &dir, const std::string &where)
+  {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (dir.empty())
+      throw InputError(where + ": must not be empty");
+    fs::path p = fs::absolute(fs::path(dir), ec);
+    if (ec)
+      throw InputError(where + ": '" + dir + "' is not a valid path");
+    // the nearest existing ancestor (or the directory itself) must be a
+    // writable directory; nothing is created here
+    while (!fs::exists(p, ec))
+      {
+        if (!p.has_parent_path() || p.parent_path() == p)
+          throw InputError(where + ": '" + dir + "' cannot be created (no existing parent directory)");
+        p = p.parent_path();
+      }
+    if (!fs::is_directory(p, ec))
+      throw InputError(where + ": '" + dir + "' cannot be used: '" + p.string() +
+                       "' exists and is not a directory");
+    if (::access(p.c_str(), W_OK | X_OK) != 0)
+      throw InputError(where + ": '" + dir + "' cannot be written: directory '" + p.string() +
+                       "' is not writable");
+  }
+
+  void
+  require_output_file(const std::string &file, const std::string &where)
+  {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (file.empty())
+      throw InputError(where + ": must not be empty");
+    if (fs::is_directory(file, ec))
+      throw InputError(where + ": '" + file + "' is a directory, not a file");
+    const fs::path parent = fs::path(file).parent_path();
+    require_output_directory(parent.empty() ? std::string(".") : parent.string(), where);
   }
 
   const std::vector<std::string> &
@@ -143,41 +265,82 @@ namespace talus
   {
     dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
     std::vector<std::string>                 args(argv + 1, argv + argc);
+    given_options.clear();
+    check_flag = false;
 
+    const std::string file_arg = tool.reads_prm ? " FILE.prm" : "";
     const auto usage = [&](std::ostream &os) {
-      os << "Usage: " << tool.name << " [--help] [--print-parameters] FILE.prm\n"
-         << "       mpirun -np N " << tool.name << " FILE.prm\n\n"
-         << tool.summary << "\n\n"
-         << "  --help               this text\n"
-         << "  --print-parameters   print a complete, documented default .prm and exit\n";
+      os << "Usage: " << tool.name << " [--help]" << (tool.reads_prm ? " [--print-parameters]" : "")
+         << " [--check]";
       for (const auto &[o, d] : tool.options)
-        os << "  " << o << (o.back() == '=' ? "VALUE" : "") << std::string(o.size() + 5 < 21 ? 21 - o.size() - (o.back() == '=' ? 5 : 0) : 1, ' ') << d << "\n";
-      os
-         << "Exit status: 0 ok, 1 internal error, 2 bad input, 3 run went unstable.\n";
+        os << " [" << o << (o.back() == '=' ? "VALUE" : "") << "]";
+      os << file_arg << "\n";
+      if (tool.reads_prm)
+        os << "       mpirun -np N " << tool.name << file_arg << "\n";
+      os << "\n" << tool.summary << "\n\n"
+         << "  --help               this text\n";
+      if (tool.reads_prm)
+        os << "  --print-parameters   print a complete, documented default .prm and exit\n"
+           << "  --check              parse and validate FILE.prm completely (entries, ranges, consistency,\n"
+           << "                       input files, output location), run nothing, write nothing; exit 0 if valid\n";
+      else
+        os << "  --check              validate the command line, run nothing; exit 0 if valid\n";
+      for (const auto &[o, d] : tool.options)
+        {
+          const std::string shown = o + (o.back() == '=' ? "VALUE" : "");
+          os << "  " << shown << std::string(shown.size() < 21 ? 21 - shown.size() : 1, ' ') << d << "\n";
+        }
+      os << "Exit status: 0 ok, 1 internal error, 2 bad input, 3 run went unstable or was stopped.\n";
+    };
+    const auto allowed_options = [&]() {
+      std::string allowed = tool.reads_prm ? "--help, --print-parameters, --check" : "--help, --check";
+      for (const auto &[o, d] : tool.options)
+        allowed += ", " + o + (o.back() == '=' ? "VALUE" : "");
+      return allowed;
     };
 
     std::string prm_file;
     bool        print = false;
-    for (const auto &a : args)
+    for (std::size_t i = 0; i < args.size(); ++i)
       {
+        const std::string &a = args[i];
         if (a == "--help" || a == "-h")
           {
             usage(log());
             return exit_ok;
           }
-        else if (a == "--print-parameters")
+        else if (a == "--print-parameters" && tool.reads_prm)
           print = true;
+        else if (a == "--check")
+          check_flag = true;
         else if (!a.empty() && a[0] == '-' &&
                  std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
                    return o.first.back() == '=' ? a.rfind(o.first, 0) == 0 : a == o.first;
                  }))
           given_options.push_back(a);
-        else if (!a.empty() && a[0] == '-')
+        else if (!a.empty() && a[0] == '-' &&
+                 std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
+                   return o.first.back() == '=' && a + "=" == o.first;
+                 }))
           {
-            std::string allowed = "--help, --print-parameters";
-            for (const auto &[o, d] : tool.options)
-              allowed += ", " + o + (o.back() == '=' ? "VALUE" : "");
-            err() << tool.name << ": error: unknown option '" << a << "' (allowed: " << allowed << ")\n";
+            // "--name VALUE"
+            if (i + 1 == args.size())
+              {
+                err() << tool.name << ": error: option " << a << " needs a value (" << a << "=VALUE)\n";
+                return exit_input_error;
+              }
+            given_options.push_back(a + "=" + args[++i]);
+          }
+        else if (!a.empty() && a[0] == '-' && a != "-")
+          {
+            err() << tool.name << ": error: unknown option '" << a << "' (allowed: " << allowed_options()
+                  << ")\n";
+            return exit_input_error;
+          }
+        else if (!tool.reads_prm)
+          {
+            err() << tool.name << ": error: unexpected argument '" << a << "' (this tool reads no parameter file; "
+                  << "allowed: " << allowed_options() << ")\n";
             return exit_input_error;
           }
         else if (prm_file.empty())
@@ -192,32 +355,55 @@ namespace talus
 
     try
       {
-        if (print)
-          {
-            dealii::ParameterHandler prm;
-            tool.declare(prm, "");
-            prm.print_parameters(log(),
-                                 dealii::ParameterHandler::OutputStyle::PRM);
-            return exit_ok;
-          }
-        if (prm_file.empty())
-          {
-            err() << tool.name << ": error: no parameter file given\n\n";
-            usage(err());
-            return exit_input_error;
-          }
-        if (!std::filesystem::is_regular_file(prm_file))
-          throw InputError("parameter file '" + prm_file + "' does not exist or is not a file");
-
         dealii::ParameterHandler prm;
+        if (tool.reads_prm)
+          {
+            if (print)
+              {
+                tool.declare(prm, "");
+                prm.print_parameters(log(), dealii::ParameterHandler::OutputStyle::PRM);
+                return exit_ok;
+              }
+            if (prm_file.empty())
+              {
+                err() << tool.name << ": error: no parameter file given\n\n";
+                usage(err());
+                return exit_input_error;
+              }
+            std::error_code ec;
+            if (!std::filesystem::exists(prm_file, ec))
+              throw InputError("parameter file '" + prm_file + "' does not exist");
+            if (!std::filesystem::is_regular_file(prm_file, ec))
+              throw InputError("parameter file '" + prm_file + "' is not a regular file");
+            try
+              {
+                tool.declare(prm, prm_file);
+                prm.parse_input(prm_file, "", /*skip_undefined=*/false, /*assert_mandatory=*/true);
+              }
+            catch (const dealii::ExceptionBase &e)
+              {
+                throw InputError("in '" + prm_file + "': " + readable_mandatory_message(exception_text(e)));
+              }
+          }
         try
           {
-            tool.declare(prm, prm_file);
-            prm.parse_input(prm_file, "", /*skip_undefined=*/false, /*assert_mandatory=*/true);
+            if (tool.check)
+              tool.check(prm, prm_file);
+          }
+        catch (const InputError &e)
+          {
+            throw InputError((prm_file.empty() ? "" : "in '" + prm_file + "': ") + e.what());
           }
         catch (const dealii::ExceptionBase &e)
           {
-            throw InputError("in '" + prm_file + "': " + exception_text(e));
+            // a value the patterns let through but the tool cannot use
+            throw InputError((prm_file.empty() ? "" : "in '" + prm_file + "': ") + exception_text(e));
+          }
+        if (check_flag)
+          {
+            log() << tool.name << ": " << (prm_file.empty() ? "command line" : "'" + prm_file + "'")
+                  << " is valid (--check: nothing was run or written)\n";
+            return exit_ok;
           }
         return tool.run(prm, prm_file);
       }
@@ -236,9 +422,20 @@ namespace talus
         err() << tool.name << ": stopped: " << e.what() << "\n";
         return exit_unstable;
       }
+    catch (const std::bad_alloc &)
+      {
+        err() << tool.name << ": error: out of memory (is the grid or the number of material points far larger "
+              << "than intended?)\n";
+        return exit_failure;
+      }
     catch (const std::exception &e)
       {
         err() << tool.name << ": internal error: " << exception_text(e) << "\n";
+        return exit_failure;
+      }
+    catch (...)
+      {
+        err() << tool.name << ": internal error: unknown exception\n";
         return exit_failure;
       }
   }

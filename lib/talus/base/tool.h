@@ -30,11 +30,20 @@ namespace talus
     /// when printing defaults; tools whose entries depend on counts in the file
     /// (number of bodies, materials) read those with peek_entry().
     std::function<void(dealii::ParameterHandler &, const std::string &prm_file)> declare;
+    /// Validate the parsed parameters completely (values, consistency between
+    /// entries, input files, where output will go) WITHOUT heavy work (no grid,
+    /// no particles, no output): throws InputError naming the entry or entity and
+    /// the allowed values. Called before run(); `--check` stops after it with
+    /// exit 0. May be empty when run() has nothing to check beyond the patterns.
+    std::function<void(dealii::ParameterHandler &, const std::string &prm_file)> check;
     /// Run with the parsed parameters; returns the exit code.
     std::function<int(dealii::ParameterHandler &, const std::string &prm_file)> run;
-    /// Extra command-line options this tool accepts besides --help and
+    /// false: the tool reads no .prm (micro-benchmarks driven by options only);
+    /// declare() is not called and run() gets an empty handler and file name.
+    bool reads_prm = true;
+    /// Extra command-line options this tool accepts besides --help, --check and
     /// --print-parameters, with a one-line description each. An option written
-    /// "--name=" takes a value ("--name=VALUE").
+    /// "--name=" takes a value ("--name=VALUE" or "--name VALUE").
     std::vector<std::pair<std::string, std::string>> options;
   };
 
@@ -45,8 +54,31 @@ namespace talus
   /// Value of "--name=VALUE" among tool_options(), or `fallback`.
   std::string tool_option_value(const std::string &name, const std::string &fallback);
   bool        tool_option_given(const std::string &name);
+  /// Integer value of "--name=VALUE" in [min, max], or `fallback` when absent;
+  /// InputError naming the option and the allowed range otherwise.
+  unsigned long tool_option_uint(const std::string &name, unsigned long fallback, unsigned long min,
+                                 unsigned long max);
+  /// True while run_tool() runs with --check (parse and validate only).
+  bool check_only();
+
+  /// InputError unless `path` names an existing, readable regular file.
+  /// `where` is the .prm entry that names it (e.g. "grid/mesh file").
+  void require_input_file(const std::string &path, const std::string &where);
+  /// InputError unless output can go to directory `dir`: it is a writable
+  /// directory, or it does not exist and its nearest existing ancestor is a
+  /// writable directory. Creates nothing.
+  void require_output_directory(const std::string &dir, const std::string &where);
+  /// Same for an output file: not a directory, and its directory usable as above.
+  void require_output_file(const std::string &file, const std::string &where);
+  /// InputError unless x is finite (not NaN, not +-inf).
+  void require_finite(double x, const std::string &where);
 
   /// main() of a tool: `return talus::run_tool(argc, argv, description);`
+  /// Command line: [--help] [--print-parameters] [--check] [tool options] FILE.prm.
+  /// The .prm is parsed strictly (unknown entries/subsections, wrong types and
+  /// unbalanced subsections are errors naming the file and line), then
+  /// tool.check() validates it; only then tool.run() starts. Every error exits
+  /// with one message and status 2 before any output is written.
   int run_tool(int argc, char **argv, const ToolDescription &tool);
 
   /// Read one entry from a .prm file before the full declaration exists

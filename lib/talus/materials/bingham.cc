@@ -22,6 +22,7 @@ namespace talus::materials
     , mu_max(prm.get_double("maximum viscosity"))
     , p_cav(prm.get_double("cavitation threshold"))
   {
+    incremental_cavitation = prm.get("cavitation recovery") == "incremental";
     setup(where);
   }
 
@@ -68,8 +69,7 @@ namespace talus::materials
                          ArrayView<double> h) const
   {
     const Stress s_old = deviator(apply_jaumann_rotation(sigma, d_omega));
-    h[h_volumetric_strain] += trace(d_eps);
-    const double p = liquid_pressure(K, h[h_volumetric_strain], p_cav);
+    const double p = update_liquid_pressure(K, h[h_volumetric_strain], trace(d_eps), p_cav, incremental_cavitation);
     double       mu_eff;
     sigma = viscoplastic_deviator(s_old, d_eps, dt, G, tau_y, mu, mu_max, !(p > p_cav), mu_eff);
     h[h_effective_viscosity] = mu_eff;

@@ -18,6 +18,7 @@ namespace talus::materials
     , mu(prm.get_double("dynamic viscosity"))
     , p_cav(prm.get_double("cavitation threshold"))
   {
+    incremental_cavitation = prm.get("cavitation recovery") == "incremental";
     setup(where);
   }
 
@@ -51,8 +52,7 @@ namespace talus::materials
                            Stress &          sigma,
                            ArrayView<double> h) const
   {
-    h[h_volumetric_strain] += trace(d_eps);
-    const double p = liquid_pressure(K, h[h_volumetric_strain], p_cav);
+    const double p = update_liquid_pressure(K, h[h_volumetric_strain], trace(d_eps), p_cav, incremental_cavitation);
     if (dt > 0 && p > p_cav)
       sigma = (2.0 * mu / dt) * deviator(d_eps);
     else

@@ -18,6 +18,10 @@ namespace talus::materials
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
+    /// Eq. 7.33 (default) or the density form after cavitation ("cavitation
+    /// recovery", see liquid_common.h)
+    bool incremental_cavitation = true;
+
     std::string  model_name() const override { return "newtonian"; }
     double       constrained_modulus() const override { return K; }
     double       dynamic_viscosity() const override { return mu; }

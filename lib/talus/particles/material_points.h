@@ -168,6 +168,10 @@ namespace talus
     std::vector<unsigned int> removed_from, inserted_into;
     bool                      sorted_last = false;
 
+    /// Particles moved (locally) since the last full sort: part of the state a
+    /// checkpoint saves, since it decides when the next memory-order sort runs.
+    unsigned long long &moves_since_sort() { return moved_since_sort; }
+
   private:
     struct Pending
     {

@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/input_checks.h>
 #include <talus/io/output.h>
 #include <talus/shape/q1.h>
 
@@ -55,13 +56,13 @@ namespace talus::explicit_mpm
             {
               std::size_t  pos = 0;
               const double v   = std::stod(s, &pos);
-              if (pos != s.size())
+              if (pos != s.size() || !std::isfinite(v))
                 throw std::invalid_argument(s);
               r.push_back(v);
             }
           catch (const std::exception &)
             {
-              throw InputError(where + ": '" + s + "' is not a number (in '" + text + "')");
+              throw InputError(where + ": '" + s + "' is not a finite number (in '" + text + "')");
             }
         }
       return r;
@@ -113,7 +114,7 @@ namespace talus::explicit_mpm
                       "Spatial dimension: 2 (plane strain, per unit thickness) or 3.");
     prm.enter_subsection("time");
     {
-      prm.declare_entry("end time", "1.0", Double(0), "Simulated duration [s].");
+      prm.declare_entry("end time", "1.0", Double(0), "Simulated duration [s], > 0 (must be set).", /*has_to_be_set=*/true);
       prm.declare_entry("courant number", "0.5", Double(0, 1),
                         "Time step as a fraction of the critical time step L_min/c (seed 000 Eq. 4.120), "
                         "used when 'time step' is 0. Range (0, 1].");
@@ -181,6 +182,21 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     declare_numerics_parameters(prm);
+    prm.enter_subsection("checkpoint");
+    {
+      prm.declare_entry("interval", "0", Double(0),
+                        "Simulated time between checkpoints (HDF5, complete state); 0 = off.");
+      prm.declare_entry("wall clock interval", "0", Double(0),
+                        "Wall-clock seconds between checkpoints (for batch time limits); 0 = off.");
+      prm.declare_entry("keep", "2", Integer(1, 1000), "Number of newest checkpoints kept.");
+      prm.declare_entry("directory", "", Anything(), "Checkpoint directory; empty = <output directory>/checkpoints.");
+      prm.declare_entry("restart", "false", Selection("false|true|if available"),
+                        "Resume from the newest valid checkpoint in the directory: 'true' (an error if there is "
+                        "none), 'if available' (else start at t = 0), 'false'. The command-line option --restart "
+                        "means 'true'. The .prm must describe the same scene (grid, materials, bodies); the end "
+                        "time and output settings may change.");
+    }
+    prm.leave_subsection();
     declare_liquid_output(prm);
 
     prm.declare_entry("number of materials", "1", Integer(1, 64),
@@ -276,6 +292,20 @@ namespace talus::explicit_mpm
       p.probes.push_back(parse_point<dim>(s, "output/probes"));
     prm.leave_subsection();
 
+    prm.enter_subsection("checkpoint");
+    p.checkpoint_interval      = prm.get_double("interval");
+    p.checkpoint_wall_interval = prm.get_double("wall clock interval");
+    p.checkpoint_keep          = prm.get_integer("keep");
+    p.checkpoint_directory     = prm.get("directory");
+    {
+      const std::string r = prm.get("restart");
+      p.restart = r == "true" ? Parameters<dim>::Restart::yes :
+                  r == "if available" ? Parameters<dim>::Restart::if_available :
+                                        Parameters<dim>::Restart::no;
+    }
+    if (tool_option_given("--restart"))
+      p.restart = Parameters<dim>::Restart::yes;
+    prm.leave_subsection();
     parse_liquid_output(prm, p.liquid);
 
     const unsigned int n_materials = prm.get_integer("number of materials");
@@ -333,8 +363,9 @@ namespace talus::explicit_mpm
             for (const auto &c : dealii::Utilities::split_string_list(prm.get("function constants"), ','))
               {
                 const auto kv = dealii::Utilities::split_string_list(c, '=');
-                require(kv.size() == 2, where + "/function constants", "'" + c + "' is not of the form name=value");
-                constants[kv[0]] = parse_doubles(kv[1], where + "/function constants")[0];
+                const auto v = kv.size() == 2 ? parse_doubles(kv[1], where + "/function constants") : std::vector<double>();
+                require(v.size() == 1, where + "/function constants", "'" + c + "' is not of the form name=value");
+                constants[kv[0]] = v[0];
               }
             auto fp = std::make_shared<dealii::FunctionParser<dim>>(dim);
             try
@@ -361,6 +392,7 @@ namespace talus::explicit_mpm
         p.bodies.push_back(b);
       }
     p.numerics = parse_numerics_parameters(prm, n_bodies);
+    check_consistency(p);
     return p;
   }
 
@@ -428,28 +460,43 @@ namespace talus::explicit_mpm
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
       smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
-    std::vector<double> density;
-    for (const auto &m : prm.materials)
-      density.push_back(m->density());
-    const auto seeded = seed_bodies(grid, prm.bodies, density, layout, particles);
-    for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-      require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
-              "contains no material point: it lies outside the grid or is smaller than one sub-cell");
-
-    // history initialisation
-    for (auto &pt : particles)
+    bool restored = false;
+    if (prm.restart != Parameters<dim>::Restart::no)
       {
-        auto        P = pt.get_properties();
-        const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
-        if (layout.n_history)
-          m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
-                               dealii::ArrayView<double>(P.data() + layout.history, m.n_history()));
+        restored = restore_checkpoint();
+        if (!restored && prm.restart == Parameters<dim>::Restart::yes)
+          throw InputError("checkpoint/restart: no valid checkpoint (checkpoint-<step>.h5) in '" +
+                           checkpoint_directory() + "'");
+        if (!restored)
+          log() << "  no checkpoint in " << checkpoint_directory() << ": starting at t = 0" << std::endl;
       }
-    if (two_phase)
-      two_phase->initialize_particles();
+    if (!restored)
+      {
+      std::vector<double> density;
+      for (const auto &m : prm.materials)
+        density.push_back(m->density());
+      const auto seeded = seed_bodies(grid, prm.bodies, density, layout, particles);
+      for (unsigned int b = 0; b < prm.bodies.size(); ++b)
+        require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
+                "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+
+      // history initialisation
+      for (auto &pt : particles)
+        {
+          auto        P = pt.get_properties();
+          const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
+          if (layout.n_history)
+            m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
+                                 dealii::ArrayView<double>(P.data() + layout.history, m.n_history()));
+        }
+      if (two_phase)
+        two_phase->initialize_particles(); // restored points carry their 2-phase state
+      }
 
     const double dt_cr = critical_time_step();
-    if (prm.time_step > 0)
+    if (restored)
+      ; // the time step of the checkpointed run (bitwise continuation)
+    else if (prm.time_step > 0)
       {
         if (prm.time_step > dt_cr && !prm.force_time_step)
           {
@@ -464,8 +511,8 @@ namespace talus::explicit_mpm
     else
       dt = prm.courant * dt_cr;
 
-    // probes: nearest particle at t = 0 (ties: lowest id)
-    for (const auto &q : prm.probes)
+    // probes: nearest particle at t = 0 (ties: lowest id); restored: saved ids
+    for (const auto &q : restored ? std::vector<dealii::Point<dim>>() : prm.probes)
       {
         std::pair<double, dealii::types::particle_index> best{std::numeric_limits<double>::max(), 0};
         for (const auto &pt : particles)
@@ -483,8 +530,11 @@ namespace talus::explicit_mpm
         const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
         local_scale += P[PropertyLayout<dim>::mass] * m.constrained_modulus() / m.density();
       }
-    energy_scale     = dealii::Utilities::MPI::sum(local_scale, comm);
-    initial_energies = energies();
+    if (!restored)
+      {
+        energy_scale     = dealii::Utilities::MPI::sum(local_scale, comm);
+        initial_energies = energies();
+      }
     collect_active_cells();
   }
 
@@ -1271,8 +1321,18 @@ namespace talus::explicit_mpm
   {
     const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
     if (root)
-      std::filesystem::create_directories(prm.output_directory);
+      {
+        std::filesystem::create_directories(prm.output_directory);
+        // temporaries of a killed run (a complete file was never replaced)
+        for (const auto &e : std::filesystem::directory_iterator(prm.output_directory))
+          if (e.path().extension() == ".part")
+            std::filesystem::remove(e.path());
+      }
     MPI_Barrier(comm);
+    const bool restored = !restored_from.empty();
+    if (restored)
+      log() << "talus-explicit: restarting from " << restored_from << " (step " << step_number << ", t = " << time
+            << " s)" << std::endl;
     const double dt_cr = critical_time_step();
     log() << "talus-explicit: " << dim << "D, " << grid.tria.n_global_active_cells() << " cells, "
           << grid.dof_handler.n_dofs() << " DoFs, " << n_particles() << " material points, "
@@ -1305,6 +1365,27 @@ namespace talus::explicit_mpm
               s << ",probe" << k << "_v" << ax[d];
           }
         s << "\n" << std::setprecision(12);
+        if (restored)
+          {
+            // the rows up to the checkpoint, from the series.csv committed with it
+            std::ifstream old(prm.output_directory + "/series.csv");
+            std::string   line;
+            unsigned int  kept = 0;
+            for (std::getline(old, line); std::getline(old, line);)
+              {
+                const auto c1 = line.find(','), c2 = line.find(',', c1 + 1);
+                if (c1 == std::string::npos || c2 == std::string::npos)
+                  break;
+                if (std::stoull(line.substr(c1 + 1, c2 - c1 - 1)) > step_number)
+                  break;
+                s << line << "\n";
+                ++kept;
+              }
+            if (kept == 0)
+              log() << "  warning: no series.csv rows before the checkpoint were found; series.csv restarts "
+                       "at the checkpoint"
+                    << std::endl;
+          }
       }
     // After a step, the update pass has already summed the energies and the
     // momentum of the new state (strain energy when need_strain_energy was
@@ -1364,11 +1445,39 @@ namespace talus::explicit_mpm
                 probe_values[k * 2 * dim + dim + d] = pt.get_properties()[PropertyLayout<dim>::velocity + d];
               }
 
-    unsigned int       vtu_counter   = 0;
-    unsigned long long lost_reported = 0;
-    write_series_row(false);
-    write_vtu(vtu_counter++);
-    double next_series = prm.series_interval, next_vtu = prm.vtu_interval;
+    unsigned int &      vtu_counter   = counters.vtu_counter;
+    unsigned long long &lost_reported = counters.lost_reported;
+    double &            next_series = counters.next_series, &next_vtu = counters.next_vtu;
+    if (!restored)
+      {
+        write_series_row(false);
+        write_vtu(vtu_counter++);
+        next_series               = prm.series_interval;
+        next_vtu                  = prm.vtu_interval;
+        counters.next_checkpoint  = prm.checkpoint_interval;
+      }
+    else
+      {
+        // the series up to the checkpoint (a VTU written after it is rewritten)
+        if (root)
+          io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
+        if (root && prm.write_grid)
+          io::write_pvd(prm.output_directory + "/grid.pvd", grid_pvd_records);
+      }
+    auto       t_checkpoint = Clock::now();
+    const auto checkpoint_due = [&](const bool last) {
+      if (last)
+        return false;
+      bool due = prm.checkpoint_interval > 0 && time >= counters.next_checkpoint - 1e-9 * dt;
+      if (prm.checkpoint_wall_interval > 0)
+        {
+          // rank 0's clock decides, so that every rank takes part
+          int w = seconds_since(t_checkpoint) >= prm.checkpoint_wall_interval ? 1 : 0;
+          MPI_Bcast(&w, 1, MPI_INT, 0, comm);
+          due = due || w;
+        }
+      return due;
+    };
 
     const auto   t_start   = Clock::now();
     auto         t_report  = t_start;
@@ -1427,6 +1536,24 @@ namespace talus::explicit_mpm
             write_vtu(vtu_counter++);
             while (prm.vtu_interval > 0 && next_vtu <= time + eps_t)
               next_vtu += prm.vtu_interval;
+          }
+        if (checkpoint_due(last_step))
+          {
+            while (prm.checkpoint_interval > 0 && counters.next_checkpoint <= time + eps_t)
+              counters.next_checkpoint += prm.checkpoint_interval;
+            if (root)
+              {
+                // series.csv up to now, committed with the checkpoint
+                series->stream().flush();
+                const std::string out = prm.output_directory + "/series.csv";
+                std::filesystem::copy_file(out + ".part", out + ".copy.part",
+                                           std::filesystem::copy_options::overwrite_existing);
+                std::filesystem::rename(out + ".copy.part", out);
+              }
+            const std::string name = write_checkpoint();
+            t_checkpoint           = Clock::now();
+            if (prm.progress)
+              log() << "  checkpoint " << name << " (step " << step_number << ", t = " << time << " s)" << std::endl;
           }
         timings.output += seconds_since(t0);
         if (prm.progress && seconds_since(t_report) > 2.0)

@@ -44,6 +44,18 @@ namespace talus::explicit_mpm
     bool                            final_particles_csv = false;
     bool                            progress            = true;
     std::vector<dealii::Point<dim>> probes;
+    // checkpoint / restart
+    double       checkpoint_interval      = 0; ///< simulated time, 0: off
+    double       checkpoint_wall_interval = 0; ///< seconds of wall time, 0: off
+    unsigned int checkpoint_keep          = 2;
+    std::string  checkpoint_directory;        ///< default <output>/checkpoints
+    enum class Restart
+    {
+      no,
+      yes,         ///< resume from the newest valid checkpoint, error if none
+      if_available ///< resume if there is one, else start from t = 0
+    };
+    Restart restart = Restart::no;
     // scene
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                        bodies;
@@ -140,6 +152,25 @@ namespace talus::explicit_mpm
     double                                        time = 0, dt = 0;
     unsigned int                                  step_number = 0;
     Energies                                      initial_energies;
+    /// Time-loop and output counters a restart resumes (saved in checkpoints).
+    struct RunCounters
+    {
+      unsigned int       vtu_counter     = 0;
+      double             next_series     = 0, next_vtu = 0, next_checkpoint = 0;
+      unsigned long long lost_reported   = 0;
+    };
+    RunCounters                                   counters;
+    /// Stage of a staged calculation (saved in checkpoints).
+    unsigned int                                  current_stage = 0;
+    /// Set by setup() when the state came from a checkpoint (its path).
+    std::string                                   restored_from;
+
+    /// Write the complete state to <checkpoint dir>/checkpoint-<step>.h5
+    /// (written as .part, renamed when complete; older ones beyond `keep`
+    /// removed). Collective. Returns the file name.
+    std::string write_checkpoint();
+    /// Checkpoint files in the directory, newest first (rank 0 lists, all get it).
+    std::vector<std::string> list_checkpoints() const;
     /// Strain energy is summed in the update pass only when a series row or a
     /// stability check needs it (set by the time loop).
     bool                                          need_strain_energy = true;
@@ -153,6 +184,10 @@ namespace talus::explicit_mpm
     std::unique_ptr<FreeSurface<dim>>             free_surface;
 
   private:
+    /// Read the newest valid checkpoint into the (empty) particle handler and
+    /// the solver state; returns false if there is none. Collective.
+    bool restore_checkpoint();
+    std::string checkpoint_directory() const;
     friend class TwoPhase<dim>;
     friend class FreeSurface<dim>;
     void collect_active_cells();

@@ -203,11 +203,14 @@ namespace talus::explicit_mpm
       {
         try
           {
-            t.traction[d] = std::stod(v[d]);
+            std::size_t pos = 0;
+            t.traction[d]   = std::stod(v[d], &pos);
+            if (pos != v[d].size() || !std::isfinite(t.traction[d]))
+              throw std::invalid_argument(v[d]);
           }
         catch (const std::exception &)
           {
-            throw InputError(where + "/traction: '" + v[d] + "' is not a number");
+            throw InputError(where + "/traction: '" + v[d] + "' is not a finite number");
           }
       }
     return t;

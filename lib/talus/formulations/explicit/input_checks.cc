@@ -1,0 +1,177 @@
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/explicit/explicit_two_phase.h>
+#include <talus/formulations/explicit/input_checks.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace talus::explicit_mpm
+{
+  namespace
+  {
+    std::string
+    fmt(const double x)
+    {
+      std::ostringstream os;
+      os << x;
+      return os.str();
+    }
+
+    template <int dim>
+    std::string
+    fmt_point(const dealii::Point<dim> &x)
+    {
+      std::ostringstream os;
+      os << "(";
+      for (unsigned int d = 0; d < dim; ++d)
+        os << (d ? ", " : "") << x[d];
+      os << ")";
+      return os.str();
+    }
+
+    /// Does a box body [lo, hi] contain a seeding position of the grid? The
+    /// seeding puts n points per direction at the sub-cell centres
+    /// L + (k + 1/2) h / n, k = 0 .. N n - 1 (h = (U - L) / N); a box is a
+    /// product of intervals, so it is enough to find one position per direction.
+    bool
+    interval_has_seed(const double L, const double U, const unsigned int N, const unsigned int n, const double lo,
+                      const double hi)
+    {
+      const double       s  = (U - L) / (double(N) * n);
+      const double       k0 = std::ceil((lo - L) / s - 0.5 - 1e-12);
+      const double       k  = std::max(0.0, k0);
+      const double       x  = L + (k + 0.5) * s;
+      const unsigned int nk = N * n;
+      return k < nk && x <= hi + 1e-12 * (U - L) && x >= lo - 1e-12 * (U - L);
+    }
+  } // namespace
+
+  template <int dim>
+  double
+  critical_time_step_of(const Parameters<dim> &p)
+  {
+    double h = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+      h = std::min(h, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
+    double dt = std::numeric_limits<double>::infinity();
+    for (const auto &c : critical_time_steps(p.materials, p.liquid.pore_liquid, h))
+      dt = std::min(dt, c.dt);
+    return dt;
+  }
+
+  template <int dim>
+  void
+  check_consistency(const Parameters<dim> &p)
+  {
+    // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
+    for (const auto &bc : p.boundary_conditions)
+      require(bc.id < 2 * dim,
+              std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
+              "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
+                "D box grid has ids 0.." + std::to_string(2 * dim - 1) + ": 0 = x-, 1 = x+, 2 = y-, 3 = y+" +
+                (dim == 3 ? ", 4 = z-, 5 = z+)" : ")"));
+
+    double n_cells = 1, cell_volume = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        n_cells *= p.grid_cells[d];
+        cell_volume *= (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
+      }
+    require(n_cells <= max_grid_cells,
+            "grid/cells",
+            fmt(n_cells) + " cells in total exceed the limit of " + fmt(max_grid_cells) +
+              " (check the numbers per direction)");
+    require(cell_volume > 0 && std::isfinite(cell_volume),
+            "grid",
+            "the cells have zero or non-finite size (corners " + fmt_point(p.grid_lower) + ", " +
+              fmt_point(p.grid_upper) + ")");
+
+    double n_points = 0;
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      {
+        const auto &      b     = p.bodies[k];
+        const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
+        // bounding box of the body
+        dealii::Point<dim> lo, hi;
+        switch (b.shape)
+          {
+            case BodyDescription<dim>::Shape::box:
+              lo = b.lower, hi = b.upper;
+              break;
+            case BodyDescription<dim>::Shape::ball:
+              for (unsigned int d = 0; d < dim; ++d)
+                lo[d] = b.center[d] - b.radius, hi[d] = b.center[d] + b.radius;
+              break;
+            case BodyDescription<dim>::Shape::polygon:
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  lo[d] = std::numeric_limits<double>::max();
+                  hi[d] = -lo[d];
+                }
+              for (const auto &v : b.polygon)
+                for (unsigned int d = 0; d < dim && d < 2; ++d)
+                  lo[d] = std::min(lo[d], v[d]), hi[d] = std::max(hi[d], v[d]);
+              break;
+          }
+        double overlap = 1;
+        for (unsigned int d = 0; d < dim; ++d)
+          overlap *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
+        require(overlap > 0,
+                where,
+                "contains no material point: it lies entirely outside the grid (body " + fmt_point(lo) + " to " +
+                  fmt_point(hi) + ", grid " + fmt_point(p.grid_lower) + " to " + fmt_point(p.grid_upper) + ")");
+        if (b.shape == BodyDescription<dim>::Shape::box)
+          for (unsigned int d = 0; d < dim; ++d)
+            require(interval_has_seed(p.grid_lower[d],
+                                      p.grid_upper[d],
+                                      p.grid_cells[d],
+                                      b.particles_per_direction,
+                                      b.lower[d],
+                                      b.upper[d]),
+                    where,
+                    "contains no material point: it is thinner than one sub-cell (cell size / particles per "
+                    "direction) in direction " +
+                      std::to_string(d) + " and holds no seeding position");
+        if (k < p.liquid.tractions.size() && p.liquid.tractions[k].face >= 0)
+          require(b.shape == BodyDescription<dim>::Shape::box,
+                  "body " + std::to_string(k) + "/traction face",
+                  "tractions are supported on box bodies only (this body is a " +
+                    std::string(b.shape == BodyDescription<dim>::Shape::ball ? "ball" : "polygon") +
+                    "; allowed here: none)");
+        n_points += overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
+      }
+    require(n_points <= max_material_points,
+            "bodies",
+            "about " + fmt(n_points) + " material points would be seeded, more than the limit of " +
+              fmt(max_material_points) + " (check 'cells' and 'particles per direction')");
+
+    if (p.time_step > 0 && !p.force_time_step)
+      {
+        const double dt_cr = critical_time_step_of(p);
+        if (p.time_step > dt_cr * (1 + 1e-12))
+          throw InputError("time/time step: " + fmt(p.time_step) + " s exceeds the critical time step " +
+                           fmt(dt_cr) +
+                           " s (seed 000 §4.6, smallest cell edge over the fastest wave speed); lower it, or set "
+                           "'force time step = true' to run anyway");
+      }
+  }
+
+  void
+  check_scene(dealii::ParameterHandler &prm, const std::string &)
+  {
+    std::string dir;
+    if (prm.get_integer("dimension") == 2)
+      dir = parse_parameters<2>(prm).output_directory;
+    else
+      dir = parse_parameters<3>(prm).output_directory;
+    require_output_directory(dir, "output/directory");
+  }
+
+  template void   check_consistency<2>(const Parameters<2> &);
+  template void   check_consistency<3>(const Parameters<3> &);
+  template double critical_time_step_of<2>(const Parameters<2> &);
+  template double critical_time_step_of<3>(const Parameters<3> &);
+} // namespace talus::explicit_mpm

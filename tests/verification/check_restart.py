@@ -1,0 +1,163 @@
+"""Checkpoint/restart of talus-explicit (issue 7).
+
+Scene: the Mohr-Coulomb column collapse of the demo on a coarse grid (history
+variables, plastic flow, points changing cells every step), checkpoints every
+0.02 s of simulated time, two kept.
+
+1. Reference: the uninterrupted run on 1 rank.
+2. The same run killed with SIGKILL at a random moment after its first
+   checkpoint (the seed is printed; TALUS_KILL_SEED overrides it), then run
+   again with --restart. Required: particles_final.csv and series.csv byte for
+   byte identical to the reference, a PVD series without duplicate or missing
+   times, no temporary (.part) file left, at most `keep` checkpoints.
+3. The newest checkpoint of a killed run, restarted on 2 ranks: final
+   particle state within 1e-10 (relative to the field's scale) of the reference.
+4. Same number of ranks with ghosts: a 2-rank run stopped early and restarted
+   on 2 ranks equals the uninterrupted 2-rank run byte for byte.
+5. A corrupt newest checkpoint is skipped (warning) and the older one used;
+   a checkpoint of another scene and --restart without any checkpoint are
+   input errors (exit 2) with a message.
+"""
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+from talus_verify import check, finish, prm_set, read_csv, run_tool
+
+tool, prm_path, work = sys.argv[1], sys.argv[2], sys.argv[3]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+base = open(prm_path).read()
+base = prm_set(base, "grid/cells", "80, 30")
+base = prm_set(base, "time/end time", "0.5")
+base = prm_set(base, "output/vtu interval", "0.05")
+base = prm_set(base, "output/series interval", "0.005")
+base = prm_set(base, "output/final particles csv", "true")
+base = prm_set(base, "output/progress", "false")
+base = prm_set(base, "checkpoint/interval", "0.02")
+base = prm_set(base, "checkpoint/keep", "2")
+
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
+
+
+def scene(name, **entries):
+    t = prm_set(base, "output/directory", name)
+    for k, v in entries.items():
+        t = prm_set(t, k.replace("__", "/").replace("_", " "), v)
+    return t
+
+
+def final(name):
+    return open(os.path.join(work, name, "particles_final.csv")).read()
+
+
+def max_rel_diff(a_name, b_name):
+    ca = read_csv(os.path.join(work, a_name, "particles_final.csv"))
+    cb = read_csv(os.path.join(work, b_name, "particles_final.csv"))
+    worst = 0.0
+    for col in ca:
+        if col == "id":
+            continue
+        xa, xb = ca[col], cb[col]
+        if len(xa) != len(xb):
+            return float("inf")
+        scale = max(1e-300, max(abs(v) for v in xa))
+        worst = max(worst, max(abs(u - v) for u, v in zip(xa, xb)) / scale)
+    return worst
+
+
+def pvd_times(name):
+    import re
+    text = open(os.path.join(work, name, "particles.pvd")).read()
+    return [float(x) for x in re.findall(r'timestep="([^"]+)"', text)]
+
+
+# 1. reference
+t0 = time.time()
+run_tool(tool, scene("reference"), work, "reference")
+t_ref = time.time() - t0
+print(f"reference run: {t_ref:.2f} s")
+
+# 2. killed at a random moment, restarted
+seed = int(os.environ.get("TALUS_KILL_SEED", random.SystemRandom().randrange(1 << 30)))
+rng = random.Random(seed)
+print(f"kill seed {seed} (set TALUS_KILL_SEED to repeat)")
+killed_prm = os.path.join(work, "killed.prm")
+open(killed_prm, "w").write(scene("killed"))
+ckdir = os.path.join(work, "killed", "checkpoints")
+killed_at = None
+for attempt in range(5):
+    shutil.rmtree(os.path.join(work, "killed"), ignore_errors=True)
+    p = subprocess.Popen([os.path.abspath(tool), killed_prm], cwd=work, env=env,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    while p.poll() is None and not (os.path.isdir(ckdir) and any(f.endswith(".h5") for f in os.listdir(ckdir))):
+        time.sleep(0.005)
+    delay = rng.uniform(0.0, 0.6 * t_ref) / (attempt + 1)
+    time.sleep(delay)
+    if p.poll() is None:
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+        killed_at = delay
+        break
+    p.wait()
+check(killed_at is not None, "the run was killed before it ended (5 attempts)")
+if killed_at is None:
+    finish()
+cks = sorted(f for f in os.listdir(ckdir) if f.endswith(".h5"))
+print(f"killed {killed_at:.3f} s after the first checkpoint; checkpoints left: {cks}")
+check(not os.path.exists(os.path.join(work, "killed", "particles_final.csv")), "the killed run did not finish")
+# keep a copy of the killed state for the 2-rank restart
+shutil.copytree(os.path.join(work, "killed"), os.path.join(work, "killed_np2"))
+open(os.path.join(work, "killed_np2.prm"), "w").write(scene("killed_np2"))
+
+p = subprocess.run([os.path.abspath(tool), killed_prm, "--restart"], cwd=work, env=env, capture_output=True, text=True)
+print(p.stdout[-600:])
+check(p.returncode == 0, f"restart exits 0 (got {p.returncode}: {p.stderr.strip()[-300:]})")
+check("restarting from" in p.stdout, "the restart says which checkpoint it resumed from")
+check(final("killed") == final("reference"), "restart on 1 rank: particles_final.csv bitwise identical to the uninterrupted run")
+s_ref = open(os.path.join(work, "reference", "series.csv")).read()
+s_kil = open(os.path.join(work, "killed", "series.csv")).read()
+check(s_kil == s_ref, f"series.csv identical to the uninterrupted run ({len(s_ref.splitlines())} rows)")
+tr, tk = pvd_times("reference"), pvd_times("killed")
+check(tk == tr, f"PVD series: {len(tk)} records, same times as the uninterrupted run, no duplicates")
+parts = [os.path.join(dp, f) for dp, _, fs in os.walk(os.path.join(work, "killed")) for f in fs if f.endswith(".part")]
+check(not parts, f"no temporary file left after the restart ({parts})")
+left = [f for f in os.listdir(ckdir) if f.endswith(".h5")]
+check(len(left) <= 2, f"at most 2 checkpoints kept ({len(left)})")
+
+# 3. the killed state restarted on 2 ranks
+cmd = ["mpirun", "--oversubscribe", "-np", "2", os.path.abspath(tool), os.path.join(work, "killed_np2.prm"), "--restart"]
+p = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True)
+check(p.returncode == 0, f"restart on 2 ranks exits 0 (got {p.returncode}: {p.stderr.strip()[-300:]})")
+if p.returncode == 0:
+    d = max_rel_diff("reference", "killed_np2")
+    check(d <= 1e-10, f"restart on 2 ranks from a 1-rank checkpoint: max relative difference {d:.2e} <= 1e-10")
+
+# 4. 2 ranks, stopped early and restarted on 2 ranks: bitwise
+run_tool(tool, scene("ref_np2"), work, "ref_np2", np=2)
+early = prm_set(scene("early_np2"), "time/end time", "0.23")
+run_tool(tool, early, work, "early_np2", np=2)
+os.remove(os.path.join(work, "early_np2", "particles_final.csv"))
+rest = prm_set(scene("early_np2"), "checkpoint/restart", "true")
+run_tool(tool, rest, work, "early_np2_restart", np=2)
+check(final("early_np2") == final("ref_np2"), "2 ranks, restarted on 2 ranks: bitwise identical to the uninterrupted 2-rank run")
+
+# 5. a corrupt newest checkpoint, another scene, no checkpoint
+cdir = os.path.join(work, "early_np2", "checkpoints")
+files = sorted(f for f in os.listdir(cdir) if f.endswith(".h5"))
+with open(os.path.join(cdir, files[-1]), "r+b") as f:
+    f.truncate(100)
+rc, out, err = run_tool(tool, prm_set(rest, "time/end time", "0.24"), work, "corrupt_restart", np=1, expect_rc=None)
+check(rc == 0 and "skipping checkpoint" in out + err and files[0] in out,
+      f"a truncated newest checkpoint is skipped and the older one ({files[0]}) used (rc {rc})")
+other = prm_set(rest, "grid/cells", "40, 15")
+rc, out, err = run_tool(tool, other, work, "other_scene", expect_rc=2)
+check(rc == 2 and "another scene" in out + err, "a checkpoint of another grid is refused (exit 2) with a message")
+none = prm_set(scene("nothing_here"), "checkpoint/restart", "true")
+rc, out, err = run_tool(tool, none, work, "no_checkpoint", expect_rc=2)
+check(rc == 2 and "no valid checkpoint" in out + err, "--restart without a checkpoint: exit 2 with a message")
+finish()
