@@ -1078,6 +1078,8 @@ namespace talus::explicit_mpm
   dealii::Tensor<1, dim>
   Solver<dim>::total_momentum() const
   {
+    if (two_phase)
+      return two_phase->total_momentum();
     dealii::Tensor<1, dim> p;
     for (const auto &pt : particles)
       for (unsigned int d = 0; d < dim; ++d)

@@ -15,14 +15,17 @@ namespace talus::explicit_mpm
   using dealii::Patterns::Double;
   using dealii::Patterns::Selection;
 
-  bool
-  any_of_drainage(const std::vector<PoreLiquid> &v, const Drainage d)
+  namespace
   {
-    for (const auto &p : v)
-      if (p.drainage == d)
-        return true;
-    return false;
-  }
+    bool
+    any_of_drainage(const std::vector<PoreLiquid> &v, const Drainage d)
+    {
+      for (const auto &p : v)
+        if (p.drainage == d)
+          return true;
+      return false;
+    }
+  } // namespace
 
   template <int dim>
   bool
@@ -417,6 +420,26 @@ namespace talus::explicit_mpm
     double v[3] = {e.kinetic, e.strain, e.gravity_potential};
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3), s.comm, dealii::ArrayView<double>(v, 3));
     return {v[0], v[1], v[2], s.external_work};
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  TwoPhase<dim>::total_momentum() const
+  {
+    using L        = PropertyLayout<dim>;
+    const auto &pl = s.prm.liquid.pore_liquid;
+    dealii::Tensor<1, dim> p;
+    for (const auto &pt : s.particles)
+      {
+        const auto         P   = pt.get_properties();
+        const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+        const double       mL  = (coupled && pl[mat].drainage == Drainage::coupled) ?
+                                   P[porosity] * pl[mat].density * P[L::volume] :
+                                   0.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] += P[L::mass] * P[L::velocity + d] + (mL > 0 ? mL * P[liquid_velocity + d] : 0.0);
+      }
+    return dealii::Utilities::MPI::sum(p, s.comm);
   }
 
   template <int dim>

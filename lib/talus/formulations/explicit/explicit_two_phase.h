@@ -115,6 +115,8 @@ namespace talus::explicit_mpm
     /// One step of §4.5.7. Collective.
     void step(const double dt);
     Energies energies() const;
+    /// sum m_S v_S + m_L v_L (collective)
+    dealii::Tensor<1, dim> total_momentum() const;
 
     unsigned int porosity = 0, pore_pressure = 0, liquid_velocity = 0, external_force = 0;
     bool         coupled = false, tractions = false;
