@@ -46,3 +46,6 @@ set_tests_properties(verification.explicit_contact PROPERTIES LABELS "fast" ENVI
 # 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
 talus_verification(explicit_checkpoint_restart check_restart.py demo/column_collapse_2d.prm)
 set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESSORS 2)
+
+# chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
+talus_verification(explicit_strain_smoothing check_smoothing.py verification/footing_incompressible.prm)
