@@ -30,6 +30,9 @@
 #include <deal.II/grid/grid_tools.h>
 
 #include <algorithm>
+#include <array>
+#include <map>
+#include <tuple>
 #include <filesystem>
 #include <sstream>
 
@@ -91,6 +94,34 @@ namespace talus::explicit_mpm
           }
       std::sort(files.rbegin(), files.rend());
       return files;
+    }
+
+    /// Partition-independent key of every locally owned DoF: vertex
+    /// coordinates and component (the vertices of the box grid are computed
+    /// identically on any number of ranks). Index: local DoF index.
+    template <int dim>
+    std::vector<std::array<double, dim + 1>> owned_dof_keys(const BackgroundGrid<dim> &grid, const unsigned int n_owned)
+    {
+      std::vector<std::array<double, dim + 1>> keys(n_owned);
+      std::vector<unsigned char>               seen(n_owned, 0);
+      for (unsigned int c = 0; c < grid.cells.size(); ++c)
+        {
+          if (grid.cell_iterators[c] == grid.tria.end()) // artificial: not cached
+            continue;
+          for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const unsigned int i = grid.cells[c].dofs[v * dim + d];
+                if (i >= n_owned || seen[i])
+                  continue;
+                seen[i] = 1;
+                const auto x = grid.cell_iterators[c]->vertex(v);
+                for (unsigned int e = 0; e < dim; ++e)
+                  keys[i][e] = x[e];
+                keys[i][dim] = d;
+              }
+        }
+      return keys;
     }
 
     /// Raw local elements (owned + ghost) of a distributed vector.
@@ -195,6 +226,29 @@ namespace talus::explicit_mpm
     f.write_rows("ranks/moves", std::vector<std::uint64_t>{relocator->moves_since_sort()}, 1);
     f.write_rows("nodal/mass", mass, 1);
     f.write_rows("nodal/force", force, 1);
+    {
+      // the same sums after the ghost contributions are added to their owners
+      // (what the next step's compress() will produce), keyed by vertex and
+      // component: a restart on another number of ranks starts from them
+      Vector m, F;
+      grid.reinit_vector(m);
+      grid.reinit_vector(F);
+      std::copy(mass.begin(), mass.end(), m.begin());
+      std::copy(force.begin(), force.end(), F.begin());
+      m.compress(dealii::VectorOperation::add);
+      F.compress(dealii::VectorOperation::add);
+      const unsigned int  n_owned = m.locally_owned_size();
+      const auto          keys    = owned_dof_keys(grid, n_owned);
+      std::vector<double> table;
+      table.reserve(n_owned * (dim + 3));
+      for (unsigned int i = 0; i < n_owned; ++i)
+        {
+          table.insert(table.end(), keys[i].begin(), keys[i].end());
+          table.push_back(m.local_element(i));
+          table.push_back(F.local_element(i));
+        }
+      f.write_rows("nodal/by_vertex", table, dim + 3);
+    }
 
     std::vector<double> pvd, grid_pvd;
     for (const auto &r : pvd_records)
@@ -367,37 +421,139 @@ namespace talus::explicit_mpm
         else
           {
             // another rank count: read a block, let deal.II send every point
-            // to the rank owning its cell
+            // to the rank owning its cell. The row index travels as the id;
+            // then every cell's points are re-inserted in the saved order with
+            // their saved ids and reference coordinates, cells in the order of
+            // their first saved row (the storage order of the run, as far as a
+            // new partition allows).
             const std::uint64_t n   = f.shape("particles/id").first;
             const auto [b, e]       = io::block_range(n, rank, n_ranks);
-            const auto          ids = f.read_rows_u64("particles/id", b, e);
             const auto          loc = f.read_rows("particles/location", b, e);
             const auto          pr  = f.read_rows("particles/properties", b, e);
-            std::vector<dealii::Point<dim>>            x(ids.size());
-            std::vector<std::vector<double>>           props(ids.size());
-            std::vector<dealii::types::particle_index> pid(ids.begin(), ids.end());
-            for (std::size_t i = 0; i < ids.size(); ++i)
+            std::vector<dealii::Point<dim>>            x(e - b);
+            std::vector<std::vector<double>>           props(e - b);
+            std::vector<dealii::types::particle_index> row(e - b);
+            for (std::size_t i = 0; i < x.size(); ++i)
               {
                 for (unsigned int d = 0; d < dim; ++d)
                   x[i][d] = loc[i * dim + d];
                 props[i].assign(pr.begin() + i * n_props, pr.begin() + (i + 1) * n_props);
+                row[i] = b + i;
               }
             const auto boxes = dealii::GridTools::compute_mesh_predicate_bounding_box(
               grid.tria, dealii::IteratorFilters::LocallyOwnedCell());
             const auto global_boxes = dealii::Utilities::MPI::all_gather(comm, boxes);
-            particles.insert_global_particles(x, global_boxes, props, pid);
+            particles.insert_global_particles(x, global_boxes, props, row);
             if (particles.n_global_particles() != n)
               throw InputError(where + ": " + std::to_string(n) + " points in the file, " +
                                std::to_string(particles.n_global_particles()) + " placed in the grid");
+
+            const auto all_ids = f.read_rows_u64("particles/id", 0, n);
+            const auto all_ref = f.read_rows("particles/reference", 0, n);
+            struct Local
+            {
+              std::uint64_t       row;
+              unsigned int        cell;
+              dealii::Point<dim>  x;
+              std::vector<double> props;
+            };
+            std::vector<Local> local;
+            local.reserve(particles.n_locally_owned_particles());
+            for (const auto &pt : particles)
+              {
+                const auto P = pt.get_properties();
+                local.push_back({pt.get_id(), pt.get_surrounding_cell()->active_cell_index(), pt.get_location(),
+                                 std::vector<double>(P.begin(), P.end())});
+              }
+            std::sort(local.begin(), local.end(), [](const Local &a, const Local &c) { return a.row < c.row; });
+            std::vector<unsigned int> cell_order;
+            std::vector<std::vector<unsigned int>> in_cell_rows(grid.cells.size());
+            for (unsigned int k = 0; k < local.size(); ++k)
+              {
+                if (in_cell_rows[local[k].cell].empty())
+                  cell_order.push_back(local[k].cell);
+                in_cell_rows[local[k].cell].push_back(k);
+              }
+            particles.clear_particles();
+            for (const unsigned int c : cell_order)
+              for (const unsigned int k : in_cell_rows[c])
+                {
+                  const auto &       q  = local[k];
+                  dealii::Point<dim> xi = grid.reference_point(c, q.x), saved;
+                  double             dist = 0;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      saved[d] = all_ref[q.row * dim + d];
+                      dist     = std::max(dist, std::abs(saved[d] - xi[d]));
+                    }
+                  // the saved coordinates unless deal.II put the point into
+                  // the neighbour of its old cell (a point on a face)
+                  particles.insert_particle(q.x, dist < 1e-10 ? saved : xi, all_ids[q.row], grid.cell_iterators[c],
+                                            dealii::ArrayView<const double>(q.props));
+                }
+            particles.update_cached_numbers(); // counts; the order is re-created below
+            {
+              // update_cached_numbers() sorted the groups: re-create the order
+              std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> its;
+              for (const unsigned int c : cell_order)
+                {
+                  const auto range = particles.particles_in_cell(grid.cell_iterators[c]);
+                  its.clear();
+                  for (auto it = range.begin(); it != range.end(); ++it)
+                    its.push_back(it);
+                  std::vector<std::tuple<dealii::Point<dim>, dealii::Point<dim>, dealii::types::particle_index,
+                                         std::vector<double>>>
+                    copy;
+                  for (const auto &it : its)
+                    {
+                      const auto P = it->get_properties();
+                      copy.emplace_back(it->get_location(), it->get_reference_location(), it->get_id(),
+                                        std::vector<double>(P.begin(), P.end()));
+                    }
+                  for (auto it = its.rbegin(); it != its.rend(); ++it)
+                    particles.remove_particle(*it);
+                  for (const auto &[xx, xi, id, P] : copy)
+                    particles.insert_particle(xx, xi, id, grid.cell_iterators[c], dealii::ArrayView<const double>(P));
+                }
+            }
+
+            // the next step's nodal sums, by vertex and component
             p2g_ready = false;
+            if (f.exists("nodal/by_vertex") && f.get_int("p2g ready"))
+              {
+                const auto  table = f.read_all("nodal/by_vertex");
+                std::map<std::array<double, dim + 1>, std::pair<double, double>> sums;
+                for (std::size_t r = 0; r + dim + 3 <= table.size(); r += dim + 3)
+                  {
+                    std::array<double, dim + 1> key;
+                    std::copy(table.begin() + r, table.begin() + r + dim + 1, key.begin());
+                    sums[key] = {table[r + dim + 1], table[r + dim + 2]};
+                  }
+                const unsigned int n_owned = nodal_mass.locally_owned_size();
+                const auto         keys    = owned_dof_keys(grid, n_owned);
+                nodal_mass                 = 0;
+                nodal_a                    = 0;
+                bool all_found             = true;
+                for (unsigned int i = 0; i < n_owned; ++i)
+                  {
+                    const auto it = sums.find(keys[i]);
+                    if (it == sums.end())
+                      all_found = false;
+                    else
+                      {
+                        nodal_mass.local_element(i) = it->second.first;
+                        nodal_a.local_element(i)    = it->second.second;
+                      }
+                  }
+                // ghosts stay zero: the compress of the next step adds nothing
+                p2g_ready = dealii::Utilities::MPI::min(all_found ? 1 : 0, comm) == 1;
+              }
             // the memory-order sort counter: this rank's share
             std::uint64_t moves = 0;
             for (const auto m : f.read_all("ranks/moves"))
               moves += static_cast<std::uint64_t>(m);
             relocator->moves_since_sort() = moves / n_ranks;
           }
-        if (!same)
-          particles.update_cached_numbers();
 
         pvd_records.clear();
         grid_pvd_records.clear();
