@@ -40,8 +40,17 @@ talus_verification(explicit_oedometer_traction check_oedometer.py verification/o
 talus_verification(explicit_block_friction check_block_friction.py verification/block_friction.prm)
 talus_verification(explicit_staged_column check_stages.py verification/staged_column.prm)
 talus_verification(explicit_k0_column check_k0.py verification/k0_column.prm)
+# chapter 6 numerics (issue 5): contact (§6.2)
+add_test(NAME verification.explicit_contact
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                 ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact)
+set_tests_properties(verification.explicit_contact PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 
 # checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
 # 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
 talus_verification(explicit_checkpoint_restart check_restart.py demo/column_collapse_2d.prm)
 set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESSORS 2)
+
+# chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
+talus_verification(explicit_strain_smoothing check_smoothing.py verification/footing_incompressible.prm)

@@ -182,6 +182,7 @@ namespace talus::explicit_mpm
     }
     prm.leave_subsection();
 
+    declare_numerics_parameters(prm);
     prm.enter_subsection("checkpoint");
     {
       prm.declare_entry("interval", "0", Double(0),
@@ -399,6 +400,7 @@ namespace talus::explicit_mpm
         for (const auto &st : p.loads.stages)
           p.end_time += st.duration;
       }
+    p.numerics = parse_numerics_parameters(prm, n_bodies);
     check_consistency(p);
     return p;
   }
@@ -479,6 +481,14 @@ namespace talus::explicit_mpm
       }
     particles.initialize(grid.tria, grid.mapping, layout.n_properties());
     relocator = std::make_unique<Relocator<dim>>(grid, particles);
+    require(!two_phase || (!prm.numerics.extended_p2g() && prm.numerics.smoothing == NumericsOptions::Smoothing::none),
+            "numerics/integration, numerics/strain smoothing, contact/pairs",
+            "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
+            "2-phase materials or tractions); use integration = mpm, strain smoothing = none, no contact pairs");
+    if (prm.numerics.contact())
+      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size());
+    if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
+      smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
     bool restored = false;
     if (prm.restart != Parameters<dim>::Restart::no)
@@ -757,6 +767,12 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::p2g_mass_and_force()
   {
+    if (prm.numerics.extended_p2g())
+      {
+        p2g_extended(*this); // MPM-MIXED and/or per-body contact fields
+        p2g_ready = true;
+        return;
+      }
     double *const M = nodal_mass.begin();
     double *const F = nodal_a.begin();
     zero_on_active(nodal_mass);
@@ -868,6 +884,7 @@ namespace talus::explicit_mpm
     // relocation, and any deal.II sort falls back to a full P2G pass.
     double *const M = nodal_mass.begin();
     double *const F = nodal_a.begin();
+    const bool    fuse = !prm.numerics.extended_p2g(); // else a full P2G pass follows
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
     // Every non-zero entry of the mass/force vectors belongs to a cell that
@@ -898,10 +915,23 @@ namespace talus::explicit_mpm
             QF::weights(xi, N, w);
             // displacement increment gradient and position increment
             double gu[dim][dim], dx[dim] = {};
-            QF::gradient(D, w, cc.inv_h, gu);
-            for (unsigned int v = 0; v < nv; ++v)
-              for (unsigned int d = 0; d < dim; ++d)
-                dx[d] += N[v] * du[v][d];
+            if (contact) // the body's own nodal velocities (§6.2)
+              {
+                double dub[nv][dim], Db[dim][QF::npairs][dim];
+                contact->body_increments(cc, static_cast<unsigned int>(P[L::body]), h, dub);
+                QF::differences(dub, Db);
+                QF::gradient(Db, w, cc.inv_h, gu);
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    dx[d] += N[v] * dub[v][d];
+              }
+            else
+              {
+                QF::gradient(D, w, cc.inv_h, gu);
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    dx[d] += N[v] * du[v][d];
+              }
             materials::Strain d_eps;
             materials::Spin   d_omega;
             for (unsigned int d = 0; d < dim; ++d)
@@ -911,6 +941,8 @@ namespace talus::explicit_mpm
                     d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
                   d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
                 }
+            if (smoothing) // §6.7.1: smoothed volumetric part
+              smoothing->apply(c, d_eps);
             const unsigned int          mat = static_cast<unsigned int>(P[L::material]);
             const materials::Material &m   = *prm.materials[mat];
             auto                        sigma = L::get_stress(P);
@@ -972,12 +1004,14 @@ namespace talus::explicit_mpm
             if (inside)
               {
                 pt->set_reference_location(nxi);
-                acc.add(nxi, P);
+                if (fuse)
+                  acc.add(nxi, P);
               }
             else
               relocator->leaving(pt, c);
           }
-        acc.scatter(cc, g, M, F);
+        if (fuse)
+          acc.scatter(cc, g, M, F);
       }
     local_energies = e;
     local_momentum = momentum;
@@ -1001,14 +1035,23 @@ namespace talus::explicit_mpm
     timings.p2g += seconds_since(t0);
     t0 = Clock::now();
     nodal_acceleration();
+    if (contact)
+      contact->correct_accelerations(*this, h);
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
-    g2p_velocity_p2g_momentum(h);
+    if (contact)
+      contact->g2p_velocity_p2g_momentum(*this, h);
+    else
+      g2p_velocity_p2g_momentum(h);
     if (control)
       control->particle_velocities(*this); // prescribed material point velocities
     timings.p2g += seconds_since(t0);
     t0 = Clock::now();
     nodal_velocity();
+    if (contact)
+      contact->correct_velocities(*this, h);
+    if (smoothing)
+      smoothing->compute(*this, h);
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
     g2p_update(h);
@@ -1026,7 +1069,8 @@ namespace talus::explicit_mpm
                       });
     // a deal.II sort recomputes reference locations and may move particles to
     // other ranks: the fused P2G is then redone from scratch
-    p2g_ready = relocation_stats.global_sorts + relocation_stats.storage_sorts == sorts_before;
+    p2g_ready = relocation_stats.global_sorts + relocation_stats.storage_sorts == sorts_before &&
+                !prm.numerics.extended_p2g();
     update_active_cells();
     timings.relocation += seconds_since(t0);
   }

@@ -3,6 +3,7 @@
 // update), Jaumann-rate stress update, volume update, relocation.
 #pragma once
 
+#include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/grid/background_grid.h>
 #include <talus/loads/settings.h>
@@ -67,6 +68,8 @@ namespace talus::explicit_mpm
     std::vector<BodyDescription<dim>>                        bodies;
     // loads, friction, damping, convergence, mass scaling, K0, stages
     loads::Settings<dim> loads;
+    // MPM-MIXED, strain smoothing, contact (seed 000 chapter 6; numerics.h)
+    NumericsOptions numerics;
     // pore liquid per material, tractions per body, free-surface detection
     // (explicit_two_phase.h)
     LiquidParameters<dim> liquid;
@@ -192,6 +195,9 @@ namespace talus::explicit_mpm
     /// Loads/friction/damping/convergence/K0/stages; null when none is used.
     std::unique_ptr<loads::LoadControl<dim>>      control;
 
+    /// chapter-6 numerics, null when switched off (numerics.h)
+    std::unique_ptr<Contact<dim>>                 contact;
+    std::unique_ptr<StrainSmoothing<dim>>         smoothing;
     /// 2-phase / traction step (separate passes; null: the fused 1-phase step)
     std::unique_ptr<TwoPhase<dim>>                two_phase;
     /// free-surface detection at output times (null: off)

@@ -1,0 +1,365 @@
+// talus — MPM-MIXED integration (seed 000 §6.6), strain smoothing (§6.7.1) and
+// the .prm entries of the chapter-6 numerics; contact is in contact.cc.
+#include <talus/base/errors.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/numerics.h>
+#include <talus/shape/q1.h>
+
+#include <deal.II/base/utilities.h>
+
+#include <cmath>
+#include <set>
+
+namespace talus::explicit_mpm
+{
+  // ================================================================ parameters
+  void
+  declare_numerics_parameters(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii::Patterns;
+    prm.enter_subsection("numerics");
+    prm.declare_entry("integration", "mpm", Selection("mpm|mpm-mixed"),
+                      "Integration of the internal force (seed 000 §6.6): 'mpm' at the material points; "
+                      "'mpm-mixed' at the Gauss point(s) of every cell whose material points fill more than "
+                      "'fill factor' of its volume (Eq. 6.33), with the volume-averaged stress of its points "
+                      "(Eq. 6.32); partially filled cells keep material point integration.");
+    prm.declare_entry("fill factor", "0.9", Double(0, 10),
+                      "F_fill of Eq. 6.33 for 'integration = mpm-mixed': a cell is integrated at its Gauss "
+                      "point when the volume of its material points exceeds F_fill x the cell volume.");
+    prm.declare_entry("strain smoothing", "none", Selection("none|cell|nodal"),
+                      "Anti-locking smoothing of the volumetric strain increment (seed 000 §6.7.1): 'none'; "
+                      "'cell' replaces each point's volumetric increment by its cell's (mean dilatation); "
+                      "'nodal' = nodal mixed discretisation: cell values averaged to the nodes weighted by cell "
+                      "volume (Eq. 6.35) and back to the cell as the mean of its nodes (Eqs. 6.36-6.37).");
+    prm.leave_subsection();
+    prm.enter_subsection("contact");
+    prm.declare_entry("pairs", "", Anything(),
+                      "Body pairs in frictional contact (seed 000 §6.2): 'a, b, mu, adhesion; ...' with body ids "
+                      "a != b, Coulomb friction coefficient mu >= 0 and adhesion >= 0 [Pa] (tangential force cap "
+                      "adhesion x contact area of the node). Empty: contact off (all bodies share one velocity "
+                      "field). With contact on, bodies whose pair is not listed stick to each other.");
+    prm.leave_subsection();
+  }
+
+  NumericsOptions
+  parse_numerics_parameters(dealii::ParameterHandler &prm, const unsigned int n_bodies)
+  {
+    NumericsOptions o;
+    prm.enter_subsection("numerics");
+    o.integration = prm.get("integration") == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed :
+                                                            NumericsOptions::Integration::mpm;
+    o.fill_factor = prm.get_double("fill factor");
+    require(o.fill_factor > 0, "numerics/fill factor", "must be > 0 (the manual uses 0.9)");
+    const std::string s = prm.get("strain smoothing");
+    o.smoothing = s == "cell" ? NumericsOptions::Smoothing::cell :
+                  s == "nodal" ? NumericsOptions::Smoothing::nodal :
+                                 NumericsOptions::Smoothing::none;
+    prm.leave_subsection();
+
+    prm.enter_subsection("contact");
+    const std::string where = "contact/pairs";
+    std::set<std::pair<unsigned int, unsigned int>> seen;
+    for (const auto &item : dealii::Utilities::split_string_list(prm.get("pairs"), ';'))
+      {
+        const auto f = dealii::Utilities::split_string_list(item, ',');
+        require(f.size() == 4, where, "'" + item + "' must be 'body a, body b, friction coefficient, adhesion'");
+        double v[4];
+        for (unsigned int k = 0; k < 4; ++k)
+          {
+            try
+              {
+                std::size_t pos = 0;
+                v[k]            = std::stod(f[k], &pos);
+                if (pos != f[k].size())
+                  throw std::invalid_argument(f[k]);
+              }
+            catch (const std::exception &)
+              {
+                throw InputError(where + ": '" + f[k] + "' in '" + item + "' is not a number");
+              }
+          }
+        for (unsigned int k = 0; k < 2; ++k)
+          require(v[k] >= 0 && v[k] == std::floor(v[k]) && v[k] < n_bodies, where,
+                  "body id '" + f[k] + "' in '" + item + "' is not one of the bodies 0.." +
+                    std::to_string(n_bodies - 1));
+        NumericsOptions::ContactPair p;
+        p.a        = static_cast<unsigned int>(v[0]);
+        p.b        = static_cast<unsigned int>(v[1]);
+        p.friction = v[2];
+        p.adhesion = v[3];
+        require(p.a != p.b, where, "'" + item + "': a body cannot be in contact with itself");
+        require(std::isfinite(p.friction) && p.friction >= 0, where,
+                "'" + item + "': the friction coefficient must be >= 0");
+        require(std::isfinite(p.adhesion) && p.adhesion >= 0, where, "'" + item + "': the adhesion must be >= 0");
+        require(seen.insert({std::min(p.a, p.b), std::max(p.a, p.b)}).second, where,
+                "'" + item + "': pair listed twice");
+        o.contact_pairs.push_back(p);
+      }
+    prm.leave_subsection();
+    return o;
+  }
+
+  // ================================================================ extended P2G
+  namespace
+  {
+    /// Per-cell, per-body accumulator for the contact fields.
+    template <int dim>
+    struct BodyAcc
+    {
+      using F = shape::Q1Factorised<dim>;
+      double lm[F::nv], lvol[F::nv], lp[F::nv][dim];
+      double T[dim][F::npairs][dim];
+      void
+      clear()
+      {
+        std::fill(&lm[0], &lm[0] + F::nv, 0.0);
+        std::fill(&lvol[0], &lvol[0] + F::nv, 0.0);
+        std::fill(&lp[0][0], &lp[0][0] + F::nv * dim, 0.0);
+        std::fill(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, 0.0);
+      }
+    };
+
+    template <int dim>
+    inline void
+    minus_V_sigma(const double *P, const double V, double (&t)[dim][dim])
+    {
+      using L = PropertyLayout<dim>;
+      t[0][0] = -V * P[L::stress + 0];
+      t[1][1] = -V * P[L::stress + 1];
+      t[0][1] = t[1][0] = -V * P[L::stress + 3];
+      if constexpr (dim == 3)
+        {
+          t[2][2]           = -V * P[L::stress + 2];
+          t[1][2] = t[2][1] = -V * P[L::stress + 4];
+          t[0][2] = t[2][0] = -V * P[L::stress + 5];
+        }
+    }
+
+    void
+    zero_on(Vector &v, const std::vector<unsigned int> &active_dofs)
+    {
+      v.zero_out_ghost_values();
+      double *x = v.begin();
+      for (const unsigned int i : active_dofs)
+        x[i] = 0.0;
+    }
+  } // namespace
+
+  template <int dim>
+  void
+  p2g_extended(Solver<dim> &s)
+  {
+    using L                    = PropertyLayout<dim>;
+    using F                    = shape::Q1Factorised<dim>;
+    constexpr unsigned int nv  = F::nv;
+    constexpr unsigned int nst = L::n_stress;
+    const bool   mixed         = s.prm.numerics.integration == NumericsOptions::Integration::mpm_mixed;
+    const double fill          = s.prm.numerics.fill_factor;
+    Contact<dim> *contact      = s.contact.get();
+    const auto    g            = s.prm.gravity;
+
+    double *const M  = s.nodal_mass.begin();
+    double *const Fv = s.nodal_a.begin();
+    zero_on(s.nodal_mass, s.active_dofs);
+    zero_on(s.nodal_a, s.active_dofs);
+    const unsigned int n_bodies = contact ? contact->n_bodies : 0;
+    std::vector<BodyAcc<dim>> bacc(n_bodies);
+    std::vector<unsigned int> touched;
+    std::vector<unsigned char> in_cell(n_bodies, 0);
+    if (contact)
+      for (auto &f : contact->fields)
+        {
+          zero_on(f.mass, s.active_dofs);
+          zero_on(f.force, s.active_dofs);
+          zero_on(f.momentum, s.active_dofs);
+        }
+    // weight of every pair moment at the cell centre: 0.5^(dim-1)
+    const double w_centre = dim == 2 ? 0.5 : 0.25;
+
+    auto pt = s.particles.begin();
+    for (const auto [c, n_in_cell] : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[c];
+        double      lm[nv] = {}, T[dim][F::npairs][dim] = {};
+        double      sV = 0, sVs[nst] = {};
+        touched.clear();
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          {
+            const double *P  = pt->get_properties().data();
+            const auto    xi = pt->get_reference_location();
+            double        N[nv], w[dim][F::npairs];
+            F::weights(xi, N, w);
+            const double m = P[L::mass], V = P[L::volume];
+            for (unsigned int v = 0; v < nv; ++v)
+              lm[v] += m * N[v];
+            double t[dim][dim];
+            minus_V_sigma<dim>(P, V, t);
+            F::add_moments(t, w, T);
+            if (mixed)
+              {
+                sV += V;
+                for (unsigned int q = 0; q < nst; ++q)
+                  sVs[q] += V * P[L::stress + q];
+              }
+            if (contact)
+              {
+                const unsigned int b = static_cast<unsigned int>(P[L::body]);
+                auto &             a = bacc[b];
+                if (!in_cell[b])
+                  {
+                    in_cell[b] = 1;
+                    touched.push_back(b);
+                    a.clear();
+                  }
+                for (unsigned int v = 0; v < nv; ++v)
+                  {
+                    a.lm[v] += m * N[v];
+                    a.lvol[v] += V * N[v];
+                    for (unsigned int d = 0; d < dim; ++d)
+                      a.lp[v][d] += m * N[v] * P[L::velocity + d];
+                  }
+                F::add_moments(t, w, a.T);
+              }
+          }
+        double cell_volume = 1.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          cell_volume *= cc.h[d];
+        // §6.6: a filled cell (Eq. 6.33) is integrated at its Gauss point with
+        // the volume-averaged stress (Eq. 6.32); for a constant stress on a box
+        // the one-point rule at the centre is exact, the same as 2^dim points.
+        // With contact, only single-body cells are mixed-integrated (the body's
+        // force must equal the cell's).
+        const bool use_mixed = mixed && sV > fill * cell_volume && (!contact || touched.size() <= 1);
+        if (use_mixed)
+          {
+            double t[dim][dim];
+            double Pavg[L::stress + nst];
+            for (unsigned int q = 0; q < nst; ++q)
+              Pavg[L::stress + q] = sVs[q] / sV;
+            minus_V_sigma<dim>(Pavg, cell_volume, t);
+            for (unsigned int kk = 0; kk < dim; ++kk)
+              for (unsigned int j = 0; j < F::npairs; ++j)
+                for (unsigned int q = 0; q < dim; ++q)
+                  T[kk][j][q] = t[q][kk] * w_centre;
+          }
+        double f[nv][dim];
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            f[v][d] = lm[v] * g[d];
+        F::expand_moments(T, cc.inv_h, f);
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const unsigned int i = cc.dofs[v * dim + d];
+              M[i] += lm[v];
+              Fv[i] += f[v][d];
+            }
+        if (contact)
+          for (const unsigned int b : touched)
+            {
+              in_cell[b] = 0;
+              auto &a    = bacc[b];
+              if (use_mixed)
+                std::copy(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, &a.T[0][0][0]);
+              double fb[nv][dim];
+              for (unsigned int v = 0; v < nv; ++v)
+                for (unsigned int d = 0; d < dim; ++d)
+                  fb[v][d] = a.lm[v] * g[d];
+              F::expand_moments(a.T, cc.inv_h, fb);
+              auto &        fl  = contact->fields[b];
+              double *const bm  = fl.mass.begin();
+              double *const bf  = fl.force.begin();
+              double *const bp  = fl.momentum.begin();
+              for (unsigned int v = 0; v < nv; ++v)
+                {
+                  bm[cc.dofs[v * dim + 0]] += a.lm[v];
+                  bm[cc.dofs[v * dim + 1]] += a.lvol[v];
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      const unsigned int i = cc.dofs[v * dim + d];
+                      bf[i] += fb[v][d];
+                      bp[i] += a.lp[v][d];
+                    }
+                }
+            }
+      }
+  }
+
+  // ================================================================ smoothing
+  template <int dim>
+  StrainSmoothing<dim>::StrainSmoothing(const BackgroundGrid<dim> &grid, const NumericsOptions::Smoothing k)
+    : kind(k)
+  {
+    cell_value.assign(grid.cells.size(), 0.0);
+    if (kind == NumericsOptions::Smoothing::nodal)
+      grid.reinit_vector(nodal);
+  }
+
+  template <int dim>
+  void
+  StrainSmoothing<dim>::compute(const Solver<dim> &s, const double dt)
+  {
+    using F                   = shape::Q1Factorised<dim>;
+    constexpr unsigned int nv = F::nv;
+    const double *const    Vn = s.nodal_p.begin();
+    // element value: the volumetric strain increment of the Q1 field at the cell
+    // centre, which is its cell average (the divergence of a Q1 field is linear
+    // in each coordinate)
+    double w[dim][F::npairs];
+    {
+      double             N[nv];
+      dealii::Point<dim> centre;
+      for (unsigned int d = 0; d < dim; ++d)
+        centre[d] = 0.5;
+      F::weights(centre, N, w);
+    }
+    for (const auto &ac : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[ac.cell];
+        double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            du[v][d] = dt * Vn[cc.dofs[v * dim + d]];
+        F::differences(du, D);
+        F::gradient(D, w, cc.inv_h, gu);
+        double tr = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          tr += gu[d][d];
+        cell_value[ac.cell] = tr;
+      }
+    if (kind == NumericsOptions::Smoothing::cell)
+      return;
+    // Eq. 6.35: nodal value = sum over the surrounding active cells of
+    // eps_el Omega_el / sum Omega_el (component 0 / component 1 of the vector)
+    zero_on(nodal, s.active_dofs);
+    double *const X = nodal.begin();
+    for (const auto &ac : s.active_cells)
+      {
+        const auto &cc     = s.grid.cells[ac.cell];
+        double      volume = 1.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          volume *= cc.h[d];
+        for (unsigned int v = 0; v < nv; ++v)
+          {
+            X[cc.dofs[v * dim + 0]] += cell_value[ac.cell] * volume;
+            X[cc.dofs[v * dim + 1]] += volume;
+          }
+      }
+    nodal.compress(dealii::VectorOperation::add);
+    nodal.update_ghost_values();
+    // Eq. 6.36: the cell's value is the mean of its nodal values
+    for (const auto &ac : s.active_cells)
+      {
+        const auto &cc  = s.grid.cells[ac.cell];
+        double      sum = 0;
+        for (unsigned int v = 0; v < nv; ++v)
+          sum += X[cc.dofs[v * dim + 0]] / X[cc.dofs[v * dim + 1]];
+        cell_value[ac.cell] = sum / nv;
+      }
+  }
+
+  template void p2g_extended<2>(Solver<2> &);
+  template void p2g_extended<3>(Solver<3> &);
+  template class StrainSmoothing<2>;
+  template class StrainSmoothing<3>;
+} // namespace talus::explicit_mpm

@@ -1,0 +1,156 @@
+// talus — optional numerics of the explicit solver (seed 000 chapter 6):
+//  * MPM-MIXED integration of the internal force (§6.6),
+//  * strain smoothing by nodal mixed discretisation (§6.7.1),
+//  * contact between bodies, predictor-corrector with Coulomb friction and
+//    adhesion (§6.2, Bardenhagen et al.).
+// Each is a .prm switch; when a switch is off its object does not exist and the
+// solver's hot loops see one null pointer test per cell or particle.
+#pragma once
+
+#include <talus/grid/background_grid.h>
+#include <talus/materials/material.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace talus::explicit_mpm
+{
+  template <int dim>
+  class Solver;
+
+  /// Options of chapter 6 read from the .prm (subsections `numerics`, `contact`).
+  struct NumericsOptions
+  {
+    enum class Integration
+    {
+      mpm,      ///< internal force integrated at the material points (MPM-MP)
+      mpm_mixed ///< Gauss integration with the cell-averaged stress in filled cells (§6.6)
+    };
+    enum class Smoothing
+    {
+      none,
+      cell, ///< volumetric strain increment replaced by the cell average (mean dilatation)
+      nodal ///< nodal mixed discretisation: cell values averaged to the nodes and back (Eqs. 6.35-6.37)
+    };
+    Integration integration = Integration::mpm;
+    double      fill_factor = 0.9; ///< F_fill of Eq. 6.33
+    Smoothing   smoothing   = Smoothing::none;
+
+    struct ContactPair
+    {
+      unsigned int a = 0, b = 0;
+      double       friction = 0; ///< Coulomb coefficient mu
+      double       adhesion = 0; ///< a [Pa]: tangential force cap a * A_k (Eq. 6.19)
+    };
+    std::vector<ContactPair> contact_pairs; ///< empty: contact off
+
+    bool contact() const { return !contact_pairs.empty(); }
+    /// the solver needs a full (non-fused) P2G pass every step
+    bool extended_p2g() const { return integration == Integration::mpm_mixed || contact(); }
+  };
+
+  void declare_numerics_parameters(dealii::ParameterHandler &prm);
+  /// Reads and validates; n_bodies for the body ids of the contact pairs.
+  NumericsOptions parse_numerics_parameters(dealii::ParameterHandler &prm, unsigned int n_bodies);
+
+  /// Full P2G of lumped mass and internal + gravity force with MPM-MIXED
+  /// integration and/or per-body fields for contact. Replaces the solver's
+  /// P2G pass when `extended_p2g()`.
+  template <int dim>
+  void p2g_extended(Solver<dim> &s);
+
+  /// Strain smoothing (§6.7.1): after the nodal velocities are known, a volumetric
+  /// strain increment per active cell; the update pass replaces each point's
+  /// volumetric part by it.
+  template <int dim>
+  class StrainSmoothing
+  {
+  public:
+    StrainSmoothing(const BackgroundGrid<dim> &grid, NumericsOptions::Smoothing kind);
+    /// From the nodal velocities of the solver (nodal_p after nodal_velocity()).
+    void compute(const Solver<dim> &s, double dt);
+    /// Replace the volumetric part of d_eps (in-plane trace in 2D) by the cell value.
+    inline void
+    apply(const unsigned int cell, materials::Strain &d_eps) const
+    {
+      double tr = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        tr += d_eps[d][d];
+      const double c = (cell_value[cell] - tr) / dim;
+      for (unsigned int d = 0; d < dim; ++d)
+        d_eps[d][d] += c;
+    }
+
+  private:
+    NumericsOptions::Smoothing kind;
+    std::vector<double>        cell_value; ///< by active cell index
+    Vector                     nodal;      ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
+  };
+
+  /// Contact between bodies (§6.2). Every body gets its own nodal mass, force,
+  /// momentum and mass gradient (distributed vectors, allocated only when
+  /// contact is on). At nodes where a body meets another one, the
+  /// predictor-corrector of Bardenhagen et al. corrects the body's velocity:
+  /// free separation, no interpenetration, Coulomb friction with adhesion for
+  /// the pairs listed in the .prm, sticking for pairs not listed.
+  template <int dim>
+  class Contact
+  {
+  public:
+    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies);
+
+    /// Lagrangian phase: after nodal_acceleration(), the corrected per-body
+    /// accelerations a~_b = (v~_b - v_b^t) / dt (Eq. 6.21).
+    void correct_accelerations(Solver<dim> &s, double dt);
+    /// G2P of the particle velocities with the per-body accelerations and P2G
+    /// of the momentum per body and combined (replaces the solver's pass).
+    void g2p_velocity_p2g_momentum(Solver<dim> &s, double dt);
+    /// Convective phase: per-body nodal velocities from momentum, corrected
+    /// by the same contact law (after the solver's nodal_velocity()).
+    void correct_velocities(Solver<dim> &s, double dt);
+    /// Displacement increments dt * v_b of body b at the vertices of a cell.
+    inline void
+    body_increments(const CellCache<dim> &cc, const unsigned int body, const double dt,
+                    double (&du)[1u << dim][dim]) const
+    {
+      const double *V = fields[body].momentum.begin();
+      for (unsigned int v = 0; v < (1u << dim); ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          du[v][d] = dt * V[cc.dofs[v * dim + d]];
+    }
+
+    /// Statistics of the last step (for the log): nodes with > 1 body, nodes corrected.
+    unsigned long long contact_nodes = 0, corrected_nodes = 0;
+
+    struct BodyFields
+    {
+      Vector mass;     ///< component 0: mass, component 1: volume (for the adhesion area)
+      Vector force;    ///< internal + gravity force; after correct_accelerations: a~_b
+      Vector momentum; ///< momentum; after correct_velocities: v~_b
+      Vector gradient; ///< minus the gradient of the nodal mass field: outward normal of the body
+    };
+    std::vector<BodyFields> fields;
+
+  private:
+    friend void p2g_extended<dim>(Solver<dim> &s);
+    const BackgroundGrid<dim> &grid;
+    unsigned int               n_bodies;
+    /// pair_index[a * n + b]: index into pairs or -1 (stick)
+    std::vector<int>                          pair_index;
+    std::vector<NumericsOptions::ContactPair> pairs;
+    double                                    cell_volume = 0;
+    double                                    h[dim];
+    /// owned active nodes: local DoF indices of their dim components
+    std::vector<std::array<unsigned int, dim>> nodes;
+    std::vector<unsigned char>                 node_marker;
+    void collect_nodes(const Solver<dim> &s);
+    void compute_normals(const Solver<dim> &s);
+    /// the contact law at one node: predicted per-body velocities vb (in),
+    /// corrected (out); returns true if a correction was applied
+    bool correct_node(const std::array<unsigned int, dim> &dofs, const std::vector<unsigned char> &constrained,
+                      std::vector<double> &mb, std::vector<std::array<double, dim>> &vb, double dt);
+  };
+} // namespace talus::explicit_mpm
