@@ -1,13 +1,17 @@
 // talus-critical-dt: the critical time step of an explicit scene, from the
 // formula (seed 000 §4.6.1) and, with --probe, measured by short runs.
+#include <talus/analysis/scheme_stability.h>
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/io/output.h>
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/particles/particle_handler.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <iomanip>
 #include <sstream>
 
@@ -34,6 +38,63 @@ namespace
     const double dt_cr = rows[ctrl].dt;
     const double dt    = s.time_step();
 
+    // Per material: the cell with the smallest edge among the cells holding its
+    // points (the controlling cell) and the points per direction (largest over the
+    // bodies of that material: the scheme limit decreases with n).
+    const unsigned int n_mat = rows.size();
+    struct CellInfo
+    {
+      double      h = std::numeric_limits<double>::max();
+      std::string id, center;
+    };
+    std::vector<CellInfo> cell_of(n_mat);
+    {
+      std::vector<double>      h_loc(n_mat, std::numeric_limits<double>::max());
+      std::vector<std::string> id_loc(n_mat), center_loc(n_mat);
+      for (const auto &pt : s.particles)
+        {
+          const unsigned int m = static_cast<unsigned int>(pt.get_properties()[2] + 0.5);
+          if (m >= n_mat)
+            continue;
+          const auto   cell = pt.get_surrounding_cell();
+          const double h    = cell->minimum_vertex_distance();
+          if (h < h_loc[m])
+            {
+              h_loc[m] = h;
+              id_loc[m] = cell->id().to_string();
+              std::ostringstream c;
+              c << std::setprecision(6) << "(" << cell->center() << ")";
+              center_loc[m] = c.str();
+            }
+        }
+      for (unsigned int m = 0; m < n_mat; ++m)
+        {
+          const auto all_h  = dealii::Utilities::MPI::all_gather(MPI_COMM_WORLD, h_loc[m]);
+          const auto all_id = dealii::Utilities::MPI::all_gather(MPI_COMM_WORLD, id_loc[m]);
+          const auto all_c  = dealii::Utilities::MPI::all_gather(MPI_COMM_WORLD, center_loc[m]);
+          for (std::size_t r = 0; r < all_h.size(); ++r)
+            if (all_h[r] < cell_of[m].h)
+              cell_of[m] = {all_h[r], all_id[r], all_c[r]};
+        }
+    }
+    std::vector<unsigned int> n_points(n_mat, 0);
+    for (const auto &b : p.bodies)
+      if (b.material_id < n_mat)
+        n_points[b.material_id] = std::max(n_points[b.material_id], b.particles_per_direction);
+    // Stability limit of the scheme actually implemented (lumped mass, USL update with
+    // the momentum re-projection), from the eigenvalues of one step on a uniform 1D
+    // grid (docs/stability-analysis.md): dt_scheme = f(n) L / c for the wave part of
+    // solid, undrained and liquid materials; not analysed for the coupled 2-phase step.
+    std::vector<double> f_scheme(n_mat, 0.0), dt_scheme(n_mat, 0.0);
+    for (unsigned int m = 0; m < n_mat; ++m)
+      if (rows[m].phase != "coupled" && n_points[m] > 0)
+        {
+          f_scheme[m]  = analysis::scheme_critical_factor_closed_form(n_points[m]);
+          dt_scheme[m] = f_scheme[m] * rows[m].dt_wave;
+          if (rows[m].phase == "liquid" && rows[m].dt_other > 0)
+            dt_scheme[m] = std::min(dt_scheme[m], rows[m].dt_other);
+        }
+
     log() << std::setprecision(6)
           << "talus-critical-dt: explicit MPM (seed 000 §4.6: 1-phase solid Eq. 4.120, dt_cr = L_min / c, "
              "c = sqrt(E_c / rho); 1-phase liquid Eq. 4.121 and the viscous limit rho L^2 / (2 mu); "
@@ -42,8 +103,9 @@ namespace
     if (s.mass_scaling != 1.0)
       log() << "  mass scaling factor " << s.mass_scaling << " (first stage): wave speeds and critical time steps "
             << "below are scaled (Eq. 6.31, dt_cr x sqrt(beta))\n";
-    for (const auto &r : rows)
+    for (std::size_t i = 0; i < rows.size(); ++i)
       {
+        const auto &r = rows[i];
         log() << "  " << r.material << " (" << r.model << ", " << r.phase << "): c = " << r.wave_speed
               << " m/s, dt_cr = " << r.dt << " s (" << r.formula << ")";
         if (r.phase == "coupled")
@@ -51,10 +113,19 @@ namespace
                 << " s, Eq. 4.122 min = " << r.dt_4_122 << " s";
         else if (r.phase == "liquid" && r.dt_other > 0)
           log() << "; L/c = " << r.dt_wave << " s, viscous = " << r.dt_other << " s";
+        log() << "\n    controlling cell " << cell_of[i].id << " centre " << cell_of[i].center << ", smallest edge "
+              << cell_of[i].h << " m; " << n_points[i] << " points per direction";
+        if (dt_scheme[i] > 0)
+          log() << "; scheme limit (1D eigenvalue analysis of the implemented step) " << dt_scheme[i] << " s = "
+                << dt_scheme[i] / r.dt << " x " << r.formula;
+        else
+          log() << "; scheme limit not analysed for this phase";
         log() << "\n";
       }
-    log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s\n"
-          << "  time step in use: " << dt << " s = " << dt / dt_cr << " x critical\n";
+    log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s (" << rows[ctrl].formula
+          << ", the default), controlling cell " << cell_of[ctrl].id << "\n"
+          << "  time step in use: " << dt << " s = " << dt / dt_cr << " x critical"
+          << (p.time_step > 0 ? " (fixed time step)" : " (Courant number " + std::to_string(p.courant) + ")") << "\n";
 
     double measured = 0, probe_lo = 0, probe_hi = 0;
     const bool probe = tool_option_given("--probe");
@@ -98,7 +169,10 @@ namespace
         measured = lo * dt_cr;
         log() << "  probe (" << n_steps << " steps per run, bisection): stable at " << lo << " x, unstable at " << hi
               << " x critical; measured critical time step " << measured << " s = " << lo
-              << " x the formula\n";
+              << " x the formula";
+        if (dt_scheme[ctrl] > 0)
+          log() << ", " << measured / dt_scheme[ctrl] << " x the scheme limit " << dt_scheme[ctrl] << " s";
+        log() << "\n";
       }
 
     const std::string csv = tool_option_value("--csv", "");
@@ -107,13 +181,15 @@ namespace
         io::AtomicFile f(csv);
         f.stream() << std::setprecision(10)
                    << "material,model,phase,formula,wave_speed,L_min,dt_critical_formula,dt_wave,dt_other,dt_eq_4_122,"
-                      "controlling,dt_in_use,courant_in_use,dt_measured,probe_stable_factor,probe_unstable_factor\n";
+                      "controlling,dt_in_use,courant_in_use,dt_measured,probe_stable_factor,probe_unstable_factor,"
+                      "controlling_cell,cell_edge,points_per_direction,scheme_factor,dt_scheme\n";
         for (std::size_t i = 0; i < rows.size(); ++i)
           f.stream() << rows[i].material << "," << rows[i].model << "," << rows[i].phase << ",\"" << rows[i].formula
                      << "\"," << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << rows[i].dt_wave << ","
                      << rows[i].dt_other << "," << rows[i].dt_4_122 << "," << (i == ctrl ? 1 : 0) << "," << dt << "," << dt / dt_cr << ","
                      << (probe && i == ctrl ? measured : 0.0) << "," << (probe && i == ctrl ? probe_lo : 0.0) << ","
-                     << (probe && i == ctrl ? probe_hi : 0.0) << "\n";
+                     << (probe && i == ctrl ? probe_hi : 0.0) << "," << cell_of[i].id << "," << cell_of[i].h << ","
+                     << n_points[i] << "," << f_scheme[i] << "," << dt_scheme[i] << "\n";
         f.commit();
       }
     return exit_ok;
@@ -128,7 +204,9 @@ main(int argc, char **argv)
   tool.summary = "Critical time step of an explicit scene (the talus-explicit .prm): per material the phase\n"
                  "(solid, liquid, undrained, coupled), the wave speed and the formula of seed 000 §4.6\n"
                  "(Eq. 4.120, 4.121 + viscous limit, 4.122 and 4.129), the controlling material and the\n"
-                 "time step in use.\n"
+                 "time step in use, the controlling cell of each material and the stability limit of\n"
+                 "the scheme actually implemented (eigenvalues of one step on a uniform 1D grid with the\n"
+                 "points per direction of the scene; docs/stability-analysis.md).\n"
                  "With --probe, the real limit is measured by bisection on short forced runs whose\n"
                  "instability check (energy growth, non-finite state) decides stable / unstable.";
   tool.declare = &talus::explicit_mpm::declare_parameters;

@@ -1,0 +1,24 @@
+// talus — von Neumann / eigenvalue stability analysis of the explicit MPM step
+// actually implemented (seed 000 §4.3.7: lumped mass, USL-type update with the
+// momentum re-projection of Eqs. 4.47-4.48), on a uniform 1D grid of linear
+// elements with n equally spaced material points per cell (at (k + 1/2) / n).
+// See docs/stability-analysis.md for the derivation.
+#pragma once
+
+namespace talus::analysis
+{
+  /// Spectral radius of the amplification matrix of one step of size
+  /// dt = factor * h / c (c = sqrt(E / rho)), for n_points points per cell on
+  /// n_cells cells: periodic (Bloch waves theta = 2 pi k / n_cells) or a bar
+  /// fixed at x = 0 and free at x = n_cells h.
+  double scheme_spectral_radius(unsigned int n_points, unsigned int n_cells, bool periodic, double factor);
+
+  /// Closed form of the limit on an infinite uniform grid (Bloch analysis of the
+  /// reduced nodal recurrence, docs/stability-analysis.md):
+  /// dt_scheme = 2 sqrt(2/3 + 1/(3 n^2)) h / c (n = 1: 2, n = 2: sqrt(3), n -> oo: sqrt(8/3)).
+  double scheme_critical_factor_closed_form(unsigned int n_points);
+
+  /// Largest factor f (dt = f h / c) for which the spectral radius stays <= 1
+  /// (to 1e-7 in |lambda|): bisection on f in [0.1, 4], to relative 1e-6.
+  double scheme_critical_factor(unsigned int n_points, unsigned int n_cells = 32, bool periodic = true);
+} // namespace talus::analysis

@@ -1,0 +1,41 @@
+// Stability limit of the implemented explicit step on a uniform 1D grid (issue 6):
+// the eigenvalues of the full point-state amplification matrix (LAPACK) must give
+// the closed form of the reduced nodal recurrence, docs/stability-analysis.md.
+#include <talus/analysis/scheme_stability.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace talus::analysis;
+
+TEST(SchemeStability, ClosedFormValues)
+{
+  EXPECT_NEAR(scheme_critical_factor_closed_form(1), 2.0, 1e-14);
+  EXPECT_NEAR(scheme_critical_factor_closed_form(2), std::sqrt(3.0), 1e-14);
+}
+
+TEST(SchemeStability, EigenvaluesMatchClosedForm)
+{
+  // the fixed-free bar of 32 cells (the verification bar): within 0.2 % for n = 1..4
+  for (unsigned int n = 1; n <= 4; ++n)
+    {
+      const double f = scheme_critical_factor(n, 32, false);
+      EXPECT_NEAR(f / scheme_critical_factor_closed_form(n), 1.0, 2e-3) << "n = " << n;
+    }
+  // periodic grid of 48 cells: the Bloch wavenumbers 2 pi k / 48 sample the critical one
+  for (unsigned int n = 1; n <= 3; ++n)
+    {
+      const double f = scheme_critical_factor(n, 48, true);
+      EXPECT_GE(f, scheme_critical_factor_closed_form(n) * (1 - 1e-5)) << "n = " << n;
+      EXPECT_NEAR(f / scheme_critical_factor_closed_form(n), 1.0, 5e-3) << "n = " << n;
+    }
+}
+
+TEST(SchemeStability, SpectralRadius)
+{
+  // undamped below the limit, growth above it (n = 2: sqrt(3))
+  EXPECT_LE(scheme_spectral_radius(2, 32, false, 1.0), 1 + 1e-7);
+  EXPECT_LE(scheme_spectral_radius(2, 32, false, 1.70), 1 + 1e-7);
+  EXPECT_GT(scheme_spectral_radius(2, 32, false, 1.76), 1.05);
+}
