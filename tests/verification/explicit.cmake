@@ -54,3 +54,10 @@ set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESS
 
 # chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
 talus_verification(explicit_strain_smoothing check_smoothing.py verification/footing_incompressible.prm)
+
+# issue 6: talus-convergence (bar without cell crossing: order >= 1.8; translating bar
+# with cell crossing: the predicted loss of convergence; bad input)
+add_test(NAME verification.convergence_bar
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_convergence.py ${TALUS_TOOLS_DIR}/talus-convergence
+                 ${TALUS_PRM_DIR} ${_w}/convergence_bar)
+set_tests_properties(verification.convergence_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
