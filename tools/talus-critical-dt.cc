@@ -91,8 +91,9 @@ namespace
         {
           f_scheme[m]  = analysis::scheme_critical_factor_closed_form(n_points[m]);
           dt_scheme[m] = f_scheme[m] * rows[m].dt_wave;
-          if (rows[m].phase == "liquid" && rows[m].dt_other > 0)
-            dt_scheme[m] = std::min(dt_scheme[m], rows[m].dt_other);
+          // the viscous limit of a liquid is not covered by the analysis
+          if (rows[m].phase == "liquid" && rows[m].dt_other > 0 && rows[m].dt_other < dt_scheme[m])
+            f_scheme[m] = dt_scheme[m] = 0;
         }
 
     log() << std::setprecision(6)
@@ -119,7 +120,7 @@ namespace
           log() << "; scheme limit (1D eigenvalue analysis of the implemented step) " << dt_scheme[i] << " s = "
                 << dt_scheme[i] / r.dt << " x " << r.formula;
         else
-          log() << "; scheme limit not analysed for this phase";
+          log() << "; scheme limit not analysed for this phase / limit";
         log() << "\n";
       }
     log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s (" << rows[ctrl].formula
