@@ -61,3 +61,8 @@ add_test(NAME verification.convergence_bar
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_convergence.py ${TALUS_TOOLS_DIR}/talus-convergence
                  ${TALUS_PRM_DIR} ${_w}/convergence_bar)
 set_tests_properties(verification.convergence_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# issue 6: the committed docs/verification/README.md matches the committed CSVs
+add_test(NAME verification.readme_matches_csv
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_readme.py ${CMAKE_SOURCE_DIR}/docs/verification)
+set_tests_properties(verification.readme_matches_csv PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 60)
