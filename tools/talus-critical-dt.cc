@@ -19,6 +19,28 @@ namespace
 {
   using namespace talus;
 
+  /// --crossing-velocity=V [m/s]: a finite number >= 0 (0 when absent)
+  double
+  crossing_velocity()
+  {
+    if (!tool_option_given("--crossing-velocity"))
+      return 0;
+    const std::string v = tool_option_value("--crossing-velocity", "");
+    std::size_t       used = 0;
+    double            x    = -1;
+    try
+      {
+        x = std::stod(v, &used);
+      }
+    catch (const std::exception &)
+      {
+        used = 0;
+      }
+    if (used != v.size() || v.empty() || !std::isfinite(x) || x < 0)
+      throw InputError("option --crossing-velocity: '" + v + "' is not a finite velocity >= 0 [m/s]");
+    return x;
+  }
+
   template <int dim>
   int
   run(dealii::ParameterHandler &prm)
@@ -123,6 +145,26 @@ namespace
           log() << "; scheme limit not analysed for this phase / limit";
         log() << "\n";
       }
+    // points crossing cells at a velocity V (Floquet analysis of the translating state)
+    const double        V_cross = crossing_velocity();
+    std::vector<double> growth(n_mat, 0.0), v_used(n_mat, 0.0), courant_m(n_mat, 0.0);
+    if (V_cross > 0)
+      for (unsigned int m = 0; m < n_mat; ++m)
+        if (f_scheme[m] > 0)
+          {
+            courant_m[m]      = dt / rows[m].dt_wave; // dt c / h of this material
+            const double voc  = V_cross / rows[m].wave_speed;
+            if (voc * courant_m[m] < 1e-3)
+              throw InputError("option --crossing-velocity: V dt / h = " + std::to_string(voc * courant_m[m]) +
+                               " < 1e-3 for " + rows[m].material + " (the analysis needs K = h / (V dt) <= 1000 steps)");
+            growth[m]  = analysis::crossing_growth_per_step(n_points[m], courant_m[m], voc, 8, &v_used[m]);
+            const double rate = std::log(growth[m]) / dt;
+            log() << "  cell crossing at V = " << V_cross << " m/s, " << rows[m].material << " (V/c = " << voc
+                  << ", analysed at " << v_used[m] << ", dt c / h = " << courant_m[m] << "): growth per step "
+                  << std::setprecision(8) << growth[m] << std::setprecision(6) << ", rate " << rate
+                  << " 1/s (e-folding time " << (rate > 0 ? 1.0 / rate : 0.0) << " s)"
+                  << (growth[m] > 1 + 1e-9 ? ": unstable while the points cross cells" : "") << "\n";
+          }
     log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s (" << rows[ctrl].formula
           << ", the default), controlling cell " << cell_of[ctrl].id << "\n"
           << "  time step in use: " << dt << " s = " << dt / dt_cr << " x critical"
@@ -183,14 +225,16 @@ namespace
         f.stream() << std::setprecision(10)
                    << "material,model,phase,formula,wave_speed,L_min,dt_critical_formula,dt_wave,dt_other,dt_eq_4_122,"
                       "controlling,dt_in_use,courant_in_use,dt_measured,probe_stable_factor,probe_unstable_factor,"
-                      "controlling_cell,cell_edge,points_per_direction,scheme_factor,dt_scheme\n";
+                      "controlling_cell,cell_edge,points_per_direction,scheme_factor,dt_scheme,crossing_velocity,"
+                      "crossing_v_over_c_analysed,crossing_growth_per_step,crossing_growth_rate\n";
         for (std::size_t i = 0; i < rows.size(); ++i)
           f.stream() << rows[i].material << "," << rows[i].model << "," << rows[i].phase << ",\"" << rows[i].formula
                      << "\"," << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << rows[i].dt_wave << ","
                      << rows[i].dt_other << "," << rows[i].dt_4_122 << "," << (i == ctrl ? 1 : 0) << "," << dt << "," << dt / dt_cr << ","
                      << (probe && i == ctrl ? measured : 0.0) << "," << (probe && i == ctrl ? probe_lo : 0.0) << ","
                      << (probe && i == ctrl ? probe_hi : 0.0) << "," << cell_of[i].id << "," << cell_of[i].h << ","
-                     << n_points[i] << "," << f_scheme[i] << "," << dt_scheme[i] << "\n";
+                     << n_points[i] << "," << f_scheme[i] << "," << dt_scheme[i] << "," << V_cross << "," << v_used[i]
+                     << "," << growth[i] << "," << (growth[i] > 0 ? std::log(growth[i]) / dt : 0.0) << "\n";
         f.commit();
       }
     return exit_ok;
@@ -213,13 +257,16 @@ main(int argc, char **argv)
   tool.declare = &talus::explicit_mpm::declare_parameters;
   tool.options = {{"--probe", "measure the limit by bisection on f x dt_cr, f in [0.5, 4]"},
                   {"--probe-steps=", "steps per probe run (default 400)"},
-                  {"--csv=", "also write the results to this CSV file"}};
+                  {"--csv=", "also write the results to this CSV file"},
+                  {"--crossing-velocity=", "points crossing cells at this velocity [m/s]: growth per step of the\n"
+                                           "      translating state at the time step in use (Floquet analysis, 1D)"}};
   tool.check   = [](dealii::ParameterHandler &prm, const std::string &) {
     if (prm.get_integer("dimension") == 2)
       talus::explicit_mpm::parse_parameters<2>(prm);
     else
       talus::explicit_mpm::parse_parameters<3>(prm);
     talus::tool_option_uint("--probe-steps", 400, 1, 1000000);
+    crossing_velocity();
     if (talus::tool_option_given("--csv"))
       talus::require_output_file(talus::tool_option_value("--csv", ""), "option --csv");
   };

@@ -39,3 +39,21 @@ TEST(SchemeStability, SpectralRadius)
   EXPECT_LE(scheme_spectral_radius(2, 32, false, 1.70), 1 + 1e-7);
   EXPECT_GT(scheme_spectral_radius(2, 32, false, 1.76), 1.05);
 }
+
+TEST(SchemeStability, CellCrossingGrowth)
+{
+  // at rest: no growth below the limit
+  EXPECT_LE(crossing_growth_per_step(2, 0.5, 0.0, 8), 1 + 1e-7);
+  // translating at V/c = 0.2, dt c/h = 0.5: parametric growth, the same on 8 and 16 cells
+  // (a per-step factor independent of h), and it grows with the step (~ 1 + a C^2)
+  double v = 0;
+  const double g8  = crossing_growth_per_step(2, 0.5, 0.2, 8, &v);
+  const double g16 = crossing_growth_per_step(2, 0.5, 0.2, 16);
+  EXPECT_NEAR(v, 0.2, 1e-12);
+  EXPECT_GT(g8, 1.03);
+  EXPECT_LT(g8, 1.04);
+  EXPECT_NEAR(g8, g16, 1e-4);
+  const double g01 = crossing_growth_per_step(2, 0.1, 0.2, 8);
+  EXPECT_GT(g01, 1.0);
+  EXPECT_LT(g01 - 1, 0.1 * (g8 - 1));
+}

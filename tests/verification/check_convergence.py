@@ -4,10 +4,15 @@
   * the translating free-free bar (points cross up to ~40 cells) at 16/32/64/128 cells,
     Courant number 0.5: the scheme analysis (docs/stability-analysis.md, "Cell crossing")
     predicts that the frozen-coefficient step stays stable (limit >= sqrt(2) h/c for any
-    shift of the points) but that the crossing error does not vanish with h: the fitted
-    order must fall below 1.0 and the finest run must not beat the 32-cell run;
+    shift of the points) but that the moving points make the step parametrically unstable
+    (growth rate ~ 1/h over a fixed time): the fitted order must fall below 1.0 and the
+    finest run must not beat the 32-cell run;
     at Courant number 0.1 the 128-cell error must be below the 32-cell error at 0.5
     (the crossing error depends on dt);
+  * the cause, predicted by the Floquet analysis of the translating state (talus-critical-dt
+    --crossing-velocity): perturbations grow by a factor mu > 1 per step (1.0355 at dt c/h =
+    0.5, V/c = 0.2, 2 points per cell), a rate ln(mu)/dt ~ 1/h; the growth rate measured
+    on the 256-cell run must be within 10 % of it;
   * CSV and plots are written; --check passes; bad input exits 2 before any output.
 Usage: check_convergence.py CONVERGENCE_TOOL PRM_DIR WORKDIR
 """
@@ -70,6 +75,33 @@ convergence(t, "crossing_c01")
 r = tv.read_csv(os.path.join(work, "crossing_c01", "translating_bar.csv"))
 e01 = dict(zip(r["value"], r["error"]))
 tv.check(e01[128] < e[32], f"cell crossing at Courant 0.1: 128-cell error {e01[128]:.3e} < {e[32]:.3e} (32 cells, 0.5)")
+
+# 2b. the growth of the crossing instability: measured on the 256-cell run (strain energy
+# ~ amplitude^2 once the growing mode dominates) against the Floquet analysis of
+# talus-critical-dt --crossing-velocity (growth per step of the translating state)
+tools = os.path.dirname(tool)
+text = open(os.path.join(prm_dir, "verification", "translating_bar.prm")).read()
+for k, v in (("grid/cells", "512, 1"), ("grid/upper corner", "2, 0.00390625"),
+             ("body 0/upper corner", "1.5, 0.00390625"), ("output/directory", "growth")):
+    text = tv.prm_set(text, k, v)
+tv.run_tool(os.path.join(tools, "talus-explicit"), text, work, "growth")
+growth_csv = os.path.join(work, "growth_dt.csv")
+p = subprocess.run([os.path.join(tools, "talus-critical-dt"), "--crossing-velocity=2", "--csv=" + growth_csv,
+                    os.path.join(work, "growth.prm")], capture_output=True, text=True, cwd=work)
+print(p.stdout)
+tv.check(p.returncode == 0, f"talus-critical-dt --crossing-velocity: exit {p.returncode} {p.stderr[:200]}")
+predicted = tv.read_csv(growth_csv)["crossing_growth_rate"][0]
+s = tv.read_csv(os.path.join(work, "growth", "series.csv"))
+import math
+base_e = max(e for t_, e in zip(s["time"], s["strain_energy"]) if t_ < 0.05)
+pts = [(t_, math.log(e)) for t_, e in zip(s["time"], s["strain_energy"]) if e > 1e3 * base_e]
+tv.check(len(pts) > 50, f"the growing mode dominates the strain energy over {len(pts)} steps (> 50)")
+if len(pts) > 2:
+    mx = sum(p_[0] for p_ in pts) / len(pts)
+    my = sum(p_[1] for p_ in pts) / len(pts)
+    rate = 0.5 * sum((a - mx) * (b - my) for a, b in pts) / sum((a - mx) ** 2 for a, _ in pts)
+    tv.check(abs(rate / predicted - 1) <= 0.10,
+             f"crossing growth rate: measured {rate:.1f} 1/s, predicted {predicted:.1f} 1/s (within 10 %)")
 
 # 3. --check and bad input
 good = os.path.join(work, "bar.prm")

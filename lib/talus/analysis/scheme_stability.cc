@@ -80,7 +80,97 @@ namespace talus::analysis
         }
       return G;
     }
+    // One step at arbitrary point positions x (h = c = E = rho = 1) on a periodic grid.
+    dealii::FullMatrix<double>
+    step_at(const std::vector<double> &x, const unsigned int n_cells, const unsigned int n, const double dt)
+    {
+      const unsigned int         np = x.size();
+      dealii::FullMatrix<double> S(np, n_cells), B(np, n_cells);
+      for (unsigned int p = 0; p < np; ++p)
+        {
+          double y = std::fmod(x[p], double(n_cells));
+          if (y < 0)
+            y += n_cells;
+          const unsigned int e  = std::min(n_cells - 1, static_cast<unsigned int>(std::floor(y)));
+          const double       xi = y - e;
+          const unsigned int e1 = (e + 1) % n_cells;
+          S(p, e) += 1 - xi;
+          S(p, e1) += xi;
+          B(p, e) -= 1;
+          B(p, e1) += 1;
+        }
+      const double        mp = 1.0 / n;
+      std::vector<double> m(n_cells, 0.0);
+      for (unsigned int p = 0; p < np; ++p)
+        for (unsigned int i = 0; i < n_cells; ++i)
+          m[i] += mp * S(p, i);
+      dealii::FullMatrix<double> A(np, np), C(np, np), G(2 * np, 2 * np);
+      for (unsigned int p = 0; p < np; ++p)
+        for (unsigned int q = 0; q < np; ++q)
+          for (unsigned int i = 0; i < n_cells; ++i)
+            {
+              A(p, q) += S(p, i) / m[i] * B(q, i) * mp;
+              C(p, q) += B(p, i) / m[i] * S(q, i) * mp;
+            }
+      for (unsigned int p = 0; p < np; ++p)
+        {
+          G(p, p) += 1;
+          G(np + p, np + p) += 1;
+          for (unsigned int q = 0; q < np; ++q)
+            {
+              G(p, np + q) = -dt * A(p, q);
+              G(np + p, q) = dt * C(p, q);
+              double ca = 0;
+              for (unsigned int r = 0; r < np; ++r)
+                ca += C(p, r) * A(r, q);
+              G(np + p, np + q) -= dt * dt * ca;
+            }
+        }
+      return G;
+    }
   } // namespace
+
+  double
+  crossing_growth_per_step(const unsigned int n, const double courant, const double v_over_c,
+                           const unsigned int n_cells, double *v_over_c_used)
+  {
+    const double       dt = courant;
+    const unsigned int K  = std::max<long>(1, std::lround(1.0 / (std::max(v_over_c, 1e-12) * dt)));
+    const double       v  = v_over_c > 0 ? 1.0 / (K * dt) : 0.0;
+    if (v_over_c_used)
+      *v_over_c_used = v;
+    const unsigned int  np    = n * n_cells;
+    const unsigned int  steps = v_over_c > 0 ? K * n_cells : 1;
+    std::vector<double> x(np);
+    for (unsigned int e = 0; e < n_cells; ++e)
+      for (unsigned int k = 0; k < n; ++k)
+        x[e * n + k] = e + (k + 0.5) / n;
+    dealii::FullMatrix<double> P(2 * np, 2 * np), T(2 * np, 2 * np);
+    for (unsigned int i = 0; i < 2 * np; ++i)
+      P(i, i) = 1;
+    double log_scale = 0; // P is renormalised to keep it finite
+    for (unsigned int s = 0; s < steps; ++s)
+      {
+        const auto G = step_at(x, n_cells, n, dt);
+        G.mmult(T, P);
+        P = T;
+        const double norm = P.linfty_norm();
+        if (norm > 1e50)
+          {
+            P *= 1.0 / norm;
+            log_scale += std::log(norm);
+          }
+        for (auto &y : x)
+          y += v * dt;
+      }
+    dealii::LAPACKFullMatrix<double> L(2 * np, 2 * np);
+    L = P;
+    L.compute_eigenvalues(false, false);
+    double r = 0;
+    for (unsigned int i = 0; i < L.m(); ++i)
+      r = std::max(r, std::abs(L.eigenvalue(i)));
+    return std::exp((std::log(r) + log_scale) / steps);
+  }
 
   double
   scheme_spectral_radius(const unsigned int n, const unsigned int n_cells, const bool periodic, const double factor)

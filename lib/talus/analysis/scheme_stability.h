@@ -21,4 +21,14 @@ namespace talus::analysis
   /// Largest factor f (dt = f h / c) for which the spectral radius stays <= 1
   /// (to 1e-7 in |lambda|): bisection on f in [0.1, 4], to relative 1e-6.
   double scheme_critical_factor(unsigned int n_points, unsigned int n_cells = 32, bool periodic = true);
+  /// Points crossing cells: growth factor per step of a perturbation of a uniformly
+  /// translating state (velocity v, points at (k + 1/2)/n + v t of every cell) on a periodic
+  /// grid of n_cells cells, for dt = courant h / c (Floquet analysis: the product of the
+  /// step matrices at the moving point positions over the time the points need to travel
+  /// the whole grid, after which the configuration repeats exactly;
+  /// docs/stability-analysis.md, "Cell crossing"). v / c is rounded so that a point moves
+  /// one cell in a whole number K of steps; `v_over_c_used` returns the value used.
+  /// 1 for v = 0 below the limit; > 1 means the crossing makes the step unstable.
+  double crossing_growth_per_step(unsigned int n_points, double courant, double v_over_c, unsigned int n_cells,
+                                  double *v_over_c_used = nullptr);
 } // namespace talus::analysis
