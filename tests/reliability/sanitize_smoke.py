@@ -50,6 +50,10 @@ cases = {
                        tiny("element/" + f, {"test/number of increments": "50", "output/plots": "false"}),
                        2 if "broken" in f else 0, [])
                       for f in sorted(os.listdir(os.path.join(prm_dir, "element")))],
+    "talus-convergence": [
+        ("check", open(os.path.join(prm_dir, "convergence", "bar_displacement.prm")).read().replace(
+            "../verification/", os.path.join(os.path.abspath(prm_dir), "verification") + "/"), 0, ["--check"]),
+        ("bad_input", "set mode = fast\n", 2, [])],
     "talus-bench-materials": [("bench", None, 0, ["--points=8", "--steps=4"])],
     "talus-bench-finite-strain": [("bench", None, 0, ["--updates=50"])],
 }

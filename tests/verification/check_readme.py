@@ -50,7 +50,7 @@ def table_after(heading):
             started = True
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
             if not set(cells[0]) <= set("-") and not cells[0].startswith("value") and cells[0] not in (
-                    "case", "exit code", "criterion"):
+                    "case", "exit code", "criterion", "Courant number"):
                 out.append(cells)
         elif started:
             break
@@ -118,6 +118,23 @@ if os.path.isfile(ld):
     tv.check(not bad, "large deformation: row matches the CSV" + (f" ({'; '.join(bad)})" if bad else ""))
 else:
     tv.check(False, "large-deformation CSV exists")
+
+cg = os.path.join(docs, "csv", "crossing_growth.csv")
+if os.path.isfile(cg):
+    rows = rows_of(cg)
+    table = table_after("### Cell crossing")
+    bad = [] if len(table) == len(rows) else [f"{len(table)} rows vs {len(rows)}"]
+    for cells, r in zip(table, rows):
+        for c, col in zip(cells[:5], ["courant", "growth_per_step_predicted", "rate_predicted", "rate_measured",
+                                      "steps_fitted"]):
+            n_numbers += 1
+            if not same(c, r[col]):
+                bad.append(f"{col} {c} vs {r[col]}")
+        if cells[5] != ("PASS" if r["ok"] == "1" else "FAIL"):
+            bad.append("result")
+    tv.check(not bad, "cell-crossing growth: rows match the CSV" + (f" ({'; '.join(bad[:3])})" if bad else ""))
+else:
+    tv.check(False, "cell-crossing growth CSV exists")
 
 sm = os.path.join(docs, "csv", "smoothing.csv")
 if os.path.isfile(sm):

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
+#include <numeric>
 #include <vector>
 
 namespace talus::analysis
@@ -134,13 +136,28 @@ namespace talus::analysis
   crossing_growth_per_step(const unsigned int n, const double courant, const double v_over_c,
                            const unsigned int n_cells, double *v_over_c_used)
   {
-    const double       dt = courant;
-    const unsigned int K  = std::max<long>(1, std::lround(1.0 / (std::max(v_over_c, 1e-12) * dt)));
-    const double       v  = v_over_c > 0 ? 1.0 / (K * dt) : 0.0;
+    const double dt = courant;
+    // distance per step r = v dt / h, rounded to the nearest fraction a / b with b <= 200:
+    // after S = b N / gcd(a, N) steps the points have moved a whole number of grid lengths
+    // and the configuration repeats exactly
+    const double d = std::max(v_over_c, 0.0) * dt;
+    unsigned long a = 0, b = 1;
+    double        best = std::numeric_limits<double>::max();
+    for (unsigned long q = 1; q <= 200 && d > 0; ++q)
+      {
+        const unsigned long p = std::lround(d * q);
+        if (p > 0 && std::abs(double(p) / q - d) < best - 1e-15)
+          {
+            best = std::abs(double(p) / q - d);
+            a    = p;
+            b    = q;
+          }
+      }
+    const double v = a > 0 ? double(a) / b / dt : 0.0;
     if (v_over_c_used)
       *v_over_c_used = v;
-    const unsigned int  np    = n * n_cells;
-    const unsigned int  steps = v_over_c > 0 ? K * n_cells : 1;
+    const unsigned int np    = n * n_cells;
+    const unsigned int steps = a > 0 ? b * n_cells / std::gcd(a, static_cast<unsigned long>(n_cells)) : 1;
     std::vector<double> x(np);
     for (unsigned int e = 0; e < n_cells; ++e)
       for (unsigned int k = 0; k < n; ++k)

@@ -26,8 +26,8 @@ namespace talus::analysis
   /// grid of n_cells cells, for dt = courant h / c (Floquet analysis: the product of the
   /// step matrices at the moving point positions over the time the points need to travel
   /// the whole grid, after which the configuration repeats exactly;
-  /// docs/stability-analysis.md, "Cell crossing"). v / c is rounded so that a point moves
-  /// one cell in a whole number K of steps; `v_over_c_used` returns the value used.
+  /// docs/stability-analysis.md, "Cell crossing"). v dt / h is rounded to the nearest
+  /// fraction a / b with b <= 200 (exact periodicity); `v_over_c_used` returns the value used.
   /// 1 for v = 0 below the limit; > 1 means the crossing makes the step unstable.
   double crossing_growth_per_step(unsigned int n_points, double courant, double v_over_c, unsigned int n_cells,
                                   double *v_over_c_used = nullptr);
