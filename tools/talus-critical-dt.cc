@@ -107,15 +107,16 @@ namespace
     // the momentum re-projection), from the eigenvalues of one step on a uniform 1D
     // grid (docs/stability-analysis.md): dt_scheme = f(n) L / c for the wave part of
     // solid, undrained and liquid materials; not analysed for the coupled 2-phase step.
-    std::vector<double> f_scheme(n_mat, 0.0), dt_scheme(n_mat, 0.0);
+    std::vector<double> f_scheme(n_mat, 0.0), dt_scheme(n_mat, 0.0), dt_moved(n_mat, 0.0);
     for (unsigned int m = 0; m < n_mat; ++m)
       if (rows[m].phase != "coupled" && n_points[m] > 0)
         {
           f_scheme[m]  = analysis::scheme_critical_factor_closed_form(n_points[m]);
           dt_scheme[m] = f_scheme[m] * rows[m].dt_wave;
+          dt_moved[m]  = analysis::scheme_critical_factor_moved(n_points[m]) * rows[m].dt_wave;
           // the viscous limit of a liquid is not covered by the analysis
           if (rows[m].phase == "liquid" && rows[m].dt_other > 0 && rows[m].dt_other < dt_scheme[m])
-            f_scheme[m] = dt_scheme[m] = 0;
+            f_scheme[m] = dt_scheme[m] = dt_moved[m] = 0;
         }
 
     log() << std::setprecision(6)
@@ -139,8 +140,9 @@ namespace
         log() << "\n    controlling cell " << cell_of[i].id << " centre " << cell_of[i].center << ", smallest edge "
               << cell_of[i].h << " m; " << n_points[i] << " points per direction";
         if (dt_scheme[i] > 0)
-          log() << "; scheme limit (1D eigenvalue analysis of the implemented step) " << dt_scheme[i] << " s = "
-                << dt_scheme[i] / r.dt << " x " << r.formula;
+          log() << "; scheme limit (1D analysis of the implemented step, docs/stability-analysis.md): points at "
+                << "their regular positions " << dt_scheme[i] << " s = " << dt_scheme[i] / r.dt << " x " << r.formula
+                << ", moved points (worst uniform shift) " << dt_moved[i] << " s = " << dt_moved[i] / r.dt << " x";
         else
           log() << "; scheme limit not analysed for this phase / limit";
         log() << "\n";
@@ -214,7 +216,8 @@ namespace
               << " x critical; measured critical time step " << measured << " s = " << lo
               << " x the formula";
         if (dt_scheme[ctrl] > 0)
-          log() << ", " << measured / dt_scheme[ctrl] << " x the scheme limit " << dt_scheme[ctrl] << " s";
+          log() << ", " << measured / dt_scheme[ctrl] << " x the scheme limit " << dt_scheme[ctrl] << " s (regular points), "
+                << measured / dt_moved[ctrl] << " x " << dt_moved[ctrl] << " s (moved points)";
         log() << "\n";
       }
 
@@ -226,7 +229,7 @@ namespace
                    << "material,model,phase,formula,wave_speed,L_min,dt_critical_formula,dt_wave,dt_other,dt_eq_4_122,"
                       "controlling,dt_in_use,courant_in_use,dt_measured,probe_stable_factor,probe_unstable_factor,"
                       "controlling_cell,cell_edge,points_per_direction,scheme_factor,dt_scheme,crossing_velocity,"
-                      "crossing_v_over_c_analysed,crossing_growth_per_step,crossing_growth_rate\n";
+                      "crossing_v_over_c_analysed,crossing_growth_per_step,crossing_growth_rate,dt_scheme_moved\n";
         for (std::size_t i = 0; i < rows.size(); ++i)
           f.stream() << rows[i].material << "," << rows[i].model << "," << rows[i].phase << ",\"" << rows[i].formula
                      << "\"," << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << rows[i].dt_wave << ","
@@ -234,7 +237,8 @@ namespace
                      << (probe && i == ctrl ? measured : 0.0) << "," << (probe && i == ctrl ? probe_lo : 0.0) << ","
                      << (probe && i == ctrl ? probe_hi : 0.0) << "," << cell_of[i].id << "," << cell_of[i].h << ","
                      << n_points[i] << "," << f_scheme[i] << "," << dt_scheme[i] << "," << V_cross << "," << v_used[i]
-                     << "," << growth[i] << "," << (growth[i] > 0 ? std::log(growth[i]) / dt : 0.0) << "\n";
+                     << "," << growth[i] << "," << (growth[i] > 0 ? std::log(growth[i]) / dt : 0.0) << ","
+                     << dt_moved[i] << "\n";
         f.commit();
       }
     return exit_ok;

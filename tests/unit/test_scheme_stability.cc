@@ -57,3 +57,20 @@ TEST(SchemeStability, CellCrossingGrowth)
   EXPECT_GT(g01, 1.0);
   EXPECT_LT(g01 - 1, 0.1 * (g8 - 1));
 }
+
+TEST(SchemeStability, MovedPoints)
+{
+  EXPECT_NEAR(scheme_critical_factor_moved(1), 1.0, 1e-14);
+  EXPECT_NEAR(scheme_critical_factor_moved(2), std::sqrt(2.0), 1e-14);
+  for (unsigned int n = 1; n <= 4; ++n)
+    {
+      const double f = scheme_critical_factor_moved(n);
+      // points on the nodes (shift of half a point spacing): the worst case, the limit is sharp
+      // (48 periodic cells sample the critical wavenumber to < 1 %)
+      EXPECT_LE(shifted_spectral_radius(n, 48, 0.5 / n, 0.995 * f), 1 + 1e-7) << "n = " << n;
+      EXPECT_GT(shifted_spectral_radius(n, 48, 0.5 / n, 1.01 * f), 1 + 1e-4) << "n = " << n;
+      // any other shift is at least as stable
+      for (const double s : {0.0, 0.1, 0.2, 0.3, 0.4})
+        EXPECT_LE(shifted_spectral_radius(n, 48, s / n, 0.995 * f), 1 + 1e-7) << "n = " << n << ", shift " << s;
+    }
+}

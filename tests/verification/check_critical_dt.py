@@ -6,6 +6,8 @@
   * --probe (bisection on forced 400-step runs) brackets the measured limit to < 1 % and finds
     it within 10 % of dt_scheme for n = 1, 2 and 4 points per direction (the issue's
     criterion); Eq. 4.120 is conservative (measured >= formula);
+  * on the colliding disks (points travel many cells during the probe runs) the measured
+    limit is within 10 % of the moved-point limit sqrt(2) h / c (worst uniform shift);
   * --csv writes the same numbers.
 Usage: check_critical_dt.py TOOL PRM WORKDIR
 """
@@ -42,6 +44,21 @@ for n in (1, 2, 4):
     tv.check(abs(meas / predicted - 1) <= 0.10,
              f"n={n}: measured limit {meas:.6g} s = {meas / predicted:.4f} x the scheme limit (within 10 %)")
     tv.check(meas >= r["dt_critical_formula"][0], f"n={n}: Eq. 4.120 is conservative ({lo:.4f} x)")
+# points that travel many cells during the probe runs (colliding disks, 2D): the limit is the
+# worst uniform shift of the points, sqrt(2) h / c for 2 points per direction
+disks = os.path.join(os.path.dirname(os.path.abspath(prm_path)), "disks_collision.prm")
+csv = os.path.join(work, "critical_dt_disks.csv")
+p = subprocess.run([os.path.abspath(tool), "--probe", "--csv=" + csv, disks], capture_output=True, text=True, cwd=work)
+print(p.stdout)
+tv.check(p.returncode == 0, f"disks: exit code {p.returncode}: {p.stderr.strip()[:200]}")
+r = tv.read_csv(csv)
+k = r["controlling"].index(1)
+moved = r["dt_scheme_moved"][k]
+tv.check(abs(moved / r["dt_critical_formula"][k] - math.sqrt(2)) < 1e-9,
+         f"disks: moved-point limit {moved:.6g} s = sqrt(2) x the formula")
+tv.check(abs(r["dt_measured"][k] / moved - 1) <= 0.10,
+         f"disks: measured limit {r['dt_measured'][k]:.6g} s = {r['dt_measured'][k] / moved:.4f} x the moved-point "
+         "limit (within 10 %)")
 q = subprocess.run([os.path.abspath(tool), "--help"], capture_output=True, text=True)
 tv.check("--probe" in q.stdout and "--csv=" in q.stdout, "--help lists the tool's options")
 tv.finish()

@@ -97,11 +97,17 @@ if os.path.isfile(sw):
     for cells, r in zip(table, rows):
         if cells[0] != r["name"]:
             bad.append(f"name {cells[0]} vs {r['name']}")
+        cells[4] = cells[4].split(" (")[0]
+        if float(r["dt_scheme"]) > 0:
+            cells[7] = str(cells[7])
+            n_numbers += 1
+            if not same(cells[7], float(r["dt_measured"]) / float(r["dt_scheme"])):
+                bad.append(f"{r['name']} ratio {cells[7]}")
         for c, col in zip(cells[3:7], ["dt_formula", "dt_scheme", "probe_stable_factor", "probe_unstable_factor"]):
             n_numbers += 1
             if not same(c, r[col]):
                 bad.append(f"{r['name']} {col} {c} vs {r[col]}")
-        if cells[7] != ("PASS" if r["ok"] == "1" else "FAIL"):
+        if cells[8] != ("PASS" if r["ok"] == "1" else "FAIL"):
             bad.append(f"{r['name']} result {cells[7]} vs ok={r['ok']}")
     tv.check(not bad, "Courant sweeps: numbers and results match the CSV" + (f" ({'; '.join(bad[:3])})" if bad else ""))
 

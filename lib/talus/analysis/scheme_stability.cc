@@ -133,6 +133,33 @@ namespace talus::analysis
   } // namespace
 
   double
+  scheme_critical_factor_moved(const unsigned int n)
+  {
+    // beta(sigma) = 1/6 + 1/(12 n^2) - sigma^2 / n^2 for a shift sigma in [-1/2, 1/2] of the
+    // point spacing; gamma = 4 beta is smallest at |sigma| = 1/2. lambda(s) = (4 c^2/h^2)
+    // s^2 (1 - gamma s^2) is largest at s^2 = 1 (gamma <= 1/2) or 1 / (2 gamma).
+    const double gamma = 2.0 / 3.0 - 2.0 / (3.0 * n * n);
+    return gamma <= 0.5 ? 1.0 / std::sqrt(1 - gamma) : 2 * std::sqrt(gamma);
+  }
+
+  double
+  shifted_spectral_radius(const unsigned int n, const unsigned int n_cells, const double shift, const double factor)
+  {
+    std::vector<double> x(n * n_cells);
+    for (unsigned int e = 0; e < n_cells; ++e)
+      for (unsigned int k = 0; k < n; ++k)
+        x[e * n + k] = e + (k + 0.5) / n + shift;
+    const auto                       G = step_at(x, n_cells, n, factor);
+    dealii::LAPACKFullMatrix<double> L(G.m(), G.n());
+    L = G;
+    L.compute_eigenvalues(false, false);
+    double r = 0;
+    for (unsigned int i = 0; i < L.m(); ++i)
+      r = std::max(r, std::abs(L.eigenvalue(i)));
+    return r;
+  }
+
+  double
   crossing_growth_per_step(const unsigned int n, const double courant, const double v_over_c,
                            const unsigned int n_cells, double *v_over_c_used)
   {

@@ -18,6 +18,17 @@ namespace talus::analysis
   /// dt_scheme = 2 sqrt(2/3 + 1/(3 n^2)) h / c (n = 1: 2, n = 2: sqrt(3), n -> oo: sqrt(8/3)).
   double scheme_critical_factor_closed_form(unsigned int n_points);
 
+  /// The same limit when the points have moved: all points of every cell shifted by the
+  /// same distance (a uniform translation) on an infinite uniform grid; the smallest limit
+  /// over the shifts, reached when points sit on the nodes:
+  /// gamma_min = 2/3 - 2/(3 n^2); dt = h / (c sqrt(1 - gamma_min)) if gamma_min <= 1/2, else
+  /// 2 sqrt(gamma_min) h / c (n = 1: 1, n = 2: sqrt(2), n = 3: 1.540, n = 4: 1.581).
+  double scheme_critical_factor_moved(unsigned int n_points);
+
+  /// Spectral radius of one step with the points of every cell shifted by `shift` (in cell
+  /// sizes) from the regular positions, periodic grid of n_cells cells, dt = factor h / c.
+  double shifted_spectral_radius(unsigned int n_points, unsigned int n_cells, double shift, double factor);
+
   /// Largest factor f (dt = f h / c) for which the spectral radius stays <= 1
   /// (to 1e-7 in |lambda|): bisection on f in [0.1, 4], to relative 1e-6.
   double scheme_critical_factor(unsigned int n_points, unsigned int n_cells = 32, bool periodic = true);
