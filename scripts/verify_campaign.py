@@ -37,7 +37,14 @@ FAMILIES = [
     ("column_settlement", "error <= 1 % for N <= 16 (no point crosses a cell face); from N = 32 on the top "
      "points cross a face at the peak settlement (0.015 m > h/4) and the cell-crossing error appears",
      lambda s, r: max(x["error"] for x in r if x["value"] <= 16) <= 0.01),
-    ("oedometer", "error <= 1 % at every resolution", lambda s, r: max(x["error"] for x in r) <= 0.01),
+    ("bar_courant", "order >= 1.8 (central differences in time; Richardson against the finest run)",
+     lambda s, r: s["observed_order"] >= 1.8),
+    ("oedometer", "error <= 1 % at every resolution and order >= 0.8 (first order expected: the traction acts on "
+     "the points of the top layer, h/4 below the face)",
+     lambda s, r: max(x["error"] for x in r) <= 0.01 and s["observed_order"] >= 0.8),
+    ("terzaghi", "error <= 3 % at every resolution and order >= 0.8 (first order expected: load and drainage act "
+     "on the points of the top layer)",
+     lambda s, r: max(x["error"] for x in r) <= 0.03 and s["observed_order"] >= 0.8),
     ("translating_bar", "order < 1 (predicted loss of convergence under cell crossing)",
      lambda s, r: s["observed_order"] < 1.0),
     ("translating_bar_courant", "error at Courant 0.1 below the error at 0.4 (crossing error depends on dt)",
