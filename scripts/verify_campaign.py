@@ -250,7 +250,9 @@ def readme():
          "Do not edit: regenerated from the CSVs in `csv/` (which `tests/verification/check_readme.py` "
          "compares with this file in ctest). Run times are wall-clock seconds on the machine of the run "
          "(2 cores shared with other jobs: indicative only); `run time` is the whole process, `loop` the "
-         "solver's time loop, `ns/pt-step` the time loop per material point and step.", ""]
+         "solver's time loop, `ns/pt-step` the time loop per material point and step. The runs are small "
+         "(16 to a few thousand points), so `ns/pt-step` includes the per-step overheads (series output, "
+         "stability check) and varies with the load of the machine; `make bench` measures throughput.", ""]
     ok_all = True
     L += ["## Convergence", "",
           "Observed order: least-squares slope of log(error) over log(abscissa) over all runs (Richardson "

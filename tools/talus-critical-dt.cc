@@ -262,8 +262,7 @@ main(int argc, char **argv)
   tool.options = {{"--probe", "measure the limit by bisection on f x dt_cr, f in [0.5, 4]"},
                   {"--probe-steps=", "steps per probe run (default 400)"},
                   {"--csv=", "also write the results to this CSV file"},
-                  {"--crossing-velocity=", "points crossing cells at this velocity [m/s]: growth per step of the\n"
-                                           "      translating state at the time step in use (Floquet analysis, 1D)"}};
+                  {"--crossing-velocity=", "points cross cells at VALUE m/s: growth per step (Floquet, 1D)"}};
   tool.check   = [](dealii::ParameterHandler &prm, const std::string &) {
     if (prm.get_integer("dimension") == 2)
       talus::explicit_mpm::parse_parameters<2>(prm);
