@@ -49,6 +49,14 @@ FAMILIES = [
      lambda s, r: s["observed_order"] < 1.0),
     ("translating_bar_courant", "error at Courant 0.1 below the error at 0.4 (crossing error depends on dt)",
      lambda s, r: {x["value"]: x["error"] for x in r}[0.1] < {x["value"]: x["error"] for x in r}[0.4]),
+    # Courant sweeps run to the end time (stress tests; no order expected)
+    ("courant_solid_bar", "Courant sweep to the end time: every run completes and error <= 1e-3 up to 1.0 x Eq. 4.120",
+     lambda s, r: len(r) == 4 and max(x["error"] for x in r) <= 1e-3),
+    ("courant_liquid", "Courant sweep to the end time: every run completes and the pressure is within 2 % of "
+     "rho g (H - Y) at every point, up to 1.0 x the viscous limit",
+     lambda s, r: len(r) == 4 and max(x["error"] for x in r) <= 0.02),
+    ("courant_two_phase", "Courant sweep to the end time: every run completes and the pore-pressure error is "
+     "<= 3 % up to 1.0 x Eq. 4.129", lambda s, r: len(r) == 4 and max(x["error"] for x in r) <= 0.03),
 ]
 
 # Courant sweeps: (name, .prm, formulation)
@@ -254,10 +262,11 @@ def readme():
          "(16 to a few thousand points), so `ns/pt-step` includes the per-step overheads (series output, "
          "stability check) and varies with the load of the machine; `make bench` measures throughput.", ""]
     ok_all = True
-    L += ["## Convergence", "",
+    L += ["## Convergence families and Courant sweeps", "",
           "Observed order: least-squares slope of log(error) over log(abscissa) over all runs (Richardson "
           "families: all but the finest). Definitions of the references: `talus-convergence --help`; the "
-          "family inputs are in `parameter_files/convergence/`.", ""]
+          "family inputs are in `parameter_files/convergence/`. The `courant_*` families are stability stress "
+          "tests of the three explicit formulations run to the end time (no order expected).", ""]
     for name, crit, test in FAMILIES:
         sp, cp = os.path.join(DOCS, "csv", name + "_summary.csv"), os.path.join(DOCS, "csv", name + ".csv")
         if not os.path.isfile(sp):
