@@ -170,6 +170,8 @@ namespace talus::loads
       os << " (mass scaling " << current->mass_scaling << ")";
     if (current->damping > 0)
       os << ", local damping " << current->damping;
+    if (current->viscous_damping > 0)
+      os << ", viscous damping " << current->viscous_damping << " 1/s";
     if (!current->tractions.empty())
       os << ", " << current->tractions.size() << " traction(s)";
     if (!current->velocities.empty())
@@ -392,7 +394,7 @@ namespace talus::loads
               }
           }
       }
-    need_vt = !friction_nodes.empty() || !prescribed_dofs.empty() || current->damping > 0 ||
+    need_vt = !friction_nodes.empty() || !prescribed_dofs.empty() || current->damping > 0 || current->viscous_damping > 0 ||
               dealii::Utilities::MPI::logical_or(!friction_nodes.empty() || !prescribed_dofs.empty(), s.comm);
     if ((need_vt || current->convergence.enabled) && vt.size() == 0)
       s.grid.reinit_vector(vt);
@@ -535,6 +537,15 @@ namespace talus::loads
         for (const unsigned int i : s.active_dofs)
           if (M[i] > 0)
             F[i] += local_damping_force(a, F[i], Pm[i]); // sign(p) = sign(v)
+      }
+    // mass-proportional (Rayleigh alpha) damping: -alpha_v m_i v_i = -alpha_v p_i
+    if (current->viscous_damping > 0)
+      {
+        const double *Pm = vt.begin();
+        const double  a  = current->viscous_damping;
+        for (const unsigned int i : s.active_dofs)
+          if (M[i] > 0)
+            F[i] -= a * Pm[i];
       }
     // mass scaling (Eq. 6.31): inertia beta m, forces unchanged
     if (current->mass_scaling != 1.0)
