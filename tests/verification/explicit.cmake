@@ -79,3 +79,4 @@ endforeach()
 # MPM-MIXED (seed 000 §6.6) with a linear cell stress: elastic column 2/4 points per direction,
 # quasi-static column with cell crossing, free block (hourglass modes; constant stress detected unstable)
 talus_verification(explicit_mpm_mixed check_mixed.py verification/elastic_column_gravity.prm)
+set_tests_properties(verification.explicit_mpm_mixed PROPERTIES PROCESSORS 2)

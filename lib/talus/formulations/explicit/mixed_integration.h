@@ -133,17 +133,24 @@ namespace talus::explicit_mpm
       return na;
     }
 
-    /// Pair moments (Q1Factorised::add_moments convention) of -int sigma grad N
-    /// over a cell of volume `cell_volume`, 2^dim Gauss points, with the linear
-    /// field (linear = false: the constant mean stress). T is overwritten.
-    void
-    moments(const double cell_volume, const bool linear, double (&T)[dim][F::npairs][dim]) const
+    /// Reference coordinate of the Gauss points along one axis (index 0 or 1).
+    static double
+    gauss(const unsigned int i)
     {
-      double mean[nst], slope[nst][dim], centre[dim];
+      return 0.5 + (i ? 0.5 : -0.5) / std::sqrt(3.0);
+    }
+
+    /// The field integrated: the fit with the limiter applied (linear), or the
+    /// mean alone (linear = false, slopes 0).
+    void
+    field(const bool linear, double (&mean)[nst], double (&slope)[nst][dim], double (&centre)[dim]) const
+    {
       fit(mean, slope, centre);
       if (!linear)
-        std::fill(&slope[0][0], &slope[0][0] + nst * dim, 0.0);
-      const double g[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
+        {
+          std::fill(&slope[0][0], &slope[0][0] + nst * dim, 0.0);
+          return;
+        }
       // limiter per component over the Gauss points
       for (unsigned int q = 0; q < nst; ++q)
         {
@@ -154,7 +161,7 @@ namespace talus::explicit_mpm
             {
               double d = 0;
               for (unsigned int k = 0; k < dim; ++k)
-                d += slope[q][k] * (g[(gp >> k) & 1u] - centre[k]);
+                d += slope[q][k] * (gauss((gp >> k) & 1u) - centre[k]);
               const double v = mean[q] + d;
               if (v > hi && d > 0)
                 phi = std::min(phi, (hi - mean[q]) / d);
@@ -165,13 +172,23 @@ namespace talus::explicit_mpm
           for (unsigned int k = 0; k < dim; ++k)
             slope[q][k] *= phi;
         }
+    }
+
+    /// Pair moments (Q1Factorised::add_moments convention) of -int sigma grad N
+    /// over a cell of volume `cell_volume`, 2^dim Gauss points, with field().
+    /// T is overwritten.
+    void
+    moments(const double cell_volume, const bool linear, double (&T)[dim][F::npairs][dim]) const
+    {
+      double mean[nst], slope[nst][dim], centre[dim];
+      field(linear, mean, slope, centre);
       std::fill(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, 0.0);
       const double wq = cell_volume / F::nv;
       for (unsigned int gp = 0; gp < F::nv; ++gp)
         {
           dealii::Point<dim> xi;
           for (unsigned int k = 0; k < dim; ++k)
-            xi[k] = g[(gp >> k) & 1u];
+            xi[k] = gauss((gp >> k) & 1u);
           double s[nst];
           for (unsigned int q = 0; q < nst; ++q)
             {
