@@ -121,7 +121,8 @@ namespace
       prm.declare_entry("grid file", "grid.msh", Anything(), "Grid file to write (gmsh MSH 2.2 ASCII).", true);
       prm.declare_entry("particle file", "particles.h5", Anything(), "Particle file to write (HDF5).", true);
       prm.declare_entry("particle csv", "", Anything(),
-                        "Optional CSV of the material points (x, y[, z], volume, material, body); empty = none.");
+                        "Optional CSV of the material points (x, y[, z], volume, material_id, body_id, and the initial "
+                        "stress if any); empty = none.");
     }
     prm.leave_subsection();
     prm.declare_entry("number of bodies", "1", Integer(0, 64), "Number of 'body k' subsections.");
@@ -365,12 +366,21 @@ namespace
         if (!out.csv.empty())
           {
             std::ofstream f(out.csv + ".part");
-            f << (dim == 2 ? "x,y" : "x,y,z") << ",volume,material_id,body_id\n" << std::setprecision(17);
-            for (std::size_t i = 0; i < r.particles.size(); ++i)
+            const auto &t       = r.particles;
+            const bool  stress  = !t.stress.empty();
+            f << (dim == 2 ? "x,y" : "x,y,z") << ",volume,material_id,body_id"
+              << (!stress ? "" : dim == 2 ? ",stress_xx,stress_yy,stress_zz,stress_xy" :
+                                            ",stress_xx,stress_yy,stress_zz,stress_xy,stress_yz,stress_xz")
+              << "\n" << std::setprecision(17);
+            for (std::size_t i = 0; i < t.size(); ++i)
               {
                 for (unsigned int d = 0; d < dim; ++d)
-                  f << r.particles.position[i * dim + d] << ",";
-                f << r.particles.volume[i] << "," << r.particles.material[i] << "," << r.particles.body[i] << "\n";
+                  f << t.position[i * dim + d] << ",";
+                f << t.volume[i] << "," << t.material[i] << "," << t.body[i];
+                if (stress)
+                  for (unsigned int k = 0; k < t.n_stress(); ++k)
+                    f << "," << t.stress[i * t.n_stress() + k];
+                f << "\n";
               }
             f.close();
             std::filesystem::rename(out.csv + ".part", out.csv);

@@ -897,8 +897,12 @@ namespace talus::mesh
       {
         const auto &p = pts[i];
         if (!(p.volume > 1e-12 * std::pow(p.scale, dim)) || !std::isfinite(p.volume))
-          throw InputError(describe_point(pts, i, s) + " has zero volume (" + std::to_string(p.volume) +
-                           "): its cell or element is degenerate");
+          {
+            std::ostringstream os;
+            os << describe_point(pts, i, s) << " has zero volume (" << p.volume
+               << " m^" << dim << "): its cell or element is degenerate";
+            throw InputError(os.str());
+          }
         ++summary.points_per_body[p.body];
         summary.volume_per_body[p.body] += p.volume;
       }
@@ -948,9 +952,13 @@ namespace talus::mesh
                       for (unsigned int d = 0; d < dim; ++d)
                         dist += (pts[i].x[d] - pts[j].x[d]) * (pts[i].x[d] - pts[j].x[d]);
                       if (std::sqrt(dist) <= tol)
-                        throw InputError(describe_point(pts, i, s) + " and " + describe_point(pts, j, s) +
-                                         " are duplicated points (distance " + std::to_string(std::sqrt(dist)) +
-                                         "): overlapping bodies, or a body mesh with duplicated elements");
+                        {
+                          std::ostringstream os;
+                          os << describe_point(pts, i, s) << " and " << describe_point(pts, j, s)
+                             << " are duplicated points (distance " << std::sqrt(dist)
+                             << " m): overlapping bodies, or a body mesh with duplicated elements";
+                          throw InputError(os.str());
+                        }
                     }
                 }
         }
