@@ -183,3 +183,61 @@ TEST(ParticleFile, RoundTrip)
   EXPECT_EQ(r.stress, t.stress);
   EXPECT_THROW(talus::io::read_particle_file(path, 3, MPI_COMM_WORLD, "test"), talus::InputError);
 }
+
+TEST(DealIIQuirks, GridInOnInvertedAndDuplicatedCells)
+{
+  // what deal.II 9.4's GridIn::read_msh(istream) does with an inverted cell
+  // (the reason talus-mesh checks the raw gmsh data itself)
+  const std::string path = "test_mesh_io_inverted.msh";
+  {
+    std::ofstream f(path);
+    f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n6\n1 0 0 0\n2 1 0 0\n3 2 0 0\n4 0 1 0\n5 1 1 0\n6 2 1 0\n"
+         "$EndNodes\n$Elements\n2\n1 3 2 1 1 1 2 5 4\n2 3 2 1 1 2 5 6 3\n$EndElements\n";
+  }
+  dealii::Triangulation<2> tria;
+  dealii::GridIn<2>        in;
+  in.attach_triangulation(tria);
+  std::ifstream f(path);
+  std::string   outcome;
+  try
+    {
+      in.read_msh(f);
+      double min_measure = 1e300;
+      for (const auto &cell : tria.active_cell_iterators())
+        min_measure = std::min(min_measure, cell->measure());
+      outcome = "accepted, " + std::to_string(tria.n_active_cells()) + " cells, smallest measure " +
+                std::to_string(min_measure);
+    }
+  catch (const std::exception &e)
+    {
+      outcome = std::string("throws: ") + std::string(e.what()).substr(0, 300);
+    }
+  // measured with 9.4.1: the inverted cell is silently re-oriented
+  EXPECT_EQ(outcome, "accepted, 2 cells, smallest measure 1.000000");
+
+  // a gmsh MSH 2.2 file lists an element once per physical group it belongs to:
+  // a surface in two groups gives every cell twice
+  const std::string dup = "test_mesh_io_duplicated.msh";
+  {
+    std::ofstream g(dup);
+    g << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+         "$EndNodes\n$Elements\n2\n1 3 2 5 1 1 2 3 4\n2 3 2 6 1 1 2 3 4\n$EndElements\n";
+  }
+  dealii::Triangulation<2> tria2;
+  dealii::GridIn<2>        in2;
+  in2.attach_triangulation(tria2);
+  std::ifstream g(dup);
+  try
+    {
+      in2.read_msh(g);
+      outcome = "accepted, " + std::to_string(tria2.n_active_cells()) + " cells";
+    }
+  catch (const std::exception &e)
+    {
+      outcome = "throws";
+    }
+  // measured with 9.4.1: two coincident cells, no error
+  EXPECT_EQ(outcome, "accepted, 2 cells");
+  // the talus reader refuses it
+  EXPECT_THROW(talus::io::read_msh(dup, 2), talus::InputError);
+}

@@ -419,6 +419,22 @@ namespace talus::io
             have_elements = true;
           }
       }
+    {
+      // a cell listed twice (gmsh lists an element once per physical group it is in)
+      std::map<std::vector<unsigned int>, std::size_t> seen;
+      const unsigned int nv = m.n_cell_vertices();
+      for (std::size_t c = 0; c < m.n_cells(); ++c)
+        {
+          std::vector<unsigned int> key(m.cells.begin() + c * nv, m.cells.begin() + (c + 1) * nv);
+          std::sort(key.begin(), key.end());
+          const auto [it, fresh] = seen.emplace(key, c);
+          if (!fresh)
+            throw InputError("grid file '" + path + "': elements " + std::to_string(m.cell_tag[it->second]) + " and " +
+                             std::to_string(m.cell_tag[c]) +
+                             " are the same cell (gmsh writes an element once per physical group it belongs to: "
+                             "put every cell in one group of its dimension, or write the grid with talus-mesh)");
+        }
+    }
     if (!have_format || !have_nodes || !have_elements)
       throw InputError("grid file '" + path + "': not a MSH 2.2 ASCII file (missing $MeshFormat, $Nodes or $Elements)");
     if (m.n_cells() == 0)
