@@ -154,4 +154,16 @@ t = tv.prm_set(explicit_prm(os.path.join(d3, "out", "grid.msh"), os.path.join(d3
                "boundary conditions/fixed", "7")
 expect_refused("explicit_missing_boundary_id", explicit, t, ["boundary id 7", "ids present: 0, 1, 2, 3"],
                outputs=("out",))
+# 12. talus-explicit: two bodies taking the same points of a particle file
+t = explicit_prm(os.path.join(d3, "out", "grid.msh"), os.path.join(d3, "out", "particles.h5"))
+t = tv.prm_set(t, "number of bodies", "2")
+t += (f"subsection body 1\n  set shape = file\n  set particle file = {os.path.join(d3, 'out', 'particles.h5')}\n"
+      f"  set file body id = 0\nend\n")
+expect_refused("explicit_same_points_twice", explicit, t, ["body 1/file body id", "already takes the points"],
+               outputs=("out",))
+# 13. talus-explicit: a grid file listing an interior face as boundary
+inner = write("interior_face.msh", msh22(strip, [(1, 3, 4, [2, 5]), (3, 0, 1, [1, 2, 5, 4]), (3, 0, 1, [2, 3, 6, 5])]))
+expect_refused("explicit_interior_face", explicit,
+               tv.prm_set(explicit_prm(inner, os.path.join(d3, "out", "particles.h5")), "boundary conditions/fixed", "3"),
+               ["boundary face 0", "boundary id 3", "inside the grid"], outputs=("out",))
 tv.finish()

@@ -256,6 +256,39 @@ namespace talus::io
   }
 
   void
+  check_faces(const GridMesh &m, const std::string &where)
+  {
+    const unsigned int nv = m.n_cell_vertices(), nf = m.n_face_vertices();
+    std::map<std::vector<unsigned int>, unsigned int> count;
+    for (std::size_t c = 0; c < m.n_cells(); ++c)
+      for (unsigned int d = 0; d < m.dim; ++d)
+        for (unsigned int side = 0; side < 2; ++side)
+          {
+            std::vector<unsigned int> key;
+            for (unsigned int v = 0; v < nv; ++v)
+              if (((v >> d) & 1u) == side)
+                key.push_back(m.cells[c * nv + v]);
+            std::sort(key.begin(), key.end());
+            ++count[key];
+          }
+    for (std::size_t k = 0; k < m.n_faces(); ++k)
+      {
+        std::vector<unsigned int> key(m.faces.begin() + k * nf, m.faces.begin() + (k + 1) * nf);
+        std::sort(key.begin(), key.end());
+        const auto it = count.find(key);
+        if (it == count.end() || it->second != 1)
+          {
+            std::ostringstream os;
+            os << where << ": boundary face " << k << " (boundary id " << m.face_boundary[k] << ", vertices";
+            for (const auto v : key)
+              os << " " << fmt_vertex(m.vertices[v], m.dim);
+            os << ") is " << (it == count.end() ? "not a face of any cell" : "inside the grid (between two cells)");
+            throw InputError(os.str());
+          }
+      }
+  }
+
+  void
   write_msh(const GridMesh &m, const std::string &path)
   {
     const std::string tmp = path + ".part";

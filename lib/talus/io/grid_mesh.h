@@ -58,6 +58,10 @@ namespace talus::io
   /// kernel needs); otherwise InputError naming the first cell that is not.
   void normalise_boxes(GridMesh &mesh, const std::string &where);
 
+  /// Every listed face must be a boundary face of the cells (a face of exactly
+  /// one cell); InputError naming the first that is not.
+  void check_faces(const GridMesh &mesh, const std::string &where);
+
   /// Write MSH 2.2 ASCII to path + ".part" and rename it to path.
   void write_msh(const GridMesh &mesh, const std::string &path);
   /// Read a MSH 2.2 ASCII grid file of dimension dim (first-order quads/hexes and

@@ -274,6 +274,7 @@ namespace talus::explicit_mpm
         require_input_file(p.grid_file, "grid/file");
         auto mesh = std::make_shared<io::GridMesh>(io::read_msh(p.grid_file, dim));
         io::normalise_boxes(*mesh, "grid/file '" + p.grid_file + "'");
+        io::check_faces(*mesh, "grid/file '" + p.grid_file + "'");
         double lo[3], hi[3];
         mesh->bounding_box(lo, hi);
         p.grid_cells.assign(dim, 1);

@@ -125,7 +125,8 @@ namespace talus::explicit_mpm
         const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
         if (b.shape == BodyDescription<dim>::Shape::file)
           {
-            const auto info = io::particle_file_info(b.particle_file, dim, MPI_COMM_WORLD, where + "/particle file");
+            const std::string entry = "body " + std::to_string(k);
+            const auto info = io::particle_file_info(b.particle_file, dim, MPI_COMM_WORLD, entry + "/particle file");
             const std::uint64_t rows = b.file_body_id < info.rows_per_body.size() ? info.rows_per_body[b.file_body_id] : 0;
             if (rows == 0)
               {
@@ -133,14 +134,20 @@ namespace talus::explicit_mpm
                 for (unsigned int i = 0; i < info.rows_per_body.size(); ++i)
                   if (info.rows_per_body[i])
                     present += (present.empty() ? "" : ", ") + std::to_string(i);
-                throw InputError(where + "/file body id: particle file '" + b.particle_file +
+                throw InputError(entry + "/file body id: particle file '" + b.particle_file +
                                  "' has no material point with body id " + std::to_string(b.file_body_id) +
                                  " (body ids present: " + (present.empty() ? "none" : present) + ")");
               }
-            require(info.max_material < p.materials.size(), where + "/particle file",
+            require(info.max_material < p.materials.size(), entry + "/particle file",
                     "'" + b.particle_file + "' uses material id " + std::to_string(info.max_material) +
                       ", but number of materials = " + std::to_string(p.materials.size()) + " (allowed 0.." +
                       std::to_string(p.materials.size() - 1) + ")");
+            for (unsigned int j = 0; j < k; ++j)
+              require(p.bodies[j].shape != BodyDescription<dim>::Shape::file ||
+                        p.bodies[j].particle_file != b.particle_file || p.bodies[j].file_body_id != b.file_body_id,
+                      entry + "/file body id",
+                      "body " + std::to_string(j) + " already takes the points of body id " +
+                        std::to_string(b.file_body_id) + " of '" + b.particle_file + "' (each point once)");
             n_points += rows;
             if (k < p.liquid.tractions.size() && p.liquid.tractions[k].face >= 0)
               throw InputError("body " + std::to_string(k) +
