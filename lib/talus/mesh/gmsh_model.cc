@@ -125,17 +125,16 @@ namespace talus::mesh
       throw InputError(w + ": unknown extension '" + ext + "' (allowed: .geo, meshed by gmsh; .msh)");
     try
       {
+        // options persist between models of one gmsh session: set all of them
+        // before every open (a .geo may still set its own)
         gmsh::clear();
         gmsh::option::setNumber("General.AbortOnError", 2);
         gmsh::option::setNumber("Mesh.ElementOrder", 1);
+        gmsh::option::setNumber("Mesh.RecombineAll", opt.recombine ? 1 : 0);
+        gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", opt.subdivide ? (dim == 2 ? 1 : 2) : 0);
         gmsh::open(file);
         if (ext == ".geo" && opt.generate)
-          {
-            gmsh::option::setNumber("Mesh.RecombineAll", opt.recombine ? 1 : 0);
-            if (opt.subdivide)
-              gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", dim == 2 ? 1 : 2);
-            gmsh::model::mesh::generate(dim);
-          }
+          gmsh::model::mesh::generate(dim);
         m.meshed = ext == ".msh" || opt.generate;
 
         gmsh::vectorpair dim_tags;
