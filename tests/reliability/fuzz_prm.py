@@ -64,20 +64,42 @@ def is_number_list(s):
 # entries that name input files by paths relative to the repository root (the
 # shipped .prm files that use gmsh meshes, issue 4: "run from the repository
 # root"); the fuzz runs in a scratch directory, so they are made absolute first
-INPUT_FILE_KEYS = ("file",)
+INPUT_FILE_KEYS = ("file", "particle file")
+
+
+def input_file_entries(text):
+    """(line index, key, value) of the entries that name input files (not those
+    of a subsection 'output', where talus-mesh names the files it writes)."""
+    out, stack = [], []
+    for i, line in enumerate(text.splitlines()):
+        st = line.split("#", 1)[0].strip()
+        m = re.match(r"subsection\s+(.*)$", st)
+        if m:
+            stack.append(m.group(1).strip())
+            continue
+        if st == "end":
+            if stack:
+                stack.pop()
+            continue
+        m = re.match(r"set\s+(.*?)\s*=\s*(.*)$", st)
+        if m and m.group(1) in INPUT_FILE_KEYS and m.group(2) and "output" not in stack:
+            out.append((i, m.group(1), m.group(2)))
+    return out
+
+
+def generated_inputs(text):
+    """Input files under output/: made by another tool first (talus-mesh ->
+    talus-explicit in a makefile chain); such a .prm is skipped."""
+    return [v for _, _, v in input_file_entries(text) if v.startswith("output/")]
 
 
 def absolute_input_files(text, path):
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(path))))
-    out = []
-    for line in text.splitlines():
-        m = re.match(r"^(\s*set\s+)(.*?)(\s*=\s*)([^#]*?)(\s*(#.*)?)$", line)
-        if m and m.group(2) in INPUT_FILE_KEYS and m.group(4) and not os.path.isabs(m.group(4)):
-            candidate = os.path.join(root, m.group(4))
-            if os.path.exists(candidate):
-                line = m.group(1) + m.group(2) + m.group(3) + candidate + m.group(5)
-        out.append(line)
-    return "\n".join(out) + ("\n" if text.endswith("\n") else "")
+    lines = text.splitlines()
+    for i, key, value in input_file_entries(text):
+        if not os.path.isabs(value) and os.path.exists(os.path.join(root, value)):
+            lines[i] = lines[i].replace(value, os.path.join(root, value), 1)
+    return "\n".join(lines) + ("\n" if text.endswith("\n") else "")
 
 
 class Prm:
@@ -454,6 +476,10 @@ def main():
     for path in prms:
         prm = Prm(path)
         rel = os.path.relpath(path, args.prm_dir)
+        missing = generated_inputs(prm.text)
+        if missing:
+            print(f"  {rel}: skipped, it reads files made by another tool first ({', '.join(missing)})")
+            continue
         readers = []
         for t in prm_tools:
             rc, out, err, probs, _ = runner.run(t, Mutation("original", prm.text, "any", base=prm), True,
