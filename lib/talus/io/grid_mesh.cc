@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -12,6 +13,8 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <type_traits>
+#include <unordered_map>
 
 namespace talus::io
 {
@@ -27,6 +30,36 @@ namespace talus::io
       os << ")";
       return os.str();
     }
+
+    /// Numbers of one line, read with strtod/strtoll (an istringstream per line
+    /// cost most of the time of reading a large grid file).
+    struct Tokens
+    {
+      const char *p;
+      bool        ok = true;
+      template <typename T>
+      Tokens &operator>>(T &x)
+      {
+        char *end = nullptr;
+        if constexpr (std::is_floating_point_v<T>)
+          x = std::strtod(p, &end);
+        else if constexpr (std::is_signed_v<T>)
+          x = static_cast<T>(std::strtoll(p, &end, 10));
+        else
+          {
+            while (*p == ' ' || *p == '\t')
+              ++p;
+            if (*p == '-')
+              ok = false;
+            x = static_cast<T>(std::strtoull(p, &end, 10));
+          }
+        if (end == p)
+          ok = false;
+        p = end;
+        return *this;
+      }
+      explicit operator bool() const { return ok; }
+    };
 
     // deal.II lexicographic <-> gmsh (counter-clockwise) vertex order; the
     // permutation is its own inverse
@@ -259,30 +292,36 @@ namespace talus::io
   check_faces(const GridMesh &m, const std::string &where)
   {
     const unsigned int nv = m.n_cell_vertices(), nf = m.n_face_vertices();
-    std::map<std::vector<unsigned int>, unsigned int> count;
+    using Key = std::array<unsigned int, 4>;
+    std::vector<Key> cell_faces;
+    cell_faces.reserve(m.n_cells() * 2 * m.dim);
     for (std::size_t c = 0; c < m.n_cells(); ++c)
       for (unsigned int d = 0; d < m.dim; ++d)
         for (unsigned int side = 0; side < 2; ++side)
           {
-            std::vector<unsigned int> key;
+            Key          key{};
+            unsigned int k = 0;
             for (unsigned int v = 0; v < nv; ++v)
               if (((v >> d) & 1u) == side)
-                key.push_back(m.cells[c * nv + v]);
-            std::sort(key.begin(), key.end());
-            ++count[key];
+                key[k++] = m.cells[c * nv + v];
+            std::sort(key.begin(), key.begin() + nf);
+            cell_faces.push_back(key);
           }
+    std::sort(cell_faces.begin(), cell_faces.end());
     for (std::size_t k = 0; k < m.n_faces(); ++k)
       {
-        std::vector<unsigned int> key(m.faces.begin() + k * nf, m.faces.begin() + (k + 1) * nf);
-        std::sort(key.begin(), key.end());
-        const auto it = count.find(key);
-        if (it == count.end() || it->second != 1)
+        Key key{};
+        std::copy(m.faces.begin() + k * nf, m.faces.begin() + (k + 1) * nf, key.begin());
+        std::sort(key.begin(), key.begin() + nf);
+        const auto range = std::equal_range(cell_faces.begin(), cell_faces.end(), key);
+        const auto count = range.second - range.first;
+        if (count != 1)
           {
             std::ostringstream os;
             os << where << ": boundary face " << k << " (boundary id " << m.face_boundary[k] << ", vertices";
-            for (const auto v : key)
-              os << " " << fmt_vertex(m.vertices[v], m.dim);
-            os << ") is " << (it == count.end() ? "not a face of any cell" : "inside the grid (between two cells)");
+            for (unsigned int v = 0; v < nf; ++v)
+              os << " " << fmt_vertex(m.vertices[key[v]], m.dim);
+            os << ") is " << (count == 0 ? "not a face of any cell" : "inside the grid (between two cells)");
             throw InputError(os.str());
           }
       }
@@ -349,7 +388,7 @@ namespace talus::io
         line.pop_back();
       return line;
     };
-    std::map<std::uint64_t, unsigned int> node_index;
+    std::unordered_map<std::uint64_t, unsigned int> node_index;
     bool                                 have_format = false, have_nodes = false, have_elements = false;
     while (std::getline(f, line))
       {
@@ -373,10 +412,12 @@ namespace talus::io
           {
             std::size_t n = 0;
             std::istringstream(next()) >> n;
+            node_index.reserve(n);
+            m.vertices.reserve(n);
             for (std::size_t i = 0; i < n; ++i)
               {
-                std::istringstream    is(next());
-                std::uint64_t         tag;
+                Tokens                is{next().c_str()};
+                std::uint64_t         tag = 0;
                 std::array<double, 3> x{};
                 is >> tag >> x[0] >> x[1] >> x[2];
                 if (!is || !std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
@@ -395,8 +436,8 @@ namespace talus::io
             std::istringstream(next()) >> n;
             for (std::size_t i = 0; i < n; ++i)
               {
-                std::istringstream is(next());
-                std::uint64_t      tag;
+                Tokens             is{next().c_str()};
+                std::uint64_t      tag = 0;
                 int                type = 0, n_tags = 0;
                 is >> tag >> type >> n_tags;
                 std::vector<long> tags(std::max(0, n_tags));
@@ -454,19 +495,22 @@ namespace talus::io
       }
     {
       // a cell listed twice (gmsh lists an element once per physical group it is in)
-      std::map<std::vector<unsigned int>, std::size_t> seen;
       const unsigned int nv = m.n_cell_vertices();
+      std::vector<std::pair<std::array<unsigned int, 8>, std::size_t>> keys(m.n_cells());
       for (std::size_t c = 0; c < m.n_cells(); ++c)
         {
-          std::vector<unsigned int> key(m.cells.begin() + c * nv, m.cells.begin() + (c + 1) * nv);
-          std::sort(key.begin(), key.end());
-          const auto [it, fresh] = seen.emplace(key, c);
-          if (!fresh)
-            throw InputError("grid file '" + path + "': elements " + std::to_string(m.cell_tag[it->second]) + " and " +
-                             std::to_string(m.cell_tag[c]) +
-                             " are the same cell (gmsh writes an element once per physical group it belongs to: "
-                             "put every cell in one group of its dimension, or write the grid with talus-mesh)");
+          keys[c].first.fill(0);
+          std::copy(m.cells.begin() + c * nv, m.cells.begin() + (c + 1) * nv, keys[c].first.begin());
+          std::sort(keys[c].first.begin(), keys[c].first.begin() + nv);
+          keys[c].second = c;
         }
+      std::sort(keys.begin(), keys.end());
+      for (std::size_t k = 1; k < keys.size(); ++k)
+        if (keys[k].first == keys[k - 1].first)
+          throw InputError("grid file '" + path + "': elements " + std::to_string(m.cell_tag[keys[k - 1].second]) +
+                           " and " + std::to_string(m.cell_tag[keys[k].second]) +
+                           " are the same cell (gmsh writes an element once per physical group it belongs to: "
+                           "put every cell in one group of its dimension, or write the grid with talus-mesh)");
     }
     if (!have_format || !have_nodes || !have_elements)
       throw InputError("grid file '" + path + "': not a MSH 2.2 ASCII file (missing $MeshFormat, $Nodes or $Elements)");
