@@ -159,6 +159,40 @@ TEST(MeshPreparation, BodyMeshVolumeEqualsAreaForEveryRule)
       }
 }
 
+TEST(MeshPreparation, TetrahedronBodyVolumeAndOutsideCheck3D)
+{
+  // a box 0.5 x 0.4 x 0.3 meshed with tetrahedra (OpenCASCADE kernel), Gauss rules n = 1..3
+  const std::string geo = "test_mesh_io_box_tets.geo";
+  {
+    std::ofstream f(geo);
+    f << "SetFactory(\"OpenCASCADE\");\nBox(1) = {0.1, 0.1, 0.1, 0.5, 0.4, 0.3};\n"
+         "Mesh.CharacteristicLengthMax = 0.15;\nPhysical Volume(\"material 3 rock\") = {1};\n";
+  }
+  for (unsigned int n = 1; n <= 3; ++n)
+    {
+      talus::mesh::Settings<3> s;
+      s.cells = {5, 5, 5};
+      talus::mesh::BodySpec<3> b;
+      b.source   = talus::mesh::BodySpec<3>::Source::gmsh;
+      b.file     = geo;
+      b.material = -1;
+      b.n        = n;
+      b.gauss    = true;
+      s.bodies.push_back(b);
+      const auto r = talus::mesh::prepare(s);
+      EXPECT_NEAR(r.summary.volume_per_body[0], 0.06, 1e-14) << "n = " << n;
+      for (const auto m : r.particles.material)
+        EXPECT_EQ(m, 3u);
+      // regular positions do not exist on tetrahedra: refused with the element named
+      s.bodies[0].gauss = false;
+      EXPECT_THROW(talus::mesh::prepare(s), talus::InputError);
+      // a grid that does not cover the body: points outside refused
+      s.bodies[0].gauss = true;
+      s.upper[2]        = 0.3;
+      EXPECT_THROW(talus::mesh::prepare(s), talus::InputError);
+    }
+}
+
 TEST(ParticleFile, RoundTrip)
 {
   talus::io::ParticleTable t;

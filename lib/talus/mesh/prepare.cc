@@ -334,13 +334,18 @@ namespace talus::mesh
                              " lies inside the domain (between two cells); boundary groups must lie on the boundary");
           face_id[key] = it->second;
         }
+      std::size_t unlabelled = 0;
       for (const auto &[key, entry] : faces)
         if (entry.first == 1)
           {
             const auto it = face_id.find(key);
             g.faces.insert(g.faces.end(), entry.second.begin(), entry.second.end());
             g.face_boundary.push_back(it == face_id.end() ? 0 : it->second);
+            unlabelled += it == face_id.end();
           }
+      if (unlabelled > 0)
+        summary.notes.push_back(std::to_string(unlabelled) +
+                                " boundary faces are in no boundary group: they get boundary id 0");
       for (const auto &gr : m.groups)
         if (gr.dim == dim && group_id(gr, "material", s.material_map) < 0)
           summary.notes.push_back("physical group " + gr.describe() + " carries no material id (a label for bodies)");
