@@ -19,7 +19,10 @@ Checked against numbers derived here, not by talus:
   - K0 stress: sigma_yy = -2000 * 9.81 * (0.7 - y), sigma_xx = sigma_zz = 0.5 sigma_yy;
   - body 1: the points are the centres of the 2 x 2 sub-cells of every 0.1 m
     cell inside the disk (counted here), each with volume 0.0025 m^2;
-  - under mpirun -np 2 the grid file and the particle CSV are byte-identical.
+  - under mpirun -np 2 the grid file and the particle CSV are byte-identical;
+  - meshes/cantilever_2d.geo meshed by talus-mesh and the MSH 2.2 file the gmsh
+    executable writes of it (where every cell of the surface "beam" appears
+    twice: it is in two physical groups) give byte-identical grid files.
 Usage: check_mesh_groups.py TOOLS_DIR REPO_DIR WORKDIR
 """
 import os
@@ -116,4 +119,16 @@ tv.check(all(abs(p["volume"][i] - 0.0025) < 1e-15 for i in b1), "body 1: every v
 for f in ("grid.msh", "particles.csv"):
     same = open(os.path.join(work, "out", f), "rb").read() == open(os.path.join(work, "out_np2", f), "rb").read()
     tv.check(same, f"mpirun -np 2: {f} byte-identical to the 1-rank file")
+# .geo vs the MSH 2.2 export of the gmsh executable (elements repeated per group)
+cant_geo = os.path.join(repo, "meshes", "cantilever_2d.geo")
+cant_msh = os.path.join(work, "cantilever_2d.msh")
+subprocess.run(["gmsh", "-2", cant_geo, "-o", cant_msh, "-format", "msh22"], capture_output=True, check=True)
+n_quads = sum(1 for etype, _, _ in read_msh(cant_msh)[1] if etype == 3)
+cant = open(os.path.join(repo, "parameter_files", "mesh", "cantilever_2d.prm")).read()
+for src, d in ((cant_geo, "cant_geo"), (cant_msh, "cant_msh")):
+    tv.run_tool(tool, cant.replace("meshes/cantilever_2d.geo", src).replace("output/mesh/cantilever_2d", d), work, d)
+same = open(os.path.join(work, "cant_geo", "grid.msh"), "rb").read() == \
+    open(os.path.join(work, "cant_msh", "grid.msh"), "rb").read()
+tv.check(n_quads == 432 + 128 and same,
+         f"cantilever: the MSH 2.2 export ({n_quads} quadrangles for 432 cells) gives the grid file of the .geo")
 tv.finish()

@@ -232,6 +232,28 @@ namespace talus::mesh
       {
         throw InputError(w + ": gmsh: " + last_error());
       }
+    // drop repeated elements (same sorted nodes), keeping the first
+    for (auto *list : {&m.cells, &m.facets})
+      {
+        std::vector<std::pair<std::vector<unsigned int>, std::size_t>> keys;
+        for (std::size_t i = 0; i < list->size(); ++i)
+          {
+            auto k = (*list)[i].nodes;
+            std::sort(k.begin(), k.end());
+            keys.emplace_back(std::move(k), i);
+          }
+        std::sort(keys.begin(), keys.end());
+        std::vector<char> drop(list->size(), 0);
+        for (std::size_t i = 1; i < keys.size(); ++i)
+          if (keys[i].first == keys[i - 1].first)
+            drop[keys[i].second] = 1;
+        std::vector<GmshElement> kept;
+        for (std::size_t i = 0; i < list->size(); ++i)
+          if (!drop[i])
+            kept.push_back(std::move((*list)[i]));
+        m.duplicates += list->size() - kept.size();
+        *list = std::move(kept);
+      }
     if (m.cells.empty())
       throw InputError(w + " contains no elements of dimension " + std::to_string(dim) +
                        (ext == ".geo" ? " after meshing (does it define a " + std::string(dim == 2 ? "surface" : "volume") + "?)" : ""));

@@ -36,6 +36,9 @@ namespace talus::mesh
     std::vector<GmshElement>           cells;  ///< elements of dimension dim
     std::vector<GmshElement>           facets; ///< elements of dimension dim - 1
     std::vector<GmshGroup>             groups; ///< physical groups of every dimension
+    /// Elements that repeated an earlier one (same nodes) and were dropped: a MSH
+    /// 2.2 file lists an element once per physical group it belongs to.
+    std::size_t                        duplicates = 0;
     /// Group of dimension d referenced by name (case-insensitive, blanks
     /// collapsed) or, if `ref` is an integer, by tag; nullptr if none.
     const GmshGroup *find(int d, const std::string &ref) const;

@@ -674,7 +674,7 @@ namespace talus::mesh
           const dealii::QGaussSimplex<dim> q(spec.n);
           for (unsigned int i = 0; i < q.size(); ++i)
             {
-              simplex_points.push_back({q.point(i)[0], q.point(i)[1], dim == 3 ? q.point(i)[dim - 1] : 0.0});
+              simplex_points.push_back({{q.point(i)[0], q.point(i)[1], dim == 3 ? q.point(i)[dim - 1] : 0.0}});
               simplex_weights.push_back(q.weight(i));
             }
         }
@@ -684,11 +684,11 @@ namespace talus::mesh
           for (unsigned int j = 0; j < n; ++j)
             for (unsigned int i = 0; i + j < n; ++i)
               {
-                simplex_points.push_back({(i + 1.0 / 3) / n, (j + 1.0 / 3) / n, 0});
+                simplex_points.push_back({{(i + 1.0 / 3) / n, (j + 1.0 / 3) / n, 0}});
                 simplex_weights.push_back(0.5 / (n * n));
                 if (i + j + 1 < n)
                   {
-                    simplex_points.push_back({(i + 2.0 / 3) / n, (j + 2.0 / 3) / n, 0});
+                    simplex_points.push_back({{(i + 2.0 / 3) / n, (j + 2.0 / 3) / n, 0}});
                     simplex_weights.push_back(0.5 / (n * n));
                   }
               }
@@ -852,6 +852,10 @@ namespace talus::mesh
         grid_model = std::make_unique<GmshModel>(load_gmsh(s.grid_file, dim, s.grid_options, "grid/file"));
         check_maps(s, *grid_model);
         gb = grid_from_gmsh(s, *grid_model, summary);
+        if (grid_model->duplicates)
+          summary.notes.push_back("grid/file: " + std::to_string(grid_model->duplicates) +
+                                  " repeated elements counted once (a MSH 2.2 file lists an element once per physical "
+                                  "group it is in)");
       }
     else
       {
@@ -891,6 +895,9 @@ namespace talus::mesh
           o.round_coordinates = s.grid_options.round_coordinates;
           const auto m = load_gmsh(s.bodies[b].file, dim, o, "body " + std::to_string(b) + "/file");
           seed_body_mesh(s, b, m, pts);
+          if (m.duplicates)
+            summary.notes.push_back("body " + std::to_string(b) + "/file: " + std::to_string(m.duplicates) +
+                                    " repeated elements counted once (MSH 2.2: one copy per physical group)");
         }
     // body order (stable): the grid-seeded points come cell by cell
     std::stable_sort(pts.begin(), pts.end(), [](const SeedPoint &a, const SeedPoint &b) { return a.body < b.body; });
@@ -961,7 +968,7 @@ namespace talus::mesh
                           std::ostringstream os;
                           os << describe_point(pts, i, s) << " and " << describe_point(pts, j, s)
                              << " are duplicated points (distance " << std::sqrt(dist)
-                             << " m): overlapping bodies, or a body mesh with duplicated elements";
+                             << " m): overlapping bodies, or duplicated elements at other nodes";
                           throw InputError(os.str());
                         }
                     }
