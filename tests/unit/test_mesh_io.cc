@@ -84,7 +84,7 @@ TEST(GridFile, RotatedBoxCellsAreNormalisedAndKeepTheirIds)
   // 2 x 1 unit squares; cell 1 starts at its upper right corner
   talus::io::GridMesh m;
   m.dim      = 2;
-  m.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}};
+  m.vertices = {{{0, 0, 0}}, {{1, 0, 0}}, {{2, 0, 0}}, {{0, 1, 0}}, {{1, 1, 0}}, {{2, 1, 0}}};
   m.cells    = {0, 1, 3, 4, /* rotated by 180 degrees: */ 5, 4, 2, 1};
   m.cell_material = {3, 4};
   m.faces         = {0, 1, 1, 2, 2, 5, 5, 4, 4, 3, 3, 0};
@@ -105,7 +105,7 @@ TEST(GridFile, InvertedAndDegenerateCellsAreNamed)
 {
   talus::io::GridMesh m;
   m.dim           = 2;
-  m.vertices      = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}};
+  m.vertices      = {{{0, 0, 0}}, {{1, 0, 0}}, {{2, 0, 0}}, {{0, 1, 0}}, {{1, 1, 0}}, {{2, 1, 0}}};
   m.cell_material = {0, 0};
   m.cell_tag      = {7, 8};
   m.cells         = {0, 1, 3, 4, 4, 5, 1, 2}; // cell 1 mirrored
@@ -155,7 +155,9 @@ TEST(MeshPreparation, BodyMeshVolumeEqualsAreaForEveryRule)
         EXPECT_NEAR(v1, 0.16, 1e-12);
         EXPECT_NEAR(v2, 0.24, 1e-12);
         if (!gauss)
-          EXPECT_EQ(r.particles.size() % (n * n), 0u);
+          {
+            EXPECT_EQ(r.particles.size() % (n * n), 0u);
+          }
       }
 }
 

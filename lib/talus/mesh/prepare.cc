@@ -939,7 +939,7 @@ namespace talus::mesh
       };
       std::unordered_map<std::array<long long, 3>, std::vector<std::size_t>, Hash> bins;
       const auto key = [&](const double *x) {
-        std::array<long long, 3> k = {0, 0, 0};
+        std::array<long long, 3> k{};
         for (unsigned int d = 0; d < dim; ++d)
           k[d] = static_cast<long long>(std::floor(x[d] / tol));
         return k;
@@ -953,7 +953,7 @@ namespace talus::mesh
             for (int b = -1; b <= 1; ++b)
               for (int c = (dim == 3 ? -1 : 0); c <= (dim == 3 ? 1 : 0); ++c)
                 {
-                  const auto it = bins.find({k0[0] + a, k0[1] + b, k0[2] + c});
+                  const auto it = bins.find({{k0[0] + a, k0[1] + b, k0[2] + c}});
                   if (it == bins.end())
                     continue;
                   for (const auto j : it->second)
