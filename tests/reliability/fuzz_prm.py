@@ -89,8 +89,18 @@ def input_file_entries(text):
 
 def generated_inputs(text):
     """Input files under output/: made by another tool first (talus-mesh ->
-    talus-explicit in a makefile chain); such a .prm is skipped."""
-    return [v for _, _, v in input_file_entries(text) if v.startswith("output/")]
+    talus-explicit in a makefile chain), and the input files a talus-convergence
+    family points its runs at through substitutions (made by the mesh stage of a
+    campaign Makefile); such a .prm is skipped."""
+    out = [v for _, _, v in input_file_entries(text) if v.startswith("output/")]
+    for line in text.splitlines():
+        st = line.split("#", 1)[0].strip()
+        m = re.match(r"set\s+substitution\s+\d+\s*=\s*(.*)$", st)
+        if m:
+            sub = re.match(r"(?:.*/)?(file|particle file)\s*=\s*(.+)$", m.group(1))
+            if sub:
+                out.append(sub.group(2).strip())
+    return out
 
 
 def absolute_input_files(text, path):
