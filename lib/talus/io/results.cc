@@ -117,8 +117,9 @@ namespace talus::io
   std::string
   quantity_help()
   {
-    return "energies (kinetic, strain, gravity potential, external work, total), momentum, probes (all probe "
-           "columns), probe_displacements, probe_velocities, probe_stresses, any series.csv column by name "
+    return "energies (kinetic, strain, gravity potential, external work, total), momentum, probes (displacement, "
+           "velocity and stress of every probe, one item per probe and field, norms of the vector/tensor over "
+           "time), probe_displacements, probe_velocities, probe_stresses, any series.csv column by name "
            "(e.g. probe0_uy, kinetic_energy; also written series:NAME), grid:displacement, grid:velocity, "
            "grid:stress, grid:mass (final fields mapped to the grid nodes; one component: grid:displacement_y, "
            "grid:stress_xx, ...), particles:position, particles:initial_position, particles:displacement, "
@@ -162,27 +163,49 @@ namespace talus::io
       return it == r.series_names.end() ? -1 : static_cast<int>(it - r.series_names.begin());
     }
 
+    /// One item made of one or more series columns (the components of a
+    /// vector or tensor: norms of the vector per time).
     Difference
-    compare_series(const Results &a, const Results &b, const std::string &name, const CompareOptions &o)
+    compare_series(const Results &a, const Results &b, const std::string &name, const std::vector<std::string> &cols,
+                   const CompareOptions &o)
     {
-      const int ia = column_index(a, name), ib = column_index(b, name);
-      if (ia < 0)
-        throw InputError("results file '" + a.path + "': no series column '" + name + "'");
-      if (ib < 0)
-        throw InputError("results file '" + b.path + "': no series column '" + name + "' (file '" + a.path +
-                         "' has it)");
+      std::vector<const std::vector<double> *> xa, xb;
+      for (const auto &c : cols)
+        {
+          const int ia = column_index(a, c), ib = column_index(b, c);
+          if (ia < 0)
+            throw InputError("results file '" + a.path + "': no series column '" + c + "'");
+          if (ib < 0)
+            throw InputError("results file '" + b.path + "': no series column '" + c + "' (file '" + a.path +
+                             "' has it)");
+          xa.push_back(&a.series[ia]);
+          xb.push_back(&b.series[ib]);
+        }
       const int ta = column_index(a, "time"), tb = column_index(b, "time");
       if (ta < 0 || tb < 0)
         throw InputError("results file '" + (ta < 0 ? a.path : b.path) + "': no series column 'time'");
-      const auto &xa = a.series[ia], &xb = b.series[ib], &Ta = a.series[ta], &Tb = b.series[tb];
-      if (xa.empty() || xb.empty())
-        throw InputError("results file '" + (xa.empty() ? a.path : b.path) + "': the series is empty");
+      const auto &Ta = a.series[ta], &Tb = b.series[tb];
+      if (Ta.empty() || Tb.empty())
+        throw InputError("results file '" + (Ta.empty() ? a.path : b.path) + "': the series is empty");
       Accumulator acc;
       acc.d.name = name;
+      const std::size_t nc = cols.size();
+      const auto        finish = [&]() {
+        Difference d = acc.result();
+        if (nc > 1 && d.n > 0) // rms over times of the vector length
+          {
+            const double f = std::sqrt(double(nc));
+            d.l2 *= f;
+            d.ref_l2 *= f;
+            d.n /= nc;
+          }
+        return d;
+      };
       if (o.time == CompareOptions::Time::final)
         {
-          acc.add(xa.back(), xb.back());
-          return acc.result();
+          for (std::size_t c = 0; c < nc; ++c)
+            acc.add(xa[c]->back(), xb[c]->back());
+          return finish();
         }
       const double t0 = std::max(Ta.front(), Tb.front()), t1 = std::min(Ta.back(), Tb.back());
       const double eps = 1e-9 * std::max({std::abs(t1), std::abs(t0), 1e-300});
@@ -194,21 +217,31 @@ namespace talus::io
             continue;
           while (j + 1 < Tb.size() && Tb[j + 1] < t)
             ++j;
-          double vb;
-          if (j + 1 < Tb.size() && Tb[j + 1] > Tb[j] && t >= Tb[j])
+          for (std::size_t c = 0; c < nc; ++c)
             {
-              const double s = std::min(1.0, (t - Tb[j]) / (Tb[j + 1] - Tb[j]));
-              vb             = xb[j] + s * (xb[j + 1] - xb[j]);
+              const auto &y = *xb[c];
+              double      vb;
+              if (j + 1 < Tb.size() && Tb[j + 1] > Tb[j] && t >= Tb[j])
+                {
+                  const double s = std::min(1.0, (t - Tb[j]) / (Tb[j + 1] - Tb[j]));
+                  vb             = y[j] + s * (y[j + 1] - y[j]);
+                }
+              else
+                vb = (j + 1 < Tb.size() && std::abs(Tb[j + 1] - t) <= eps) ? y[j + 1] : y[j];
+              acc.add((*xa[c])[i], vb);
             }
-          else
-            vb = (j + 1 < Tb.size() && std::abs(Tb[j + 1] - t) <= eps) ? xb[j + 1] : xb[j];
-          acc.add(xa[i], vb);
         }
       if (acc.d.n == 0)
         throw InputError("results files '" + a.path + "' and '" + b.path + "' have no common times (" +
                          std::to_string(Ta.front()) + ".." + std::to_string(Ta.back()) + " s vs " +
                          std::to_string(Tb.front()) + ".." + std::to_string(Tb.back()) + " s)");
-      return acc.result();
+      return finish();
+    }
+
+    Difference
+    compare_series(const Results &a, const Results &b, const std::string &name, const CompareOptions &o)
+    {
+      return compare_series(a, b, name, std::vector<std::string>{name}, o);
     }
 
     /// permutation sorting the rows of a table lexicographically
@@ -343,14 +376,38 @@ namespace talus::io
           }
         else if (q == "momentum")
           add_series(series_matching(std::regex("momentum_[xyz]")), q);
-        else if (q == "probes")
-          add_series(series_matching(std::regex("probe[0-9]+_.*")), q);
-        else if (q == "probe_displacements")
-          add_series(series_matching(std::regex("probe[0-9]+_u[xyz]")), q);
-        else if (q == "probe_velocities")
-          add_series(series_matching(std::regex("probe[0-9]+_v[xyz]")), q);
-        else if (q == "probe_stresses")
-          add_series(series_matching(std::regex("probe[0-9]+_stress_.*")), q);
+        else if (q == "probes" || q == "probe_displacements" || q == "probe_velocities" || q == "probe_stresses")
+          {
+            // one item per probe and vector/tensor (norms of the vector per time)
+            const std::vector<std::pair<std::string, std::string>> kinds = {
+              {"u", "probe([0-9]+)_u[xyz]"}, {"v", "probe([0-9]+)_v[xyz]"}, {"stress", "probe([0-9]+)_stress_.*"}};
+            bool any = false;
+            for (const auto &[kind, pattern] : kinds)
+              {
+                if ((q == "probe_displacements" && kind != "u") || (q == "probe_velocities" && kind != "v") ||
+                    (q == "probe_stresses" && kind != "stress"))
+                  continue;
+                const auto              cols = series_matching(std::regex(pattern));
+                std::vector<std::string> ids;
+                for (const auto &c : cols)
+                  {
+                    const std::string id = c.substr(5, c.find('_') - 5);
+                    if (std::find(ids.begin(), ids.end(), id) == ids.end())
+                      ids.push_back(id);
+                  }
+                for (const auto &id : ids)
+                  {
+                    std::vector<std::string> mine;
+                    for (const auto &c : cols)
+                      if (c.rfind("probe" + id + "_", 0) == 0)
+                        mine.push_back(c);
+                    out.push_back(compare_series(a, b, "probe" + id + "_" + kind, mine, o));
+                    any = true;
+                  }
+              }
+            if (!any)
+              throw InputError("quantity '" + q + "': results file '" + a.path + "' has no probes (output/probes)");
+          }
         else if (q.rfind("series:", 0) == 0)
           out.push_back(compare_series(a, b, q.substr(7), o));
         else if (q.rfind("grid:", 0) == 0)

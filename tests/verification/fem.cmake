@@ -1,0 +1,21 @@
+# FEM on the same grid (numerics/integration = fem | ul-fem, talus-fem), results
+# files and talus-compare (issue 4). Label "fast".
+set(_v ${CMAKE_CURRENT_SOURCE_DIR}/verification)
+set(_w ${CMAKE_BINARY_DIR}/tests/verification)
+set(_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1;PYTHONPATH=${_v}")
+
+# cantilever under self-weight vs Timoshenko: FEM 2 %, MPM 3 % (issue 4)
+foreach(_mode_tol "fem;0.02" "ul-fem;0.02" "mpm;0.03")
+  list(GET _mode_tol 0 _mode)
+  list(GET _mode_tol 1 _tol)
+  add_test(NAME verification.fem_cantilever_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_cantilever.py ${TALUS_TOOLS_DIR}
+                   ${TALUS_PRM_DIR}/verification/cantilever_self_weight.prm ${_w}/fem_cantilever_${_mode} ${_mode} ${_tol})
+  set_tests_properties(verification.fem_cantilever_${_mode} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+endforeach()
+
+# oedometer under gravity: MPM, FEM, UL-FEM vs analytic and each other; talus-compare exit codes
+add_test(NAME verification.fem_oedometer_box
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_oedometer.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/verification/oedometer_gravity.prm ${_w}/fem_oedometer_box)
+set_tests_properties(verification.fem_oedometer_box PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
