@@ -61,12 +61,31 @@ def is_number_list(s):
     return len(parts) > 0 and all(is_number(x) for x in parts if x != "") and any(x != "" for x in parts)
 
 
+# entries that name input files by paths relative to the repository root (the
+# shipped .prm files that use gmsh meshes, issue 4: "run from the repository
+# root"); the fuzz runs in a scratch directory, so they are made absolute first
+INPUT_FILE_KEYS = ("file",)
+
+
+def absolute_input_files(text, path):
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(path))))
+    out = []
+    for line in text.splitlines():
+        m = re.match(r"^(\s*set\s+)(.*?)(\s*=\s*)([^#]*?)(\s*(#.*)?)$", line)
+        if m and m.group(2) in INPUT_FILE_KEYS and m.group(4) and not os.path.isabs(m.group(4)):
+            candidate = os.path.join(root, m.group(4))
+            if os.path.exists(candidate):
+                line = m.group(1) + m.group(2) + m.group(3) + candidate + m.group(5)
+        out.append(line)
+    return "\n".join(out) + ("\n" if text.endswith("\n") else "")
+
+
 class Prm:
     """A .prm file as lines with their subsection path, key and value."""
 
     def __init__(self, path):
         self.path = path
-        self.text = open(path, encoding="utf-8", errors="replace").read()
+        self.text = absolute_input_files(open(path, encoding="utf-8", errors="replace").read(), path)
         self.lines = self.text.splitlines()
         self.entries = []  # (line index, subsection path tuple, key, value)
         self.subsections = []  # (line index of 'subsection', path tuple)

@@ -11,7 +11,11 @@ and checks
     another grid (mismatched grids), unknown norm: exit 2 each, naming them;
   * FEM and UL-FEM on 2 ranks = on 1 rank over 0.2 s, undamped (talus-compare,
     relative Linf <= 1e-10).
-Usage: check_fem_oedometer.py TOOLS_DIR PRM WORKDIR [GRID_ARGS]
+With a talus-mesh .prm as 4th argument the same column runs on the gmsh mesh
+(meshes/oedometer_2d.geo through talus-mesh: grid file + particle file, grid/source
+= file, body shape = file) for every mode, and FEM on the gmsh grid must equal FEM
+on the equivalent box grid (relative Linf <= 1e-10).
+Usage: check_fem_oedometer.py TOOLS_DIR PRM WORKDIR [MESH_PRM]
 """
 import os
 import subprocess
@@ -20,7 +24,21 @@ import sys
 import talus_verify as tv
 
 tools, prm_path, work = sys.argv[1:4]
+mesh_prm = sys.argv[4] if len(sys.argv) > 4 else None
 base = open(prm_path).read()
+if mesh_prm:
+    # talus-mesh: gmsh .geo -> grid file + particle file (paths from the repository root)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(mesh_prm)))
+    mtext = open(mesh_prm).read()
+    geo = [l.split("=", 1)[1].strip() for l in mtext.splitlines() if l.strip().startswith("set file")][0]
+    mtext = tv.prm_set(mtext, "grid/file", os.path.join(root, geo))
+    mtext = tv.prm_set(mtext, "output/grid file", f"{work}/mesh/grid.msh")
+    mtext = tv.prm_set(mtext, "output/particle file", f"{work}/mesh/particles.h5")
+    _, out, _ = tv.run_tool(f"{tools}/talus-mesh", mtext, work, "talus_mesh")
+    print(out.strip())
+    for k, v in {"grid/source": "file", "grid/file": f"{work}/mesh/grid.msh", "body 0/shape": "file",
+                 "body 0/particle file": f"{work}/mesh/particles.h5"}.items():
+        base = tv.prm_set(base, k, v)
 E, nu, rho, g, H = 1e7, 0.3, 2000.0, 9.81, 1.0
 E_oed = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 
@@ -71,6 +89,16 @@ compare(ul, fem, q, 0, ["--time=final", "--tolerance=0.01"])
 pert = run("fem_stiff", "talus-fem", "fem", {"material 0/linear elastic/young modulus": "1.03e7"})
 check_analytic("fem_stiff", 1.03 * E_oed)
 compare(pert, mpm, q, 1, ["--time=final", "--tolerance=0.01"])
+
+if mesh_prm:
+    # FEM on the gmsh grid == FEM on the same grid made as a box from parameters
+    box = tv.prm_set(open(prm_path).read(), "grid/cells", "2, 20")
+    saved, base = base, box
+    fem_box = run("fem_box_2x20", "talus-fem", "fem")
+    base = saved
+    compare(fem, fem_box, "grid:displacement,grid:stress,probes,energies", 0,
+            ["--norm=relative-linf", "--tolerance=1e-10"])
+    tv.finish()
 
 # bad input
 p = compare(f"{work}/none.h5", mpm, q, 2)

@@ -19,3 +19,9 @@ add_test(NAME verification.fem_oedometer_box
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_oedometer.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/verification/oedometer_gravity.prm ${_w}/fem_oedometer_box)
 set_tests_properties(verification.fem_oedometer_box PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+# the same on the gmsh mesh (meshes/oedometer_2d.geo -> talus-mesh -> grid + particle files)
+add_test(NAME verification.fem_oedometer_gmsh
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_oedometer.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/verification/oedometer_gravity.prm ${_w}/fem_oedometer_gmsh
+                 ${TALUS_PRM_DIR}/mesh/oedometer_2d.prm)
+set_tests_properties(verification.fem_oedometer_gmsh PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)

@@ -1,13 +1,17 @@
 #include <talus/base/errors.h>
 #include <talus/grid/background_grid.h>
+#include <talus/io/grid_mesh.h>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/tria_description.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 
 namespace talus
@@ -56,6 +60,66 @@ namespace talus
 
   template <int dim>
   void
+  BackgroundGrid<dim>::make_from_mesh(const io::GridMesh &mesh)
+  {
+    require(mesh.dim == dim, "grid/file", "the grid file is " + std::to_string(mesh.dim) + "D, the scene " +
+                                            std::to_string(dim) + "D");
+    constexpr unsigned int nv = dealii::GeometryInfo<dim>::vertices_per_cell;
+    constexpr unsigned int nf = dealii::GeometryInfo<dim>::vertices_per_face;
+    // keep only the vertices the cells use (deal.II refuses unused ones)
+    std::vector<unsigned int> new_index(mesh.vertices.size(), dealii::numbers::invalid_unsigned_int);
+    std::vector<dealii::Point<dim>> vertices;
+    for (const unsigned int v : mesh.cells)
+      if (new_index[v] == dealii::numbers::invalid_unsigned_int)
+        {
+          new_index[v] = vertices.size();
+          dealii::Point<dim> x;
+          for (unsigned int d = 0; d < dim; ++d)
+            x[d] = mesh.vertices[v][d];
+          vertices.push_back(x);
+        }
+    std::vector<dealii::CellData<dim>> cells(mesh.n_cells());
+    for (std::size_t c = 0; c < mesh.n_cells(); ++c)
+      {
+        for (unsigned int v = 0; v < nv; ++v)
+          cells[c].vertices[v] = new_index[mesh.cells[c * nv + v]];
+        cells[c].material_id = mesh.cell_material[c];
+      }
+    tria.create_triangulation(vertices, cells, dealii::SubCellData());
+    // boundary ids: match faces by their sorted vertex indices
+    std::map<std::array<unsigned int, nf>, unsigned int> face_id;
+    for (std::size_t k = 0; k < mesh.n_faces(); ++k)
+      {
+        std::array<unsigned int, nf> key;
+        bool                         known = true;
+        for (unsigned int v = 0; v < nf; ++v)
+          {
+            key[v] = new_index[mesh.faces[k * nf + v]];
+            known  = known && key[v] != dealii::numbers::invalid_unsigned_int;
+          }
+        require(known, "grid/file", "boundary face " + std::to_string(k) + " uses a vertex that no cell has");
+        std::sort(key.begin(), key.end());
+        face_id[key] = mesh.face_boundary[k];
+      }
+    std::size_t matched = 0;
+    for (const auto &cell : tria.active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->at_boundary())
+          {
+            std::array<unsigned int, nf> key;
+            for (unsigned int v = 0; v < nf; ++v)
+              key[v] = cell->face(f)->vertex_index(v);
+            std::sort(key.begin(), key.end());
+            const auto it = face_id.find(key);
+            cell->face(f)->set_boundary_id(it == face_id.end() ? 0 : it->second);
+            matched += it != face_id.end();
+          }
+    // (a listed face that is interior, or not a face at all, is refused by talus-mesh)
+    (void)matched;
+  }
+
+  template <int dim>
+  void
   BackgroundGrid<dim>::setup()
   {
     dof_handler.distribute_dofs(fe);
@@ -92,8 +156,8 @@ namespace talus
               const double expected = p0[d] + (((v >> d) & 1u) ? cc.h[d] : 0.0);
               if (std::abs(cell->vertex(v)[d] - expected) > 1e-10 * std::abs(cc.h[d]) || !(cc.h[d] > 0))
                 throw InputError("grid: cell " + cell->id().to_string() + " at " +
-                                 std::to_string(p0[0]) + ",... is not an axis-aligned box; "
-                                 "the background grid must consist of axis-aligned quads/hexes");
+                                 std::to_string(p0[0]) + ",... is not an axis-aligned box with lexicographic "
+                                 "vertex order; the MPM background grid must consist of axis-aligned quads/hexes");
             }
         cell->get_dof_indices(dof_indices);
         for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)

@@ -18,6 +18,10 @@
 
 namespace talus
 {
+  namespace io
+  {
+    struct GridMesh;
+  }
   using Vector = dealii::LinearAlgebra::distributed::Vector<double>;
 
   /// Kinematic boundary condition on every node of a boundary id (seed 000 §5.1):
@@ -59,6 +63,11 @@ namespace talus
     void make_box(const dealii::Point<dim> &       lower,
                   const dealii::Point<dim> &       upper,
                   const std::vector<unsigned int> &n_cells);
+
+    /// Grid read from a file (io::read_msh): the cells must be axis-aligned boxes
+    /// with lexicographic vertex order (io::normalise_boxes); material ids and
+    /// boundary ids as in the mesh (boundary faces not listed keep id 0).
+    void make_from_mesh(const io::GridMesh &mesh);
 
     /// Distribute DoFs and build the cell cache. Throws InputError if a cell is
     /// not an axis-aligned box (the Q1 kernel and MappingCartesian need boxes).

@@ -1,11 +1,15 @@
 #include <talus/base/errors.h>
+#include <talus/io/particle_file.h>
 #include <talus/particles/material_points.h>
 
 #include <deal.II/base/mpi.h>
 
 #include <algorithm>
 #include <chrono>
+#include <climits>
 #include <cmath>
+#include <map>
+#include <sstream>
 
 namespace talus
 {
@@ -109,6 +113,8 @@ namespace talus
               }
             return inside;
           }
+        case Shape::file:
+          return false; // not seeded by seed_bodies()
       }
     return false;
   }
@@ -194,6 +200,177 @@ namespace talus
                                   p.xi,
                                   offset + i,
                                   grid.cell_iterators[p.cell],
+                                  dealii::ArrayView<const double>(props.data(), props.size()));
+      }
+    particles.update_cached_numbers();
+    result.n_particles = dealii::Utilities::MPI::sum(n_local, grid.comm);
+    for (auto &v : result.volume_per_body)
+      v = dealii::Utilities::MPI::sum(v, grid.comm);
+    return result;
+  }
+
+  template <int dim>
+  SeedingResult
+  insert_file_bodies(const BackgroundGrid<dim> &               grid,
+                     const std::vector<BodyDescription<dim>> & bodies,
+                     const std::vector<double> &               density_of_material,
+                     const PropertyLayout<dim> &               layout,
+                     dealii::Particles::ParticleHandler<dim> & particles,
+                     const unsigned long long                  first_id)
+  {
+    SeedingResult result;
+    result.volume_per_body.assign(bodies.size(), 0.0);
+    std::map<std::string, io::ParticleTable> tables;
+    for (const auto &b : bodies)
+      if (b.shape == BodyDescription<dim>::Shape::file && !tables.count(b.particle_file))
+        tables[b.particle_file] = io::read_particle_file(b.particle_file, dim, grid.comm, "body '" + b.name + "'");
+    if (tables.empty())
+      return result;
+
+    // bucket grid over the locally owned cells (boxes) for the point location
+    double lo[dim], hi[dim], h_sum = 0;
+    unsigned int n_owned = 0;
+    for (unsigned int d = 0; d < dim; ++d)
+      lo[d] = std::numeric_limits<double>::max(), hi[d] = -lo[d];
+    for (const auto &cc : grid.cells)
+      if (cc.locally_owned)
+        {
+          ++n_owned;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              lo[d] = std::min(lo[d], cc.lower[d]);
+              hi[d] = std::max(hi[d], cc.lower[d] + cc.h[d]);
+              h_sum += cc.h[d];
+            }
+        }
+    const double bucket = n_owned ? h_sum / (dim * n_owned) : 1.0;
+    unsigned int nb[dim];
+    std::size_t  n_buckets = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        nb[d] = n_owned ? std::max(1u, static_cast<unsigned int>(std::min(1e6, std::ceil((hi[d] - lo[d]) / bucket)))) : 1;
+        n_buckets *= nb[d];
+      }
+    const auto bucket_of = [&](const double x, const unsigned int d) {
+      const double r = std::floor((x - lo[d]) / bucket);
+      return static_cast<int>(std::max(-1.0, std::min(double(nb[d]), r)));
+    };
+    std::vector<std::vector<unsigned int>> buckets(n_owned ? n_buckets : 0);
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cells[c].locally_owned)
+        {
+          const auto &cc = grid.cells[c];
+          int         b0[dim], b1[dim];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double tol = 1e-10 * cc.h[d];
+              b0[d] = std::max(0, bucket_of(cc.lower[d] - tol, d));
+              b1[d] = std::min(int(nb[d]) - 1, bucket_of(cc.lower[d] + cc.h[d] + tol, d));
+            }
+          for (int k = (dim == 3 ? b0[dim - 1] : 0); k <= (dim == 3 ? b1[dim - 1] : 0); ++k)
+            for (int j = b0[1]; j <= b1[1]; ++j)
+              for (int i = b0[0]; i <= b1[0]; ++i)
+                buckets[i + nb[0] * (j + std::size_t(nb[1]) * k)].push_back(c);
+        }
+    const auto locate = [&](const dealii::Point<dim> &x) -> unsigned int {
+      if (buckets.empty())
+        return dealii::numbers::invalid_unsigned_int;
+      std::size_t idx = 0, stride = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const int b = bucket_of(x[d], d);
+          if (b < 0 || b >= int(nb[d]))
+            return dealii::numbers::invalid_unsigned_int;
+          idx += b * stride;
+          stride *= nb[d];
+        }
+      for (const unsigned int c : buckets[idx])
+        {
+          const auto &cc = grid.cells[c];
+          bool        in = true;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double r = (x[d] - cc.lower[d]) * cc.inv_h[d];
+              in             = in && r >= -1e-12 && r <= 1 + 1e-12;
+            }
+          if (in)
+            return c;
+        }
+      return dealii::numbers::invalid_unsigned_int;
+    };
+
+    // all points of the file bodies, in body then row order
+    struct Row
+    {
+      const io::ParticleTable *table;
+      std::size_t              row;
+      unsigned int             body;
+    };
+    std::vector<Row> rows;
+    for (unsigned int b = 0; b < bodies.size(); ++b)
+      if (bodies[b].shape == BodyDescription<dim>::Shape::file)
+        {
+          const auto &t = tables[bodies[b].particle_file];
+          for (std::size_t i = 0; i < t.size(); ++i)
+            if (t.body[i] == bodies[b].file_body_id)
+              rows.push_back({&t, i, b});
+        }
+    const int rank = dealii::Utilities::MPI::this_mpi_process(grid.comm);
+    std::vector<int>          owner(rows.size(), INT_MAX);
+    std::vector<unsigned int> cell_of(rows.size(), dealii::numbers::invalid_unsigned_int);
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      {
+        dealii::Point<dim> x;
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d] = rows[k].table->position[rows[k].row * dim + d];
+        cell_of[k] = locate(x);
+        if (cell_of[k] != dealii::numbers::invalid_unsigned_int)
+          owner[k] = rank;
+      }
+    if (!owner.empty())
+      MPI_Allreduce(MPI_IN_PLACE, owner.data(), owner.size(), MPI_INT, MPI_MIN, grid.comm);
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      if (owner[k] == INT_MAX)
+        {
+          std::ostringstream os;
+          os << "body " << rows[k].body << " ('" << bodies[rows[k].body].name << "'): material point " << rows[k].row
+             << " of particle file '" << bodies[rows[k].body].particle_file << "' at (";
+          for (unsigned int d = 0; d < dim; ++d)
+            os << (d ? ", " : "") << rows[k].table->position[rows[k].row * dim + d];
+          os << ") lies outside the grid (was the file made for another grid?)";
+          throw InputError(os.str());
+        }
+
+    std::vector<double> props(layout.n_properties(), 0.0);
+    unsigned long long  n_local = 0;
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      {
+        const auto &t    = *rows[k].table;
+        const auto  i    = rows[k].row;
+        const auto &body = bodies[rows[k].body];
+        result.volume_per_body[rows[k].body] += owner[k] == rank ? t.volume[i] : 0.0;
+        if (owner[k] != rank)
+          continue;
+        ++n_local;
+        dealii::Point<dim> x;
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d] = t.position[i * dim + d];
+        dealii::Point<dim> xi = grid.reference_point(cell_of[k], x);
+        for (unsigned int d = 0; d < dim; ++d)
+          xi[d] = std::min(1.0, std::max(0.0, xi[d]));
+        std::fill(props.begin(), props.end(), 0.0);
+        const unsigned int m   = static_cast<unsigned int>(t.material[i]);
+        props[layout.mass]     = density_of_material[m] * t.volume[i];
+        props[layout.volume]   = t.volume[i];
+        props[layout.material] = m;
+        props[layout.body]     = rows[k].body;
+        const dealii::Tensor<1, dim> v = body.velocity_field ? body.velocity_field(x) : body.initial_velocity;
+        for (unsigned int d = 0; d < dim; ++d)
+          props[layout.velocity + d] = v[d];
+        if (!t.stress.empty())
+          for (unsigned int s = 0; s < t.n_stress(); ++s)
+            props[layout.stress + s] = t.stress[i * t.n_stress() + s];
+        particles.insert_particle(x, xi, first_id + k, grid.cell_iterators[cell_of[k]],
                                   dealii::ArrayView<const double>(props.data(), props.size()));
       }
     particles.update_cached_numbers();
@@ -299,6 +476,12 @@ namespace talus
   template SeedingResult seed_bodies(const BackgroundGrid<2> &, const std::vector<BodyDescription<2>> &,
                                      const std::vector<double> &, const PropertyLayout<2> &,
                                      dealii::Particles::ParticleHandler<2> &);
+  template SeedingResult insert_file_bodies(const BackgroundGrid<2> &, const std::vector<BodyDescription<2>> &,
+                                            const std::vector<double> &, const PropertyLayout<2> &,
+                                            dealii::Particles::ParticleHandler<2> &, unsigned long long);
+  template SeedingResult insert_file_bodies(const BackgroundGrid<3> &, const std::vector<BodyDescription<3>> &,
+                                            const std::vector<double> &, const PropertyLayout<3> &,
+                                            dealii::Particles::ParticleHandler<3> &, unsigned long long);
   template SeedingResult seed_bodies(const BackgroundGrid<3> &, const std::vector<BodyDescription<3>> &,
                                      const std::vector<double> &, const PropertyLayout<3> &,
                                      dealii::Particles::ParticleHandler<3> &);

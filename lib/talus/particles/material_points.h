@@ -84,13 +84,16 @@ namespace talus
     {
       box,
       ball, ///< disk in 2D, sphere in 3D
-      polygon
+      polygon,
+      file ///< the points of a talus particle file (io/particle_file.h)
     };
     Shape                          shape = Shape::box;
     dealii::Point<dim>             lower, upper;    // box
     dealii::Point<dim>             center;          // ball
     double                         radius = 0;      // ball
     std::vector<dealii::Point<2>>  polygon;         // polygon (2D)
+    std::string                    particle_file;   // file
+    unsigned int                   file_body_id = 0; // file: rows with this body id
     unsigned int                   material_id = 0;
     unsigned int                   particles_per_direction = 2;
     dealii::Tensor<1, dim>         initial_velocity;
@@ -117,6 +120,22 @@ namespace talus
                             const std::vector<double> &                 density_of_material,
                             const PropertyLayout<dim> &                 layout,
                             dealii::Particles::ParticleHandler<dim> &   particles);
+
+  /// Insert the material points of the bodies with shape = file: the rows of
+  /// their particle files whose body id is the body's file_body_id, in body and
+  /// row order, with ids from `first_id` on. Material id and volume (and the
+  /// initial stress, if the file has one) come from the file; body = the body's
+  /// index; mass = density of the material x volume; velocity as for the shapes.
+  /// Every rank reads the files; each point goes to the rank owning the cell that
+  /// contains it (a point on a cell face: the lowest rank). A point in no cell of
+  /// the grid is an InputError naming it. Collective.
+  template <int dim>
+  SeedingResult insert_file_bodies(const BackgroundGrid<dim> &               grid,
+                                   const std::vector<BodyDescription<dim>> & bodies,
+                                   const std::vector<double> &               density_of_material,
+                                   const PropertyLayout<dim> &               layout,
+                                   dealii::Particles::ParticleHandler<dim> & particles,
+                                   unsigned long long                        first_id);
 
   struct RelocationStats
   {

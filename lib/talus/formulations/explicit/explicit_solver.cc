@@ -137,6 +137,13 @@ namespace talus::explicit_mpm
 
     prm.enter_subsection("grid");
     {
+      prm.declare_entry("source", "box", Selection("box|file"),
+                        "Background grid: 'box' (lower corner, upper corner, cells below) or 'file' (the grid "
+                        "file written by talus-mesh, entry 'file'; see docs/mesh.md). A grid from a file must "
+                        "consist of axis-aligned rectangles/boxes (MPM limitation); its boundary ids and "
+                        "material ids come from the file.");
+      prm.declare_entry("file", "", Anything(),
+                        "grid/source = file: grid file (gmsh MSH 2.2 ASCII as written by talus-mesh).");
       prm.declare_entry("lower corner", zeros(dim), Anything(),
                         "Lower corner of the box background grid [m], dim comma-separated numbers.");
       prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(),
@@ -230,9 +237,16 @@ namespace talus::explicit_mpm
         prm.enter_subsection("body " + std::to_string(k));
         prm.declare_entry("name", "body " + std::to_string(k), Anything(), "Name used in messages.");
         prm.declare_entry("material", "0", Integer(0), "Material id (index of a 'material k' subsection).");
-        prm.declare_entry("shape", "box", Selection("box|ball|polygon"),
+        prm.declare_entry("shape", "box", Selection("box|ball|polygon|file"),
                           "Region filled with material points: box (lower/upper corner), ball (disk in 2D, "
-                          "sphere in 3D: center, radius) or polygon (2D: vertices).");
+                          "sphere in 3D: center, radius), polygon (2D: vertices), or file: the material points "
+                          "of a particle file written by talus-mesh ('particle file', 'file body id'), with "
+                          "their positions, volumes, material ids (the entry 'material' is then not used) and "
+                          "initial stresses if the file has them.");
+        prm.declare_entry("particle file", "", Anything(), "shape = file: the particle file (HDF5, talus-mesh).");
+        prm.declare_entry("file body id", "-1", Integer(-1, 65535),
+                          "shape = file: take the rows of the file with this body id; -1 = the index k of this "
+                          "'body k' subsection.");
         prm.declare_entry("lower corner", zeros(dim), Anything(), "Box: lower corner [m].");
         prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(), "Box: upper corner [m].");
         prm.declare_entry("center", zeros(dim), Anything(), "Ball: center [m].");
@@ -267,15 +281,32 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     prm.enter_subsection("grid");
-    p.grid_lower = parse_point<dim>(prm.get("lower corner"), "grid/lower corner");
-    p.grid_upper = parse_point<dim>(prm.get("upper corner"), "grid/upper corner");
-    p.grid_cells = parse_ids(prm.get("cells"), "grid/cells");
-    require(p.grid_cells.size() == dim, "grid/cells", "needs exactly " + std::to_string(dim) + " integers");
-    for (unsigned int d = 0; d < dim; ++d)
+    if (prm.get("source") == "file")
       {
-        require(p.grid_cells[d] > 0, "grid/cells", "every entry must be > 0");
-        require(p.grid_upper[d] > p.grid_lower[d], "grid/upper corner",
-                "must exceed 'lower corner' in every direction");
+        p.grid_file = prm.get("file");
+        require_input_file(p.grid_file, "grid/file");
+        auto mesh = std::make_shared<io::GridMesh>(io::read_msh(p.grid_file, dim));
+        io::normalise_boxes(*mesh, "grid/file '" + p.grid_file + "'");
+        double lo[3], hi[3];
+        mesh->bounding_box(lo, hi);
+        p.grid_cells.assign(dim, 1);
+        p.grid_cells[0] = mesh->n_cells();
+        for (unsigned int d = 0; d < dim; ++d)
+          p.grid_lower[d] = lo[d], p.grid_upper[d] = hi[d];
+        p.grid_mesh = mesh;
+      }
+    else
+      {
+        p.grid_lower = parse_point<dim>(prm.get("lower corner"), "grid/lower corner");
+        p.grid_upper = parse_point<dim>(prm.get("upper corner"), "grid/upper corner");
+        p.grid_cells = parse_ids(prm.get("cells"), "grid/cells");
+        require(p.grid_cells.size() == dim, "grid/cells", "needs exactly " + std::to_string(dim) + " integers");
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            require(p.grid_cells[d] > 0, "grid/cells", "every entry must be > 0");
+            require(p.grid_upper[d] > p.grid_lower[d], "grid/upper corner",
+                    "must exceed 'lower corner' in every direction");
+          }
       }
     prm.leave_subsection();
 
@@ -364,9 +395,17 @@ namespace talus::explicit_mpm
             b.radius = prm.get_double("radius");
             require(b.radius > 0, where + "/radius", "must be > 0 for shape = ball");
           }
+        else if (shape == "file")
+          {
+            b.shape         = BodyDescription<dim>::Shape::file;
+            b.particle_file = prm.get("particle file");
+            require_input_file(b.particle_file, where + "/particle file");
+            const int id    = prm.get_integer("file body id");
+            b.file_body_id  = id < 0 ? k : static_cast<unsigned int>(id);
+          }
         else
           {
-            require(dim == 2, where + "/shape", "polygon bodies exist in 2D only (allowed in 3D: box|ball)");
+            require(dim == 2, where + "/shape", "polygon bodies exist in 2D only (allowed in 3D: box|ball|file)");
             b.shape = BodyDescription<dim>::Shape::polygon;
             for (const auto &s : dealii::Utilities::split_string_list(prm.get("vertices"), ';'))
               b.polygon.push_back(parse_point<2>(s, where + "/vertices"));
@@ -486,7 +525,10 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::setup()
   {
-    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
+    if (prm.grid_mesh)
+      grid.make_from_mesh(*prm.grid_mesh);
+    else
+      grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
     constrained = grid.constrained_dofs(prm.boundary_conditions);
     grid.reinit_vector(nodal_mass);
@@ -542,7 +584,12 @@ namespace talus::explicit_mpm
       std::vector<double> density;
       for (const auto &m : prm.materials)
         density.push_back(m->density());
-      const auto seeded = fem ? fem->seed(density) : seed_bodies(grid, prm.bodies, density, layout, particles);
+      auto       seeded = seed_bodies(grid, prm.bodies, density, layout, particles);
+      const auto filed  = insert_file_bodies(grid, prm.bodies, density, layout, particles, seeded.n_particles);
+      for (unsigned int b = 0; b < prm.bodies.size(); ++b)
+        seeded.volume_per_body[b] += filed.volume_per_body[b];
+      if (fem) // the cells these points occupy get Gauss points instead (fem.h)
+        seeded = fem->seed(density);
       for (unsigned int b = 0; b < prm.bodies.size(); ++b)
         require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
                 "contains no material point: it lies outside the grid or is smaller than one sub-cell");

@@ -7,6 +7,7 @@
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/grid/background_grid.h>
+#include <talus/io/grid_mesh.h>
 #include <talus/loads/settings.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
@@ -36,9 +37,13 @@ namespace talus::explicit_mpm
     double       time_step       = 0.0; ///< 0: courant x critical
     bool         force_time_step = false;
     unsigned int max_steps       = 0; ///< 0: no limit
-    // grid
+    // grid: a box from grid_lower/upper/cells, or (grid/source = file) the mesh
+    // of a grid file, read and checked while parsing (grid_lower/upper are then
+    // its bounding box, grid_cells = {number of cells, 1, ...})
     dealii::Point<dim>        grid_lower, grid_upper;
     std::vector<unsigned int> grid_cells;
+    std::string                              grid_file;
+    std::shared_ptr<const io::GridMesh>      grid_mesh;
     std::vector<BoundaryCondition> boundary_conditions;
     dealii::Tensor<1, dim>    gravity;
     // stability

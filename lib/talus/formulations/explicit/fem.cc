@@ -157,27 +157,32 @@ namespace talus::explicit_mpm
     struct NewPoint
     {
       dealii::Point<dim> x, xi;
-      unsigned int       cell, body;
+      unsigned int       cell, body, material;
       double             volume;
     };
     std::vector<NewPoint> points;
     SeedingResult         result;
     result.volume_per_body.assign(bodies.size(), 0.0);
+    // cells covered by a body: those holding its points in the MPM seeding
+    std::vector<int> body_of_cell(grid.cells.size(), -1), material_of_cell(grid.cells.size(), -1);
+    for (const auto &pt : s.particles)
+      {
+        const unsigned int c = pt.get_surrounding_cell()->active_cell_index();
+        const int          b = static_cast<int>(pt.get_properties()[L::body]);
+        if (body_of_cell[c] < 0 || b < body_of_cell[c])
+          {
+            body_of_cell[c]     = b;
+            material_of_cell[c] = static_cast<int>(pt.get_properties()[L::material]);
+          }
+      }
+    s.particles.clear_particles();
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
       {
-        if (!grid.cells[c].locally_owned)
+        if (!grid.cells[c].locally_owned || body_of_cell[c] < 0)
           continue;
         double X[nv][dim];
         current_vertices(c, X);
-        dealii::Point<dim> centre;
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            centre[d] += X[v][d] / nv;
-        unsigned int b = 0;
-        while (b < bodies.size() && !bodies[b].contains(centre))
-          ++b;
-        if (b == bodies.size())
-          continue;
+        const unsigned int b = body_of_cell[c];
         for (unsigned int q = 0; q < nv; ++q)
           {
             dealii::Point<dim> xi, x;
@@ -193,7 +198,7 @@ namespace talus::explicit_mpm
             for (unsigned int v = 0; v < nv; ++v)
               for (unsigned int d = 0; d < dim; ++d)
                 x[d] += N[v] * X[v][d];
-            points.push_back({x, xi, c, b, det * weight});
+            points.push_back({x, xi, c, b, static_cast<unsigned int>(material_of_cell[c]), det * weight});
           }
       }
 
@@ -209,9 +214,9 @@ namespace talus::explicit_mpm
         const auto &p    = points[i];
         const auto &body = bodies[p.body];
         std::fill(props.begin(), props.end(), 0.0);
-        props[L::mass]     = density_of_material[body.material_id] * p.volume;
+        props[L::mass]     = density_of_material[p.material] * p.volume;
         props[L::volume]   = p.volume;
-        props[L::material] = body.material_id;
+        props[L::material] = p.material;
         props[L::body]     = p.body;
         const dealii::Tensor<1, dim> v = body.velocity_field ? body.velocity_field(p.x) : body.initial_velocity;
         for (unsigned int d = 0; d < dim; ++d)

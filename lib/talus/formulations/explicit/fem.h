@@ -38,8 +38,10 @@ namespace talus::explicit_mpm
     /// `updated_lagrangian`: ul-fem (the mesh follows the material).
     FemIntegration(Solver<dim> &solver, bool updated_lagrangian);
 
-    /// Gauss points of every locally owned cell whose centre lies in a body
-    /// (first body wins, as for the MPM seeding); volume = det J w, mass =
+    /// Replace the material points of the MPM seeding (primitives and particle
+    /// files, already in the particle handler) by the Gauss points of the cells
+    /// they occupy: a cell is covered by the lowest body id among its points and
+    /// takes that body's (first point's) material; volume = det J w, mass =
     /// density x volume, velocity from the body. Ids global and contiguous.
     /// Collective.
     SeedingResult seed(const std::vector<double> &density_of_material);

@@ -2,6 +2,7 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/formulations/explicit/input_checks.h>
+#include <talus/io/particle_file.h>
 
 #include <algorithm>
 #include <cmath>
@@ -55,8 +56,11 @@ namespace talus::explicit_mpm
   critical_time_step_of(const Parameters<dim> &p)
   {
     double h = std::numeric_limits<double>::max();
-    for (unsigned int d = 0; d < dim; ++d)
-      h = std::min(h, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
+    if (p.grid_mesh)
+      h = p.grid_mesh->min_edge();
+    else
+      for (unsigned int d = 0; d < dim; ++d)
+        h = std::min(h, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
     double dt = std::numeric_limits<double>::infinity();
     for (const auto &c : critical_time_steps(p.materials, p.liquid.pore_liquid, h))
       dt = std::min(dt, c.dt);
@@ -74,8 +78,20 @@ namespace talus::explicit_mpm
   void
   check_consistency(const Parameters<dim> &p)
   {
+    if (p.grid_mesh)
+      {
+        const auto ids = p.grid_mesh->boundary_ids();
+        std::string list;
+        for (const auto i : ids)
+          list += (list.empty() ? "" : ", ") + std::to_string(i);
+        for (const auto &bc : p.boundary_conditions)
+          require(std::find(ids.begin(), ids.end(), bc.id) != ids.end(),
+                  std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
+                  "boundary id " + std::to_string(bc.id) + " does not exist in the grid file '" + p.grid_file +
+                    "' (ids present: " + (list.empty() ? "none" : list) + ")");
+      }
     // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
-    for (const auto &bc : p.boundary_conditions)
+    for (const auto &bc : p.grid_mesh ? std::vector<BoundaryCondition>() : p.boundary_conditions)
       require(bc.id < 2 * dim,
               std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
               "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
@@ -87,6 +103,11 @@ namespace talus::explicit_mpm
       {
         n_cells *= p.grid_cells[d];
         cell_volume *= (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
+      }
+    if (p.grid_mesh) // mean cell volume of the bounding box (an estimate for the point count)
+      {
+        const double h = p.grid_mesh->min_edge();
+        require(h > 0 && std::isfinite(h), "grid/file", "'" + p.grid_file + "' has a cell with an edge of zero length");
       }
     require(n_cells <= max_grid_cells,
             "grid/cells",
@@ -102,6 +123,31 @@ namespace talus::explicit_mpm
       {
         const auto &      b     = p.bodies[k];
         const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
+        if (b.shape == BodyDescription<dim>::Shape::file)
+          {
+            const auto info = io::particle_file_info(b.particle_file, dim, MPI_COMM_WORLD, where + "/particle file");
+            const std::uint64_t rows = b.file_body_id < info.rows_per_body.size() ? info.rows_per_body[b.file_body_id] : 0;
+            if (rows == 0)
+              {
+                std::string present;
+                for (unsigned int i = 0; i < info.rows_per_body.size(); ++i)
+                  if (info.rows_per_body[i])
+                    present += (present.empty() ? "" : ", ") + std::to_string(i);
+                throw InputError(where + "/file body id: particle file '" + b.particle_file +
+                                 "' has no material point with body id " + std::to_string(b.file_body_id) +
+                                 " (body ids present: " + (present.empty() ? "none" : present) + ")");
+              }
+            require(info.max_material < p.materials.size(), where + "/particle file",
+                    "'" + b.particle_file + "' uses material id " + std::to_string(info.max_material) +
+                      ", but number of materials = " + std::to_string(p.materials.size()) + " (allowed 0.." +
+                      std::to_string(p.materials.size() - 1) + ")");
+            n_points += rows;
+            if (k < p.liquid.tractions.size() && p.liquid.tractions[k].face >= 0)
+              throw InputError("body " + std::to_string(k) +
+                               "/traction face: tractions are supported on box bodies only (this body is "
+                               "read from a file; allowed here: none)");
+            continue;
+          }
         // bounding box of the body
         dealii::Point<dim> lo, hi;
         switch (b.shape)
@@ -123,6 +169,8 @@ namespace talus::explicit_mpm
                 for (unsigned int d = 0; d < dim && d < 2; ++d)
                   lo[d] = std::min(lo[d], v[d]), hi[d] = std::max(hi[d], v[d]);
               break;
+            case BodyDescription<dim>::Shape::file:
+              break; // handled above
           }
         double overlap = 1;
         for (unsigned int d = 0; d < dim; ++d)
@@ -131,7 +179,7 @@ namespace talus::explicit_mpm
                 where,
                 "contains no material point: it lies entirely outside the grid (body " + fmt_point(lo) + " to " +
                   fmt_point(hi) + ", grid " + fmt_point(p.grid_lower) + " to " + fmt_point(p.grid_upper) + ")");
-        if (b.shape == BodyDescription<dim>::Shape::box)
+        if (b.shape == BodyDescription<dim>::Shape::box && !p.grid_mesh)
           for (unsigned int d = 0; d < dim; ++d)
             require(interval_has_seed(p.grid_lower[d],
                                       p.grid_upper[d],
