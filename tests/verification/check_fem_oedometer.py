@@ -28,7 +28,7 @@ mesh_prm = sys.argv[4] if len(sys.argv) > 4 else None
 base = open(prm_path).read()
 if mesh_prm:
     # talus-mesh: gmsh .geo -> grid file + particle file (paths from the repository root)
-    root = os.path.dirname(os.path.dirname(os.path.abspath(mesh_prm)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(mesh_prm))))
     mtext = open(mesh_prm).read()
     geo = [l.split("=", 1)[1].strip() for l in mtext.splitlines() if l.strip().startswith("set file")][0]
     mtext = tv.prm_set(mtext, "grid/file", os.path.join(root, geo))
@@ -58,8 +58,8 @@ def check_analytic(name, Eo=E_oed):
     p = tv.read_csv(f"{work}/{name}/particles_final.csv")
     X = [x - u for x, u in zip(p["pos_x"], p["u_x"])]
     Y = [y - u for y, u in zip(p["pos_y"], p["u_y"])]
-    for target in (1.0, 0.5):
-        k = min(range(len(X)), key=lambda i: ((X[i] - 0.05) ** 2 + (Y[i] - target) ** 2, p["id"][i]))
+    for target in (1.0, 0.49):  # the probe positions (no ties between points)
+        k = min(range(len(X)), key=lambda i: ((X[i] - 0.04) ** 2 + (Y[i] - target) ** 2, p["id"][i]))
         ref = -rho * g * (H * Y[k] - Y[k] ** 2 / 2) / Eo
         err = abs(p["u_y"][k] - ref) / abs(ref)
         tv.check(err < 0.01, f"{name}: settlement at y = {Y[k]:.5f}: {p['u_y'][k]:.6e} m vs analytic "
@@ -92,20 +92,25 @@ compare(pert, mpm, q, 1, ["--time=final", "--tolerance=0.01"])
 
 if mesh_prm:
     # FEM on the gmsh grid == FEM on the same grid made as a box from parameters
+    # (undamped over a fixed time: with local damping the different summation
+    # order grows from round-off to ~1e-7 by the end of the quasi-static run)
+    fixed = {"convergence/enabled": "false", "time/end time": "0.2", "damping/local damping": "0"}
+    fem_mesh = run("fem_gmsh_fixed", "talus-fem", "fem", fixed, converge=False)
     box = tv.prm_set(open(prm_path).read(), "grid/cells", "2, 20")
     saved, base = base, box
-    fem_box = run("fem_box_2x20", "talus-fem", "fem")
+    fem_box = run("fem_box_2x20_fixed", "talus-fem", "fem", fixed, converge=False)
     base = saved
-    compare(fem, fem_box, "grid:displacement,grid:stress,probes,energies", 0,
+    compare(fem_mesh, fem_box, "grid:displacement,grid:stress,probes,strain_energy,gravity_potential_energy", 0,
             ["--norm=relative-linf", "--tolerance=1e-10"])
-    tv.finish()
 
 # bad input
 p = compare(f"{work}/none.h5", mpm, q, 2)
 tv.check("none.h5" in p.stderr, "missing file named")
 p = compare(fem, mpm, "grid:displacement,settlement", 2)
 tv.check("settlement" in p.stderr and "allowed" in p.stderr, "unknown quantity named with the allowed ones")
+saved, base = base, open(prm_path).read()  # a box grid of other cells
 other = run("other_grid", "talus-fem", "fem", {"grid/cells": "4, 20"})
+base = saved
 p = compare(other, mpm, "grid:displacement", 2, ["--time=final"])
 tv.check("mismatched grids" in p.stderr, "mismatched grids reported")
 p = compare(fem, mpm, q, 2, ["--norm=l3"])
