@@ -25,3 +25,9 @@ add_test(NAME verification.fem_oedometer_gmsh
                  ${TALUS_PRM_DIR}/verification/oedometer_gravity.prm ${_w}/fem_oedometer_gmsh
                  ${TALUS_PRM_DIR}/mesh/oedometer_2d.prm)
 set_tests_properties(verification.fem_oedometer_gmsh PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+
+# parameter_files/examples/Makefile: the chain runs, a second make does nothing
+add_test(NAME verification.examples_makefile
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_examples_makefile.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/examples ${_w}/examples_makefile)
+set_tests_properties(verification.examples_makefile PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
