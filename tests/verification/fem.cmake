@@ -31,3 +31,9 @@ add_test(NAME verification.examples_makefile
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_examples_makefile.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/examples ${_w}/examples_makefile)
 set_tests_properties(verification.examples_makefile PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# 3D (hexahedra): column under gravity with fem, ul-fem, mpm
+add_test(NAME verification.fem_column_3d
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_column_3d.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/verification/elastic_column_gravity_3d.prm ${_w}/fem_column_3d)
+set_tests_properties(verification.fem_column_3d PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
