@@ -2,6 +2,7 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/fem.h>
+#include <talus/shape/q1_iso.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -11,88 +12,6 @@ namespace talus::explicit_mpm
 {
   namespace
   {
-    /// Isoparametric Q1 on a general (possibly deformed) quad/hex: values and
-    /// reference derivatives at xi, and real-space gradients for given vertex
-    /// coordinates. Vertex numbering as deal.II (bit d of v = coordinate d).
-    template <int dim>
-    struct IsoQ1
-    {
-      static constexpr unsigned int nv = 1u << dim;
-
-      static inline void
-      shape(const dealii::Point<dim> &xi, double (&N)[nv], double (&dN)[nv][dim])
-      {
-        double f[dim][2];
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            f[d][0] = 1.0 - xi[d];
-            f[d][1] = xi[d];
-          }
-        for (unsigned int v = 0; v < nv; ++v)
-          {
-            double n = 1.0;
-            for (unsigned int d = 0; d < dim; ++d)
-              n *= f[d][(v >> d) & 1u];
-            N[v] = n;
-            for (unsigned int e = 0; e < dim; ++e)
-              {
-                double g = ((v >> e) & 1u) ? 1.0 : -1.0;
-                for (unsigned int d = 0; d < dim; ++d)
-                  if (d != e)
-                    g *= f[d][(v >> d) & 1u];
-                dN[v][e] = g;
-              }
-          }
-      }
-
-      /// G[v][k] = dN_v/dx_k for vertex coordinates X; returns det J.
-      static inline double
-      gradients(const double (&X)[nv][dim], const double (&dN)[nv][dim], double (&G)[nv][dim])
-      {
-        double J[dim][dim] = {};
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            for (unsigned int e = 0; e < dim; ++e)
-              J[d][e] += X[v][d] * dN[v][e];
-        double Ji[dim][dim], det;
-        if constexpr (dim == 2)
-          {
-            det      = J[0][0] * J[1][1] - J[0][1] * J[1][0];
-            const double r = 1.0 / det;
-            Ji[0][0] = J[1][1] * r;
-            Ji[0][1] = -J[0][1] * r;
-            Ji[1][0] = -J[1][0] * r;
-            Ji[1][1] = J[0][0] * r;
-          }
-        else
-          {
-            const double c00 = J[1][1] * J[2][2] - J[1][2] * J[2][1];
-            const double c01 = J[1][2] * J[2][0] - J[1][0] * J[2][2];
-            const double c02 = J[1][0] * J[2][1] - J[1][1] * J[2][0];
-            det              = J[0][0] * c00 + J[0][1] * c01 + J[0][2] * c02;
-            const double r   = 1.0 / det;
-            Ji[0][0]         = c00 * r;
-            Ji[1][0]         = c01 * r;
-            Ji[2][0]         = c02 * r;
-            Ji[0][1]         = (J[0][2] * J[2][1] - J[0][1] * J[2][2]) * r;
-            Ji[1][1]         = (J[0][0] * J[2][2] - J[0][2] * J[2][0]) * r;
-            Ji[2][1]         = (J[0][1] * J[2][0] - J[0][0] * J[2][1]) * r;
-            Ji[0][2]         = (J[0][1] * J[1][2] - J[0][2] * J[1][1]) * r;
-            Ji[1][2]         = (J[0][2] * J[1][0] - J[0][0] * J[1][2]) * r;
-            Ji[2][2]         = (J[0][0] * J[1][1] - J[0][1] * J[1][0]) * r;
-          }
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int k = 0; k < dim; ++k)
-            {
-              double g = 0;
-              for (unsigned int e = 0; e < dim; ++e)
-                g += dN[v][e] * Ji[e][k];
-              G[v][k] = g;
-            }
-        return det;
-      }
-    };
-
     /// t = -V sigma (in-plane part in 2D), the internal force integrand
     template <int dim>
     inline void
@@ -189,8 +108,8 @@ namespace talus::explicit_mpm
             for (unsigned int d = 0; d < dim; ++d)
               xi[d] = 0.5 + (((q >> d) & 1u) ? gauss : -gauss);
             double N[nv], dN[nv][dim], G[nv][dim];
-            IsoQ1<dim>::shape(xi, N, dN);
-            const double det = IsoQ1<dim>::gradients(X, dN, G);
+            shape::IsoQ1<dim>::shape(xi, N, dN);
+            const double det = shape::IsoQ1<dim>::gradients(X, dN, G);
             if (!(det > 0))
               throw InputError("grid: cell " + grid.cell_iterators[c]->id().to_string() +
                                " is inverted or degenerate (det J = " + std::to_string(det) +
@@ -269,8 +188,8 @@ namespace talus::explicit_mpm
           {
             const double *P = pt->get_properties().data();
             double        N[nv], dN[nv][dim], G[nv][dim], t[dim][dim];
-            IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
-            IsoQ1<dim>::gradients(X, dN, G);
+            shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
+            shape::IsoQ1<dim>::gradients(X, dN, G);
             minus_V_sigma<dim>(P, P[L::volume], t);
             for (unsigned int v = 0; v < nv; ++v)
               {
@@ -325,8 +244,8 @@ namespace talus::explicit_mpm
           {
             double *     P = pt->get_properties().data();
             double       N[nv], dN[nv][dim], G[nv][dim];
-            IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
-            const double det0 = IsoQ1<dim>::gradients(X0, dN, G);
+            shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
+            const double det0 = shape::IsoQ1<dim>::gradients(X0, dN, G);
             double       gu[dim][dim] = {}, dx[dim] = {};
             for (unsigned int v = 0; v < nv; ++v)
               for (unsigned int a = 0; a < dim; ++a)
@@ -358,7 +277,7 @@ namespace talus::explicit_mpm
             if (ul)
               {
                 // the point follows its cell: x_p = sum N_i x_i, V_p = det J w
-                det1 = IsoQ1<dim>::gradients(X1, dN, G);
+                det1 = shape::IsoQ1<dim>::gradients(X1, dN, G);
                 P[L::volume] *= det1 / det0;
                 for (unsigned int d = 0; d < dim; ++d)
                   x[d] += dx[d];
