@@ -10,7 +10,9 @@ and checks
   * bad input to talus-compare: missing file, unknown quantity, results of
     another grid (mismatched grids), unknown norm: exit 2 each, naming them;
   * FEM and UL-FEM on 2 ranks = on 1 rank over 0.2 s, undamped (talus-compare,
-    relative Linf <= 1e-10).
+    relative Linf <= 1e-10);
+  * FEM restarted from a checkpoint = the uninterrupted run, exactly; ul-fem
+    refuses checkpoints.
 With a talus-mesh .prm as 4th argument the same column runs on the gmsh mesh
 (meshes/oedometer_2d.geo through talus-mesh: grid file + particle file, grid/source
 = file, body shape = file) for every mode, and FEM on the gmsh grid must equal FEM
@@ -89,6 +91,22 @@ compare(ul, fem, q, 0, ["--time=final", "--tolerance=0.01"])
 pert = run("fem_stiff", "talus-fem", "fem", {"material 0/linear elastic/young modulus": "1.03e7"})
 check_analytic("fem_stiff", 1.03 * E_oed)
 compare(pert, mpm, q, 1, ["--time=final", "--tolerance=0.01"])
+
+# FEM checkpoint/restart: a run to 0.06 s with a checkpoint at 0.05 s, restarted
+# to 0.1 s, equals the uninterrupted run exactly (series.csv byte-identical, every
+# compared norm 0); ul-fem refuses checkpoints (exit 2)
+ck = {"convergence/enabled": "false", "checkpoint/interval": "0.05"}
+run("fem_restart", "talus-fem", "fem", dict(ck, **{"time/end time": "0.06"}), converge=False)
+restarted = run("fem_restart", "talus-fem", "fem", dict(ck, **{"time/end time": "0.1", "checkpoint/restart": "true"}),
+                converge=False)
+whole = run("fem_whole", "talus-fem", "fem", dict(ck, **{"time/end time": "0.1"}), converge=False)
+same = open(f"{work}/fem_restart/series.csv").read() == open(f"{work}/fem_whole/series.csv").read()
+tv.check(same, "fem restart: series.csv byte-identical to the uninterrupted run")
+compare(restarted, whole, "probes,energies,grid:displacement,grid:stress,particles:displacement,particles:stress", 0,
+        ["--norm=linf", "--tolerance=0"])
+text = tv.prm_set(tv.prm_set(base, "numerics/integration", "ul-fem"), "checkpoint/interval", "0.05")
+_, _, err = tv.run_tool(f"{tools}/talus-fem", text, work, "ulfem_checkpoint", expect_rc=2)
+tv.check("checkpoint" in err and "ul-fem" in err, "ul-fem with checkpoints refused naming the entry")
 
 if mesh_prm:
     # FEM on the gmsh grid == FEM on the same grid made as a box from parameters

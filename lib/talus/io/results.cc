@@ -215,13 +215,15 @@ namespace talus::io
           const double t = Ta[i];
           if (t < t0 - eps || t > t1 + eps)
             continue;
-          while (j + 1 < Tb.size() && Tb[j + 1] < t)
+          while (j + 1 < Tb.size() && Tb[j + 1] <= t)
             ++j;
           for (std::size_t c = 0; c < nc; ++c)
             {
               const auto &y = *xb[c];
               double      vb;
-              if (j + 1 < Tb.size() && Tb[j + 1] > Tb[j] && t >= Tb[j])
+              if (t == Tb[j])
+                vb = y[j]; // same time: exact (identical files compare to 0)
+              else if (j + 1 < Tb.size() && Tb[j + 1] > Tb[j] && t >= Tb[j])
                 {
                   const double s = std::min(1.0, (t - Tb[j]) / (Tb[j + 1] - Tb[j]));
                   vb             = y[j] + s * (y[j + 1] - y[j]);
