@@ -37,3 +37,9 @@ add_test(NAME verification.fem_column_3d
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_column_3d.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/verification/elastic_column_gravity_3d.prm ${_w}/fem_column_3d)
 set_tests_properties(verification.fem_column_3d PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# mesh convergence of the cantilever (FEM quadratic, MPM below 1 % on the finest grid); long: label verify
+add_test(NAME verification.fem_cantilever_convergence
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_fem_cantilever_convergence.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/verification/cantilever_self_weight.prm ${_w}/fem_cantilever_convergence)
+set_tests_properties(verification.fem_cantilever_convergence PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)

@@ -1201,7 +1201,8 @@ namespace talus::explicit_mpm
     if (two_phase)
       return two_phase->energies();
     using L = PropertyLayout<dim>;
-    Energies e;
+    Energies   e;
+    const bool fixed_points = fem && !fem->updated_lagrangian(); // at their Gauss points: x = X + u
     for (const auto &pt : particles)
       {
         const auto  P = pt.get_properties();
@@ -1210,7 +1211,7 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           {
             v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += gravity[d] * pt.get_location()[d];
+            gx += gravity[d] * (pt.get_location()[d] + (fixed_points ? P[L::displacement + d] : 0.0));
           }
         e.kinetic += 0.5 * P[L::mass] * v2;
         e.gravity_potential -= P[L::mass] * gx;
