@@ -11,7 +11,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export OMP_NUM_THREADS=1
 
-.PHONY: all deps configure build demo test verify sanitize bench clean
+.PHONY: all deps configure build demo test verify campaign sanitize bench clean
 
 all: build
 
@@ -34,6 +34,15 @@ test: build
 
 verify: build sanitize
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L "fast|verify"
+	$(MAKE) campaign
+
+# The verification campaign (issue 6, `make verify` only): convergence families,
+# Courant sweeps, large-deformation and near-incompressible stress tests; regenerates
+# docs/verification/README.md (+ csv/, png/) and checks it against the CSVs.
+campaign: build
+	python3 scripts/verify_campaign.py $(BUILD_DIR)
+	cd $(BUILD_DIR) && ctest --output-on-failure -R "verification.readme_matches_csv"
+	$(MAKE) -C parameter_files/campaigns BUILD=$(abspath $(BUILD_DIR))
 
 # Unit tests and short runs of every tool (plus the fast .prm fuzz subset) built
 # with -DTALUS_SANITIZE=ON in $(SAN_BUILD_DIR); any ASan/UBSan report fails.

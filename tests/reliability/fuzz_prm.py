@@ -355,6 +355,14 @@ class Runner:
                 for f in os.listdir(src):
                     if not f.endswith(".prm"):
                         os.symlink(os.path.join(src, f), os.path.join(indir, f))
+                # a .prm that names another .prm by a relative path (talus-convergence:
+                # "base parameter file") finds it at the same relative place
+                m = re.search(r"^\s*set\s+base parameter file\s*=\s*(\S+)", mut.base.text, re.M)
+                if m and not os.path.isabs(m.group(1)):
+                    dst = os.path.normpath(os.path.join(indir, m.group(1)))
+                    if dst.startswith(base + os.sep) and not os.path.exists(dst):
+                        os.makedirs(os.path.dirname(dst), exist_ok=True)
+                        os.symlink(os.path.normpath(os.path.join(src, m.group(1))), dst)
             prm = os.path.join(indir, "mutated.prm")
             if mut.data is not None:
                 data = mut.data

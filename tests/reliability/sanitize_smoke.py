@@ -66,6 +66,10 @@ cases = {
           "--quantities=probes,energies,grid:displacement,grid:stress,particles:displacement", "--tolerance=1e9"]),
         ("missing_file", None, 2, ["none.h5", os.path.join(work, "talus-fem", "oedometer_fem", "out", "r.h5")]),
     ],
+    "talus-convergence": [
+        ("check", open(os.path.join(prm_dir, "convergence", "bar_displacement.prm")).read().replace(
+            "../verification/", os.path.join(os.path.abspath(prm_dir), "verification") + "/"), 0, ["--check"]),
+        ("bad_input", "set mode = fast\n", 2, [])],
     "talus-bench-materials": [("bench", None, 0, ["--points=8", "--steps=4"])],
     "talus-bench-finite-strain": [("bench", None, 0, ["--updates=50"])],
 }

@@ -20,6 +20,8 @@ cases = [
      "traction face"),
     ("free surface factor", [("liquid/free surface factor", "1")], "free surface factor"),
     ("damping", [("two phase/local damping", "1")], "local damping"),
+    ("1-phase damping with 2-phase", [("damping/local damping", "0.5")], "damping/local damping"),
+    ("1-phase loads with 2-phase", [("loads/number of tractions", "1")], "loads/traction"),
 ]
 for name, edits, needle in cases:
     text = base

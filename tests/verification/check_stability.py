@@ -6,8 +6,8 @@
   step, and no NaN in any output file.
 Note: the momentum re-projection of seed 000 §4.3.7 (Eqs. 4.47-4.48) damps the
 highest grid mode (by 4x per step for the checkerboard mode with 2 points per cell),
-so the measured limit of this scheme on the bar is 1.7-1.8 x the Eq. 4.120 value
-for 1-4 points per direction: a forced 1.5 x run is stable. See docs/explicit.md.
+so the measured limit of this scheme on the bar is sqrt(3) x the Eq. 4.120 value
+for 2 points per direction (docs/stability-analysis.md): a forced 1.5 x run is stable.
 Usage: check_stability.py TOOL PRM WORKDIR
 """
 import glob

@@ -54,3 +54,41 @@ set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESS
 
 # chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
 talus_verification(explicit_strain_smoothing check_smoothing.py verification/footing_incompressible.prm)
+
+# issue 6: talus-convergence (bar without cell crossing: order >= 1.8; translating bar
+# with cell crossing: the predicted loss of convergence; bad input)
+add_test(NAME verification.convergence_bar
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_convergence.py ${TALUS_TOOLS_DIR}/talus-convergence
+                 ${TALUS_PRM_DIR} ${_w}/convergence_bar)
+set_tests_properties(verification.convergence_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# issue 6: the committed docs/verification/README.md matches the committed CSVs
+add_test(NAME verification.readme_matches_csv
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_readme.py ${CMAKE_SOURCE_DIR}/docs/verification)
+set_tests_properties(verification.readme_matches_csv PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 60)
+
+# granular column collapse (issue 5, seed 001 §6.1): run-out d_inf within 15 % of seed 001
+# Table 6.5 for a = 1.2 and 3. Coarse (cell d_i/12) under "fast"; d_i/18 and d_i/36 under "verify".
+foreach(_a 1.2 3)
+  foreach(_r 0.6666666667 1 2)
+    if(_r STREQUAL "0.6666666667")
+      set(_n explicit_column_collapse_a${_a}_coarse)
+      set(_l fast)
+    elseif(_r STREQUAL "1")
+      set(_n explicit_column_collapse_a${_a})
+      set(_l verify)
+    else()
+      set(_n explicit_column_collapse_a${_a}_fine)
+      set(_l verify)
+    endif()
+    add_test(NAME verification.${_n}
+             COMMAND ${Python3_EXECUTABLE} ${_v}/check_column_collapse.py ${TALUS_TOOLS_DIR}/talus-explicit
+                     ${TALUS_PRM_DIR}/verification/column_collapse_a${_a}.prm ${_w}/${_n} ${_r})
+    set_tests_properties(verification.${_n} PROPERTIES LABELS "${_l}" ENVIRONMENT "${_env}" TIMEOUT 3000)
+  endforeach()
+endforeach()
+
+# MPM-MIXED (seed 000 §6.6) with a linear cell stress: elastic column 2/4 points per direction,
+# quasi-static column with cell crossing, free block (hourglass modes; constant stress detected unstable)
+talus_verification(explicit_mpm_mixed check_mixed.py verification/elastic_column_gravity.prm)
+set_tests_properties(verification.explicit_mpm_mixed PROPERTIES PROCESSORS 2)

@@ -108,3 +108,21 @@ def finish():
         print(f"{len(_failures)} check(s) failed")
         sys.exit(1)
     print("all checks passed")
+
+
+def parasitic_growth_rate(series, t_early=0.05, start_factor=1e3, stop_fraction=1e-3):
+    """Amplitude growth rate [1/s] of a growing parasitic mode from a series.csv dict: half
+    the least-squares slope of log(strain energy) over the rows where it exceeds
+    start_factor x its largest value before t_early (the mode dominates) and stays below
+    stop_fraction x the initial kinetic energy (the perturbation is still small: linear
+    regime). Returns (rate, number of rows fitted); rate is nan with fewer than 3 rows."""
+    import math
+    t, e = series["time"], series["strain_energy"]
+    base = max(x for tt, x in zip(t, e) if tt < t_early)
+    cap = stop_fraction * series["kinetic_energy"][0]
+    pts = [(tt, math.log(x)) for tt, x in zip(t, e) if start_factor * base < x < cap]
+    if len(pts) < 3:
+        return float("nan"), len(pts)
+    mx = sum(a for a, _ in pts) / len(pts)
+    my = sum(b for _, b in pts) / len(pts)
+    return 0.5 * sum((a - mx) * (b - my) for a, b in pts) / sum((a - mx) ** 2 for a, _ in pts), len(pts)

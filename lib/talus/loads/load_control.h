@@ -97,9 +97,19 @@ namespace talus::loads
       unsigned int  axis;
       int           side;
       double        area;
+      double        h; ///< cell size normal to the wall
       unsigned char state; ///< 0 free/separating, 1 stick, 2 slip
     };
     std::vector<FrictionNode> friction_nodes;
+    /// Per grid cell: bit f set if face f lies on a friction boundary.
+    std::vector<unsigned char> friction_faces;
+    /// Per DoF (the normal component of a friction node): the smallest
+    /// displacement away from that wall of the points in the adjacent cells,
+    /// sum over ranks by min. A node whose material has moved away from the
+    /// wall by more than `lift_tolerance` x the cell size is free (no contact).
+    Vector       lift;
+    static constexpr double lift_tolerance = 1e-3;
+    bool         any_friction = false;
     struct PrescribedDof
     {
       unsigned int dof, condition, component;

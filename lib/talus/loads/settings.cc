@@ -231,6 +231,10 @@ namespace talus::loads
                         "Local damping factor alpha of seed 000 §6.3 (Eq. 6.23): nodal f_damp = -alpha |f| sign(v); "
                         "0 = off; 0.7-0.8 for quasi-static runs." +
                           std::string(stage ? " -1: as the top-level 'damping'." : ""));
+      prm.declare_entry("viscous damping", stage ? "-1" : "0", Double(stage ? -1 : 0),
+                        "Mass-proportional (Rayleigh alpha) damping [1/s]: nodal f_damp = -alpha_v m_i v_i (the "
+                        "damping of the granular column collapse of seed 001 §6.1, alpha = 1.5 1/s); 0 = off." +
+                          std::string(stage ? " -1: as the top-level 'damping'." : ""));
       prm.leave_subsection();
       prm.enter_subsection("mass scaling");
       prm.declare_entry("factor", stage ? "-1" : "1", Double(stage ? -1 : 0),
@@ -263,6 +267,10 @@ namespace talus::loads
       const double a = prm.get_double("local damping");
       s.damping      = (a < 0 && base) ? base->damping : a;
       require(s.damping >= 0 && s.damping < 1, pre + "damping/local damping", "must be in [0, 1)");
+      const double av   = prm.get_double("viscous damping");
+      s.viscous_damping = (av < 0 && base) ? base->viscous_damping : av;
+      require(s.viscous_damping >= 0 && std::isfinite(s.viscous_damping), pre + "damping/viscous damping",
+              "must be >= 0 [1/s]");
       prm.leave_subsection();
       prm.enter_subsection("mass scaling");
       const double b = prm.get_double("factor");
@@ -299,7 +307,7 @@ namespace talus::loads
       if (k.enabled)
         return true;
     for (const auto &s : stages)
-      if (!s.friction_ids.empty() || !s.tractions.empty() || !s.velocities.empty() || s.damping > 0 ||
+      if (!s.friction_ids.empty() || !s.tractions.empty() || !s.velocities.empty() || s.damping > 0 || s.viscous_damping > 0 ||
           s.mass_scaling != 1.0 || s.convergence.enabled)
         return true;
     return false;

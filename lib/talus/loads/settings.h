@@ -81,6 +81,7 @@ namespace talus::loads
     std::vector<Traction<dim>>               tractions;   ///< stage loads (stage time)
     std::vector<PrescribedVelocity<dim>>     velocities;
     double                                   damping      = 0; ///< local damping alpha
+    double                                   viscous_damping = 0; ///< mass-proportional alpha_v [1/s]
     double                                   mass_scaling = 1; ///< beta
     Convergence                              convergence;
     /// number of leading tractions/velocities that are global loads (top-level

@@ -647,6 +647,7 @@ namespace talus::explicit_mpm
         const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
         local_scale += P[PropertyLayout<dim>::mass] * m.constrained_modulus() / m.density();
       }
+    total_mass_setup = total_mass();
     if (!restored)
       {
         energy_scale     = dealii::Utilities::MPI::sum(local_scale, comm);
@@ -1328,7 +1329,14 @@ namespace talus::explicit_mpm
     const double available = initial_energies.kinetic + initial_energies.strain +
                              std::max(0.0, initial_energies.gravity_potential - v[2]) + std::abs(external_work);
     const double now = v[0] + v[1];
-    if (now > prm.energy_growth_limit * available + 1e-12 * energy_scale)
+    // floor: 1e-4 of the potential energy of the mass over the grid's diagonal,
+    // so that an undamped oscillation returning to its start (released
+    // potential ~0) with a round-off-sized energy error is not taken for growth
+    double diagonal = 0;
+    for (unsigned int d = 0; d < dim; ++d)
+      diagonal += (prm.grid_upper[d] - prm.grid_lower[d]) * (prm.grid_upper[d] - prm.grid_lower[d]);
+    const double floor = 1e-12 * energy_scale + 1e-4 * total_mass_setup * gravity.norm() * std::sqrt(diagonal);
+    if (now > prm.energy_growth_limit * available + floor)
       {
         os << "step " << step_number << " (t = " << time << " s, dt = " << dt
            << " s): kinetic + strain energy grew to " << now << " J, more than " << prm.energy_growth_limit

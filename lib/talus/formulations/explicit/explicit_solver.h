@@ -195,6 +195,8 @@ namespace talus::explicit_mpm
     /// stability check needs it (set by the time loop).
     bool                                          need_strain_energy = true;
     double                                        energy_scale = 0;
+    /// total mass of the points at setup (for the floor of the stability check)
+    double                                        total_mass_setup = 0;
     /// Gravity of the running stage (prm.gravity without stages).
     dealii::Tensor<1, dim>                        gravity;
     /// Mass scaling factor beta of the running stage (seed 000 §6.5): nodal

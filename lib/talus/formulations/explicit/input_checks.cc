@@ -199,6 +199,39 @@ namespace talus::explicit_mpm
                     "; allowed here: none)");
         n_points += overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
       }
+    // the separate 2-phase / body-traction step (explicit_two_phase.cc) does not
+    // call the hooks of lib/talus/loads: refuse them instead of ignoring them
+    if (p.liquid.any_coupled() || p.liquid.any_traction())
+      {
+        std::string used;
+        if (p.loads.staged)
+          used = "number of stages";
+        for (unsigned int k = 0; k < p.loads.k0.size() && used.empty(); ++k)
+          if (p.loads.k0[k].enabled)
+            used = "body " + std::to_string(k) + "/initial stress";
+        for (const auto &st : p.loads.stages)
+          if (used.empty())
+            {
+              if (!st.friction_ids.empty())
+                used = "boundary conditions/friction";
+              else if (!st.tractions.empty())
+                used = "loads/traction";
+              else if (!st.velocities.empty())
+                used = "loads/velocity";
+              else if (st.damping > 0)
+                used = "damping/local damping";
+              else if (st.viscous_damping > 0)
+                used = "damping/viscous damping";
+              else if (st.mass_scaling != 1.0)
+                used = "mass scaling/factor";
+              else if (st.convergence.enabled)
+                used = "convergence/enabled";
+            }
+        require(used.empty(), used,
+                "is not available with coupled 2-phase materials or body tractions ('traction face'): the "
+                "2-phase step has its own tractions ('body k/traction face', 'traction') and damping ('two "
+                "phase/local damping'); remove this entry (allowed here: its default)");
+      }
     require(n_points <= max_material_points,
             "bodies",
             "about " + fmt(n_points) + " material points would be seeded, more than the limit of " +

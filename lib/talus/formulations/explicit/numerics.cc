@@ -2,6 +2,7 @@
 // the .prm entries of the chapter-6 numerics; contact is in contact.cc.
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/mixed_integration.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/shape/q1.h>
 
@@ -33,6 +34,11 @@ namespace talus::explicit_mpm
     prm.declare_entry("fill factor", "0.9", Double(0, 10),
                       "F_fill of Eq. 6.33 for 'integration = mpm-mixed': a cell is integrated at its Gauss "
                       "point when the volume of its material points exceeds F_fill x the cell volume.");
+    prm.declare_entry("mixed stress field", "linear", Selection("linear|constant"),
+                      "Cell stress of 'integration = mpm-mixed': 'linear' = volume-weighted least-squares fit of "
+                      "the points' stresses (mean = Eq. 6.32), integrated at the 2^dim Gauss points; 'constant' = "
+                      "the volume-averaged stress of Eq. 6.32 alone, as in the manual (exact on tetrahedra, but on "
+                      "quads/hexes it leaves the hourglass modes unresisted: measured unstable, docs/explicit.md).");
     prm.declare_entry("strain smoothing", "none", Selection("none|cell|nodal"),
                       "Anti-locking smoothing of the volumetric strain increment (seed 000 §6.7.1): 'none'; "
                       "'cell' replaces each point's volumetric increment by its cell's (mean dilatation); "
@@ -61,6 +67,7 @@ namespace talus::explicit_mpm
                                                NumericsOptions::Integration::mpm;
     }
     o.fill_factor = prm.get_double("fill factor");
+    o.mixed_linear = prm.get("mixed stress field") == "linear";
     require(o.fill_factor > 0, "numerics/fill factor", "must be > 0 (the manual uses 0.9)");
     const std::string s = prm.get("strain smoothing");
     o.smoothing = s == "cell" ? NumericsOptions::Smoothing::cell :
@@ -164,11 +171,11 @@ namespace talus::explicit_mpm
     using L                    = PropertyLayout<dim>;
     using F                    = shape::Q1Factorised<dim>;
     constexpr unsigned int nv  = F::nv;
-    constexpr unsigned int nst = L::n_stress;
     const bool   mixed         = s.prm.numerics.integration == NumericsOptions::Integration::mpm_mixed;
     const double fill          = s.prm.numerics.fill_factor;
+    const bool   linear_stress = s.prm.numerics.mixed_linear;
     Contact<dim> *contact      = s.contact.get();
-    const auto    g            = s.prm.gravity;
+    const auto    g            = s.gravity; // of the running stage
 
     double *const M  = s.nodal_mass.begin();
     double *const Fv = s.nodal_a.begin();
@@ -185,15 +192,15 @@ namespace talus::explicit_mpm
           zero_on(f.force, s.active_dofs);
           zero_on(f.momentum, s.active_dofs);
         }
-    // weight of every pair moment at the cell centre: 0.5^(dim-1)
-    const double w_centre = dim == 2 ? 0.5 : 0.25;
+    CellStressFit<dim> stress_fit; // MPM-MIXED: linear cell stress (mixed_integration.h)
 
     auto pt = s.particles.begin();
     for (const auto [c, n_in_cell] : s.active_cells)
       {
         const auto &cc = s.grid.cells[c];
         double      lm[nv] = {}, T[dim][F::npairs][dim] = {};
-        double      sV = 0, sVs[nst] = {};
+        if (mixed)
+          stress_fit.clear();
         touched.clear();
         for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
           {
@@ -208,11 +215,7 @@ namespace talus::explicit_mpm
             minus_V_sigma<dim>(P, V, t);
             F::add_moments(t, w, T);
             if (mixed)
-              {
-                sV += V;
-                for (unsigned int q = 0; q < nst; ++q)
-                  sVs[q] += V * P[L::stress + q];
-              }
+              stress_fit.add(xi, V, P + L::stress);
             if (contact)
               {
                 const unsigned int b = static_cast<unsigned int>(P[L::body]);
@@ -236,24 +239,14 @@ namespace talus::explicit_mpm
         double cell_volume = 1.0;
         for (unsigned int d = 0; d < dim; ++d)
           cell_volume *= cc.h[d];
-        // §6.6: a filled cell (Eq. 6.33) is integrated at its Gauss point with
-        // the volume-averaged stress (Eq. 6.32); for a constant stress on a box
-        // the one-point rule at the centre is exact, the same as 2^dim points.
+        // §6.6: a filled cell (Eq. 6.33) is integrated at its 2^dim Gauss points
+        // with a stress field linear in the cell, fitted to its points (mean =
+        // Eq. 6.32; see mixed_integration.h for why not constant on Q1 cells).
         // With contact, only single-body cells are mixed-integrated (the body's
         // force must equal the cell's).
-        const bool use_mixed = mixed && sV > fill * cell_volume && (!contact || touched.size() <= 1);
+        const bool use_mixed = mixed && stress_fit.sV > fill * cell_volume && (!contact || touched.size() <= 1);
         if (use_mixed)
-          {
-            double t[dim][dim];
-            double Pavg[L::stress + nst];
-            for (unsigned int q = 0; q < nst; ++q)
-              Pavg[L::stress + q] = sVs[q] / sV;
-            minus_V_sigma<dim>(Pavg, cell_volume, t);
-            for (unsigned int kk = 0; kk < dim; ++kk)
-              for (unsigned int j = 0; j < F::npairs; ++j)
-                for (unsigned int q = 0; q < dim; ++q)
-                  T[kk][j][q] = t[q][kk] * w_centre;
-          }
+          stress_fit.moments(cell_volume, linear_stress, T);
         double f[nv][dim];
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)

@@ -39,6 +39,7 @@ namespace talus::explicit_mpm
     };
     Integration integration = Integration::mpm;
     double      fill_factor = 0.9; ///< F_fill of Eq. 6.33
+    bool        mixed_linear = true; ///< MPM-MIXED cell stress linear (else constant, Eq. 6.32 alone)
     Smoothing   smoothing   = Smoothing::none;
 
     struct ContactPair
