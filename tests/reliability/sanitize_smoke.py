@@ -50,6 +50,22 @@ cases = {
                        tiny("element/" + f, {"test/number of increments": "50", "output/plots": "false"}),
                        2 if "broken" in f else 0, [])
                       for f in sorted(os.listdir(os.path.join(prm_dir, "element")))],
+    "talus-fem": [
+        ("oedometer_fem", tiny("verification/oedometer_gravity.prm", dict(short, **{"output/results file": "r.h5"})),
+         0, []),
+        ("oedometer_ulfem", tiny("verification/oedometer_gravity.prm",
+                                 dict(short, **{"output/results file": "r.h5", "numerics/integration": "ul-fem"})),
+         0, []),
+        ("bad_input", tiny("verification/oedometer_gravity.prm", {"numerics/strain smoothing": "cell"}), 2, []),
+    ],
+    # runs after talus-fem (see the order below) and compares its results
+    "talus-compare": [
+        ("fem_vs_ulfem", None, 0,
+         [os.path.join(work, "talus-fem", "oedometer_fem", "out", "r.h5"),
+          os.path.join(work, "talus-fem", "oedometer_ulfem", "out", "r.h5"),
+          "--quantities=probes,energies,grid:displacement,grid:stress,particles:displacement", "--tolerance=1e9"]),
+        ("missing_file", None, 2, ["none.h5", os.path.join(work, "talus-fem", "oedometer_fem", "out", "r.h5")]),
+    ],
     "talus-convergence": [
         ("check", open(os.path.join(prm_dir, "convergence", "bar_displacement.prm")).read().replace(
             "../verification/", os.path.join(os.path.abspath(prm_dir), "verification") + "/"), 0, ["--check"]),
@@ -62,6 +78,7 @@ env.update({"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"
             "UBSAN_OPTIONS": env.get("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1")})
 report = re.compile(r"AddressSanitizer|LeakSanitizer|runtime error:|UndefinedBehaviorSanitizer")
 tools = sorted(t for t in os.listdir(tools_dir) if t.startswith("talus-") and os.access(os.path.join(tools_dir, t), os.X_OK))
+tools.sort(key=lambda t: t == "talus-compare")  # last: it reads the results of talus-fem
 for t in tools:
     if t not in cases:
         tv.check(False, f"{t}: no sanitizer smoke case; add one to tests/reliability/sanitize_smoke.py")

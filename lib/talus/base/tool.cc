@@ -268,7 +268,7 @@ namespace talus
     given_options.clear();
     check_flag = false;
 
-    const std::string file_arg = tool.reads_prm ? " FILE.prm" : "";
+    const std::string file_arg = tool.reads_prm ? (tool.prm_optional ? " [FILE.prm]" : " FILE.prm") : "";
     const auto usage = [&](std::ostream &os) {
       os << "Usage: " << tool.name << " [--help]" << (tool.reads_prm ? " [--print-parameters]" : "")
          << " [--check]";
@@ -364,13 +364,17 @@ namespace talus
                 prm.print_parameters(log(), dealii::ParameterHandler::OutputStyle::PRM);
                 return exit_ok;
               }
-            if (prm_file.empty())
+            if (prm_file.empty() && tool.prm_optional)
+              tool.declare(prm, "");
+            else if (prm_file.empty())
               {
                 err() << tool.name << ": error: no parameter file given\n\n";
                 usage(err());
                 return exit_input_error;
               }
             std::error_code ec;
+            if (!prm_file.empty())
+            {
             if (!std::filesystem::exists(prm_file, ec))
               throw InputError("parameter file '" + prm_file + "' does not exist");
             if (!std::filesystem::is_regular_file(prm_file, ec))
@@ -384,6 +388,7 @@ namespace talus
               {
                 throw InputError("in '" + prm_file + "': " + readable_mandatory_message(exception_text(e)));
               }
+            }
           }
         try
           {

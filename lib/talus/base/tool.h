@@ -41,6 +41,9 @@ namespace talus
     /// false: the tool reads no .prm (micro-benchmarks driven by options only);
     /// declare() is not called and run() gets an empty handler and file name.
     bool reads_prm = true;
+    /// With reads_prm: the .prm may be omitted; the declared defaults (changed
+    /// by the tool's options in check()/run()) are used then.
+    bool prm_optional = false;
     /// Extra command-line options this tool accepts besides --help, --check and
     /// --print-parameters, with a one-line description each. An option written
     /// "--name=" takes a value ("--name=VALUE" or "--name VALUE").

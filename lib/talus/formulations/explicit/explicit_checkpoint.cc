@@ -573,6 +573,7 @@ namespace talus::explicit_mpm
         for (const double id : f.read_all("probes/ids"))
           probe_ids.push_back(static_cast<dealii::types::particle_index>(id));
         probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
+        probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
         restored_from = file;
         return true;
       }

@@ -104,6 +104,13 @@ namespace talus::explicit_mpm
   void
   declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
   {
+    declare_parameters_with_integration(prm, prm_file, "mpm");
+  }
+
+  void
+  declare_parameters_with_integration(dealii::ParameterHandler &prm, const std::string &prm_file,
+                                      const std::string &default_integration)
+  {
     const unsigned int dim = dealii::Utilities::string_to_int(
       peek_entry(prm_file, "", "dimension", "2", Selection("2|3")));
     const unsigned int n_materials = dealii::Utilities::string_to_int(
@@ -185,11 +192,17 @@ namespace talus::explicit_mpm
       prm.declare_entry("progress", "true", Bool(), "Print progress with an ETA every few seconds.");
       prm.declare_entry("probes", "", Anything(),
                         "Points 'x,y[,z]; x,y[,z]; ...': the material point nearest to each at t = 0 is tracked; "
-                        "its displacement and velocity go to series.csv.");
+                        "its displacement, velocity and stress go to series.csv (and the results file).");
+      prm.declare_entry("results file", "", Anything(),
+                        "HDF5 results written at the end of the run (for talus-compare and post-processing), "
+                        "relative to the output directory unless absolute; empty = none. Holds the columns of "
+                        "series.csv (energies, momentum, probes over time), the probe displacements, velocities "
+                        "and stresses over time, the final material point fields and the final fields mapped to "
+                        "the grid nodes (lumped projection). Layout in docs/fem.md.");
     }
     prm.leave_subsection();
 
-    declare_numerics_parameters(prm);
+    declare_numerics_parameters(prm, default_integration);
     prm.enter_subsection("checkpoint");
     {
       prm.declare_entry("interval", "0", Double(0),
@@ -324,6 +337,9 @@ namespace talus::explicit_mpm
     require(!p.output_directory.empty(), "output/directory", "must not be empty");
     for (const auto &s : dealii::Utilities::split_string_list(prm.get("probes"), ';'))
       p.probes.push_back(parse_point<dim>(s, "output/probes"));
+    p.results_file = prm.get("results file");
+    if (!p.results_file.empty() && p.results_file.front() != '/')
+      p.results_file = p.output_directory + "/" + p.results_file;
     prm.leave_subsection();
 
     prm.enter_subsection("checkpoint");
@@ -441,6 +457,24 @@ namespace talus::explicit_mpm
           p.end_time += st.duration;
       }
     p.numerics = parse_numerics_parameters(prm, n_bodies);
+    if (p.numerics.fem())
+      {
+        const std::string mode = p.numerics.integration == NumericsOptions::Integration::fem ? "fem" : "ul-fem";
+        require(!p.numerics.contact(), "contact/pairs",
+                "contact is not available with numerics/integration = " + mode +
+                  " (the Gauss points of one mesh share one velocity field); allowed: empty");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing is not available with numerics/integration = " + mode + "; allowed: none");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/integration",
+                "'" + mode + "' runs the 1-phase step only: coupled 2-phase materials and body tractions are "
+                "refused (allowed with them: mpm)");
+        require(p.numerics.integration == NumericsOptions::Integration::fem ||
+                  (p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
+                   p.restart == Parameters<dim>::Restart::no),
+                "checkpoint",
+                "checkpoints and restarts are not available with numerics/integration = ul-fem (the moved "
+                "mesh is not saved); allowed: interval = 0, wall clock interval = 0, restart = false");
+      }
     check_consistency(p);
     return p;
   }
@@ -524,6 +558,9 @@ namespace talus::explicit_mpm
       }
     particles.initialize(grid.tria, grid.mapping, layout.n_properties());
     relocator = std::make_unique<Relocator<dim>>(grid, particles);
+    if (prm.numerics.fem())
+      fem = std::make_unique<FemIntegration<dim>>(*this, prm.numerics.integration ==
+                                                           NumericsOptions::Integration::ul_fem);
     require(!two_phase || (!prm.numerics.extended_p2g() && prm.numerics.smoothing == NumericsOptions::Smoothing::none),
             "numerics/integration, numerics/strain smoothing, contact/pairs",
             "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
@@ -552,6 +589,8 @@ namespace talus::explicit_mpm
       const auto filed  = insert_file_bodies(grid, prm.bodies, density, layout, particles, seeded.n_particles);
       for (unsigned int b = 0; b < prm.bodies.size(); ++b)
         seeded.volume_per_body[b] += filed.volume_per_body[b];
+      if (fem) // the cells these points occupy get Gauss points instead (fem.h)
+        seeded = fem->seed(density);
       for (unsigned int b = 0; b < prm.bodies.size(); ++b)
         require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
                 "contains no material point: it lies outside the grid or is smaller than one sub-cell");
@@ -599,6 +638,7 @@ namespace talus::explicit_mpm
         probe_ids.push_back(std::min_element(all.begin(), all.end())->second);
       }
     probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
+    probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
 
     // energy scale for the instability floor: sum m c^2
     double local_scale = 0;
@@ -814,6 +854,12 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::p2g_mass_and_force()
   {
+    if (fem)
+      {
+        fem->p2g_mass_and_force(); // Gauss points, current cell geometry (fem.cc)
+        p2g_ready = true;
+        return;
+      }
     if (prm.numerics.extended_p2g())
       {
         p2g_extended(*this); // MPM-MIXED and/or per-body contact fields
@@ -925,6 +971,7 @@ namespace talus::explicit_mpm
     bool                   bad = false;
     const bool             track_probes = !probe_ids.empty();
     std::fill(probe_values.begin(), probe_values.end(), 0.0);
+    std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
     // the mass and force of the next step are accumulated here, at the updated
     // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
     // the next cycle fused into this pass); moved particles are added by the
@@ -1033,11 +1080,15 @@ namespace talus::explicit_mpm
             if (track_probes)
               for (unsigned int k = 0; k < probe_ids.size(); ++k)
                 if (pt->get_id() == probe_ids[k])
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      probe_values[k * 2 * dim + d]       = P[L::displacement + d];
-                      probe_values[k * 2 * dim + dim + d] = P[L::velocity + d];
-                    }
+                  {
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        probe_values[k * 2 * dim + d]       = P[L::displacement + d];
+                        probe_values[k * 2 * dim + dim + d] = P[L::velocity + d];
+                      }
+                    for (unsigned int q = 0; q < L::n_stress; ++q)
+                      probe_stress[k * L::n_stress + q] = P[L::stress + q];
+                  }
 
             // new reference coordinates: same cell if still inside
             bool               inside = true;
@@ -1101,6 +1152,15 @@ namespace talus::explicit_mpm
       smoothing->compute(*this, h);
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
+    if (fem)
+      {
+        // FEM / UL-FEM: points stay in their cells, no relocation; the update
+        // pass accumulates the next step's mass and force (fem.cc)
+        fem->update(h);
+        p2g_ready = true;
+        timings.g2p += seconds_since(t0);
+        return;
+      }
     g2p_update(h);
     timings.g2p += seconds_since(t0);
     t0 = Clock::now();
@@ -1143,7 +1203,8 @@ namespace talus::explicit_mpm
     if (two_phase)
       return two_phase->energies();
     using L = PropertyLayout<dim>;
-    Energies e;
+    Energies   e;
+    const bool fixed_points = fem && !fem->updated_lagrangian(); // at their Gauss points: x = X + u
     for (const auto &pt : particles)
       {
         const auto  P = pt.get_properties();
@@ -1152,7 +1213,7 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           {
             v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += gravity[d] * pt.get_location()[d];
+            gx += gravity[d] * (pt.get_location()[d] + (fixed_points ? P[L::displacement + d] : 0.0));
           }
         e.kinetic += 0.5 * P[L::mass] * v2;
         e.gravity_potential -= P[L::mass] * gx;
@@ -1362,9 +1423,11 @@ namespace talus::explicit_mpm
     for (const auto &pt : particles)
       {
         std::vector<double> r = {static_cast<double>(pt.get_id())};
+        const auto          P = pt.get_properties();
+        // fem: the point stays at its Gauss point; its position is that plus u
+        const bool fixed = fem && !fem->updated_lagrangian();
         for (unsigned int d = 0; d < dim; ++d)
-          r.push_back(pt.get_location()[d]);
-        const auto P = pt.get_properties();
+          r.push_back(pt.get_location()[d] + (fixed ? P[L::displacement + d] : 0.0));
         for (unsigned int d = 0; d < dim; ++d)
           r.push_back(P[L::displacement + d]);
         for (unsigned int d = 0; d < dim; ++d)
@@ -1433,7 +1496,9 @@ namespace talus::explicit_mpm
             << " s)" << std::endl;
     const double dt_cr = critical_time_step();
     log() << "talus-explicit: " << dim << "D, " << grid.tria.n_global_active_cells() << " cells, "
-          << grid.dof_handler.n_dofs() << " DoFs, " << n_particles() << " material points, "
+          << grid.dof_handler.n_dofs() << " DoFs, " << n_particles()
+          << (fem ? (fem->updated_lagrangian() ? " Gauss points (ul-fem), " : " Gauss points (fem), ") :
+                    " material points, ")
           << dealii::Utilities::MPI::n_mpi_processes(comm) << " rank(s)\n"
           << "  critical time step " << dt_cr << " s (L_min " << grid.min_cell_size() << " m), dt = " << dt
           << " s (" << dt / dt_cr << " x critical), end time " << prm.end_time << " s\n";
@@ -1464,6 +1529,13 @@ namespace talus::explicit_mpm
             for (unsigned int d = 0; d < dim; ++d)
               s << ",probe" << k << "_v" << ax[d];
           }
+        // probe stresses after all displacement/velocity columns
+        {
+          const auto names = layout.names();
+          for (unsigned int k = 0; k < probe_ids.size(); ++k)
+            for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
+              s << ",probe" << k << "_" << names[PropertyLayout<dim>::stress + q];
+        }
         s << "\n" << std::setprecision(12);
         if (restored)
           {
@@ -1512,10 +1584,14 @@ namespace talus::explicit_mpm
         }
       if (free_surface)
         free_surface->update();
-      std::vector<double> probes(probe_values.size());
+      std::vector<double> probes(probe_values.size()), probe_sigma(probe_stress.size());
       if (!probe_values.empty())
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
-                                    dealii::ArrayView<double>(probes));
+        {
+          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
+                                      dealii::ArrayView<double>(probes));
+          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_stress), comm,
+                                      dealii::ArrayView<double>(probe_sigma));
+        }
       if (!root)
         return;
       auto &s = series->stream();
@@ -1534,6 +1610,8 @@ namespace talus::explicit_mpm
         }
       for (const double v : probes)
         s << "," << v;
+      for (const double v : probe_sigma)
+        s << "," << v;
       s << "\n";
     };
     // probe values at t = 0
@@ -1541,11 +1619,16 @@ namespace talus::explicit_mpm
       for (const auto &pt : particles)
         for (unsigned int k = 0; k < probe_ids.size(); ++k)
           if (pt.get_id() == probe_ids[k])
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                probe_values[k * 2 * dim + d]       = pt.get_properties()[PropertyLayout<dim>::displacement + d];
-                probe_values[k * 2 * dim + dim + d] = pt.get_properties()[PropertyLayout<dim>::velocity + d];
-              }
+            {
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  probe_values[k * 2 * dim + d]       = pt.get_properties()[PropertyLayout<dim>::displacement + d];
+                  probe_values[k * 2 * dim + dim + d] = pt.get_properties()[PropertyLayout<dim>::velocity + d];
+                }
+              for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
+                probe_stress[k * PropertyLayout<dim>::n_stress + q] =
+                  pt.get_properties()[PropertyLayout<dim>::stress + q];
+            }
 
     unsigned int &      vtu_counter   = counters.vtu_counter;
     unsigned long long &lost_reported = counters.lost_reported;
@@ -1704,6 +1787,8 @@ namespace talus::explicit_mpm
       throw RunStopped(instability + " Output up to the previous step is in " + prm.output_directory + ".");
     if (prm.final_particles_csv)
       write_final_particles();
+    if (!prm.results_file.empty())
+      write_results(prm.output_directory + "/series.csv");
 
     const double ns = 1e9 * timings.total / std::max(1.0, double(step_number) * double(n_particles()));
     log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid

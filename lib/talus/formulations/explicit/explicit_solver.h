@@ -3,6 +3,7 @@
 // update), Jaumann-rate stress update, volume update, relocation.
 #pragma once
 
+#include <talus/formulations/explicit/fem.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/grid/background_grid.h>
@@ -56,6 +57,7 @@ namespace talus::explicit_mpm
     bool                            final_particles_csv = false;
     bool                            progress            = true;
     std::vector<dealii::Point<dim>> probes;
+    std::string                     results_file; ///< HDF5 results at the end ("": none)
     // checkpoint / restart
     double       checkpoint_interval      = 0; ///< simulated time, 0: off
     double       checkpoint_wall_interval = 0; ///< seconds of wall time, 0: off
@@ -83,6 +85,9 @@ namespace talus::explicit_mpm
   /// Declare the complete .prm of talus-explicit. `prm_file` (may be empty)
   /// provides the dimension and the numbers of materials and bodies.
   void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file);
+  /// The same with another default of 'numerics/integration' (talus-fem: "fem").
+  void declare_parameters_with_integration(dealii::ParameterHandler &prm, const std::string &prm_file,
+                                           const std::string &default_integration);
 
   /// Read the parsed parameters (validating them; InputError names the entry).
   template <int dim>
@@ -209,6 +214,13 @@ namespace talus::explicit_mpm
     std::unique_ptr<TwoPhase<dim>>                two_phase;
     /// free-surface detection at output times (null: off)
     std::unique_ptr<FreeSurface<dim>>             free_surface;
+    /// FEM / UL-FEM on the same grid (numerics/integration = fem | ul-fem;
+    /// null for MPM): Gauss-point seeding and its own update pass (fem.h)
+    std::unique_ptr<FemIntegration<dim>>          fem;
+
+    /// Write the results file (output/results file, HDF5): series, probes,
+    /// final particle fields and fields mapped to the grid nodes. Collective.
+    void write_results(const std::string &series_csv) const;
 
   private:
     friend class loads::LoadControl<dim>;
@@ -218,6 +230,7 @@ namespace talus::explicit_mpm
     std::string checkpoint_directory() const;
     friend class TwoPhase<dim>;
     friend class FreeSurface<dim>;
+    friend class FemIntegration<dim>;
     void collect_active_cells();
     void update_active_cells();
     void collect_active_dofs();
@@ -248,5 +261,6 @@ namespace talus::explicit_mpm
     std::vector<std::pair<double, std::string>> pvd_records, grid_pvd_records;
     std::vector<dealii::types::particle_index>  probe_ids;
     std::vector<double>                         probe_values; // local, (u, v) per probe
+    std::vector<double>                         probe_stress; // local, n_stress per probe
   };
 } // namespace talus::explicit_mpm

@@ -620,6 +620,7 @@ namespace talus::explicit_mpm
     bool                   bad  = false;
     double                 work = 0; // of the tractions over this step
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
+    std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     {
       auto pt = s.particles.begin();
       for (const auto [c, n_in_cell] : s.active_cells)
@@ -709,11 +710,15 @@ namespace talus::explicit_mpm
                 bad = true;
               for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
                 if (pt->get_id() == s.probe_ids[k2])
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
-                      s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
-                    }
+                  {
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
+                        s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
+                      }
+                    for (unsigned int q = 0; q < L::n_stress; ++q)
+                      s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
+                  }
               bool               inside = true;
               dealii::Point<dim> nxi;
               for (unsigned int d = 0; d < dim; ++d)

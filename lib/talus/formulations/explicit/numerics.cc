@@ -15,15 +15,22 @@ namespace talus::explicit_mpm
 {
   // ================================================================ parameters
   void
-  declare_numerics_parameters(dealii::ParameterHandler &prm)
+  declare_numerics_parameters(dealii::ParameterHandler &prm, const std::string &default_integration)
   {
     using namespace dealii::Patterns;
     prm.enter_subsection("numerics");
-    prm.declare_entry("integration", "mpm", Selection("mpm|mpm-mixed"),
-                      "Integration of the internal force (seed 000 §6.6): 'mpm' at the material points; "
+    prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
+                      "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
+                      "UL-FEM): 'mpm' at the material points; "
                       "'mpm-mixed' at the Gauss point(s) of every cell whose material points fill more than "
                       "'fill factor' of its volume (Eq. 6.33), with the volume-averaged stress of its points "
-                      "(Eq. 6.32); partially filled cells keep material point integration.");
+                      "(Eq. 6.32); partially filled cells keep material point integration. "
+                      "'fem': finite elements on the same grid from the same time loop: the integration points "
+                      "are the 2^dim Gauss points of every cell covered by a body (volume = JxW, mass = "
+                      "density x JxW) and stay there; small strain on the fixed mesh (no motion, no relocation, "
+                      "the displacement accumulates). 'ul-fem': the same points, but the mesh follows the "
+                      "material (updated Lagrangian FEM: nodes move with the nodal displacement increments, "
+                      "gradients and volumes from the current cell geometry). See docs/fem.md.");
     prm.declare_entry("fill factor", "0.9", Double(0, 10),
                       "F_fill of Eq. 6.33 for 'integration = mpm-mixed': a cell is integrated at its Gauss "
                       "point when the volume of its material points exceeds F_fill x the cell volume.");
@@ -52,8 +59,13 @@ namespace talus::explicit_mpm
   {
     NumericsOptions o;
     prm.enter_subsection("numerics");
-    o.integration = prm.get("integration") == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed :
-                                                            NumericsOptions::Integration::mpm;
+    {
+      const std::string i = prm.get("integration");
+      o.integration       = i == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed :
+                            i == "fem"       ? NumericsOptions::Integration::fem :
+                            i == "ul-fem"    ? NumericsOptions::Integration::ul_fem :
+                                               NumericsOptions::Integration::mpm;
+    }
     o.fill_factor = prm.get_double("fill factor");
     o.mixed_linear = prm.get("mixed stress field") == "linear";
     require(o.fill_factor > 0, "numerics/fill factor", "must be > 0 (the manual uses 0.9)");

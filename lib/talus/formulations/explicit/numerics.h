@@ -26,8 +26,10 @@ namespace talus::explicit_mpm
   {
     enum class Integration
     {
-      mpm,      ///< internal force integrated at the material points (MPM-MP)
-      mpm_mixed ///< Gauss integration with the cell-averaged stress in filled cells (§6.6)
+      mpm,       ///< internal force integrated at the material points (MPM-MP)
+      mpm_mixed, ///< Gauss integration with the cell-averaged stress in filled cells (§6.6)
+      fem,       ///< points fixed at the Gauss points of their cells, small strain (fem.h)
+      ul_fem     ///< Gauss points of cells that follow the material (updated Lagrangian FEM, fem.h)
     };
     enum class Smoothing
     {
@@ -49,11 +51,14 @@ namespace talus::explicit_mpm
     std::vector<ContactPair> contact_pairs; ///< empty: contact off
 
     bool contact() const { return !contact_pairs.empty(); }
+    /// integration points stay at the Gauss points of their cells (fem, ul-fem)
+    bool fem() const { return integration == Integration::fem || integration == Integration::ul_fem; }
     /// the solver needs a full (non-fused) P2G pass every step
     bool extended_p2g() const { return integration == Integration::mpm_mixed || contact(); }
   };
 
-  void declare_numerics_parameters(dealii::ParameterHandler &prm);
+  /// `default_integration`: the default of 'numerics/integration' (talus-fem: "fem").
+  void declare_numerics_parameters(dealii::ParameterHandler &prm, const std::string &default_integration = "mpm");
   /// Reads and validates; n_bodies for the body ids of the contact pairs.
   NumericsOptions parse_numerics_parameters(dealii::ParameterHandler &prm, unsigned int n_bodies);
 

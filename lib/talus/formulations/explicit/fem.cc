@@ -1,0 +1,351 @@
+// talus — FEM / UL-FEM integration in the explicit solver (see fem.h).
+#include <talus/base/errors.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/fem.h>
+#include <talus/shape/q1_iso.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <cmath>
+
+namespace talus::explicit_mpm
+{
+  namespace
+  {
+    /// t = -V sigma (in-plane part in 2D), the internal force integrand
+    template <int dim>
+    inline void
+    minus_V_sigma(const double *P, const double V, double (&t)[dim][dim])
+    {
+      using L = PropertyLayout<dim>;
+      t[0][0] = -V * P[L::stress + 0];
+      t[1][1] = -V * P[L::stress + 1];
+      t[0][1] = t[1][0] = -V * P[L::stress + 3];
+      if constexpr (dim == 3)
+        {
+          t[2][2]           = -V * P[L::stress + 2];
+          t[1][2] = t[2][1] = -V * P[L::stress + 4];
+          t[0][2] = t[2][0] = -V * P[L::stress + 5];
+        }
+    }
+  } // namespace
+
+  template <int dim>
+  FemIntegration<dim>::FemIntegration(Solver<dim> &solver, const bool updated_lagrangian)
+    : s(solver)
+    , ul(updated_lagrangian)
+  {
+    const auto &grid = s.grid;
+    vertices.assign(grid.cells.size() * nv * dim, 0.0);
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cell_iterators[c] != grid.tria.end())
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            vertices[(c * nv + v) * dim + d] = grid.cell_iterators[c]->vertex(v)[d];
+    if (ul)
+      grid.reinit_vector(nodal_u);
+  }
+
+  template <int dim>
+  void
+  FemIntegration<dim>::current_vertices(const unsigned int c, double (&X)[nv][dim]) const
+  {
+    const double *X0 = vertices.data() + c * nv * dim;
+    for (unsigned int v = 0; v < nv; ++v)
+      for (unsigned int d = 0; d < dim; ++d)
+        X[v][d] = X0[v * dim + d];
+    if (ul)
+      {
+        const auto &  cc = s.grid.cells[c];
+        const double *U  = nodal_u.begin();
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            X[v][d] += U[cc.dofs[v * dim + d]];
+      }
+  }
+
+  template <int dim>
+  SeedingResult
+  FemIntegration<dim>::seed(const std::vector<double> &density_of_material)
+  {
+    using L                = PropertyLayout<dim>;
+    const auto &grid       = s.grid;
+    const auto &bodies     = s.prm.bodies;
+    const double gauss     = 0.5 / std::sqrt(3.0);
+    const double weight    = 1.0 / nv; // Gauss weights on the unit cell
+    struct NewPoint
+    {
+      dealii::Point<dim> x, xi;
+      unsigned int       cell, body, material;
+      double             volume;
+    };
+    std::vector<NewPoint> points;
+    SeedingResult         result;
+    result.volume_per_body.assign(bodies.size(), 0.0);
+    // cells covered by a body: those holding its points in the MPM seeding
+    std::vector<int> body_of_cell(grid.cells.size(), -1), material_of_cell(grid.cells.size(), -1);
+    for (const auto &pt : s.particles)
+      {
+        const unsigned int c = pt.get_surrounding_cell()->active_cell_index();
+        const int          b = static_cast<int>(pt.get_properties()[L::body]);
+        if (body_of_cell[c] < 0 || b < body_of_cell[c])
+          {
+            body_of_cell[c]     = b;
+            material_of_cell[c] = static_cast<int>(pt.get_properties()[L::material]);
+          }
+      }
+    s.particles.clear_particles();
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      {
+        if (!grid.cells[c].locally_owned || body_of_cell[c] < 0)
+          continue;
+        double X[nv][dim];
+        current_vertices(c, X);
+        const unsigned int b = body_of_cell[c];
+        for (unsigned int q = 0; q < nv; ++q)
+          {
+            dealii::Point<dim> xi, x;
+            for (unsigned int d = 0; d < dim; ++d)
+              xi[d] = 0.5 + (((q >> d) & 1u) ? gauss : -gauss);
+            double N[nv], dN[nv][dim], G[nv][dim];
+            shape::IsoQ1<dim>::shape(xi, N, dN);
+            const double det = shape::IsoQ1<dim>::gradients(X, dN, G);
+            if (!(det > 0))
+              throw InputError("grid: cell " + grid.cell_iterators[c]->id().to_string() +
+                               " is inverted or degenerate (det J = " + std::to_string(det) +
+                               " at a Gauss point); numerics/integration = fem | ul-fem needs valid cells");
+            for (unsigned int v = 0; v < nv; ++v)
+              for (unsigned int d = 0; d < dim; ++d)
+                x[d] += N[v] * X[v][d];
+            points.push_back({x, xi, c, b, static_cast<unsigned int>(material_of_cell[c]), det * weight});
+          }
+      }
+
+    const unsigned long long n_local = points.size();
+    unsigned long long       offset  = 0;
+    MPI_Exscan(&n_local, &offset, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, grid.comm);
+    if (dealii::Utilities::MPI::this_mpi_process(grid.comm) == 0)
+      offset = 0;
+    s.particles.reserve(points.size());
+    std::vector<double> props(s.layout.n_properties(), 0.0);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      {
+        const auto &p    = points[i];
+        const auto &body = bodies[p.body];
+        std::fill(props.begin(), props.end(), 0.0);
+        props[L::mass]     = density_of_material[p.material] * p.volume;
+        props[L::volume]   = p.volume;
+        props[L::material] = p.material;
+        props[L::body]     = p.body;
+        const dealii::Tensor<1, dim> v = body.velocity_field ? body.velocity_field(p.x) : body.initial_velocity;
+        for (unsigned int d = 0; d < dim; ++d)
+          props[L::velocity + d] = v[d];
+        result.volume_per_body[p.body] += p.volume;
+        s.particles.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
+                                    dealii::ArrayView<const double>(props.data(), props.size()));
+      }
+    s.particles.update_cached_numbers();
+    result.n_particles = dealii::Utilities::MPI::sum(n_local, grid.comm);
+    for (auto &v : result.volume_per_body)
+      v = dealii::Utilities::MPI::sum(v, grid.comm);
+    return result;
+  }
+
+  template <int dim>
+  void
+  FemIntegration<dim>::collect_moving_dofs()
+  {
+    const unsigned int         n = s.nodal_mass.locally_owned_size() + s.grid.partitioner->n_ghost_indices();
+    std::vector<unsigned char> mark(n, 0);
+    moving_dofs.clear();
+    for (const auto &ac : s.active_cells)
+      for (const unsigned int i : s.grid.cells[ac.cell].dofs)
+        if (!mark[i])
+          {
+            mark[i] = 1;
+            moving_dofs.push_back(i);
+          }
+  }
+
+  template <int dim>
+  void
+  FemIntegration<dim>::p2g_mass_and_force()
+  {
+    using L                = PropertyLayout<dim>;
+    double *const M        = s.nodal_mass.begin();
+    double *const F        = s.nodal_a.begin();
+    const auto    g        = s.gravity;
+    s.zero_on_active(s.nodal_mass);
+    s.zero_on_active(s.nodal_a);
+    auto pt = s.particles.begin();
+    for (const auto [c, n_in_cell] : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[c];
+        double      X[nv][dim];
+        current_vertices(c, X);
+        double lm[nv] = {}, f[nv][dim] = {};
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          {
+            const double *P = pt->get_properties().data();
+            double        N[nv], dN[nv][dim], G[nv][dim], t[dim][dim];
+            shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
+            shape::IsoQ1<dim>::gradients(X, dN, G);
+            minus_V_sigma<dim>(P, P[L::volume], t);
+            for (unsigned int v = 0; v < nv; ++v)
+              {
+                lm[v] += P[L::mass] * N[v];
+                for (unsigned int a = 0; a < dim; ++a)
+                  for (unsigned int b = 0; b < dim; ++b)
+                    f[v][a] += t[a][b] * G[v][b];
+              }
+          }
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const unsigned int i = cc.dofs[v * dim + d];
+              M[i] += lm[v];
+              F[i] += f[v][d] + lm[v] * g[d];
+            }
+      }
+  }
+
+  template <int dim>
+  void
+  FemIntegration<dim>::update(const double h)
+  {
+    using L                     = PropertyLayout<dim>;
+    constexpr unsigned int nst  = L::n_stress;
+    const double *const    Vn   = s.nodal_p.begin();
+    const auto             g    = s.gravity;
+    double *const          M    = s.nodal_mass.begin();
+    double *const          F    = s.nodal_a.begin();
+    Energies               e;
+    dealii::Tensor<1, dim> momentum;
+    bool                   bad          = false;
+    const bool             track_probes = !s.probe_ids.empty();
+    std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
+    std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
+    s.zero_on_active(s.nodal_mass);
+    s.zero_on_active(s.nodal_a);
+    auto pt = s.particles.begin();
+    for (const auto [c, n_in_cell] : s.active_cells)
+      {
+        const auto &cc = s.grid.cells[c];
+        double      X0[nv][dim], X1[nv][dim], du[nv][dim];
+        current_vertices(c, X0);
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // seed 000 Eq. 4.49
+              X1[v][d] = X0[v][d] + (ul ? du[v][d] : 0.0);
+            }
+        double lm[nv] = {}, f[nv][dim] = {};
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          {
+            double *     P = pt->get_properties().data();
+            double       N[nv], dN[nv][dim], G[nv][dim];
+            shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
+            const double det0 = shape::IsoQ1<dim>::gradients(X0, dN, G);
+            double       gu[dim][dim] = {}, dx[dim] = {};
+            for (unsigned int v = 0; v < nv; ++v)
+              for (unsigned int a = 0; a < dim; ++a)
+                {
+                  dx[a] += N[v] * du[v][a];
+                  for (unsigned int b = 0; b < dim; ++b)
+                    gu[a][b] += du[v][a] * G[v][b];
+                }
+            materials::Strain d_eps;
+            materials::Spin   d_omega; // zero for small strain (fem)
+            for (unsigned int a = 0; a < dim; ++a)
+              for (unsigned int b = 0; b < dim; ++b)
+                {
+                  if (b >= a)
+                    d_eps[a][b] = 0.5 * (gu[a][b] + gu[b][a]);
+                  if (ul)
+                    d_omega[a][b] = 0.5 * (gu[a][b] - gu[b][a]);
+                }
+            const unsigned int         mat   = static_cast<unsigned int>(P[L::material]);
+            const materials::Material &m     = *s.prm.materials[mat];
+            auto                       sigma = L::get_stress(P);
+            m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.layout.history, m.n_history()));
+            L::set_stress(sigma, P);
+
+            dealii::Point<dim> x = pt->get_location();
+            for (unsigned int d = 0; d < dim; ++d)
+              P[L::displacement + d] += dx[d];
+            double det1 = det0;
+            if (ul)
+              {
+                // the point follows its cell: x_p = sum N_i x_i, V_p = det J w
+                det1 = shape::IsoQ1<dim>::gradients(X1, dN, G);
+                P[L::volume] *= det1 / det0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  x[d] += dx[d];
+                pt->set_location(x);
+              }
+            const double mass = P[L::mass];
+            double       v2 = 0, gx = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                v2 += P[L::velocity + d] * P[L::velocity + d];
+                // fem: the current position is the Gauss point plus the displacement
+                gx += g[d] * (ul ? x[d] : x[d] + P[L::displacement + d]);
+                momentum[d] += mass * P[L::velocity + d];
+              }
+            e.kinetic += 0.5 * mass * v2;
+            e.gravity_potential -= mass * gx;
+            if (s.need_strain_energy)
+              e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+            if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
+                !(P[L::volume] > 0) || !(det1 > 0))
+              bad = true;
+            if (track_probes)
+              for (unsigned int q = 0; q < s.probe_ids.size(); ++q)
+                if (pt->get_id() == s.probe_ids[q])
+                  {
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        s.probe_values[q * 2 * dim + d]       = P[L::displacement + d];
+                        s.probe_values[q * 2 * dim + dim + d] = P[L::velocity + d];
+                      }
+                    for (unsigned int j = 0; j < nst; ++j)
+                      s.probe_stress[q * nst + j] = P[L::stress + j];
+                  }
+
+            // next step's mass and internal force at the updated state
+            double t[dim][dim];
+            minus_V_sigma<dim>(P, P[L::volume], t);
+            for (unsigned int v = 0; v < nv; ++v)
+              {
+                lm[v] += mass * N[v];
+                for (unsigned int a = 0; a < dim; ++a)
+                  for (unsigned int b = 0; b < dim; ++b)
+                    f[v][a] += t[a][b] * G[v][b];
+              }
+          }
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const unsigned int i = cc.dofs[v * dim + d];
+              M[i] += lm[v];
+              F[i] += f[v][d] + lm[v] * g[d];
+            }
+      }
+    if (ul)
+      {
+        // move the nodes of the cells with points (owned and ghost entries:
+        // the ghost velocities are current, so no exchange is needed)
+        if (moving_dofs.empty())
+          collect_moving_dofs();
+        double *U = nodal_u.begin();
+        for (const unsigned int i : moving_dofs)
+          U[i] += h * Vn[i];
+      }
+    s.local_energies = e;
+    s.local_momentum = momentum;
+    s.local_bad      = bad;
+  }
+
+  template class FemIntegration<2>;
+  template class FemIntegration<3>;
+} // namespace talus::explicit_mpm

@@ -1,0 +1,241 @@
+// talus — the HDF5 results file of the explicit solver (output/results file):
+// series, probes over time, final particle fields and final fields mapped to
+// the grid nodes. Read by talus-compare (lib/talus/io/results.h). Layout in
+// docs/fem.md.
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/io/hdf5.h>
+#include <talus/io/results.h>
+#include <talus/shape/q1.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace talus::explicit_mpm
+{
+  template <int dim>
+  void
+  Solver<dim>::write_results(const std::string &series_csv) const
+  {
+    using L                    = PropertyLayout<dim>;
+    constexpr unsigned int nst = L::n_stress;
+    constexpr unsigned int nv  = shape::Q1<dim>::n_vertices;
+    const bool             root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
+
+    // ---- series: the columns of series.csv (complete, also after a restart)
+    std::string text;
+    if (root)
+      {
+        std::ifstream     in(series_csv);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        text = ss.str();
+      }
+    text = dealii::Utilities::MPI::broadcast(comm, text, 0);
+    std::vector<std::string>         names;
+    std::vector<std::vector<double>> columns;
+    {
+      std::istringstream is(text);
+      std::string        line;
+      if (std::getline(is, line))
+        names = dealii::Utilities::split_string_list(line, ',');
+      columns.assign(names.size(), {});
+      while (std::getline(is, line))
+        {
+          const auto f = dealii::Utilities::split_string_list(line, ',');
+          if (f.size() != names.size())
+            break;
+          for (std::size_t k = 0; k < f.size(); ++k)
+            columns[k].push_back(std::stod(f[k]));
+        }
+    }
+
+    io::H5File out(prm.results_file, io::H5File::Mode::create, comm);
+    out.set_attribute("format", std::string(io::results_format));
+    out.set_attribute("version", std::int64_t(io::results_version));
+    out.set_attribute("dimension", std::int64_t(dim));
+    {
+      const auto  i    = prm.numerics.integration;
+      const char *mode = i == NumericsOptions::Integration::fem       ? "fem" :
+                         i == NumericsOptions::Integration::ul_fem    ? "ul-fem" :
+                         i == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
+                                                                        "mpm";
+      out.set_attribute("integration", std::string(mode));
+    }
+    out.set_attribute("ranks", std::int64_t(dealii::Utilities::MPI::n_mpi_processes(comm)));
+    out.set_attribute("time", time);
+    out.set_attribute("steps", std::int64_t(step_number));
+    out.set_attribute("material points", std::int64_t(n_particles()));
+    std::string joined;
+    for (const auto &n : names)
+      joined += (joined.empty() ? "" : ",") + n;
+    out.set_attribute("series columns", joined);
+    for (std::size_t k = 0; k < names.size(); ++k)
+      out.write_global("series/" + names[k], columns[k], 1);
+
+    // ---- probes: time x (probe, component) tables from the series columns
+    const unsigned int n_probes = probe_ids.size();
+    out.set_attribute("probes", std::int64_t(n_probes));
+    if (n_probes > 0)
+      {
+        const char *ax[]     = {"x", "y", "z"};
+        const auto  pnames   = layout.names();
+        const auto  column   = [&](const std::string &n) -> const std::vector<double> & {
+          for (std::size_t k = 0; k < names.size(); ++k)
+            if (names[k] == n)
+              return columns[k];
+          throw std::runtime_error("results: series.csv has no column '" + n + "'");
+        };
+        const std::size_t n_rows = names.empty() ? 0 : columns[0].size();
+        const auto        table  = [&](const std::vector<std::string> &cols) {
+          std::vector<double> t(n_rows * cols.size());
+          for (std::size_t c = 0; c < cols.size(); ++c)
+            {
+              const auto &v = column(cols[c]);
+              for (std::size_t r = 0; r < n_rows; ++r)
+                t[r * cols.size() + c] = v[r];
+            }
+          return t;
+        };
+        std::vector<std::string> u, v, sg;
+        for (unsigned int k = 0; k < n_probes; ++k)
+          {
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                u.push_back("probe" + std::to_string(k) + "_u" + ax[d]);
+                v.push_back("probe" + std::to_string(k) + "_v" + ax[d]);
+              }
+            for (unsigned int q = 0; q < nst; ++q)
+              sg.push_back("probe" + std::to_string(k) + "_" + pnames[L::stress + q]);
+          }
+        out.write_global("probes/time", column("time"), 1);
+        out.write_global("probes/displacement", table(u), n_probes * dim);
+        out.write_global("probes/velocity", table(v), n_probes * dim);
+        out.write_global("probes/stress", table(sg), n_probes * nst);
+        // initial positions X = x - u of the tracked points
+        std::vector<double> X(n_probes * dim, 0.0);
+        for (const auto &pt : particles)
+          for (unsigned int k = 0; k < n_probes; ++k)
+            if (pt.get_id() == probe_ids[k])
+              for (unsigned int d = 0; d < dim; ++d)
+                X[k * dim + d] = fem && !fem->updated_lagrangian() ?
+                                   pt.get_location()[d] :
+                                   pt.get_location()[d] - pt.get_properties()[L::displacement + d];
+        std::vector<double> Xs(X.size());
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(X), comm, dealii::ArrayView<double>(Xs));
+        out.write_global("probes/initial_position", Xs, dim);
+      }
+
+    // ---- final material point fields (each rank its rows)
+    {
+      std::vector<std::uint64_t> id;
+      std::vector<double>        x, X, u, vel, sig, vol, mass, mat, body;
+      for (const auto &pt : particles)
+        {
+          const auto P   = pt.get_properties();
+          const bool fix = fem && !fem->updated_lagrangian(); // fem: the point stays at its Gauss point
+          id.push_back(pt.get_id());
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double loc = pt.get_location()[d], ud = P[L::displacement + d];
+              x.push_back(fix ? loc + ud : loc);
+              X.push_back(fix ? loc : loc - ud);
+              u.push_back(ud);
+              vel.push_back(P[L::velocity + d]);
+            }
+          for (unsigned int q = 0; q < nst; ++q)
+            sig.push_back(P[L::stress + q]);
+          vol.push_back(P[L::volume]);
+          mass.push_back(P[L::mass]);
+          mat.push_back(P[L::material]);
+          body.push_back(P[L::body]);
+        }
+      out.write_rows("particles/id", id, 1);
+      out.write_rows("particles/position", x, dim);
+      out.write_rows("particles/initial_position", X, dim);
+      out.write_rows("particles/displacement", u, dim);
+      out.write_rows("particles/velocity", vel, dim);
+      out.write_rows("particles/stress", sig, nst);
+      out.write_rows("particles/volume", vol, 1);
+      out.write_rows("particles/mass", mass, 1);
+      out.write_rows("particles/material_id", mat, 1);
+      out.write_rows("particles/body_id", body, 1);
+    }
+
+    // ---- final fields mapped to the grid nodes: lumped projection
+    //   m_i = sum m_p N_i, u_i = sum m_p N_i u_p / m_i, v_i likewise,
+    //   sigma_i = sum V_p N_i sigma_p / sum V_p N_i
+    {
+      constexpr unsigned int n_sv = (nst + dim - 1) / dim; // stress components over dim-vectors
+      std::vector<Vector>    w(3 + n_sv);                  // weights (m, V), u, v, stress blocks
+      for (auto &vec : w)
+        grid.reinit_vector(vec);
+      auto pt = particles.begin();
+      for (const auto [c, n_in_cell] : active_cells)
+        {
+          const auto &cc = grid.cells[c];
+          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+            {
+              const auto P = pt->get_properties();
+              double     N[nv];
+              shape::Q1<dim>::values(pt->get_reference_location(), N);
+              for (unsigned int v = 0; v < nv; ++v)
+                {
+                  const double mN = P[L::mass] * N[v], VN = P[L::volume] * N[v];
+                  w[0].local_element(cc.dofs[v * dim + 0]) += mN;
+                  w[0].local_element(cc.dofs[v * dim + 1]) += VN;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      w[1].local_element(cc.dofs[v * dim + d]) += mN * P[L::displacement + d];
+                      w[2].local_element(cc.dofs[v * dim + d]) += mN * P[L::velocity + d];
+                    }
+                  for (unsigned int q = 0; q < nst; ++q)
+                    w[3 + q / dim].local_element(cc.dofs[v * dim + q % dim]) += VN * P[L::stress + q];
+                }
+            }
+        }
+      for (auto &vec : w)
+        vec.compress(dealii::VectorOperation::add);
+      const unsigned int         n_owned = nodal_mass.locally_owned_size();
+      std::vector<unsigned char> done(n_owned, 0);
+      std::vector<double>        X, m, u, vel, sig;
+      for (unsigned int c = 0; c < grid.cells.size(); ++c)
+        {
+          if (grid.cell_iterators[c] == grid.tria.end())
+            continue;
+          const auto &cc = grid.cells[c];
+          for (unsigned int v = 0; v < nv; ++v)
+            {
+              const unsigned int i0 = cc.dofs[v * dim + 0];
+              if (i0 >= n_owned || done[i0])
+                continue;
+              done[i0]        = 1;
+              const double mi = w[0].local_element(i0), Vi = w[0].local_element(cc.dofs[v * dim + 1]);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  X.push_back(grid.cell_iterators[c]->vertex(v)[d]);
+                  const unsigned int i = cc.dofs[v * dim + d];
+                  u.push_back(mi > 0 ? w[1].local_element(i) / mi : 0.0);
+                  vel.push_back(mi > 0 ? w[2].local_element(i) / mi : 0.0);
+                }
+              for (unsigned int q = 0; q < nst; ++q)
+                sig.push_back(Vi > 0 ? w[3 + q / dim].local_element(cc.dofs[v * dim + q % dim]) / Vi : 0.0);
+              m.push_back(mi);
+            }
+        }
+      out.write_rows("grid/vertices", X, dim);
+      out.write_rows("grid/mass", m, 1);
+      out.write_rows("grid/displacement", u, dim);
+      out.write_rows("grid/velocity", vel, dim);
+      out.write_rows("grid/stress", sig, nst);
+    }
+    out.commit();
+    log() << "  results: " << prm.results_file << std::endl;
+  }
+
+  template void Solver<2>::write_results(const std::string &) const;
+  template void Solver<3>::write_results(const std::string &) const;
+} // namespace talus::explicit_mpm
