@@ -70,6 +70,16 @@ cases = {
         ("check", open(os.path.join(prm_dir, "convergence", "bar_displacement.prm")).read().replace(
             "../verification/", os.path.join(os.path.abspath(prm_dir), "verification") + "/"), 0, ["--check"]),
         ("bad_input", "set mode = fast\n", 2, [])],
+    # a box grid with a box body, and the gmsh column (meshed through the gmsh API)
+    "talus-mesh": [
+        ("box", "set dimension = 2\nsubsection grid\n  set cells = 4, 4\nend\n"
+                "subsection body 0\n  set upper corner = 0.5, 0.5\nend\n"
+                "subsection output\n  set grid file = g.msh\n  set particle file = p.h5\nend\n", 0, []),
+        ("gmsh_column", open(os.path.join(prm_dir, "mesh", "elastic_column_2d.prm")).read().replace(
+            "meshes/", os.path.join(os.path.abspath(prm_dir), "..", "meshes") + "/"), 0, []),
+        ("bad_input", "set dimension = 2\nsubsection grid\n  set cells = 0, 4\nend\n"
+                      "subsection output\n  set grid file = g.msh\n  set particle file = p.h5\nend\n", 2, []),
+    ],
     "talus-bench-materials": [("bench", None, 0, ["--points=8", "--steps=4"])],
     "talus-bench-finite-strain": [("bench", None, 0, ["--updates=50"])],
 }
