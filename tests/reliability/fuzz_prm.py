@@ -490,8 +490,11 @@ def main():
     # .prm files next to a Makefile belong to a make chain (parameter_files/examples):
     # they read files that the chain makes, relative to its output directory, so
     # they are checked by their own test (verification.examples_makefile)
+    # (the run directories a make chain writes below parameter_files, out/ and output/,
+    # are not shipped files either)
     prms = sorted(os.path.join(r, f) for r, _, fs in os.walk(args.prm_dir) for f in fs
-                  if f.endswith(".prm") and not os.path.exists(os.path.join(r, "Makefile")))
+                  if f.endswith(".prm") and not os.path.exists(os.path.join(r, "Makefile"))
+                  and not {"out", "output"} & set(os.path.relpath(r, args.prm_dir).split(os.sep)))
     jobs = []  # (tool, mutation)
     n_mut = 0
     per_prm = 40

@@ -445,3 +445,47 @@ namespace talus
       }
   }
 } // namespace talus
+
+namespace talus
+{
+  std::vector<double>
+  parse_doubles(const std::string &text, const std::string &where)
+  {
+    std::vector<double> r;
+    for (const auto &s : dealii::Utilities::split_string_list(text, ','))
+      {
+        try
+          {
+            std::size_t  pos = 0;
+            const double v   = std::stod(s, &pos);
+            if (pos != s.size() || !std::isfinite(v))
+              throw std::invalid_argument(s);
+            r.push_back(v);
+          }
+        catch (const std::exception &)
+          {
+            throw InputError(where + ": '" + s + "' is not a finite number (in '" + text + "')");
+          }
+      }
+    return r;
+  }
+
+  template <int dim>
+  dealii::Point<dim>
+  parse_point(const std::string &text, const std::string &where)
+  {
+    const auto v = parse_doubles(text, where);
+    require(v.size() == dim,
+            where,
+            "needs exactly " + std::to_string(dim) + " comma-separated numbers for dimension " +
+              std::to_string(dim) + " (got '" + text + "')");
+    dealii::Point<dim> p;
+    for (unsigned int d = 0; d < dim; ++d)
+      p[d] = v[d];
+    return p;
+  }
+
+  template dealii::Point<1> parse_point<1>(const std::string &, const std::string &);
+  template dealii::Point<2> parse_point<2>(const std::string &, const std::string &);
+  template dealii::Point<3> parse_point<3>(const std::string &, const std::string &);
+} // namespace talus

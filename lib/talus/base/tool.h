@@ -5,6 +5,7 @@
 #pragma once
 
 #include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
 
 #include <functional>
 #include <string>
@@ -75,6 +76,14 @@ namespace talus
   void require_output_file(const std::string &file, const std::string &where);
   /// InputError unless x is finite (not NaN, not +-inf).
   void require_finite(double x, const std::string &where);
+
+  /// The comma-separated numbers of a .prm value; InputError naming `where` and the
+  /// offending item unless every item is a finite number.
+  std::vector<double> parse_doubles(const std::string &text, const std::string &where);
+  /// A point given as exactly dim comma-separated finite numbers (InputError otherwise).
+  /// Instantiated for dim = 1, 2, 3.
+  template <int dim>
+  dealii::Point<dim> parse_point(const std::string &text, const std::string &where);
 
   /// main() of a tool: `return talus::run_tool(argc, argv, description);`
   /// Command line: [--help] [--print-parameters] [--check] [tool options] FILE.prm.

@@ -22,40 +22,7 @@ namespace talus::loads
       return dim == 2 ? "0, 0" : "0, 0, 0";
     }
 
-    std::vector<double>
-    doubles(const std::string &text, const std::string &where)
-    {
-      std::vector<double> r;
-      for (const auto &s : dealii::Utilities::split_string_list(text, ','))
-        {
-          try
-            {
-              std::size_t  pos = 0;
-              const double v   = std::stod(s, &pos);
-              if (pos != s.size() || !std::isfinite(v))
-                throw std::invalid_argument(s);
-              r.push_back(v);
-            }
-          catch (const std::exception &)
-            {
-              throw InputError(where + ": '" + s + "' is not a number (in '" + text + "')");
-            }
-        }
-      return r;
-    }
 
-    template <int dim>
-    dealii::Point<dim>
-    point(const std::string &text, const std::string &where)
-    {
-      const auto v = doubles(text, where);
-      require(v.size() == dim, where,
-              "needs exactly " + std::to_string(dim) + " comma-separated numbers (got '" + text + "')");
-      dealii::Point<dim> p;
-      for (unsigned int d = 0; d < dim; ++d)
-        p[d] = v[d];
-      return p;
-    }
 
     std::vector<dealii::types::boundary_id>
     ids(const std::string &text, const std::string &where, const unsigned int dim)
@@ -63,7 +30,7 @@ namespace talus::loads
       std::vector<dealii::types::boundary_id> r;
       if (text == "none")
         return r;
-      for (const auto &x : doubles(text, where))
+      for (const auto &x : parse_doubles(text, where))
         {
           require(x >= 0 && x == std::floor(x) && x < 2 * dim, where,
                   "boundary id " + std::to_string(x) + " does not exist (box grid ids 0.." +
@@ -159,13 +126,13 @@ namespace talus::loads
             }
           else
             {
-              t.lower = point<dim>(prm.get("region lower corner"), where + "/region lower corner");
-              t.upper = point<dim>(prm.get("region upper corner"), where + "/region upper corner");
+              t.lower = parse_point<dim>(prm.get("region lower corner"), where + "/region lower corner");
+              t.upper = parse_point<dim>(prm.get("region upper corner"), where + "/region upper corner");
               for (unsigned int d = 0; d < dim; ++d)
                 require(t.upper[d] > t.lower[d], where + "/region upper corner",
                         "must exceed 'region lower corner' in every direction");
             }
-          t.traction = point<dim>(prm.get("traction"), where + "/traction");
+          t.traction = parse_point<dim>(prm.get("traction"), where + "/traction");
           t.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
           prm.leave_subsection();
           tractions.push_back(t);
@@ -189,8 +156,8 @@ namespace talus::loads
           else if (a == "region")
             {
               v.target = PrescribedVelocity<dim>::Target::region;
-              v.lower  = point<dim>(prm.get("region lower corner"), where + "/region lower corner");
-              v.upper  = point<dim>(prm.get("region upper corner"), where + "/region upper corner");
+              v.lower  = parse_point<dim>(prm.get("region lower corner"), where + "/region lower corner");
+              v.upper  = parse_point<dim>(prm.get("region upper corner"), where + "/region upper corner");
               for (unsigned int d = 0; d < dim; ++d)
                 require(v.upper[d] >= v.lower[d], where + "/region upper corner",
                         "must not be below 'region lower corner'");
@@ -214,7 +181,7 @@ namespace talus::loads
                           std::string(dim == 2 ? "x, y" : "x, y, z") + ")");
                 v.component[c[0] - 'x'] = true;
               }
-          v.velocity = point<dim>(prm.get("velocity"), where + "/velocity");
+          v.velocity = parse_point<dim>(prm.get("velocity"), where + "/velocity");
           v.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
           prm.leave_subsection();
           velocities.push_back(v);
@@ -409,7 +376,7 @@ namespace talus::loads
         const std::string k0 = prm.get("K0"), level = prm.get("surface level");
         z.surcharge          = prm.get_double("surcharge");
         if (!level.empty())
-          z.surface_level = doubles(level, where + "/surface level").at(0);
+          z.surface_level = parse_doubles(level, where + "/surface level").at(0);
         prm.leave_subsection();
         prm.leave_subsection();
         if (z.enabled)
@@ -434,7 +401,7 @@ namespace talus::loads
                 z.K0 = 1.0 - std::sin(phi * M_PI / 180.0);
               }
             else
-              z.K0 = doubles(k0, where + "/K0").at(0);
+              z.K0 = parse_doubles(k0, where + "/K0").at(0);
             require(z.K0 >= 0, where + "/K0", "must be >= 0");
           }
         s.k0.push_back(z);
@@ -454,7 +421,7 @@ namespace talus::loads
         require(st.duration > 0, where + "/duration", "must be > 0");
         prm.enter_subsection("gravity");
         const std::string g = prm.get("acceleration");
-        st.gravity          = g.empty() ? top.gravity : dealii::Tensor<1, dim>(point<dim>(g, where + "/gravity/acceleration"));
+        st.gravity          = g.empty() ? top.gravity : dealii::Tensor<1, dim>(parse_point<dim>(g, where + "/gravity/acceleration"));
         prm.leave_subsection();
         prm.enter_subsection("boundary conditions");
         const auto list = [&](const char *e, const std::vector<dealii::types::boundary_id> &inherited) {

@@ -74,6 +74,24 @@ namespace talus
     static void set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p);
   };
 
+  /// t = -V sigma of the point with properties P (the in-plane part in 2D): the
+  /// integrand of the internal force f_int,i = -sum_p t grad N_i(x_p).
+  template <int dim>
+  inline void
+  minus_V_sigma(const double *P, const double V, double (&t)[dim][dim])
+  {
+    using L = PropertyLayout<dim>;
+    t[0][0] = -V * P[L::stress + 0];
+    t[1][1] = -V * P[L::stress + 1];
+    t[0][1] = t[1][0] = -V * P[L::stress + 3];
+    if constexpr (dim == 3)
+      {
+        t[2][2]           = -V * P[L::stress + 2];
+        t[1][2] = t[2][1] = -V * P[L::stress + 4];
+        t[0][2] = t[2][0] = -V * P[L::stress + 5];
+      }
+  }
+
   /// A body made of material points: a primitive region filled with regular
   /// points in every grid cell it covers (seed 000 §4.3.2: equal shares of the
   /// cell volume).

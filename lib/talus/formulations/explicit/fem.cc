@@ -10,25 +10,6 @@
 
 namespace talus::explicit_mpm
 {
-  namespace
-  {
-    /// t = -V sigma (in-plane part in 2D), the internal force integrand
-    template <int dim>
-    inline void
-    minus_V_sigma(const double *P, const double V, double (&t)[dim][dim])
-    {
-      using L = PropertyLayout<dim>;
-      t[0][0] = -V * P[L::stress + 0];
-      t[1][1] = -V * P[L::stress + 1];
-      t[0][1] = t[1][0] = -V * P[L::stress + 3];
-      if constexpr (dim == 3)
-        {
-          t[2][2]           = -V * P[L::stress + 2];
-          t[1][2] = t[2][1] = -V * P[L::stress + 4];
-          t[0][2] = t[2][0] = -V * P[L::stress + 5];
-        }
-    }
-  } // namespace
 
   template <int dim>
   FemIntegration<dim>::FemIntegration(Solver<dim> &solver, const bool updated_lagrangian)

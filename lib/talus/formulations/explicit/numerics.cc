@@ -138,21 +138,6 @@ namespace talus::explicit_mpm
       }
     };
 
-    template <int dim>
-    inline void
-    minus_V_sigma(const double *P, const double V, double (&t)[dim][dim])
-    {
-      using L = PropertyLayout<dim>;
-      t[0][0] = -V * P[L::stress + 0];
-      t[1][1] = -V * P[L::stress + 1];
-      t[0][1] = t[1][0] = -V * P[L::stress + 3];
-      if constexpr (dim == 3)
-        {
-          t[2][2]           = -V * P[L::stress + 2];
-          t[1][2] = t[2][1] = -V * P[L::stress + 4];
-          t[0][2] = t[2][0] = -V * P[L::stress + 5];
-        }
-    }
 
     void
     zero_on(Vector &v, const std::vector<unsigned int> &active_dofs)
