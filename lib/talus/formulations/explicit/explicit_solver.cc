@@ -746,17 +746,8 @@ namespace talus::explicit_mpm
         const double m = P[L::mass], V = P[L::volume];
         for (unsigned int v = 0; v < F::nv; ++v)
           lm[v] += m * N[v];
-        // t = -V sigma (in-plane part in 2D)
         double t[dim][dim];
-        t[0][0] = -V * P[L::stress + 0];
-        t[1][1] = -V * P[L::stress + 1];
-        t[0][1] = t[1][0] = -V * P[L::stress + 3];
-        if constexpr (dim == 3)
-          {
-            t[2][2]           = -V * P[L::stress + 2];
-            t[1][2] = t[2][1] = -V * P[L::stress + 4];
-            t[0][2] = t[2][0] = -V * P[L::stress + 5];
-          }
+        minus_V_sigma<dim>(P, V, t);
         F::add_moments(t, w, T);
       }
 
