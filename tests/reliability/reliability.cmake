@@ -17,7 +17,7 @@ if(NOT TALUS_SANITIZE)
   set_tests_properties(reliability.fuzz_prm_full PROPERTIES LABELS "verify" ENVIRONMENT "${_renv}" TIMEOUT 1800 PROCESSORS 2)
 else()
   # LeakSanitizer: the MPI stack keeps its start-up allocations until exit
-  set(_senv "${_renv};LSAN_OPTIONS=suppressions=${_r}/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1;ASAN_OPTIONS=detect_leaks=1:abort_on_error=0")
+  set(_senv "${_renv};LSAN_OPTIONS=suppressions=${_r}/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1;ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:fast_unwind_on_malloc=0")
   add_test(NAME sanitize.tools_smoke
            COMMAND ${Python3_EXECUTABLE} ${_r}/sanitize_smoke.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR} ${_rw}/smoke)
   set_tests_properties(sanitize.tools_smoke PROPERTIES LABELS "sanitize" ENVIRONMENT "${_senv}" TIMEOUT 3600)
