@@ -73,7 +73,7 @@ namespace
     {
       std::vector<double>      h_loc(n_mat, std::numeric_limits<double>::max());
       std::vector<std::string> id_loc(n_mat), center_loc(n_mat);
-      for (const auto &pt : s.particles)
+      for (const auto &pt : s.points.handler)
         {
           const unsigned int m = static_cast<unsigned int>(pt.get_properties()[2] + 0.5);
           if (m >= n_mat)

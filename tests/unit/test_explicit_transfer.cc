@@ -105,10 +105,10 @@ relocation_and_momentum()
     }
   EXPECT_LT(worst, 1e-12) << "fused P2G differs from a fresh P2G";
   EXPECT_EQ(s.n_particles(), n0);
-  unsigned long long local = s.particles.n_locally_owned_particles();
+  unsigned long long local = s.points.handler.n_locally_owned_particles();
   EXPECT_EQ(dealii::Utilities::MPI::sum(local, MPI_COMM_WORLD), n0);
-  EXPECT_GT(dealii::Utilities::MPI::sum(s.relocation_stats.moved_locally, MPI_COMM_WORLD) +
-              s.relocation_stats.global_sorts,
+  EXPECT_GT(dealii::Utilities::MPI::sum(s.points.relocation_stats.moved_locally, MPI_COMM_WORLD) +
+              s.points.relocation_stats.global_sorts,
             0u)
     << "the test must move particles across cells";
   EXPECT_NEAR(s.total_mass(), m0, 1e-13 * m0);
@@ -117,7 +117,7 @@ relocation_and_momentum()
     EXPECT_NEAR(p1[d], p0[d], 1e-12 * m0) << "no external force: momentum conserved";
   // every particle sits inside the cell it is stored in, with consistent
   // reference coordinates
-  for (const auto &pt : s.particles)
+  for (const auto &pt : s.points.handler)
     {
       const auto c  = pt.get_surrounding_cell()->active_cell_index();
       const auto xi = s.grid.reference_point(c, pt.get_location());
@@ -130,7 +130,7 @@ relocation_and_momentum()
     }
   // ids unique and complete
   std::vector<dealii::types::particle_index> ids;
-  for (const auto &pt : s.particles)
+  for (const auto &pt : s.points.handler)
     ids.push_back(pt.get_id());
   auto all = dealii::Utilities::MPI::all_gather(MPI_COMM_WORLD, ids);
   std::vector<dealii::types::particle_index> merged;

@@ -135,7 +135,7 @@ TEST(Loads, K0InitialStressesExact)
     using L          = PropertyLayout<2>;
     double worst_ratio = 0, worst_sv = 0;
     unsigned int n = 0;
-    for (const auto &pt : s.particles)
+    for (const auto &pt : s.points.handler)
       {
         const auto P  = pt.get_properties();
         const int  b  = static_cast<int>(P[L::body]);
@@ -164,7 +164,7 @@ TEST(Loads, TractionForcesSumToTractionTimesArea)
     const unsigned off = s.control->point_force_offset();
     double fx = 0, fy = 0;
     unsigned int n = 0;
-    for (const auto &pt : s.particles)
+    for (const auto &pt : s.points.handler)
       {
         const auto P = pt.get_properties();
         if (P[off] != 0 || P[off + 1] != 0)

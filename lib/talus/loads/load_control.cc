@@ -61,7 +61,7 @@ namespace talus::loads
     const unsigned int n_bodies = settings.k0.size();
     // top of every body along e (material point + half its spacing)
     std::vector<double> top(n_bodies, -std::numeric_limits<double>::max());
-    for (const auto &pt : s.particles)
+    for (const auto &pt : s.points.handler)
       {
         const auto         P = pt.get_properties();
         const unsigned int b = static_cast<unsigned int>(P[L::body]);
@@ -76,7 +76,7 @@ namespace talus::loads
       dealii::Utilities::MPI::max(dealii::ArrayView<const double>(top), s.comm, dealii::ArrayView<double>(all));
       top = all;
     }
-    for (auto &pt : s.particles)
+    for (auto &pt : s.points.handler)
       {
         auto               P = pt.get_properties();
         const unsigned int b = static_cast<unsigned int>(P[L::body]);
@@ -200,7 +200,7 @@ namespace talus::loads
     using L                   = PropertyLayout<dim>;
     const unsigned int off    = force_offset;
     const unsigned int nslots = settings.max_tractions;
-    for (auto &pt : s.particles)
+    for (auto &pt : s.points.handler)
       {
         auto P = pt.get_properties();
         for (unsigned int i = 0; i < nslots * dim; ++i)
@@ -224,7 +224,7 @@ namespace talus::loads
         double extreme = -std::numeric_limits<double>::max();
         if (t.target == Traction<dim>::Target::body_face)
           {
-            for (const auto &pt : s.particles)
+            for (const auto &pt : s.points.handler)
               if (static_cast<unsigned int>(pt.get_properties()[L::body]) == t.body)
                 extreme = std::max(extreme, t.side * initial(pt)[t.axis]);
             extreme = dealii::Utilities::MPI::max(extreme, s.comm);
@@ -241,7 +241,7 @@ namespace talus::loads
         };
         double       area_sum = 0;
         unsigned int n_sel    = 0;
-        for (const auto &pt : s.particles)
+        for (const auto &pt : s.points.handler)
           if (selected(pt))
             {
               area_sum += pt.get_properties()[L::volume] / spacing(pt);
@@ -260,7 +260,7 @@ namespace talus::loads
                 area *= b.upper[d] - b.lower[d];
             scale = area / area_sum;
           }
-        for (auto &pt : s.particles)
+        for (auto &pt : s.points.handler)
           if (selected(pt))
             {
               auto         P  = pt.get_properties();
@@ -446,8 +446,8 @@ namespace talus::loads
     if (any_friction)
       for (unsigned int i = 0; i < lift.locally_owned_size() + lift.get_partitioner()->n_ghost_indices(); ++i)
         lift.local_element(i) = std::numeric_limits<double>::max();
-    auto               pt   = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto               pt   = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &        cc    = s.grid.cells[c];
         const unsigned char faces = any_friction ? friction_faces[c] : 0;
@@ -674,8 +674,8 @@ namespace talus::loads
     constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     double *const          Pn = s.nodal_p.begin();
     double                 work = 0;
-    auto                   pt   = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto                   pt   = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[c];
         for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)

@@ -67,7 +67,7 @@ namespace talus::explicit_mpm
             }
         }
     };
-    for (const auto &ac : s.active_cells)
+    for (const auto &ac : s.points.active_cells())
       add(grid.cells[ac.cell]);
     // owned nodes that only other ranks' particles touch: any cell around them
     if (dealii::Utilities::MPI::n_mpi_processes(s.comm) > 1)
@@ -106,7 +106,7 @@ namespace talus::explicit_mpm
           x[i] = 0.0;
       }
     const double w = dim == 2 ? 0.5 : 0.25; // pair weight at the cell centre
-    for (const auto &ac : s.active_cells)
+    for (const auto &ac : s.points.active_cells())
       {
         const auto &cc = grid.cells[ac.cell];
         for (auto &f : fields)
@@ -319,8 +319,8 @@ namespace talus::explicit_mpm
     zero(s.nodal_p);
     for (auto &f : fields)
       zero(f.momentum);
-    auto pt = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto pt = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[c];
         for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)

@@ -187,15 +187,15 @@ namespace talus::explicit_mpm
     f.set_attribute("initial strain", initial_energies.strain);
     f.set_attribute("initial potential", initial_energies.gravity_potential);
     f.set_attribute("initial external work", initial_energies.external_work);
-    f.set_attribute("moved locally", std::int64_t(relocation_stats.moved_locally));
-    f.set_attribute("global sorts", std::int64_t(relocation_stats.global_sorts));
-    f.set_attribute("storage sorts", std::int64_t(relocation_stats.storage_sorts));
-    f.set_attribute("lost", std::int64_t(relocation_stats.lost));
-    f.write_global("scene/signature", scene_signature(prm, layout), 1);
+    f.set_attribute("moved locally", std::int64_t(points.relocation_stats.moved_locally));
+    f.set_attribute("global sorts", std::int64_t(points.relocation_stats.global_sorts));
+    f.set_attribute("storage sorts", std::int64_t(points.relocation_stats.storage_sorts));
+    f.set_attribute("lost", std::int64_t(points.relocation_stats.lost));
+    f.write_global("scene/signature", scene_signature(prm, points.layout), 1);
 
     // particles in storage order
-    const unsigned int         n_props = layout.n_properties();
-    const std::size_t          n_local = particles.n_locally_owned_particles();
+    const unsigned int         n_props = points.layout.n_properties();
+    const std::size_t          n_local = points.handler.n_locally_owned_particles();
     std::vector<std::uint64_t> ids, cells;
     std::vector<double>        loc, ref, props;
     ids.reserve(n_local);
@@ -203,7 +203,7 @@ namespace talus::explicit_mpm
     loc.reserve(n_local * dim);
     ref.reserve(n_local * dim);
     props.reserve(n_local * n_props);
-    for (const auto &pt : particles)
+    for (const auto &pt : points.handler)
       {
         ids.push_back(pt.get_id());
         cells.push_back(pt.get_surrounding_cell()->active_cell_index());
@@ -224,7 +224,7 @@ namespace talus::explicit_mpm
     const auto mass = local_elements(nodal_mass), force = local_elements(nodal_a);
     f.write_rows("ranks/n_particles", std::vector<std::uint64_t>{ids.size()}, 1);
     f.write_rows("ranks/n_dofs", std::vector<std::uint64_t>{mass.size()}, 1);
-    f.write_rows("ranks/moves", std::vector<std::uint64_t>{relocator->moves_since_sort()}, 1);
+    f.write_rows("ranks/moves", std::vector<std::uint64_t>{points.relocator().moves_since_sort()}, 1);
     f.write_rows("nodal/mass", mass, 1);
     f.write_rows("nodal/force", force, 1);
     {
@@ -279,7 +279,7 @@ namespace talus::explicit_mpm
     const auto   files   = list_checkpoints();
     const auto   n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
     const auto   rank    = dealii::Utilities::MPI::this_mpi_process(comm);
-    const auto   own_sig = scene_signature(prm, layout);
+    const auto   own_sig = scene_signature(prm, points.layout);
     for (const auto &file : files)
       {
         // a file that cannot be read is skipped (the older one is tried);
@@ -328,15 +328,15 @@ namespace talus::explicit_mpm
         energy_scale             = f.get_double("energy scale");
         initial_energies         = {f.get_double("initial kinetic"), f.get_double("initial strain"),
                             f.get_double("initial potential"), f.get_double("initial external work")};
-        relocation_stats.moved_locally = f.get_int("moved locally");
-        relocation_stats.global_sorts  = f.get_int("global sorts");
-        relocation_stats.storage_sorts = f.get_int("storage sorts");
-        relocation_stats.lost          = f.get_int("lost");
+        points.relocation_stats.moved_locally = f.get_int("moved locally");
+        points.relocation_stats.global_sorts  = f.get_int("global sorts");
+        points.relocation_stats.storage_sorts = f.get_int("storage sorts");
+        points.relocation_stats.lost          = f.get_int("lost");
         // the next interval-driven checkpoint follows the current settings
         if (prm.checkpoint_interval > 0 && counters.next_checkpoint <= time)
           counters.next_checkpoint = time + prm.checkpoint_interval;
 
-        const unsigned int n_props   = layout.n_properties();
+        const unsigned int n_props   = points.layout.n_properties();
         const bool         same      = f.get_int("ranks") == static_cast<std::int64_t>(n_ranks);
         if (same)
           {
@@ -351,55 +351,31 @@ namespace talus::explicit_mpm
             const auto          loc   = f.read_rows("particles/location", begin, end);
             const auto          ref   = f.read_rows("particles/reference", begin, end);
             const auto          props = f.read_rows("particles/properties", begin, end);
-            particles.reserve(ids.size());
+            // the points cell group by cell group, in the saved storage order
+            std::vector<unsigned int>                                             cell_order;
+            std::vector<std::vector<typename MaterialPointSet<dim>::SavedPoint>> groups;
             for (std::size_t i = 0; i < ids.size(); ++i)
               {
-                dealii::Point<dim> x, xi;
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    x[d]  = loc[i * dim + d];
-                    xi[d] = ref[i * dim + d];
-                  }
                 if (cells[i] >= grid.cell_iterators.size() || !grid.cell_iterators[cells[i]]->is_locally_owned())
                   throw InputError(where + ": particle " + std::to_string(ids[i]) +
                                    " refers to a cell this rank does not own (grid partition differs)");
-                particles.insert_particle(x, xi, ids[i], grid.cell_iterators[cells[i]],
-                                          dealii::ArrayView<const double>(props.data() + i * n_props, n_props));
-              }
-            // deal.II's update_cached_numbers() sorts the cell groups of the
-            // storage into cell order, while the run keeps them in the order
-            // its moves created (a cell that receives its first point goes to
-            // the end): the loops walk that order and the sums follow it. So,
-            // after the counts are up to date, every cell's points are taken
-            // out and inserted again, group by group in the saved order (a
-            // re-created group goes to the end of the owned cells).
-            particles.update_cached_numbers();
-            std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> in_cell;
-            for (std::size_t i = 0; i < ids.size();)
-              {
-                std::size_t j = i;
-                while (j < ids.size() && cells[j] == cells[i])
-                  ++j;
-                const auto &cell  = grid.cell_iterators[cells[i]];
-                const auto  range = particles.particles_in_cell(cell);
-                in_cell.clear();
-                for (auto it = range.begin(); it != range.end(); ++it)
-                  in_cell.push_back(it);
-                for (auto it = in_cell.rbegin(); it != in_cell.rend(); ++it)
-                  particles.remove_particle(*it);
-                for (std::size_t k = i; k < j; ++k)
+                if (i == 0 || cells[i] != cells[i - 1])
                   {
-                    dealii::Point<dim> x, xi;
-                    for (unsigned int d = 0; d < dim; ++d)
-                      {
-                        x[d]  = loc[k * dim + d];
-                        xi[d] = ref[k * dim + d];
-                      }
-                    particles.insert_particle(x, xi, ids[k], cell,
-                                              dealii::ArrayView<const double>(props.data() + k * n_props, n_props));
+                    cell_order.push_back(cells[i]);
+                    groups.emplace_back();
                   }
-                i = j;
+                typename MaterialPointSet<dim>::SavedPoint q;
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    q.x[d]  = loc[i * dim + d];
+                    q.xi[d] = ref[i * dim + d];
+                  }
+                q.id         = ids[i];
+                q.properties = props.data() + i * n_props;
+                groups.back().push_back(q);
               }
+            points.handler.reserve(ids.size());
+            points.insert_in_order(cell_order, groups);
             // the nodal sums of the next step, exactly as the run left them
             const auto ndofs = f.read_rows_u64("ranks/n_dofs", 0, n_ranks);
             std::uint64_t dof_begin = 0;
@@ -418,7 +394,7 @@ namespace talus::explicit_mpm
               }
             else
               p2g_ready = false;
-            relocator->moves_since_sort() = f.read_rows_u64("ranks/moves", rank, rank + 1)[0];
+            points.relocator().moves_since_sort() = f.read_rows_u64("ranks/moves", rank, rank + 1)[0];
           }
         else
           {
@@ -445,10 +421,10 @@ namespace talus::explicit_mpm
             const auto boxes = dealii::GridTools::compute_mesh_predicate_bounding_box(
               grid.tria, dealii::IteratorFilters::LocallyOwnedCell());
             const auto global_boxes = dealii::Utilities::MPI::all_gather(comm, boxes);
-            particles.insert_global_particles(x, global_boxes, props, row);
-            if (particles.n_global_particles() != n)
+            points.handler.insert_global_particles(x, global_boxes, props, row);
+            if (points.handler.n_global_particles() != n)
               throw InputError(where + ": " + std::to_string(n) + " points in the file, " +
-                               std::to_string(particles.n_global_particles()) + " placed in the grid");
+                               std::to_string(points.handler.n_global_particles()) + " placed in the grid");
 
             const auto all_ids = f.read_rows_u64("particles/id", 0, n);
             const auto all_ref = f.read_rows("particles/reference", 0, n);
@@ -460,8 +436,8 @@ namespace talus::explicit_mpm
               std::vector<double> props;
             };
             std::vector<Local> local;
-            local.reserve(particles.n_locally_owned_particles());
-            for (const auto &pt : particles)
+            local.reserve(points.handler.n_locally_owned_particles());
+            for (const auto &pt : points.handler)
               {
                 const auto P = pt.get_properties();
                 local.push_back({pt.get_id(), pt.get_surrounding_cell()->active_cell_index(), pt.get_location(),
@@ -476,48 +452,28 @@ namespace talus::explicit_mpm
                   cell_order.push_back(local[k].cell);
                 in_cell_rows[local[k].cell].push_back(k);
               }
-            particles.clear_particles();
-            for (const unsigned int c : cell_order)
-              for (const unsigned int k : in_cell_rows[c])
-                {
-                  const auto &       q  = local[k];
-                  dealii::Point<dim> xi = grid.reference_point(c, q.x), saved;
-                  double             dist = 0;
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      saved[d] = all_ref[q.row * dim + d];
-                      dist     = std::max(dist, std::abs(saved[d] - xi[d]));
-                    }
-                  // the saved coordinates unless deal.II put the point into
-                  // the neighbour of its old cell (a point on a face)
-                  particles.insert_particle(q.x, dist < 1e-10 ? saved : xi, all_ids[q.row], grid.cell_iterators[c],
-                                            dealii::ArrayView<const double>(q.props));
-                }
-            particles.update_cached_numbers(); // counts; the order is re-created below
-            {
-              // update_cached_numbers() sorted the groups: re-create the order
-              std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> its;
-              for (const unsigned int c : cell_order)
-                {
-                  const auto range = particles.particles_in_cell(grid.cell_iterators[c]);
-                  its.clear();
-                  for (auto it = range.begin(); it != range.end(); ++it)
-                    its.push_back(it);
-                  std::vector<std::tuple<dealii::Point<dim>, dealii::Point<dim>, dealii::types::particle_index,
-                                         std::vector<double>>>
-                    copy;
-                  for (const auto &it : its)
-                    {
-                      const auto P = it->get_properties();
-                      copy.emplace_back(it->get_location(), it->get_reference_location(), it->get_id(),
-                                        std::vector<double>(P.begin(), P.end()));
-                    }
-                  for (auto it = its.rbegin(); it != its.rend(); ++it)
-                    particles.remove_particle(*it);
-                  for (const auto &[xx, xi, id, P] : copy)
-                    particles.insert_particle(xx, xi, id, grid.cell_iterators[c], dealii::ArrayView<const double>(P));
-                }
-            }
+            points.handler.clear_particles();
+            std::vector<std::vector<typename MaterialPointSet<dim>::SavedPoint>> groups(cell_order.size());
+            for (std::size_t g = 0; g < cell_order.size(); ++g)
+              {
+                const unsigned int c = cell_order[g];
+                for (const unsigned int k : in_cell_rows[c])
+                  {
+                    const auto &       q  = local[k];
+                    dealii::Point<dim> xi = grid.reference_point(c, q.x), saved;
+                    double             dist = 0;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        saved[d] = all_ref[q.row * dim + d];
+                        dist     = std::max(dist, std::abs(saved[d] - xi[d]));
+                      }
+                    // the saved coordinates unless deal.II put the point into
+                    // the neighbour of its old cell (a point on a face)
+                    groups[g].push_back({q.x, dist < 1e-10 ? saved : xi,
+                                         static_cast<dealii::types::particle_index>(all_ids[q.row]), q.props.data()});
+                  }
+              }
+            points.insert_in_order(cell_order, groups);
 
             // the next step's nodal sums, by vertex and component
             p2g_ready = false;
@@ -554,7 +510,7 @@ namespace talus::explicit_mpm
             std::uint64_t moves = 0;
             for (const auto m : f.read_all("ranks/moves"))
               moves += static_cast<std::uint64_t>(m);
-            relocator->moves_since_sort() = moves / n_ranks;
+            points.relocator().moves_since_sort() = moves / n_ranks;
           }
 
         pvd_records.clear();

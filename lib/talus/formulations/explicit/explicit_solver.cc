@@ -4,7 +4,9 @@
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/io/output.h>
 #include <talus/loads/load_control.h>
-#include <talus/shape/q1.h>
+#include <talus/shape/bspline2_box.h>
+#include <talus/shape/q1_box.h>
+#include <talus/transfer/point_ops.h>
 
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
@@ -422,6 +424,30 @@ namespace talus::explicit_mpm
           p.end_time += st.duration;
       }
     p.numerics = parse_numerics_parameters(prm, n_bodies);
+    if (p.numerics.bspline())
+      {
+        // the passes that are not yet kernel templates (transfer/) walk with Q1
+        const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
+                                "(its particle passes use linear shape functions); allowed: ";
+        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
+                std::string(p.numerics.integration == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
+                            p.numerics.integration == NumericsOptions::Integration::fem     ? "fem" :
+                                                                                              "ul-fem") +
+                  why + "mpm");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing" + why + "none");
+        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/shape function",
+                "coupled 2-phase materials and body tractions" + why + "1-phase materials without tractions");
+        require(!p.loads.active(), "numerics/shape function",
+                "the loads sections (tractions, prescribed velocities, boundary friction, damping, mass scaling, "
+                "quasi-static convergence, K0, stages)" + why + "none of them");
+        require(!p.grid_mesh, "grid/source",
+                "a grid file with quadratic B-splines: they need a uniform box grid; allowed: box");
+        for (unsigned int d = 0; d < dim; ++d)
+          require(p.grid_cells[d] >= shape::BSpline2<dim>::min_cells, "grid/cells",
+                  "quadratic B-splines need at least 3 cells per direction (the wall treatment)");
+      }
     if (p.numerics.fem())
       {
         const std::string mode = p.numerics.integration == NumericsOptions::Integration::fem ? "fem" : "ul-fem";
@@ -450,6 +476,7 @@ namespace talus::explicit_mpm
     : prm(p)
     , comm(c)
     , grid(c)
+    , points(grid, "points")
     , gravity(p.gravity)
   {}
 
@@ -496,6 +523,8 @@ namespace talus::explicit_mpm
     else
       grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
+    if (prm.numerics.bspline())
+      grid.setup_bspline_patches(); // the 4^dim node patch of every owned cell
     constrained = grid.constrained_dofs(prm.boundary_conditions);
     grid.reinit_vector(nodal_mass);
     grid.reinit_vector(nodal_a);
@@ -504,25 +533,24 @@ namespace talus::explicit_mpm
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
-    layout.n_history = n_history;
+    points.layout.n_history = n_history;
     if (prm.loads.active())
       {
         control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
-        control->extend_layout(layout);
+        control->extend_layout(points.layout);
       }
     // 2-phase / traction properties and the free-surface flag: only when used
     if (prm.liquid.any_coupled() || prm.liquid.any_traction())
       {
         two_phase = std::make_unique<TwoPhase<dim>>(*this);
-        two_phase->extend_layout(layout);
+        two_phase->extend_layout(points.layout);
       }
     if (prm.liquid.free_surface_factor > 0)
       {
         free_surface = std::make_unique<FreeSurface<dim>>(*this, prm.liquid.free_surface_factor);
-        free_surface->extend_layout(layout);
+        free_surface->extend_layout(points.layout);
       }
-    particles.initialize(grid.tria, grid.mapping, layout.n_properties());
-    relocator = std::make_unique<Relocator<dim>>(grid, particles);
+    points.initialize();
     if (prm.numerics.fem())
       fem = std::make_unique<FemIntegration<dim>>(*this, prm.numerics.integration ==
                                                            NumericsOptions::Integration::ul_fem);
@@ -550,8 +578,8 @@ namespace talus::explicit_mpm
       std::vector<double> density;
       for (const auto &m : prm.materials)
         density.push_back(m->density());
-      auto       seeded = seed_bodies(grid, prm.bodies, density, layout, particles);
-      const auto filed  = insert_file_bodies(grid, prm.bodies, density, layout, particles, seeded.n_particles);
+      auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
+      const auto filed  = insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
       for (unsigned int b = 0; b < prm.bodies.size(); ++b)
         seeded.volume_per_body[b] += filed.volume_per_body[b];
       if (fem) // the cells these points occupy get Gauss points instead (fem.h)
@@ -563,13 +591,13 @@ namespace talus::explicit_mpm
         control->initial_state(*this); // K0 stresses, stage 0 (gravity, boundaries, mass scaling)
 
       // history initialisation
-      for (auto &pt : particles)
+      for (auto &pt : points.handler)
         {
           auto        P = pt.get_properties();
           const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
-          if (layout.n_history)
+          if (points.layout.n_history)
             m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
-                                 dealii::ArrayView<double>(P.data() + layout.history, m.n_history()));
+                                 dealii::ArrayView<double>(P.data() + points.layout.history, m.n_history()));
         }
       if (two_phase)
         two_phase->initialize_particles(); // restored points carry their 2-phase state
@@ -597,7 +625,7 @@ namespace talus::explicit_mpm
     for (const auto &q : restored ? std::vector<dealii::Point<dim>>() : prm.probes)
       {
         std::pair<double, dealii::types::particle_index> best{std::numeric_limits<double>::max(), 0};
-        for (const auto &pt : particles)
+        for (const auto &pt : points.handler)
           best = std::min(best, std::make_pair(pt.get_location().distance(q), pt.get_id()));
         const auto all = dealii::Utilities::MPI::all_gather(comm, best);
         probe_ids.push_back(std::min_element(all.begin(), all.end())->second);
@@ -607,7 +635,7 @@ namespace talus::explicit_mpm
 
     // energy scale for the instability floor: sum m c^2
     double local_scale = 0;
-    for (const auto &pt : particles)
+    for (const auto &pt : points.handler)
       {
         const auto  P = pt.get_properties();
         const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
@@ -626,54 +654,7 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::collect_active_cells()
   {
-    active_cells.clear();
-    auto it = particles.begin();
-    while (it != particles.end())
-      {
-        const auto   cell = it->get_surrounding_cell();
-        unsigned int n    = 0;
-        for (; it != particles.end() && it->get_surrounding_cell() == cell; ++it)
-          ++n;
-        active_cells.push_back({cell->active_cell_index(), n});
-      }
-    particles_in_cell_count.assign(grid.cells.size(), 0);
-    cell_erased.assign(grid.cells.size(), 0);
-    for (const auto &ac : active_cells)
-      particles_in_cell_count[ac.cell] = ac.n_particles;
-    collect_active_dofs();
-  }
-
-  template <int dim>
-  void
-  Solver<dim>::update_active_cells()
-  {
-    // Mirror of deal.II 9.4's storage after local moves: a cell emptied by a
-    // removal loses its list entry, a cell that receives its first particle is
-    // appended at the end of the owned cells, in insertion order.
-    if (relocator->sorted_last)
-      {
-        collect_active_cells();
-        return;
-      }
-    auto &count = particles_in_cell_count;
-    for (const unsigned int c : relocator->removed_from)
-      if (--count[c] == 0)
-        cell_erased[c] = 1;
-    const std::size_t n_old = active_cells.size();
-    for (const unsigned int c : relocator->inserted_into)
-      if (count[c]++ == 0)
-        active_cells.push_back({c, 0});
-    std::size_t out = 0;
-    for (std::size_t i = 0; i < active_cells.size(); ++i)
-      {
-        const unsigned int c = active_cells[i].cell;
-        if (i < n_old && cell_erased[c])
-          continue; // this entry was erased (a re-filled cell sits at the end)
-        active_cells[out++] = {c, count[c]};
-      }
-    active_cells.resize(out);
-    for (const unsigned int c : relocator->removed_from)
-      cell_erased[c] = 0;
+    points.collect_active_cells();
     collect_active_dofs();
   }
 
@@ -687,13 +668,21 @@ namespace talus::explicit_mpm
     if (dof_marker.size() != n_owned)
       dof_marker.assign(n_owned, 0);
     active_dofs.clear();
-    for (const auto &ac : active_cells)
-      for (const unsigned int i : grid.cells[ac.cell].dofs)
-        if (i < n_owned && !dof_marker[i])
-          {
-            dof_marker[i] = 1;
-            active_dofs.push_back(i);
-          }
+    const auto add = [&](const unsigned int i) {
+      if (i < n_owned && !dof_marker[i])
+        {
+          dof_marker[i] = 1;
+          active_dofs.push_back(i);
+        }
+    };
+    if (prm.numerics.bspline()) // the nodes of the cells' patches (invalid outside the grid: skipped)
+      for (const auto &ac : points.active_cells())
+        for (const unsigned int i : grid.patch(ac.cell).dofs)
+          add(i);
+    else
+      for (const auto &ac : points.active_cells())
+        for (const unsigned int i : grid.cells[ac.cell].dofs)
+          add(i);
     for (const auto &range : grid.partitioner->import_indices())
       for (unsigned int i = range.first; i < range.second; ++i)
         if (!dof_marker[i])
@@ -718,94 +707,6 @@ namespace talus::explicit_mpm
   }
 
   // ---------------------------------------------------------------- P2G (A)
-  namespace
-  {
-    /// Per-cell accumulator of lumped mass and internal force (Eqs. 4.32, 4.41)
-    /// in sum-factorised form; gravity (Eq. 4.34) is m_v g per vertex.
-    template <int dim>
-    struct CellForce
-    {
-      using F                   = shape::Q1Factorised<dim>;
-      double lm[F::nv]          = {};
-      double T[dim][F::npairs][dim] = {};
-
-      /// add one particle with properties P at reference point xi
-      inline void
-      add(const dealii::Point<dim> &xi, const double *P)
-      {
-        using L = PropertyLayout<dim>;
-        double N[F::nv], w[dim][F::npairs];
-        F::weights(xi, N, w);
-        add(N, w, P);
-      }
-
-      inline void
-      add(const double (&N)[F::nv], const double (&w)[dim][F::npairs], const double *P)
-      {
-        using L        = PropertyLayout<dim>;
-        const double m = P[L::mass], V = P[L::volume];
-        for (unsigned int v = 0; v < F::nv; ++v)
-          lm[v] += m * N[v];
-        double t[dim][dim];
-        minus_V_sigma<dim>(P, V, t);
-        F::add_moments(t, w, T);
-      }
-
-      /// expand and add to the nodal vectors
-      inline void
-      scatter(const CellCache<dim> &cc, const dealii::Tensor<1, dim> &g, double *M, double *Fv) const
-      {
-        double f[F::nv][dim];
-        for (unsigned int v = 0; v < F::nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            f[v][d] = lm[v] * g[d];
-        F::expand_moments(T, cc.inv_h, f);
-        for (unsigned int v = 0; v < F::nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              const unsigned int i = cc.dofs[v * dim + d];
-              M[i] += lm[v];
-              Fv[i] += f[v][d];
-            }
-      }
-    };
-  } // namespace
-
-  namespace
-  {
-    /// Walks `distance` particles ahead of a loop and prefetches their data.
-    /// Particles that changed cell sit in recycled storage slots scattered in
-    /// memory; prefetching hides most of that latency (measured on the 3D bench).
-    template <int dim>
-    class Prefetcher
-    {
-    public:
-      Prefetcher(dealii::Particles::ParticleHandler<dim> &ph, const unsigned int distance)
-        : it(ph.begin())
-        , end(ph.end())
-      {
-        for (unsigned int i = 0; i < distance && it != end; ++i)
-          ++it;
-      }
-      inline void
-      next(const bool with_location)
-      {
-        if (it == end)
-          return;
-        const double *P = it->get_properties().data();
-        __builtin_prefetch(P);
-        __builtin_prefetch(P + 8);
-        __builtin_prefetch(&it->get_reference_location());
-        if (with_location)
-          __builtin_prefetch(&it->get_location());
-        ++it;
-      }
-
-    private:
-      typename dealii::Particles::ParticleHandler<dim>::particle_iterator it, end;
-    };
-  } // namespace
-
   template <int dim>
   void
   Solver<dim>::p2g_mass_and_force()
@@ -822,19 +723,21 @@ namespace talus::explicit_mpm
         p2g_ready = true;
         return;
       }
-    double *const M = nodal_mass.begin();
-    double *const F = nodal_a.begin();
+    if (prm.numerics.bspline())
+      p2g_mass_and_force_with<shape::BSpline2Box<dim>>();
+    else
+      p2g_mass_and_force_with<shape::Q1Box<dim>>();
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::p2g_mass_and_force_with()
+  {
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
-    auto               pt = particles.begin();
-    Prefetcher<dim>    ahead(particles, prefetch_distance);
-    for (const auto [c, n_in_cell] : active_cells)
-      {
-        CellForce<dim> acc;
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(false))
-          acc.add(pt->get_reference_location(), pt->get_properties().data());
-        acc.scatter(grid.cells[c], gravity, M, F);
-      }
+    transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+    transfer::for_each_active_cell(points, p2g);
     p2g_ready = true;
   }
 
@@ -861,42 +764,20 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::g2p_velocity_p2g_momentum(const double h)
   {
-    using L                   = PropertyLayout<dim>;
-    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
-    const double *const    A  = nodal_a.begin();
-    double *const          Pn = nodal_p.begin();
+    if (prm.numerics.bspline())
+      g2p_velocity_p2g_momentum_with<shape::BSpline2Box<dim>>(h);
+    else
+      g2p_velocity_p2g_momentum_with<shape::Q1Box<dim>>(h);
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::g2p_velocity_p2g_momentum_with(const double h)
+  {
     zero_on_active(nodal_p);
-    auto            pt = particles.begin();
-    Prefetcher<dim> ahead(particles, prefetch_distance);
-    for (const auto [c, n_in_cell] : active_cells)
-      {
-        const auto &cc = grid.cells[c];
-        double      a[nv][dim], lp[nv][dim] = {};
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            a[v][d] = A[cc.dofs[v * dim + d]];
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(false))
-          {
-            double *   P = pt->get_properties().data();
-            double     N[nv];
-            shape::Q1<dim>::values(pt->get_reference_location(), N);
-            double *vel = P + L::velocity;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                double s = 0;
-                for (unsigned int v = 0; v < nv; ++v)
-                  s += N[v] * a[v][d];
-                vel[d] += h * s; // seed 000 Eq. 4.46
-              }
-            const double m = P[L::mass];
-            for (unsigned int v = 0; v < nv; ++v)
-              for (unsigned int d = 0; d < dim; ++d)
-                lp[v][d] += m * N[v] * vel[d]; // Eq. 4.47
-          }
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            Pn[cc.dofs[v * dim + d]] += lp[v][d];
-      }
+    transfer::UpdateVelocityScatterMomentum<dim, K> op{grid, nodal_a.begin(), nodal_p.begin(), h};
+    transfer::for_each_active_cell(points, op);
     nodal_p.compress(dealii::VectorOperation::add);
   }
 
@@ -914,162 +795,182 @@ namespace talus::explicit_mpm
   }
 
   // ---------------------------------------------------------------- G2P update (C)
+  namespace
+  {
+    /// The explicit point physics of the update pass (seed 000 §4.3.7): strain
+    /// and spin increments from the gradient of the displacement increment,
+    /// the constitutive update, the volume update, and the sums of energies,
+    /// momentum, finiteness and probes at the new position.
+    template <int dim, class K>
+    struct ExplicitPointUpdate
+    {
+      using L = PropertyLayout<dim>;
+      const std::vector<std::shared_ptr<const materials::Material>> &materials;
+      const unsigned int                                             history;
+      const double                                                   h;
+      const dealii::Tensor<1, dim>                                   g;
+      Contact<dim> *                                                 contact;
+      const StrainSmoothing<dim> *                                   smoothing;
+      const bool                                                     need_strain_energy;
+      const std::vector<dealii::types::particle_index> &             probe_ids;
+      std::vector<double> &                                          probe_values;
+      std::vector<double> &                                          probe_stress;
+
+      Energies                      e        = {};
+      dealii::Tensor<1, dim>        momentum = {};
+      bool                          bad      = false;
+      // from update() to moved() of the same point
+      dealii::SymmetricTensor<2, 3> sigma = {};
+      const materials::Material *   material = nullptr;
+
+      inline void
+      increments(const typename K::Cell & cell,
+                 const typename K::Eval & ev,
+                 const typename K::Field &du,
+                 const double *           P,
+                 double (&gu)[dim][dim],
+                 double (&dx)[dim])
+      {
+        if constexpr (std::is_same_v<K, shape::Q1Box<dim>>)
+          if (contact) // the body's own nodal velocities (§6.2)
+            {
+              typename K::Field dub;
+              contact->body_increments(*cell.cc, static_cast<unsigned int>(P[L::body]), h, dub.u);
+              shape::Q1Factorised<dim>::differences(dub.u, dub.D);
+              transfer::default_increments<dim, K>(cell, ev, dub, gu, dx);
+              return;
+            }
+        transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
+      }
+
+      inline void
+      update(const unsigned int c, const typename K::Cell &cell, double *P, const double (&gu)[dim][dim])
+      {
+        materials::Strain d_eps;
+        materials::Spin   d_omega;
+        for (unsigned int d = 0; d < dim; ++d)
+          for (unsigned int k = 0; k < dim; ++k)
+            {
+              if (k >= d)
+                d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
+              d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
+            }
+        if (smoothing) // §6.7.1: smoothed volumetric part
+          smoothing->apply(c, d_eps);
+        material = materials[static_cast<unsigned int>(P[L::material])].get();
+        sigma    = L::get_stress(P);
+        material->update_stress(d_eps, d_omega, h, sigma,
+                                dealii::ArrayView<double>(P + history, material->n_history()));
+        L::set_stress(sigma, P);
+        const double dvol = trace(d_eps);
+        P[L::volume] *= (1.0 + dvol); // Eq. 4.50 (density follows as m / V)
+        // A point never integrates more than the volume of its cell. Without
+        // this bound, points that separate from the mass at a free surface
+        // (cohesionless material at the apex, sigma = 0) dilate without limit
+        // under the grid's velocity gradient (1e6 x measured in the demo
+        // column collapse) and blow the run up when they land again.
+        double cell_volume = 1.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          cell_volume *= cell.cc->h[d];
+        if (P[L::volume] > cell_volume)
+          P[L::volume] = cell_volume;
+      }
+
+      inline void
+      moved(const transfer::PointIterator<dim> &it, const double *P, const dealii::Point<dim> &x)
+      {
+        const double mass = P[L::mass];
+        double       v2 = 0, gx = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            v2 += P[L::velocity + d] * P[L::velocity + d];
+            gx += g[d] * x[d];
+          }
+        e.kinetic += 0.5 * mass * v2;
+        for (unsigned int d = 0; d < dim; ++d)
+          momentum[d] += mass * P[L::velocity + d];
+        e.gravity_potential -= mass * gx;
+        if (need_strain_energy)
+          e.strain += P[L::volume] * material->elastic_energy_density(sigma);
+        if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
+            !(P[L::volume] > 0))
+          bad = true;
+        if (!probe_ids.empty())
+          for (unsigned int k = 0; k < probe_ids.size(); ++k)
+            if (it->get_id() == probe_ids[k])
+              {
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    probe_values[k * 2 * dim + d]       = P[L::displacement + d];
+                    probe_values[k * 2 * dim + dim + d] = P[L::velocity + d];
+                  }
+                for (unsigned int q = 0; q < L::n_stress; ++q)
+                  probe_stress[k * L::n_stress + q] = P[L::stress + q];
+              }
+      }
+    };
+  } // namespace
+
   template <int dim>
   void
   Solver<dim>::g2p_update(const double h)
   {
-    using L                   = PropertyLayout<dim>;
-    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
-    const double *const    Vn = nodal_p.begin();
-    const auto             g  = gravity;
-    Energies               e;
-    dealii::Tensor<1, dim> momentum;
-    bool                   bad = false;
-    const bool             track_probes = !probe_ids.empty();
+    if (prm.numerics.bspline())
+      g2p_update_with<shape::BSpline2Box<dim>>(h);
+    else
+      g2p_update_with<shape::Q1Box<dim>>(h);
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::g2p_update_with(const double h)
+  {
     std::fill(probe_values.begin(), probe_values.end(), 0.0);
     std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
+    ExplicitPointUpdate<dim, K> physics{prm.materials, points.layout.history, h, gravity,
+                                        contact.get(), smoothing.get(), need_strain_energy,
+                                        probe_ids, probe_values, probe_stress};
     // the mass and force of the next step are accumulated here, at the updated
     // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
     // the next cycle fused into this pass); moved particles are added by the
     // relocation, and any deal.II sort falls back to a full P2G pass.
-    double *const M = nodal_mass.begin();
-    double *const F = nodal_a.begin();
-    const bool    fuse = !prm.numerics.extended_p2g(); // else a full P2G pass follows
-    zero_on_active(nodal_mass);
-    zero_on_active(nodal_a);
     // Every non-zero entry of the mass/force vectors belongs to a cell that
     // holds particles now (writes go only to cells that hold particles after
     // the relocation), so clearing the active DoFs clears everything, and the
     // cells that receive moved particles below start from zero.
-    auto            pt = particles.begin();
-    Prefetcher<dim> ahead(particles, prefetch_distance);
-    for (const auto [c, n_in_cell] : active_cells)
+    zero_on_active(nodal_mass);
+    zero_on_active(nodal_a);
+    transfer::UpdateAndMove<dim, K, ExplicitPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h,
+                                                                         physics};
+    if (prm.numerics.extended_p2g()) // a full P2G pass follows
+      transfer::for_each_active_cell(points, update);
+    else
       {
-        const auto &cc = grid.cells[c];
-        double      du[nv][dim];
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // Eq. 4.49
-        double cell_volume = 1.0;
-        for (unsigned int d = 0; d < dim; ++d)
-          cell_volume *= cc.h[d];
-        using QF = shape::Q1Factorised<dim>;
-        double D[dim][QF::npairs][dim];
-        QF::differences(du, D);
-        CellForce<dim> acc;
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(true))
-          {
-            double *   P  = pt->get_properties().data();
-            const auto xi = pt->get_reference_location();
-            double     N[nv], w[dim][QF::npairs];
-            QF::weights(xi, N, w);
-            // displacement increment gradient and position increment
-            double gu[dim][dim], dx[dim] = {};
-            if (contact) // the body's own nodal velocities (§6.2)
-              {
-                double dub[nv][dim], Db[dim][QF::npairs][dim];
-                contact->body_increments(cc, static_cast<unsigned int>(P[L::body]), h, dub);
-                QF::differences(dub, Db);
-                QF::gradient(Db, w, cc.inv_h, gu);
-                for (unsigned int v = 0; v < nv; ++v)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    dx[d] += N[v] * dub[v][d];
-              }
-            else
-              {
-                QF::gradient(D, w, cc.inv_h, gu);
-                for (unsigned int v = 0; v < nv; ++v)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    dx[d] += N[v] * du[v][d];
-              }
-            materials::Strain d_eps;
-            materials::Spin   d_omega;
-            for (unsigned int d = 0; d < dim; ++d)
-              for (unsigned int k = 0; k < dim; ++k)
-                {
-                  if (k >= d)
-                    d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
-                  d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
-                }
-            if (smoothing) // §6.7.1: smoothed volumetric part
-              smoothing->apply(c, d_eps);
-            const unsigned int          mat = static_cast<unsigned int>(P[L::material]);
-            const materials::Material &m   = *prm.materials[mat];
-            auto                        sigma = L::get_stress(P);
-            m.update_stress(d_eps, d_omega, h, sigma,
-                            dealii::ArrayView<double>(P + layout.history, m.n_history()));
-            L::set_stress(sigma, P);
-            const double dvol = trace(d_eps);
-            P[L::volume] *= (1.0 + dvol); // Eq. 4.50 (density follows as m / V)
-            // A point never integrates more than the volume of its cell. Without
-            // this bound, points that separate from the mass at a free surface
-            // (cohesionless material at the apex, sigma = 0) dilate without limit
-            // under the grid's velocity gradient (1e6 x measured in the demo
-            // column collapse) and blow the run up when they land again.
-            if (P[L::volume] > cell_volume)
-              P[L::volume] = cell_volume;
-
-            // position (Eq. 4.51), displacement
-            auto x = pt->get_location();
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                x[d] += dx[d];
-                P[L::displacement + d] += dx[d];
-              }
-            const double mass = P[L::mass];
-            double       v2 = 0, gx = 0;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                v2 += P[L::velocity + d] * P[L::velocity + d];
-                gx += g[d] * x[d];
-              }
-            e.kinetic += 0.5 * mass * v2;
-            for (unsigned int d = 0; d < dim; ++d)
-              momentum[d] += mass * P[L::velocity + d];
-            e.gravity_potential -= mass * gx;
-            if (need_strain_energy)
-              e.strain += P[L::volume] * m.elastic_energy_density(sigma);
-            if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
-                !(P[L::volume] > 0))
-              bad = true;
-
-            if (track_probes)
-              for (unsigned int k = 0; k < probe_ids.size(); ++k)
-                if (pt->get_id() == probe_ids[k])
-                  {
-                    for (unsigned int d = 0; d < dim; ++d)
-                      {
-                        probe_values[k * 2 * dim + d]       = P[L::displacement + d];
-                        probe_values[k * 2 * dim + dim + d] = P[L::velocity + d];
-                      }
-                    for (unsigned int q = 0; q < L::n_stress; ++q)
-                      probe_stress[k * L::n_stress + q] = P[L::stress + q];
-                  }
-
-            // new reference coordinates: same cell if still inside
-            bool               inside = true;
-            dealii::Point<dim> nxi;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                nxi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
-                inside = inside && nxi[d] >= 0.0 && nxi[d] <= 1.0;
-              }
-            pt->set_location(x);
-            if (inside)
-              {
-                pt->set_reference_location(nxi);
-                if (fuse)
-                  acc.add(nxi, P);
-              }
-            else
-              relocator->leaving(pt, c);
-          }
-        if (fuse)
-          acc.scatter(cc, g, M, F);
+        transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+        transfer::Fused                    fused{update, p2g};
+        transfer::for_each_active_cell(points, fused);
       }
-    local_energies = e;
-    local_momentum = momentum;
-    local_bad      = bad;
+    local_energies = physics.e;
+    local_momentum = physics.momentum;
+    local_bad      = physics.bad;
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::relocate_with()
+  {
+    // moved points add their mass and force to the next step's sums; a deal.II
+    // sort recomputes reference locations and may move points to other ranks:
+    // the fused P2G is then redone from scratch
+    transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+    const bool                         sorted =
+      points.relocate([&](const unsigned int c, const dealii::Point<dim> &xi, const double *P) {
+        p2g.scatter_one(c, xi, P);
+      });
+    p2g_ready = !sorted && !prm.numerics.extended_p2g();
+    collect_active_dofs();
   }
 
   template <int dim>
@@ -1120,21 +1021,10 @@ namespace talus::explicit_mpm
     g2p_update(h);
     timings.g2p += seconds_since(t0);
     t0 = Clock::now();
-    const auto   sorts_before = relocation_stats.global_sorts + relocation_stats.storage_sorts;
-    double *const M           = nodal_mass.begin();
-    double *const F           = nodal_a.begin();
-    relocator->finish(relocation_stats,
-                      [&](const unsigned int c, const dealii::Point<dim> &xi, const double *P) {
-                        const auto &   cc = grid.cells[c];
-                        CellForce<dim> acc;
-                        acc.add(xi, P);
-                        acc.scatter(cc, gravity, M, F);
-                      });
-    // a deal.II sort recomputes reference locations and may move particles to
-    // other ranks: the fused P2G is then redone from scratch
-    p2g_ready = relocation_stats.global_sorts + relocation_stats.storage_sorts == sorts_before &&
-                !prm.numerics.extended_p2g();
-    update_active_cells();
+    if (prm.numerics.bspline())
+      relocate_with<shape::BSpline2Box<dim>>();
+    else
+      relocate_with<shape::Q1Box<dim>>();
     timings.relocation += seconds_since(t0);
   }
 
@@ -1161,7 +1051,7 @@ namespace talus::explicit_mpm
     using L = PropertyLayout<dim>;
     Energies   e;
     const bool fixed_points = fem && !fem->updated_lagrangian(); // at their Gauss points: x = X + u
-    for (const auto &pt : particles)
+    for (const auto &pt : points.handler)
       {
         const auto  P = pt.get_properties();
         const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
@@ -1187,7 +1077,7 @@ namespace talus::explicit_mpm
     if (two_phase)
       return two_phase->total_momentum();
     dealii::Tensor<1, dim> p;
-    for (const auto &pt : particles)
+    for (const auto &pt : points.handler)
       for (unsigned int d = 0; d < dim; ++d)
         p[d] += pt.get_properties()[PropertyLayout<dim>::mass] *
                 pt.get_properties()[PropertyLayout<dim>::velocity + d];
@@ -1199,7 +1089,7 @@ namespace talus::explicit_mpm
   Solver<dim>::total_mass() const
   {
     double m = 0;
-    for (const auto &pt : particles)
+    for (const auto &pt : points.handler)
       m += pt.get_properties()[PropertyLayout<dim>::mass];
     return dealii::Utilities::MPI::sum(m, comm);
   }
@@ -1208,11 +1098,8 @@ namespace talus::explicit_mpm
   std::pair<double, bool>
   Solver<dim>::check_incremental_state()
   {
-    const auto kept = active_cells;
-    collect_active_cells();
-    bool same = kept.size() == active_cells.size();
-    for (std::size_t i = 0; same && i < kept.size(); ++i)
-      same = kept[i].cell == active_cells[i].cell && kept[i].n_particles == active_cells[i].n_particles;
+    const bool same = points.check_active_cells();
+    collect_active_dofs();
     if (!p2g_ready)
       return {0.0, same};
     const unsigned int  n = nodal_mass.locally_owned_size() + grid.partitioner->n_ghost_indices();
@@ -1345,7 +1232,7 @@ namespace talus::explicit_mpm
     if (free_surface)
       free_surface->update();
     dealii::Particles::DataOut<dim> out;
-    out.build_patches(particles, layout.names(), layout.interpretations());
+    out.build_patches(points.handler, points.layout.names(), points.layout.interpretations());
     dealii::DataOutBase::VtkFlags flags;
     flags.time              = time;
     flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
@@ -1376,7 +1263,7 @@ namespace talus::explicit_mpm
   {
     using L = PropertyLayout<dim>;
     std::vector<std::vector<double>> rows;
-    for (const auto &pt : particles)
+    for (const auto &pt : points.handler)
       {
         std::vector<double> r = {static_cast<double>(pt.get_id())};
         const auto          P = pt.get_properties();
@@ -1391,7 +1278,7 @@ namespace talus::explicit_mpm
         for (unsigned int k = 0; k < L::n_stress; ++k)
           r.push_back(P[L::stress + k]);
         r.push_back(P[L::volume]);
-        for (const auto &e : layout.extras)
+        for (const auto &e : points.layout.extras)
           for (unsigned int i = 0; i < e.size; ++i)
             r.push_back(P[e.offset + i]);
         rows.push_back(r);
@@ -1411,11 +1298,11 @@ namespace talus::explicit_mpm
       header.push_back(std::string("u_") + ax[d]);
     for (unsigned int d = 0; d < dim; ++d)
       header.push_back(std::string("v_") + ax[d]);
-    const auto names = layout.names();
+    const auto names = points.layout.names();
     for (unsigned int k = 0; k < L::n_stress; ++k)
       header.push_back(names[L::stress + k]);
     header.push_back("volume");
-    for (const auto &e : layout.extras)
+    for (const auto &e : points.layout.extras)
       for (unsigned int i = 0; i < e.size; ++i)
         header.push_back(e.size == 1 ? e.name : e.name + "_" + std::string(ax[i < 3 ? i : 0]));
     io::AtomicFile f(prm.output_directory + "/particles_final.csv");
@@ -1487,7 +1374,7 @@ namespace talus::explicit_mpm
           }
         // probe stresses after all displacement/velocity columns
         {
-          const auto names = layout.names();
+          const auto names = points.layout.names();
           for (unsigned int k = 0; k < probe_ids.size(); ++k)
             for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
               s << ",probe" << k << "_" << names[PropertyLayout<dim>::stress + q];
@@ -1555,7 +1442,7 @@ namespace talus::explicit_mpm
         << e.external_work << "," << e.total();
       for (unsigned int d = 0; d < dim; ++d)
         s << "," << p[d];
-      s << "," << n_particles() << "," << relocation_stats.lost;
+      s << "," << n_particles() << "," << points.relocation_stats.lost;
       if (control && control->has_convergence())
         s << "," << control->force_ratio << "," << control->energy_ratio;
       if (free_surface)
@@ -1572,7 +1459,7 @@ namespace talus::explicit_mpm
     };
     // probe values at t = 0
     if (!probe_ids.empty())
-      for (const auto &pt : particles)
+      for (const auto &pt : points.handler)
         for (unsigned int k = 0; k < probe_ids.size(); ++k)
           if (pt.get_id() == probe_ids[k])
             {
@@ -1654,13 +1541,13 @@ namespace talus::explicit_mpm
         try
           {
             check_stability();
-            if (relocation_stats.lost > lost_reported)
+            if (points.relocation_stats.lost > lost_reported)
               {
                 std::ostringstream os;
                 os << "step " << step_number << " (t = " << time << " s): "
-                   << relocation_stats.lost - lost_reported << " material point(s) left the grid ("
-                   << relocation_stats.lost << " in total)";
-                lost_reported = relocation_stats.lost;
+                   << points.relocation_stats.lost - lost_reported << " material point(s) left the grid ("
+                   << points.relocation_stats.lost << " in total)";
+                lost_reported = points.relocation_stats.lost;
                 if (prm.stop_on_lost_particles)
                   throw RunStopped(os.str() + "; 'stability/lost particles = stop'. Enlarge the grid or "
                                                     "add boundary conditions.");
@@ -1689,7 +1576,7 @@ namespace talus::explicit_mpm
         auto t0 = Clock::now();
         if (series_due)
           {
-            write_series_row(!relocator->sorted_last);
+            write_series_row(!points.relocator().sorted_last);
             while (next_series <= time + eps_t)
               next_series += prm.series_interval > 0 ? prm.series_interval : dt;
           }
@@ -1749,9 +1636,9 @@ namespace talus::explicit_mpm
     const double ns = 1e9 * timings.total / std::max(1.0, double(step_number) * double(n_particles()));
     log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid
           << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves "
-          << relocation_stats.seconds_moves << ", sorts " << relocation_stats.seconds_sorts << "), output "
-          << timings.output << "; particles moved cell " << relocation_stats.moved_locally << ", full sorts "
-          << relocation_stats.global_sorts << ", memory-order sorts " << relocation_stats.storage_sorts << ", lost " << relocation_stats.lost << "\n";
+          << points.relocation_stats.seconds_moves << ", sorts " << points.relocation_stats.seconds_sorts << "), output "
+          << timings.output << "; particles moved cell " << points.relocation_stats.moved_locally << ", full sorts "
+          << points.relocation_stats.global_sorts << ", memory-order sorts " << points.relocation_stats.storage_sorts << ", lost " << points.relocation_stats.lost << "\n";
     log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "
           << timings.total << " s, " << std::setprecision(3) << ns << " ns/particle-step, output in "
           << prm.output_directory << "/ (particles.pvd, series.csv)" << std::endl;

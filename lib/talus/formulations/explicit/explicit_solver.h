@@ -10,7 +10,7 @@
 #include <talus/io/grid_mesh.h>
 #include <talus/loads/settings.h>
 #include <talus/materials/material.h>
-#include <talus/particles/material_points.h>
+#include <talus/particles/material_point_set.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/particles/particle_handler.h>
@@ -135,7 +135,7 @@ namespace talus::explicit_mpm
     Energies                  energies() const;
     dealii::Tensor<1, dim>    total_momentum() const;
     double                    total_mass() const;
-    unsigned long long        n_particles() const { return particles.n_global_particles(); }
+    unsigned long long        n_particles() const { return points.handler.n_global_particles(); }
 
     /// For tests: after step(), the mass/force accumulated by the fused update
     /// pass and the relocation must equal a fresh P2G of the new state, and the
@@ -151,23 +151,16 @@ namespace talus::explicit_mpm
     const Parameters<dim> &                       prm;
     MPI_Comm                                      comm;
     BackgroundGrid<dim>                           grid;
-    PropertyLayout<dim>                           layout;
-    dealii::Particles::ParticleHandler<dim>       particles;
-    std::unique_ptr<Relocator<dim>>               relocator;
+    /// The material points (one set; its layout, cell list and relocation).
+    MaterialPointSet<dim>                         points;
     std::vector<unsigned char>                    constrained;
+    /// Nodal lumped mass; nodal_a holds the force until nodal_acceleration()
+    /// divides it, then the acceleration; nodal_p the momentum until
+    /// nodal_velocity(), then the velocity.
     Vector                                        nodal_mass, nodal_a, nodal_p;
-    /// Cells with particles in the storage order of the ParticleHandler, with
-    /// their particle counts: the loops walk one particle iterator along this
-    /// list and never look cells up in the triangulation.
-    struct ActiveCell
-    {
-      unsigned int cell, n_particles;
-    };
-    std::vector<ActiveCell>                       active_cells;
     /// Locally owned DoFs (local indices) of the active cells plus those other
     /// ranks contribute to: the only nodes the grid update visits.
     std::vector<unsigned int>                     active_dofs;
-    RelocationStats                               relocation_stats;
     Timings                                       timings;
     double                                        time = 0, dt = 0;
     unsigned int                                  step_number = 0;
@@ -231,22 +224,26 @@ namespace talus::explicit_mpm
     friend class TwoPhase<dim>;
     friend class FreeSurface<dim>;
     friend class FemIntegration<dim>;
+    /// Cell list of the points from storage, and the active DoFs.
     void collect_active_cells();
-    void update_active_cells();
     void collect_active_dofs();
-    std::vector<unsigned int>  particles_in_cell_count; // by active cell index
-    std::vector<unsigned char> cell_erased;
 
     void zero_on_active(Vector &v) const;
     std::vector<unsigned char> dof_marker;
-    /// particles the loops prefetch ahead (8 measured best: 317 -> 227 ns per
-    /// particle-step on a 164k-point 3D scene vs no prefetch)
-    unsigned int prefetch_distance = 8;
+    // the walks of the step (transfer/ ops), templated on the shape kernel
     void p2g_mass_and_force();
+    template <class Kernel>
+    void p2g_mass_and_force_with();
     void nodal_acceleration();
     void g2p_velocity_p2g_momentum(const double dt);
+    template <class Kernel>
+    void g2p_velocity_p2g_momentum_with(const double dt);
     void nodal_velocity();
     void g2p_update(const double dt);
+    template <class Kernel>
+    void g2p_update_with(const double dt);
+    template <class Kernel>
+    void relocate_with();
     void check_stability() const;
     void write_vtu(unsigned int counter);
     void write_final_particles() const;

@@ -355,7 +355,7 @@ namespace talus::explicit_mpm
   {
     using L          = PropertyLayout<dim>;
     const auto &pl   = s.prm.liquid.pore_liquid;
-    for (auto &pt : s.particles)
+    for (auto &pt : s.points.handler)
       {
         double *           P   = pt.get_properties().data();
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
@@ -394,7 +394,7 @@ namespace talus::explicit_mpm
     using L        = PropertyLayout<dim>;
     const auto &pl = s.prm.liquid.pore_liquid;
     Energies    e;
-    for (const auto &pt : s.particles)
+    for (const auto &pt : s.points.handler)
       {
         const auto         P   = pt.get_properties();
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
@@ -429,7 +429,7 @@ namespace talus::explicit_mpm
     using L        = PropertyLayout<dim>;
     const auto &pl = s.prm.liquid.pore_liquid;
     dealii::Tensor<1, dim> p;
-    for (const auto &pt : s.particles)
+    for (const auto &pt : s.points.handler)
       {
         const auto         P   = pt.get_properties();
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
@@ -467,8 +467,8 @@ namespace talus::explicit_mpm
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         s.zero_on_active(*v);
     {
-      auto pt = s.particles.begin();
-      for (const auto [c, n_in_cell] : s.active_cells)
+      auto pt = s.points.handler.begin();
+      for (const auto [c, n_in_cell] : s.points.active_cells())
         {
           const auto &cc = s.grid.cells[c];
           for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
@@ -563,8 +563,8 @@ namespace talus::explicit_mpm
     if (coupled)
       s.zero_on_active(p_liquid);
     {
-      auto pt = s.particles.begin();
-      for (const auto [c, n_in_cell] : s.active_cells)
+      auto pt = s.points.handler.begin();
+      for (const auto [c, n_in_cell] : s.points.active_cells())
         {
           const auto &cc = s.grid.cells[c];
           for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
@@ -622,8 +622,8 @@ namespace talus::explicit_mpm
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     {
-      auto pt = s.particles.begin();
-      for (const auto [c, n_in_cell] : s.active_cells)
+      auto pt = s.points.handler.begin();
+      for (const auto [c, n_in_cell] : s.points.active_cells())
         {
           const auto &cc          = s.grid.cells[c];
           double      cell_volume = 1.0;
@@ -660,7 +660,7 @@ namespace talus::explicit_mpm
               const materials::Material &m     = *s.prm.materials[mat];
               auto                       sigma = L::get_stress(P);
               m.update_stress(d_eps, d_omega, h, sigma,
-                              dealii::ArrayView<double>(P + s.layout.history, m.n_history()));
+                              dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
               L::set_stress(sigma, P);
               const double dvS = trace(d_eps);
               double       mL = 0, vl2 = 0;
@@ -730,7 +730,7 @@ namespace talus::explicit_mpm
               if (inside)
                 pt->set_reference_location(nxi);
               else
-                s.relocator->leaving(pt, c);
+                s.points.leaving(pt, c);
             }
         }
     }
@@ -742,9 +742,9 @@ namespace talus::explicit_mpm
     s.timings.g2p += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 
     const auto t2 = std::chrono::steady_clock::now();
-    s.relocator->finish(s.relocation_stats);
+    s.points.relocate();
     s.p2g_ready = false;
-    s.update_active_cells();
+    s.collect_active_dofs();
     s.timings.relocation += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
   }
 
@@ -777,8 +777,8 @@ namespace talus::explicit_mpm
     volume = 0.0;
     double *const Mn = mass.begin(), *const Vn = volume.begin();
     {
-      auto pt = s.particles.begin();
-      for (const auto [c, n_in_cell] : s.active_cells)
+      auto pt = s.points.handler.begin();
+      for (const auto [c, n_in_cell] : s.points.active_cells())
         {
           const auto &cc   = s.grid.cells[c];
           double      vol = 1.0;
@@ -804,8 +804,8 @@ namespace talus::explicit_mpm
 
     unsigned long long  n_flagged = 0;
     std::vector<double> lo(dim, std::numeric_limits<double>::max()), hi(dim, -std::numeric_limits<double>::max());
-    auto                pt = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto                pt = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[c];
         for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)

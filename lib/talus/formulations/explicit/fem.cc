@@ -65,7 +65,7 @@ namespace talus::explicit_mpm
     result.volume_per_body.assign(bodies.size(), 0.0);
     // cells covered by a body: those holding its points in the MPM seeding
     std::vector<int> body_of_cell(grid.cells.size(), -1), material_of_cell(grid.cells.size(), -1);
-    for (const auto &pt : s.particles)
+    for (const auto &pt : s.points.handler)
       {
         const unsigned int c = pt.get_surrounding_cell()->active_cell_index();
         const int          b = static_cast<int>(pt.get_properties()[L::body]);
@@ -75,7 +75,7 @@ namespace talus::explicit_mpm
             material_of_cell[c] = static_cast<int>(pt.get_properties()[L::material]);
           }
       }
-    s.particles.clear_particles();
+    s.points.handler.clear_particles();
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
       {
         if (!grid.cells[c].locally_owned || body_of_cell[c] < 0)
@@ -107,8 +107,8 @@ namespace talus::explicit_mpm
     MPI_Exscan(&n_local, &offset, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, grid.comm);
     if (dealii::Utilities::MPI::this_mpi_process(grid.comm) == 0)
       offset = 0;
-    s.particles.reserve(points.size());
-    std::vector<double> props(s.layout.n_properties(), 0.0);
+    s.points.handler.reserve(points.size());
+    std::vector<double> props(s.points.layout.n_properties(), 0.0);
     for (std::size_t i = 0; i < points.size(); ++i)
       {
         const auto &p    = points[i];
@@ -122,10 +122,10 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           props[L::velocity + d] = v[d];
         result.volume_per_body[p.body] += p.volume;
-        s.particles.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
+        s.points.handler.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
                                     dealii::ArrayView<const double>(props.data(), props.size()));
       }
-    s.particles.update_cached_numbers();
+    s.points.handler.update_cached_numbers();
     result.n_particles = dealii::Utilities::MPI::sum(n_local, grid.comm);
     for (auto &v : result.volume_per_body)
       v = dealii::Utilities::MPI::sum(v, grid.comm);
@@ -139,7 +139,7 @@ namespace talus::explicit_mpm
     const unsigned int         n = s.nodal_mass.locally_owned_size() + s.grid.partitioner->n_ghost_indices();
     std::vector<unsigned char> mark(n, 0);
     moving_dofs.clear();
-    for (const auto &ac : s.active_cells)
+    for (const auto &ac : s.points.active_cells())
       for (const unsigned int i : s.grid.cells[ac.cell].dofs)
         if (!mark[i])
           {
@@ -158,8 +158,8 @@ namespace talus::explicit_mpm
     const auto    g        = s.gravity;
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
-    auto pt = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto pt = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[c];
         double      X[nv][dim];
@@ -208,8 +208,8 @@ namespace talus::explicit_mpm
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
-    auto pt = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto pt = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[c];
         double      X0[nv][dim], X1[nv][dim], du[nv][dim];
@@ -248,7 +248,7 @@ namespace talus::explicit_mpm
             const unsigned int         mat   = static_cast<unsigned int>(P[L::material]);
             const materials::Material &m     = *s.prm.materials[mat];
             auto                       sigma = L::get_stress(P);
-            m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.layout.history, m.n_history()));
+            m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
             L::set_stress(sigma, P);
 
             dealii::Point<dim> x = pt->get_location();

@@ -19,6 +19,14 @@ namespace talus::explicit_mpm
   {
     using namespace dealii::Patterns;
     prm.enter_subsection("numerics");
+    prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
+                      "Shape functions of the particle-grid transfers: 'linear' (Q1 on the grid cells) or "
+                      "'quadratic bspline' (uniform quadratic B-splines on the grid nodes, 3 nodes per direction "
+                      "per point: no cell-crossing noise; at the grid walls the outside node is a ghost carrying "
+                      "the linear extrapolation, so fixed and roller walls hold exactly at the wall; "
+                      "docs/shape-functions.md). Quadratic B-splines need a uniform box grid with at least 3 "
+                      "cells per direction and integration = mpm, without strain smoothing, contact, 2-phase "
+                      "materials, tractions or prescribed velocities.");
     prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
                       "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
                       "UL-FEM): 'mpm' at the material points; "
@@ -59,6 +67,9 @@ namespace talus::explicit_mpm
   {
     NumericsOptions o;
     prm.enter_subsection("numerics");
+    o.shape_function = prm.get("shape function") == "quadratic bspline" ?
+                         NumericsOptions::ShapeFunction::quadratic_bspline :
+                         NumericsOptions::ShapeFunction::linear;
     {
       const std::string i = prm.get("integration");
       o.integration       = i == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed :
@@ -179,8 +190,8 @@ namespace talus::explicit_mpm
         }
     CellStressFit<dim> stress_fit; // MPM-MIXED: linear cell stress (mixed_integration.h)
 
-    auto pt = s.particles.begin();
-    for (const auto [c, n_in_cell] : s.active_cells)
+    auto pt = s.points.handler.begin();
+    for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[c];
         double      lm[nv] = {}, T[dim][F::npairs][dim] = {};
@@ -303,7 +314,7 @@ namespace talus::explicit_mpm
         centre[d] = 0.5;
       F::weights(centre, N, w);
     }
-    for (const auto &ac : s.active_cells)
+    for (const auto &ac : s.points.active_cells())
       {
         const auto &cc = s.grid.cells[ac.cell];
         double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
@@ -323,7 +334,7 @@ namespace talus::explicit_mpm
     // eps_el Omega_el / sum Omega_el (component 0 / component 1 of the vector)
     zero_on(nodal, s.active_dofs);
     double *const X = nodal.begin();
-    for (const auto &ac : s.active_cells)
+    for (const auto &ac : s.points.active_cells())
       {
         const auto &cc     = s.grid.cells[ac.cell];
         double      volume = 1.0;
@@ -338,7 +349,7 @@ namespace talus::explicit_mpm
     nodal.compress(dealii::VectorOperation::add);
     nodal.update_ghost_values();
     // Eq. 6.36: the cell's value is the mean of its nodal values
-    for (const auto &ac : s.active_cells)
+    for (const auto &ac : s.points.active_cells())
       {
         const auto &cc  = s.grid.cells[ac.cell];
         double      sum = 0;

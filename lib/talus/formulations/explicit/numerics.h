@@ -37,6 +37,14 @@ namespace talus::explicit_mpm
       cell, ///< volumetric strain increment replaced by the cell average (mean dilatation)
       nodal ///< nodal mixed discretisation: cell values averaged to the nodes and back (Eqs. 6.35-6.37)
     };
+    /// Shape functions of the particle-grid transfers (docs/shape-functions.md).
+    enum class ShapeFunction
+    {
+      linear,           ///< Q1 on the box cells (shape/q1_box.h)
+      quadratic_bspline ///< quadratic B-splines, 3^dim nodes per point (shape/bspline2_box.h)
+    };
+    ShapeFunction shape_function = ShapeFunction::linear;
+    bool bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
     Integration integration = Integration::mpm;
     double      fill_factor = 0.9; ///< F_fill of Eq. 6.33
     bool        mixed_linear = true; ///< MPM-MIXED cell stress linear (else constant, Eq. 6.32 alone)

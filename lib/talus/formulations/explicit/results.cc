@@ -82,7 +82,7 @@ namespace talus::explicit_mpm
     if (n_probes > 0)
       {
         const char *ax[]     = {"x", "y", "z"};
-        const auto  pnames   = layout.names();
+        const auto  pnames   = points.layout.names();
         const auto  column   = [&](const std::string &n) -> const std::vector<double> & {
           for (std::size_t k = 0; k < names.size(); ++k)
             if (names[k] == n)
@@ -117,7 +117,7 @@ namespace talus::explicit_mpm
         out.write_global("probes/stress", table(sg), n_probes * nst);
         // initial positions X = x - u of the tracked points
         std::vector<double> X(n_probes * dim, 0.0);
-        for (const auto &pt : particles)
+        for (const auto &pt : points.handler)
           for (unsigned int k = 0; k < n_probes; ++k)
             if (pt.get_id() == probe_ids[k])
               for (unsigned int d = 0; d < dim; ++d)
@@ -133,7 +133,7 @@ namespace talus::explicit_mpm
     {
       std::vector<std::uint64_t> id;
       std::vector<double>        x, X, u, vel, sig, vol, mass, mat, body;
-      for (const auto &pt : particles)
+      for (const auto &pt : points.handler)
         {
           const auto P   = pt.get_properties();
           const bool fix = fem && !fem->updated_lagrangian(); // fem: the point stays at its Gauss point
@@ -173,8 +173,8 @@ namespace talus::explicit_mpm
       std::vector<Vector>    w(3 + n_sv);                  // weights (m, V), u, v, stress blocks
       for (auto &vec : w)
         grid.reinit_vector(vec);
-      auto pt = particles.begin();
-      for (const auto [c, n_in_cell] : active_cells)
+      auto pt = points.handler.begin();
+      for (const auto [c, n_in_cell] : points.active_cells())
         {
           const auto &cc = grid.cells[c];
           for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)

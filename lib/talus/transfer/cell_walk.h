@@ -1,0 +1,113 @@
+// talus — the one particle walk. Every pass over the material points of a set
+// (P2G, G2P, the fused explicit update, ...) is this walk with an op:
+//
+//   op.begin_cell(c)         once per active cell: gather nodal data, reset sums
+//   op.point(c, it)          once per point of the cell (it: particle iterator)
+//   op.end_cell(c)           once per active cell: scatter the cell's sums
+//
+// The walk follows the set's (cell, count) list in storage order with one
+// particle iterator (no cell look-ups) and prefetches a few points ahead.
+// Ops are templates (kernel and physics as template parameters) so the hot
+// loop is one inlined pass; compose ops with transfer::Fused.
+#pragma once
+
+#include <talus/particles/material_point_set.h>
+
+namespace talus::transfer
+{
+  /// Walks `distance` particles ahead of a loop and prefetches their data.
+  /// Points that changed cell sit in recycled storage slots scattered in
+  /// memory; prefetching hides most of that latency (measured on the 3D bench:
+  /// 317 -> 227 ns per particle-step with 8 points ahead).
+  template <int dim>
+  class Prefetcher
+  {
+  public:
+    Prefetcher(dealii::Particles::ParticleHandler<dim> &ph, const unsigned int distance)
+      : it(ph.begin())
+      , end(ph.end())
+    {
+      for (unsigned int i = 0; i < distance && it != end; ++i)
+        ++it;
+    }
+    inline void
+    next(const bool with_location)
+    {
+      if (it == end)
+        return;
+      const double *P = it->get_properties().data();
+      __builtin_prefetch(P);
+      __builtin_prefetch(P + 8);
+      __builtin_prefetch(&it->get_reference_location());
+      if (with_location)
+        __builtin_prefetch(&it->get_location());
+      ++it;
+    }
+
+  private:
+    typename dealii::Particles::ParticleHandler<dim>::particle_iterator it, end;
+  };
+
+  /// Points prefetched ahead by the walks (8 measured best on the 3D bench).
+  inline constexpr unsigned int prefetch_distance = 8;
+
+  template <int dim>
+  using PointIterator = typename dealii::Particles::ParticleHandler<dim>::particle_iterator;
+
+  /// The walk. `Op::prefetch_location` (a static constexpr bool) says whether
+  /// the op reads the points' locations (then they are prefetched too).
+  template <int dim, class Op>
+  inline void
+  for_each_active_cell(MaterialPointSet<dim> &set, Op &op)
+  {
+    auto            pt = set.handler.begin();
+    Prefetcher<dim> ahead(set.handler, prefetch_distance);
+    for (const auto [c, n_in_cell] : set.active_cells())
+      {
+        op.begin_cell(c);
+        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(Op::prefetch_location))
+          op.point(c, pt);
+        op.end_cell(c);
+      }
+  }
+
+  /// Two ops in one pass: `first` runs on every point; `second` only on those
+  /// for which first.point returned true (e.g. the points that stayed in their
+  /// cell after an update, which the fused P2G of the next step then adds).
+  template <class First, class Second>
+  struct Fused
+  {
+    Fused(First &first, Second &second)
+      : first(first)
+      , second(second)
+    {}
+    First &                      first;
+    Second &                     second;
+    static constexpr bool        prefetch_location = First::prefetch_location || Second::prefetch_location;
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      first.begin_cell(c);
+      second.begin_cell(c);
+    }
+    template <class It>
+    inline bool
+    point(const unsigned int c, It &it)
+    {
+      if (first.point(c, it))
+        {
+          second.point(c, it);
+          return true;
+        }
+      return false;
+    }
+    inline void
+    end_cell(const unsigned int c)
+    {
+      first.end_cell(c);
+      second.end_cell(c);
+    }
+  };
+  template <class First, class Second>
+  Fused(First &, Second &) -> Fused<First, Second>;
+} // namespace talus::transfer
