@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/grid/background_grid.h>
 #include <talus/io/grid_mesh.h>
+#include <talus/shape/bspline2.h>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/dofs/dof_tools.h>
@@ -10,6 +11,7 @@
 #include <deal.II/grid/tria_description.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -204,6 +206,125 @@ namespace talus
           }
         neighbours.insert(neighbours.end(), nb.begin(), nb.end());
         cells[c].neighbours_end = neighbours.size();
+      }
+
+    // a rebuilt grid (repartition, restart) keeps a requested B-spline stencil valid
+    if (!patch_of_cell.empty())
+      setup_bspline_patches();
+  }
+
+  template <int dim>
+  void
+  BackgroundGrid<dim>::setup_bspline_patches()
+  {
+    const std::string where  = "grid";
+    const std::string reason = ": quadratic B-spline shape functions need a uniform box grid (equal "
+                               "axis-aligned cells filling the box; every face of the box is a wall)";
+    const char        axis[] = "xyz";
+    const unsigned int invalid = dealii::numbers::invalid_unsigned_int;
+
+    // the box from the owned cells of all ranks
+    double lo[dim], hi[dim], hmin[dim], hmax[dim];
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lo[d] = hmin[d] = std::numeric_limits<double>::max();
+        hi[d] = hmax[d] = -std::numeric_limits<double>::max();
+      }
+    for (const auto &cc : cells)
+      if (cc.locally_owned)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            lo[d]   = std::min(lo[d], cc.lower[d]);
+            hi[d]   = std::max(hi[d], cc.lower[d] + cc.h[d]);
+            hmin[d] = std::min(hmin[d], cc.h[d]);
+            hmax[d] = std::max(hmax[d], cc.h[d]);
+          }
+    std::size_t n_box = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lo[d]   = dealii::Utilities::MPI::min(lo[d], comm);
+        hmin[d] = dealii::Utilities::MPI::min(hmin[d], comm);
+        hi[d]   = dealii::Utilities::MPI::max(hi[d], comm);
+        hmax[d] = dealii::Utilities::MPI::max(hmax[d], comm);
+        if (hmax[d] - hmin[d] > 1e-10 * hmax[d])
+          throw InputError(where + reason + "; the cell size in " + axis[d] + " varies from " +
+                           std::to_string(hmin[d]) + " to " + std::to_string(hmax[d]));
+        const double       extent = hi[d] - lo[d];
+        const unsigned int n      = static_cast<unsigned int>(std::lround(extent / hmax[d]));
+        box.lower[d]              = lo[d];
+        box.n_cells[d]            = n;
+        box.h[d]                  = extent / n;
+        box.inv_h[d]              = n / extent;
+        if (n < shape::BSpline2<dim>::min_cells)
+          throw InputError(where + ": quadratic B-spline shape functions need at least " +
+                           std::to_string(shape::BSpline2<dim>::min_cells) + " cells in every direction; the grid has " +
+                           std::to_string(n) + " in " + axis[d]);
+        n_box *= n;
+      }
+    if (n_box != tria.n_global_active_cells())
+      throw InputError(where + reason + "; the grid has " + std::to_string(tria.n_global_active_cells()) +
+                       " cells, its bounding box holds " + std::to_string(n_box));
+
+    patch_of_cell.assign(cells.size(), invalid);
+    patches.clear();
+    std::vector<std::array<unsigned int, dim>> index(cells.size());
+    bool                                       on_lattice = true;
+    for (unsigned int c = 0; c < cells.size(); ++c)
+      if (cell_iterators[c] != tria.end())
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double r = (cells[c].lower[d] - box.lower[d]) * box.inv_h[d];
+            const long   k = std::lround(r);
+            on_lattice     = on_lattice && std::abs(r - k) < 1e-6 && k >= 0 && k < long(box.n_cells[d]);
+            index[c][d]    = static_cast<unsigned int>(std::max(k, 0l));
+          }
+    if (dealii::Utilities::MPI::min(on_lattice ? 1 : 0, comm) == 0)
+      throw InputError(where + reason + "; a cell corner is off the lattice of the box");
+
+    constexpr unsigned int nv = CellCache<dim>::n_vertices;
+    for (unsigned int c = 0; c < cells.size(); ++c)
+      {
+        if (!cells[c].locally_owned)
+          continue;
+        patch_of_cell[c] = patches.size();
+        BSplinePatch<dim> p;
+        std::fill(std::begin(p.dofs), std::end(p.dofs), invalid);
+        for (unsigned int d = 0; d < dim; ++d)
+          p.i_cell[d] = index[c][d];
+        // the patch nodes are the vertices of the cell and its vertex neighbours
+        for (unsigned int k = cells[c].neighbours_begin; k < cells[c].neighbours_end; ++k)
+          {
+            const unsigned int n = neighbours[k];
+            for (unsigned int v = 0; v < nv; ++v)
+              {
+                unsigned int slot = 0, m = 1;
+                for (unsigned int d = 0; d < dim; ++d, m *= 4)
+                  slot += (index[n][d] + ((v >> d) & 1u) + 1 - index[c][d]) * m;
+                for (unsigned int comp = 0; comp < dim; ++comp)
+                  {
+                    unsigned int &dst = p.dofs[slot * dim + comp];
+                    const unsigned int src = cells[n].dofs[v * dim + comp];
+                    if (dst != invalid && dst != src)
+                      throw std::logic_error("BackgroundGrid::setup_bspline_patches: two DoFs for one node");
+                    dst = src;
+                  }
+              }
+          }
+        // every slot inside the grid must be found (the ghost layer holds them)
+        for (unsigned int slot = 0; slot < BSplinePatch<dim>::n_slots; ++slot)
+          {
+            bool inside = true;
+            for (unsigned int d = 0, s = slot; d < dim; ++d, s /= 4)
+              {
+                const long node = long(index[c][d]) - 1 + long(s % 4);
+                inside          = inside && node >= 0 && node <= long(box.n_cells[d]);
+              }
+            if (inside != (p.dofs[slot * dim] != invalid))
+              throw std::logic_error("BackgroundGrid::setup_bspline_patches: patch node of cell " +
+                                     cell_iterators[c]->id().to_string() +
+                                     (inside ? " missing from the ghost layer" : " outside the grid"));
+          }
+        patches.push_back(p);
       }
   }
 

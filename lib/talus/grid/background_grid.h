@@ -52,6 +52,32 @@ namespace talus
     bool         locally_owned    = false;
   };
 
+  /// Stencil data of the quadratic B-spline kernel (shape/bspline2.h) for one
+  /// locally owned cell: its integer position in the uniform box and the local
+  /// (owned + ghost) DoF indices of the 4^dim nodes j-1..j+2 per direction.
+  template <int dim>
+  struct BSplinePatch
+  {
+    static constexpr unsigned int n_slots = dim == 2 ? 16 : 64;
+    /// cell index per direction, 0 <= i_cell[d] < n_cells[d]
+    unsigned int i_cell[dim];
+    /// Local index of DoF (slot s, component c) at [s*dim + c]; slot s = p_0 + 4 p_1
+    /// (+ 16 p_2) is node i_cell[d] - 1 + p_d. numbers::invalid_unsigned_int for
+    /// slots outside the grid.
+    unsigned int dofs[n_slots * dim];
+  };
+
+  /// The grid as a uniform box (for the B-spline kernel): lower corner, cell size,
+  /// cells per direction.
+  template <int dim>
+  struct UniformBox
+  {
+    double       lower[dim];
+    double       h[dim];
+    double       inv_h[dim];
+    unsigned int n_cells[dim];
+  };
+
   template <int dim>
   class BackgroundGrid
   {
@@ -101,6 +127,16 @@ namespace talus
     /// Smallest cell edge over the whole grid (all ranks).
     double min_cell_size() const { return global_min_h; }
 
+    /// Build the B-spline stencil (box, patches) after setup(); collective. Only a
+    /// B-spline run calls it, so a Q1 run keeps its memory. Throws InputError if
+    /// the grid is not a uniform box (equal cells on a lattice filling the
+    /// bounding box) or has fewer than 3 cells in a direction.
+    void setup_bspline_patches();
+
+    /// Patch of locally owned cell c (active_cell_index); setup_bspline_patches() first.
+    const BSplinePatch<dim> &patch(const unsigned int c) const { return patches[patch_of_cell[c]]; }
+    bool has_patches() const { return !patch_of_cell.empty(); }
+
     MPI_Comm                                           comm;
     dealii::parallel::distributed::Triangulation<dim> tria;
     dealii::FESystem<dim>                              fe;
@@ -113,6 +149,12 @@ namespace talus
     std::vector<CellCache<dim>>                                             cells;
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_iterators;
     std::vector<unsigned int>                                               neighbours;
+
+    /// Filled by setup_bspline_patches(): the box, one patch per locally owned
+    /// cell, and per active cell the index of its patch (invalid if not owned).
+    UniformBox<dim>                box{};
+    std::vector<BSplinePatch<dim>> patches;
+    std::vector<unsigned int>      patch_of_cell;
 
   private:
     double global_min_h = 0;
