@@ -23,7 +23,7 @@ Definitions (Lube et al. measure from the fixed wall, so d_inf = d_i + run-out):
 The reference uses the damping of seed 001: mass-proportional (Rayleigh alpha)
 damping 1.5 1/s, `damping/viscous damping` in the .prm.
 
-Usage: check_column_collapse.py TOOL PRM WORKDIR [REFINE]
+Usage: check_column_collapse.py TOOL PRM WORKDIR [REFINE [MAX_SEPARATED]]
   REFINE multiplies the number of cells in each direction (0.5: the coarse ctest
   version; 1: the .prm as given, cell d_i/18; 2: cell d_i/36).
 """
@@ -42,6 +42,8 @@ TOLERANCE = 0.15
 
 tool, prm_path, work = sys.argv[1:4]
 refine = float(sys.argv[4]) if len(sys.argv) > 4 else 1.0
+# if given: the largest number of points allowed beyond the contiguous front
+max_separated = int(sys.argv[5]) if len(sys.argv) > 5 else None
 text = open(prm_path).read()
 
 
@@ -118,6 +120,9 @@ print(f"h_inf = {h_inf:.4f} m (Table 6.5: {h_ref}, {100 * (h_inf - h_ref) / h_re
       f"t_inf = {t_inf:.3f} s (Table 6.5: {t_ref}, {100 * (t_inf - t_ref) / t_ref:+.1f} %)")
 if a in THESIS:
     print("seed 001 Kratos MPM (d_inf, h_inf, t_inf) for meshes 1-3: " + "; ".join(str(x) for x in THESIS[a]))
+if max_separated is not None:
+    tv.check(n_beyond <= max_separated,
+             f"{n_beyond} points separated from the deposit (beyond its contiguous front; at most {max_separated})")
 tv.check(abs(err) < TOLERANCE,
          f"run-out d_inf = {d_inf:.4f} m within {100 * TOLERANCE:.0f} % of seed 001 Table 6.5 ({d_ref} m)")
 tv.finish()

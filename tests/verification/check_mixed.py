@@ -69,19 +69,7 @@ def noise(parts):
 
 
 def time_average(s):
-    t, u = s["time"], s["probe0_uy"]
-    mean = sum(u) / len(u)
-    up = tv.zero_crossings(t, [x - mean for x in u], direction=+1)
-    if len(up) < 2:
-        return float("nan")
-    ta, tb = up[-2], up[-1]
-    num = 0.0
-    for i in range(1, len(t)):
-        lo, hi = max(t[i - 1], ta), min(t[i], tb)
-        if hi > lo:
-            f = lambda x: u[i - 1] + (u[i] - u[i - 1]) * (x - t[i - 1]) / (t[i] - t[i - 1])
-            num += 0.5 * (f(lo) + f(hi)) * (hi - lo)
-    return num / (tb - ta)
+    return tv.time_average_last_period(s["time"], s["probe0_uy"])[0]
 
 
 def run(name, edits):

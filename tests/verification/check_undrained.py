@@ -22,17 +22,9 @@ def mean_top(text, name):
     tv.run_tool(tool, text, work, name)
     s = tv.read_csv(f"{work}/{name}/series.csv")
     t, u = s["time"], s["probe0_uy"]
-    mean = sum(u) / len(u)
-    up = tv.zero_crossings(t, [x - mean for x in u], direction=+1)
-    tv.check(len(up) >= 2, f"{name}: at least two upward crossings of the mean")
-    ta, tb = up[-2], up[-1]
-    num = 0.0
-    for i in range(1, len(t)):
-        lo, hi = max(t[i - 1], ta), min(t[i], tb)
-        if hi > lo:
-            f = lambda x: u[i - 1] + (u[i] - u[i - 1]) * (x - t[i - 1]) / (t[i] - t[i - 1])
-            num += 0.5 * (f(lo) + f(hi)) * (hi - lo)
-    return num / (tb - ta), tb - ta
+    avg, period = tv.time_average_last_period(t, u)
+    tv.check(period == period, f"{name}: at least two upward crossings of the mean")
+    return avg, period
 
 
 base = open(prm_path).read()

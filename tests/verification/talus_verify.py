@@ -126,3 +126,41 @@ def parasitic_growth_rate(series, t_early=0.05, start_factor=1e3, stop_fraction=
     mx = sum(a for a, _ in pts) / len(pts)
     my = sum(b for _, b in pts) / len(pts)
     return 0.5 * sum((a - mx) * (b - my) for a, b in pts) / sum((a - mx) ** 2 for a, _ in pts), len(pts)
+
+
+def time_average_last_period(t, u):
+    """(average, period): the time average of u(t) over its last full
+    oscillation period (between the last two upward crossings of its mean,
+    trapezoidal on the linear interpolation of u) and that period; (nan, nan)
+    if there are fewer than two crossings."""
+    mean = sum(u) / len(u)
+    up = zero_crossings(t, [x - mean for x in u], direction=+1)
+    if len(up) < 2:
+        return float("nan"), float("nan")
+    ta, tb = up[-2], up[-1]
+    num = 0.0
+    for i in range(1, len(t)):
+        lo, hi = max(t[i - 1], ta), min(t[i], tb)
+        if hi > lo:
+            f = lambda x: u[i - 1] + (u[i] - u[i - 1]) * (x - t[i - 1]) / (t[i] - t[i - 1])
+            num += 0.5 * (f(lo) + f(hi)) * (hi - lo)
+    return num / (tb - ta), tb - ta
+
+
+def polyfit_noise(xs, ys, deg=4):
+    """RMS residual of a least-squares polynomial fit of degree deg of ys(xs)."""
+    n = deg + 1
+    A = [[sum(x ** (i + j) for x in xs) for j in range(n)] for i in range(n)]
+    b = [sum(y * x ** i for x, y in zip(xs, ys)) for i in range(n)]
+    M = [row[:] + [b[i]] for i, row in enumerate(A)]
+    for c in range(n):
+        p = max(range(c, n), key=lambda r: abs(M[r][c]))
+        M[c], M[p] = M[p], M[c]
+        for r in range(n):
+            if r != c:
+                f = M[r][c] / M[c][c]
+                for k in range(c, n + 1):
+                    M[r][k] -= f * M[c][k]
+    coef = [M[i][n] / M[i][i] for i in range(n)]
+    r2 = sum((y - sum(coef[i] * x ** i for i in range(n))) ** 2 for x, y in zip(xs, ys))
+    return (r2 / len(xs)) ** 0.5

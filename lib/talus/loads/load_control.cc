@@ -425,14 +425,13 @@ namespace talus::loads
     constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     h                         = step;
     const bool vt_now         = need_vt || check_step(s);
-    if (!have_tractions && !vt_now)
+    if (vt_now) // nodal momentum p^t of the points (the shape functions of the run)
+      s.scatter_point_momentum(vt);
+    if (!have_tractions && !any_friction)
       return;
     double *const T   = have_tractions ? trac.begin() : nullptr;
-    double *const Pm  = vt_now ? vt.begin() : nullptr;
     if (have_tractions)
       s.zero_on_active(trac);
-    if (vt_now)
-      s.zero_on_active(vt);
     // time factors of the tractions at t
     const unsigned int  nt = current->tractions.size();
     std::vector<double> factor(nt);
@@ -468,8 +467,6 @@ namespace talus::loads
                         l                    = std::min(l, away);
                       }
                   }
-            double        N[nv];
-            bool          have_N = false;
             if (have_tractions)
               {
                 double f[dim] = {};
@@ -483,23 +480,14 @@ namespace talus::loads
                       }
                 if (any)
                   {
+                    double N[nv];
                     shape::Q1<dim>::values(pt->get_reference_location(), N);
-                    have_N = true;
                     for (unsigned int v = 0; v < nv; ++v)
                       for (unsigned int d = 0; d < dim; ++d)
                         T[cc.dofs[v * dim + d]] += N[v] * f[d]; // Eq. 5.3
                     for (unsigned int d = 0; d < dim; ++d)
                       work += f[d] * P[L::velocity + d] * h;
                   }
-              }
-            if (vt_now)
-              {
-                if (!have_N)
-                  shape::Q1<dim>::values(pt->get_reference_location(), N);
-                const double m = P[L::mass];
-                for (unsigned int v = 0; v < nv; ++v)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    Pm[cc.dofs[v * dim + d]] += m * N[v] * P[L::velocity + d];
               }
           }
       }
@@ -508,8 +496,6 @@ namespace talus::loads
         trac.compress(dealii::VectorOperation::add);
         s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
       }
-    if (vt_now)
-      vt.compress(dealii::VectorOperation::add);
     if (any_friction)
       lift.compress(dealii::VectorOperation::min);
   }

@@ -120,6 +120,45 @@ namespace talus::transfer
     }
   };
 
+  /// P2G of the points' momentum m_p v_p (Eq. 4.47) at their current reference
+  /// locations into Pn (the nodal momentum p^t the loads use before a step).
+  template <int dim, class K>
+  struct ScatterMomentum
+  {
+    ScatterMomentum(const BackgroundGrid<dim> &grid, double *Pn)
+      : grid(grid)
+      , Pn(Pn)
+    {}
+    const BackgroundGrid<dim> &grid;
+    double *const              Pn;
+
+    static constexpr bool prefetch_location = false;
+    typename K::Cell      cell;
+    typename K::Momentum  sums;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      sums = typename K::Momentum();
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      using L         = PropertyLayout<dim>;
+      const double *P = it->get_properties().data();
+      typename K::Values N;
+      K::values(cell, it->get_reference_location(), N);
+      sums.add(N, P[L::mass], P + L::velocity);
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {
+      sums.scatter(cell, Pn);
+    }
+  };
+
   /// The update of the points from the nodal velocity V over a step h: the
   /// displacement increment du = h V is interpolated (Eq. 4.51) and its
   /// gradient handed to the formulation's point physics (strain, stress,

@@ -439,9 +439,10 @@ namespace talus::explicit_mpm
         require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/shape function",
                 "coupled 2-phase materials and body tractions" + why + "1-phase materials without tractions");
-        require(!p.loads.active(), "numerics/shape function",
-                "the loads sections (tractions, prescribed velocities, boundary friction, damping, mass scaling, "
-                "quasi-static convergence, K0, stages)" + why + "none of them");
+        for (const auto &st : p.loads.stages)
+          require(st.tractions.empty() && st.velocities.empty() && st.friction_ids.empty(), "numerics/shape function",
+                  "tractions, prescribed velocities and boundary friction (loads sections)" + why +
+                    "damping, mass scaling, quasi-static convergence, K0 and stages");
         require(!p.grid_mesh, "grid/source",
                 "a grid file with quadratic B-splines: they need a uniform box grid; allowed: box");
         for (unsigned int d = 0; d < dim; ++d)
@@ -779,6 +780,23 @@ namespace talus::explicit_mpm
     transfer::UpdateVelocityScatterMomentum<dim, K> op{grid, nodal_a.begin(), nodal_p.begin(), h};
     transfer::for_each_active_cell(points, op);
     nodal_p.compress(dealii::VectorOperation::add);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::scatter_point_momentum(Vector &v)
+  {
+    zero_on_active(v);
+    const auto walk = [&](auto kernel) {
+      using K = decltype(kernel);
+      transfer::ScatterMomentum<dim, K> op(grid, v.begin());
+      transfer::for_each_active_cell(points, op);
+    };
+    if (prm.numerics.bspline())
+      walk(shape::BSpline2Box<dim>());
+    else
+      walk(shape::Q1Box<dim>());
+    v.compress(dealii::VectorOperation::add);
   }
 
   template <int dim>

@@ -144,6 +144,10 @@ namespace talus::explicit_mpm
     /// the active DoFs and ghosts) and whether the cell lists agree.
     std::pair<double, bool> check_incremental_state();
 
+    /// P2G of the points' momentum m v into v (zeroed first; compressed).
+    /// Collective. Used by the loads (nodal velocity before the step).
+    void scatter_point_momentum(Vector &v);
+
     /// Nodal lumped mass and momentum after a P2G of the current particle state
     /// (for tests): returns global sums sum_i m_i and sum_i p_i.
     std::pair<double, dealii::Tensor<1, dim>> grid_mass_and_momentum();
