@@ -1,15 +1,16 @@
 #!/bin/bash
 # make bench: the explicit MPM benchmark (3D soft block spreading under gravity,
-# 8 material points per cell, > 1.3M points, fixed number of steps, one rank).
+# 8 material points per cell, 512k points, fixed number of steps, one rank), with
+# linear shape functions and then with quadratic B-splines.
 # Prints ns per particle-step with a breakdown and the fraction of material points
 # that changed cell per step. Build type must be Release (the Makefile's default).
 set -euo pipefail
 BUILD=${1:-build}
-PRM=parameter_files/bench/block_spreading_3d.prm
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 grep -q "CMAKE_BUILD_TYPE:STRING=Release" "$BUILD/CMakeCache.txt" || {
   echo "bench: $BUILD is not a Release build; refusing to benchmark the debug library" >&2; exit 2; }
+for PRM in parameter_files/bench/block_spreading_3d.prm parameter_files/bench/block_spreading_3d_bspline.prm; do
 echo "bench: $PRM (single rank)"
 "$BUILD/tools/talus-explicit" "$PRM" | tee "$LOG"
 python3 - "$LOG" <<'PY'
@@ -27,3 +28,4 @@ for name, v in zip(names, b.groups()[:5]):
 print("  %-30s %7.1f ns/particle-step" % ("total", 1e9 * wall / ps))
 print("  material points changing cell per step: %.1f %%" % (100.0 * int(b.group(6)) / ps))
 PY
+done
