@@ -1053,3 +1053,27 @@ TEST(BSplinePatches, Memory)
             << sizeof(BSplinePatch<3>) << ", CellCache<2> " << sizeof(CellCache<2>) << ", CellCache<3> "
             << sizeof(CellCache<3>) << "\n";
 }
+
+// setup() again (repartition, restart) rebuilds a requested stencil; a grid
+// that never asked for it has none (a Q1 run keeps its memory).
+TEST(BSplinePatches, RebuiltBySetup)
+{
+  BackgroundGrid<2> q1(MPI_COMM_WORLD);
+  q1.make_box(dealii::Point<2>(0, 0), dealii::Point<2>(1, 1), {4, 4});
+  q1.setup();
+  EXPECT_FALSE(q1.has_patches());
+  EXPECT_TRUE(q1.patches.empty());
+
+  BackgroundGrid<2>  grid(MPI_COMM_WORLD);
+  dealii::Point<2>   lower;
+  double             h[2];
+  make_grid<2>(grid, {6, 4}, lower, h);
+  ASSERT_TRUE(grid.has_patches());
+  const std::vector<BSplinePatch<2>> before = grid.patches;
+  grid.patches.clear();
+  grid.setup();
+  ASSERT_EQ(grid.patches.size(), before.size());
+  for (std::size_t k = 0; k < before.size(); ++k)
+    for (unsigned int i = 0; i < BSplinePatch<2>::n_slots * 2; ++i)
+      EXPECT_EQ(grid.patches[k].dofs[i], before[k].dofs[i]);
+}
