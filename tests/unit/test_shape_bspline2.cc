@@ -1022,6 +1022,20 @@ TEST(BSplinePatches, RefusesNonUniformGrids)
       }
   }
   {
+    // a grid file whose vertex lines are off by 1e-9 of the extent (rounded
+    // coordinates) is still a uniform box
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
+    auto         mesh  = io::make_box_mesh(2, lo, hi, {5, 4});
+    for (auto &v : mesh.vertices)
+      if (std::lround(v[0] * 5) % 2 == 1)
+        v[0] += 1e-9;
+    BackgroundGrid<2> grid(MPI_COMM_WORLD);
+    grid.make_from_mesh(mesh);
+    grid.setup();
+    EXPECT_NO_THROW(grid.setup_bspline_patches());
+    EXPECT_EQ(grid.box.n_cells[0], 5u);
+  }
+  {
     // L-shaped: a uniform lattice that does not fill its bounding box
     const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
     auto         mesh  = io::make_box_mesh(2, lo, hi, {4, 4});
