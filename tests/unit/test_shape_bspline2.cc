@@ -1022,6 +1022,20 @@ TEST(BSplinePatches, RefusesNonUniformGrids)
       }
   }
   {
+    // a grid file whose vertex lines are off by 1e-9 of the extent (rounded
+    // coordinates) is still a uniform box
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
+    auto         mesh  = io::make_box_mesh(2, lo, hi, {5, 4});
+    for (auto &v : mesh.vertices)
+      if (std::lround(v[0] * 5) % 2 == 1)
+        v[0] += 1e-9;
+    BackgroundGrid<2> grid(MPI_COMM_WORLD);
+    grid.make_from_mesh(mesh);
+    grid.setup();
+    EXPECT_NO_THROW(grid.setup_bspline_patches());
+    EXPECT_EQ(grid.box.n_cells[0], 5u);
+  }
+  {
     // L-shaped: a uniform lattice that does not fill its bounding box
     const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
     auto         mesh  = io::make_box_mesh(2, lo, hi, {4, 4});
@@ -1052,4 +1066,28 @@ TEST(BSplinePatches, Memory)
   std::cout << "  sizeof: BSplinePatch<2> " << sizeof(BSplinePatch<2>) << ", BSplinePatch<3> "
             << sizeof(BSplinePatch<3>) << ", CellCache<2> " << sizeof(CellCache<2>) << ", CellCache<3> "
             << sizeof(CellCache<3>) << "\n";
+}
+
+// setup() again (repartition, restart) rebuilds a requested stencil; a grid
+// that never asked for it has none (a Q1 run keeps its memory).
+TEST(BSplinePatches, RebuiltBySetup)
+{
+  BackgroundGrid<2> q1(MPI_COMM_WORLD);
+  q1.make_box(dealii::Point<2>(0, 0), dealii::Point<2>(1, 1), {4, 4});
+  q1.setup();
+  EXPECT_FALSE(q1.has_patches());
+  EXPECT_TRUE(q1.patches.empty());
+
+  BackgroundGrid<2>  grid(MPI_COMM_WORLD);
+  dealii::Point<2>   lower;
+  double             h[2];
+  make_grid<2>(grid, {6, 4}, lower, h);
+  ASSERT_TRUE(grid.has_patches());
+  const std::vector<BSplinePatch<2>> before = grid.patches;
+  grid.patches.clear();
+  grid.setup();
+  ASSERT_EQ(grid.patches.size(), before.size());
+  for (std::size_t k = 0; k < before.size(); ++k)
+    for (unsigned int i = 0; i < BSplinePatch<2>::n_slots * 2; ++i)
+      EXPECT_EQ(grid.patches[k].dofs[i], before[k].dofs[i]);
 }

@@ -246,7 +246,9 @@ namespace talus
         hmin[d] = dealii::Utilities::MPI::min(hmin[d], comm);
         hi[d]   = dealii::Utilities::MPI::max(hi[d], comm);
         hmax[d] = dealii::Utilities::MPI::max(hmax[d], comm);
-        if (hmax[d] - hmin[d] > 1e-10 * hmax[d])
+        // 1e-6: grid files carry node coordinates rounded to ~1e-10 of the extent
+        // (talus-mesh), i.e. cell sizes differing by up to ~1e-10 n relative
+        if (hmax[d] - hmin[d] > 1e-6 * hmax[d])
           throw InputError(where + reason + "; the cell size in " + axis[d] + " varies from " +
                            std::to_string(hmin[d]) + " to " + std::to_string(hmax[d]));
         const double       extent = hi[d] - lo[d];

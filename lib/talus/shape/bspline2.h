@@ -47,39 +47,25 @@ namespace talus::shape
                 double (&N)[3],
                 double (&dN)[3])
     {
-      double s; // point position relative to the window's middle node, in [-1/2, 1/2]
-      if (xi < 0.5)
+      // Which half of the cell is data-dependent and unpredictable for the points of a
+      // cell: select it without a branch; only the (rare, predictable) wall test branches.
+      const bool upper = xi >= 0.5;
+      if (upper ? j + 1 == n : j == 0)
         {
-          if (j == 0) // lower wall half cell: linear hats on nodes 0, 1
-            {
-              first = 1;
-              N[0]  = 1.0 - xi;
-              N[1]  = xi;
-              N[2]  = 0.0;
-              dN[0] = -inv_h;
-              dN[1] = inv_h;
-              dN[2] = 0.0;
-              return;
-            }
-          first = 0;
-          s     = xi;
+          // wall half cell: linear hats on nodes 0, 1 (window 0, 1, 2) resp. n-1, n
+          // (window n-2, n-1, n)
+          const unsigned int o = upper ? 1 : 0, z = upper ? 0 : 2;
+          first                = upper ? 0 : 1;
+          N[o]                 = 1.0 - xi;
+          N[o + 1]             = xi;
+          N[z]                 = 0.0;
+          dN[o]                = -inv_h;
+          dN[o + 1]            = inv_h;
+          dN[z]                = 0.0;
+          return;
         }
-      else
-        {
-          if (j + 1 == n) // upper wall half cell: linear hats on nodes n-1, n
-            {
-              first = 0;
-              N[0]  = 0.0;
-              N[1]  = 1.0 - xi;
-              N[2]  = xi;
-              dN[0] = 0.0;
-              dN[1] = -inv_h;
-              dN[2] = inv_h;
-              return;
-            }
-          first = 1;
-          s     = xi - 1.0;
-        }
+      first          = upper ? 1 : 0;
+      const double s = upper ? xi - 1.0 : xi; // relative to the window's middle node, in [-1/2, 1/2]
       const double a = 0.5 - s, b = 0.5 + s;
       N[0]  = 0.5 * a * a;
       N[1]  = 0.75 - s * s;
