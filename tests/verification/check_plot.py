@@ -169,7 +169,9 @@ tv.check(n_out == 6 and len(snaps) == n_out, f"solver: {len(snaps)} snapshots an
 tv.check(all(os.path.isfile(x) for x in paths), f"solver: the {len(paths)} announced PNGs exist")
 tv.check(sorted(os.path.abspath(x) for x in paths) == files_below(os.path.join(run, "png")),
          "solver: nothing but the announced PNGs in run/png")
-check_pngs(snaps, (800, 600), "solver snapshots")
+auto_h = read_png(snaps[0])[1] if snaps else 0
+check_pngs(snaps, (800, auto_h), "solver snapshots (auto size: 800 wide, the scene's height at equal scale)")
+tv.check(260 <= auto_h <= 500, f"auto size: 800 x {auto_h} (a plot area of 200 to 700 px, the block 0.8 x 0.4 m)")
 check_pngs([x for x in paths if "/series_" in x], (800, 500), "solver series plots")
 fields = open(os.path.join(run, "fields.txt")).read()
 tv.check("material 0 = linear elastic" in fields and "dimension = 2" in fields, "solver wrote fields.txt")
@@ -187,7 +189,7 @@ tv.check(all(w in names for w in want), f"series plots {', '.join(want)} drawn")
 tv.check(sum(1 for x in names if x.startswith("snapshot_stress_yy_")) == n_out, "one stress snapshot per output")
 check_pngs([os.path.join(work, x) for x in paths if "snapshot_" in x], (640, 480), "talus-plot snapshots")
 check_pngs([os.path.join(work, x) for x in paths if "series_" in x], (700, 400), "talus-plot series plots")
-m = re.search(r"colour range \[([-\d.e+]+), ([-\d.e+]+)\]", p.stdout)
+m = re.search(r"colour range \(robust\) \[([-\d.e+]+), ([-\d.e+]+)\]", p.stdout)
 tv.check(m is not None and float(m.group(1)) < float(m.group(2)) <= 0.0 + 1e-9 * abs(float(m.group(1))),
          f"one colour range for all frames, from the compressive stresses ({m.group(0) if m else '?'})")
 
