@@ -11,6 +11,7 @@ drawn by the solver itself (png snapshots = every output) and by talus-plot:
     [0.5, 1.3] x [0, 0.4]) matches the axes mapping within 2 pixels: the plot frame is found
     in the image (its black border) and the data window is the one talus-plot reports;
   * a 3D run drawn as a slice and as a projection; an empty slice is refused (exit 2);
+  * a 2-rank run draws its last output from both VTU pieces;
   * talus-fem accepts and draws `png snapshots = final`.
 Usage: check_plot.py TOOLS_DIR WORKDIR
 """
@@ -282,7 +283,15 @@ p = run_plot(["--view=slice y = 5", "--output=p3_empty", "run3d"], 2)
 tv.check(p.returncode == 2 and "no material point in the slice" in p.stderr
          and not os.path.exists(os.path.join(work, "p3_empty")), f"empty slice: exit {p.returncode}, nothing written")
 
-# ---- 6. talus-fem draws its final state too
+# ---- 6. two ranks: the snapshot of the last output reads both VTU pieces (all 128 points)
+text = tv.prm_set(BLOCK, "output/directory", "run_np2")
+text = tv.prm_set(text, "output/png snapshots", "final")
+rc, out, err = tv.run_tool(os.path.join(tools, "talus-explicit"), text, work, "block_np2", np=2)
+m = re.search(r"talus-plot: 1 frame\(s\) of (\d+) points from (\d+) VTU piece", out)
+tv.check(m is not None and m.groups() == ("128", "2") and len(announced(out)) == 6,
+         f"2 ranks: {m.group(0) if m else 'no frame line'}; {len(announced(out))} PNGs announced")
+
+# ---- 7. talus-fem draws its final state too
 text = tv.prm_set(BLOCK, "output/directory", "runfem")
 text = tv.prm_set(text, "output/png snapshots", "final")
 text = tv.prm_set(text, "output/vtu interval", "0")

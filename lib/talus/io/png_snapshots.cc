@@ -85,6 +85,8 @@ namespace talus::io
   void
   draw_png_snapshots(dealii::ParameterHandler &prm, MPI_Comm comm)
   {
+    // every rank's VTU piece of the last output is complete before rank 0 reads them
+    MPI_Barrier(comm);
     if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
       return;
     std::string dir, mode, field;
