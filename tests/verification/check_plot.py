@@ -223,7 +223,9 @@ p = run_plot(["--check", "--output=chk", "run"])
 tv.check(p.returncode == 0 and not os.path.exists(os.path.join(work, "chk")), "--check: exit 0, nothing written")
 
 # ---- 4. coloured extent of the block at t = 0 vs the axes mapping
-p = run_plot(["--frames=first", "--field=body id", "--series=none", "--size=900,600", "--output=p2", "run"])
+# a fixed window: the mapping does not depend on what is drawn
+p = run_plot(["--frames=first", "--field=body id", "--series=none", "--size=900,600", "--window=0.2,1.6,-0.1,0.6",
+              "--output=p2", "run"])
 m = re.search(r"window x \[(\S+), (\S+)\] y \[(\S+), (\S+)\] m = pixels x \[(\d+), (\d+)\] y \[(\d+), (\d+)\]",
               p.stdout)
 png = announced(p.stdout)[0]
@@ -251,8 +253,9 @@ L, R = find_line(w, hx0, col_dark), find_line(w, hx1, col_dark)
 T, B = find_line(h, hy0, row_dark), find_line(h, hy1, row_dark)
 tv.check(None not in (L, R, T, B), f"plot frame found in the image at the reported pixels: x {L}..{R}, y {T}..{B}")
 if None not in (L, R, T, B):
+    # coloured: at least half covered by the body colour #1f77b4 (saturation 149) over white
     coloured = [(x, y) for y in range(T + 2, B - 1) for x in range(L + 2, R - 1)
-                if max(rows[y][x]) - min(rows[y][x]) > 60]
+                if max(rows[y][x]) - min(rows[y][x]) > 75]
     cx0, cx1 = min(c[0] for c in coloured), max(c[0] for c in coloured)
     cy0, cy1 = min(c[1] for c in coloured), max(c[1] for c in coloured)
     to_px = lambda x: L + (x - x0) / (x1 - x0) * (R - L)
