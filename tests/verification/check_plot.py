@@ -12,6 +12,8 @@ drawn by the solver itself (png snapshots = every output) and by talus-plot:
     in the image (its black border) and the data window is the one talus-plot reports;
   * a 3D run drawn as a slice and as a projection; an empty slice is refused (exit 2);
   * a 2-rank run draws its last output from both VTU pieces;
+  * a failure to draw after a complete run is a warning (exit 0, results in place); a solver
+    without talus-plot next to it refuses png snapshots with exit 2 before running;
   * talus-fem accepts and draws `png snapshots = final`.
 Usage: check_plot.py TOOLS_DIR WORKDIR
 """
@@ -294,7 +296,25 @@ m = re.search(r"talus-plot: 1 frame\(s\) of (\d+) points from (\d+) VTU piece", 
 tv.check(m is not None and m.groups() == ("128", "2") and len(announced(out)) == 6,
          f"2 ranks: {m.group(0) if m else 'no frame line'}; {len(announced(out))} PNGs announced")
 
-# ---- 7. talus-fem draws its final state too
+# ---- 7. a failure to draw: a warning, the run still exits 0 (docs/plot.md)
+text = tv.prm_set(BLOCK, "output/directory", "run_warn")
+text = tv.prm_set(text, "output/png snapshots", "final")
+text = tv.prm_set(text, "output/png field", "pore pressure")  # a 1-phase run has none
+rc, out, err = tv.run_tool(os.path.join(tools, "talus-explicit"), text, work, "block_warn", expect_rc=None)
+tv.check(rc == 0 and "warning: output/png snapshots = final: the pictures were not drawn" in err
+         and "'pore pressure' is not available" in err and os.path.isfile(os.path.join(work, "run_warn", "series.csv")),
+         f"drawing failed after a complete run: exit {rc}, warning on stderr, results in place")
+# talus-plot missing next to the solver: refused by --check (exit 2) before any run
+lone = os.path.join(work, "lone")
+os.makedirs(lone)
+shutil.copy(os.path.join(tools, "talus-explicit"), lone)
+text = tv.prm_set(BLOCK, "output/png snapshots", "final")
+rc, out, err = tv.run_tool(os.path.join(lone, "talus-explicit"), text, lone, "lone", expect_rc=None)
+tv.check(rc == 2 and "output/png snapshots" in err and "needs talus-plot next to the solver" in err
+         and not os.path.exists(os.path.join(lone, "run")),
+         f"no talus-plot next to the solver: exit {rc}, {err.strip()[:150]}")
+
+# ---- 8. talus-fem draws its final state too
 text = tv.prm_set(BLOCK, "output/directory", "runfem")
 text = tv.prm_set(text, "output/png snapshots", "final")
 text = tv.prm_set(text, "output/vtu interval", "0")
