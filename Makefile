@@ -26,8 +26,13 @@ configure: deps $(BUILD_DIR)/build.ninja
 build: configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
+# the demo .prm sets `output/png snapshots = final`: the run ends by drawing its final deposit
 demo: build
+	@rm -f output/column_collapse_2d/png/snapshot_*.png
 	$(BUILD_DIR)/tools/talus-explicit parameter_files/demo/column_collapse_2d.prm
+	@png=$$(ls output/column_collapse_2d/png/snapshot_*.png 2>/dev/null | tail -n 1); \
+	  if [ -n "$$png" ]; then echo "demo: the final deposit is drawn in $$png"; \
+	  else echo "demo: no PNG of the final deposit was drawn (see the warning above)"; fi
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE "verify|bench"

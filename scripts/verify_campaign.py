@@ -59,6 +59,9 @@ FAMILIES = [
      "<= 3 % up to 1.0 x Eq. 4.129", lambda s, r: len(r) == 4 and max(x["error"] for x in r) <= 0.03),
 ]
 
+# the final state of the large-deformation case, drawn by the run itself (talus-plot)
+LARGE_DEFORMATION_PNG = "large_deformation_disks.png"
+
 # Courant sweeps: (name, .prm, formulation)
 # (name, .prm, formulation, the analysed limit the measured one is compared with)
 SWEEPS = [
@@ -166,6 +169,11 @@ def run_large_deformation(build, work, only):
     import talus_verify as tv
     text = tv.prm_set(text, "output/directory", ".")
     text = tv.prm_set(text, "output/final particles csv", "true")
+    # the run draws its final state (talus-plot), embedded in the README
+    text = tv.prm_set(text, "output/png snapshots", "final")
+    text = tv.prm_set(text, "output/png field", "velocity magnitude")
+    for old in glob.glob(os.path.join(d, "png", "snapshot_*.png")):
+        os.remove(old)
     with open(os.path.join(d, "disks.prm"), "w") as f:
         f.write(text)
     t0 = time.perf_counter()
@@ -182,6 +190,12 @@ def run_large_deformation(build, work, only):
     n_p = s[0]["n_particles"] if s else 1
     cells_crossed = int(m.group(1)) / n_p if m else float("nan")
     ok = p.returncode == 0 and ratio_max <= 1.02 and cells_crossed >= 5
+    snaps = sorted(glob.glob(os.path.join(d, "png", "snapshot_*.png")))
+    if snaps:
+        shutil.copy(snaps[-1], os.path.join(DOCS, "png", LARGE_DEFORMATION_PNG))
+    else:
+        print("FAIL: the disks run drew no snapshot (output/png snapshots = final)")
+        ok = False
     write_atomic(os.path.join(DOCS, "csv", "large_deformation.csv"),
                  "case,exit_code,energy_max_over_initial,energy_end_over_initial,cell_changes_per_point,"
                  f"wall_s,ok\ndisks_collision,{p.returncode},{ratio_max:.10g},{ratio_end:.10g},{cells_crossed:.10g},"
@@ -321,6 +335,10 @@ def readme():
               "|---|---|---|---|---|---|",
               f"| {int(x['exit_code'])} | {x['energy_max_over_initial']:.4f} | {x['energy_end_over_initial']:.4f} | "
               f"{x['cell_changes_per_point']:.1f} | {x['wall_s']:.1f} | {'PASS' if ok else 'FAIL'} |", ""]
+        if os.path.isfile(os.path.join(DOCS, "png", LARGE_DEFORMATION_PNG)):
+            L += ["The final state, drawn by the run itself (`output/png snapshots = final`, talus-plot; "
+                  "points coloured by the velocity magnitude):", "",
+                  f"![colliding disks at the end time](png/{LARGE_DEFORMATION_PNG})", ""]
     else:
         ok_all = False
     cg = os.path.join(DOCS, "csv", "crossing_growth.csv")

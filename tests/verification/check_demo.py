@@ -6,7 +6,8 @@ consistency check of a real large-deformation run:
   * the column has collapsed and come to rest: the potential energy dropped by
     more than 40 % (height of the centre of mass), the final kinetic energy is below
     5 % of its peak, and the run-out (99th percentile of the point positions) exceeds twice the
-    initial column width.
+    initial column width;
+  * the run drew its final deposit (a PNG, output/png snapshots = final).
 Usage: check_demo.py TOOL PRM WORKDIR
 """
 import csv
@@ -31,5 +32,10 @@ parts = tv.read_csv(f"{work}/out/particles_final.csv")
 xs = sorted(parts["pos_x"])
 runout = xs[int(0.99 * len(xs))]  # a few separated points travel further (see docs/explicit.md)
 tv.check(runout > 0.2, f"run-out (99th percentile of x) {runout:.3f} m beyond twice the initial width 0.1 m")
+# the .prm draws the final deposit (output/png snapshots = final, issue 17)
+import glob
+pngs = glob.glob(f"{work}/out/png/snapshot_plastic_strain_*.png")
+tv.check(len(pngs) == 1 and open(pngs[0], "rb").read(8) == b"\x89PNG\r\n\x1a\n",
+         f"the final deposit is drawn: {', '.join(pngs) or 'no PNG'}")
 print(f"run-out: 99th percentile {runout:.3f} m, farthest point {xs[-1]:.3f} m; final height {max(parts['pos_y']):.3f} m")
 tv.finish()

@@ -4,7 +4,8 @@ Every table row of the README is compared with the CSV row it came from, number 
 number, to the printed precision: the convergence tables (value, abscissa, error,
 pairwise order, run times, points, steps, ns per point-step), the observed orders, the
 Courant sweeps, the large-deformation row and the smoothing criteria. Also: every plot
-the README shows exists and is a PNG, every convergence CSV has a table, and a PASS/FAIL
+the README shows exists and is a PNG (the large-deformation case shows one snapshot of its final
+state, issue 17), every convergence CSV has a table, and a PASS/FAIL
 printed matches the criterion flag in the CSV. A number edited in the README or a
 regenerated CSV without its README fails this check.
 Usage: check_readme.py DOCS_VERIFICATION_DIR
@@ -124,6 +125,17 @@ if os.path.isfile(ld):
     tv.check(not bad, "large deformation: row matches the CSV" + (f" ({'; '.join(bad)})" if bad else ""))
 else:
     tv.check(False, "large-deformation CSV exists")
+
+# issue 17: the large-deformation case shows its final state (a snapshot drawn by the run)
+sec = text[text.index("### Large deformation"):].split("\n### ")[0] if "### Large deformation" in text else ""
+pics = re.findall(r"\]\((png/[^)]+)\)", sec)
+tv.check(len(pics) == 1 and os.path.isfile(os.path.join(docs, pics[0]))
+         and open(os.path.join(docs, pics[0]), "rb").read(8) == b"\x89PNG\r\n\x1a\n",
+         f"large deformation: one snapshot embedded and present ({', '.join(pics) or 'none'})")
+# every picture the README shows exists and is a PNG
+missing = [x for x in re.findall(r"\]\((png/[^)]+)\)", text)
+           if not (os.path.isfile(os.path.join(docs, x)) and open(os.path.join(docs, x), "rb").read(4) == b"\x89PNG")]
+tv.check(not missing, "every picture of the README exists and is a PNG" + (f" (missing: {missing[:3]})" if missing else ""))
 
 cg = os.path.join(docs, "csv", "crossing_growth.csv")
 if os.path.isfile(cg):

@@ -3,6 +3,7 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/io/output.h>
+#include <talus/io/png_snapshots.h>
 #include <talus/loads/load_control.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
@@ -166,6 +167,7 @@ namespace talus::explicit_mpm
                         "series.csv (energies, momentum, probes over time), the probe displacements, velocities "
                         "and stresses over time, the final material point fields and the final fields mapped to "
                         "the grid nodes (lumped projection). Layout in docs/fem.md.");
+      io::declare_png_snapshot_parameters(prm);
     }
     prm.leave_subsection();
 
@@ -307,6 +309,7 @@ namespace talus::explicit_mpm
     p.results_file = prm.get("results file");
     if (!p.results_file.empty() && p.results_file.front() != '/')
       p.results_file = p.output_directory + "/" + p.results_file;
+    io::check_png_snapshot_parameters(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("checkpoint");
@@ -1680,6 +1683,7 @@ namespace talus::explicit_mpm
         s.setup();
         s.run();
       }
+    io::draw_png_snapshots(prm, MPI_COMM_WORLD); // after every output file is complete
     return exit_ok;
   }
 
