@@ -34,6 +34,7 @@ namespace talus
     cell_erased.assign(grid.cells.size(), 0);
     for (const auto &ac : cells)
       count_in_cell[ac.cell] = ac.n_particles;
+    cells_changed = true;
   }
 
   template <int dim>
@@ -49,7 +50,8 @@ namespace talus
         collect_active_cells();
         return;
       }
-    auto &count = count_in_cell;
+    auto &count   = count_in_cell;
+    cells_changed = false;
     for (const unsigned int c : r.removed_from)
       if (--count[c] == 0)
         cell_erased[c] = 1;
@@ -62,9 +64,13 @@ namespace talus
       {
         const unsigned int c = cells[i].cell;
         if (i < n_old && cell_erased[c])
-          continue; // this entry was erased (a re-filled cell sits at the end)
+          {
+            cells_changed = true;
+            continue; // this entry was erased (a re-filled cell sits at the end)
+          }
         cells[out++] = {c, count[c]};
       }
+    cells_changed = cells_changed || cells.size() > n_old;
     cells.resize(out);
     for (const unsigned int c : r.removed_from)
       cell_erased[c] = 0;

@@ -68,6 +68,11 @@ namespace talus
     /// possibly sent to other ranks).
     bool relocate(const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved = {});
 
+    /// Whether the last collect or relocate changed the set of cells holding
+    /// points (not just their counts): consumers that derive data from the
+    /// cell set (active DoFs) may skip their update when it did not.
+    bool cell_set_changed() const { return cells_changed; }
+
     Relocator<dim> &      relocator() { return *relocator_ptr; }
     const Relocator<dim> &relocator() const { return *relocator_ptr; }
 
@@ -94,6 +99,7 @@ namespace talus
     std::vector<ActiveCell>         cells;
     std::vector<unsigned int>       count_in_cell; // by active cell index
     std::vector<unsigned char>      cell_erased;
+    bool                            cells_changed = true;
     void                            update_active_cells();
   };
 } // namespace talus

@@ -146,6 +146,36 @@ namespace talus::shape
       }
     };
 
+    /// Mass and force of one point scattered on its window only (a point moved
+    /// into another cell: no per-cell sums over the whole patch).
+    static inline void
+    scatter_point(const Cell &                  c,
+                  const Eval &                  e,
+                  const double                  m,
+                  const double (&t)[dim][dim],
+                  const dealii::Tensor<1, dim> &g,
+                  double *                      M,
+                  double *                      Fv)
+    {
+      double N[n_window], G[n_window][dim];
+      W::values_and_gradients(e, N, G);
+      const unsigned int first = W::first_slot(e);
+      for (unsigned int w = 0; w < n_window; ++w)
+        {
+          const unsigned int s  = first + W::window_offset(w);
+          const double       mn = m * N[w];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              double q = 0;
+              for (unsigned int k = 0; k < dim; ++k)
+                q += t[d][k] * G[w][k];
+              const unsigned int i = c.dofs[s * dim + d]; // a window node is always in the grid
+              M[i] += mn;
+              Fv[i] += mn * g[d] + q;
+            }
+        }
+    }
+
     /// sum_p m_p N(x_p) v_p of a cell's points on the patch
     struct Momentum
     {

@@ -137,6 +137,21 @@ namespace talus::shape
       }
     };
 
+    /// Mass and force of one point (a point moved into another cell).
+    static inline void
+    scatter_point(const Cell &                  c,
+                  const Eval &                  e,
+                  const double                  m,
+                  const double (&t)[dim][dim],
+                  const dealii::Tensor<1, dim> &g,
+                  double *                      M,
+                  double *                      Fv)
+    {
+      MassForce sums;
+      sums.add(e, m, t);
+      sums.scatter(c, g, M, Fv);
+    }
+
     /// sum_p m_p N_v(x_p) v_p of a cell's points (Eq. 4.47)
     struct Momentum
     {

@@ -96,9 +96,22 @@ namespace talus::transfer
     {
       if (first.point(c, it))
         {
-          second.point(c, it);
+          if constexpr (moves_points<First>(0))
+            second.point_at(c, it, first.xi_new); // no read-back from storage
+          else
+            second.point(c, it);
           return true;
         }
+      return false;
+    }
+    template <class Op>
+    static constexpr auto moves_points(int) -> decltype(Op::moves_points, bool())
+    {
+      return Op::moves_points;
+    }
+    template <class Op>
+    static constexpr bool moves_points(long)
+    {
       return false;
     }
     inline void

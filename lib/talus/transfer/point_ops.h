@@ -55,6 +55,13 @@ namespace talus::transfer
       add(it->get_reference_location(), it->get_properties().data());
       return true;
     }
+    /// the same with the reference location known (a fused op after a move)
+    inline bool
+    point_at(const unsigned int, PointIterator<dim> &it, const dealii::Point<dim> &xi)
+    {
+      add(xi, it->get_properties().data());
+      return true;
+    }
     inline void
     end_cell(const unsigned int)
     {
@@ -64,9 +71,13 @@ namespace talus::transfer
     inline void
     scatter_one(const unsigned int c, const dealii::Point<dim> &xi, const double *P)
     {
-      begin_cell(c);
-      add(xi, P);
-      end_cell(c);
+      using L                    = PropertyLayout<dim>;
+      const typename K::Cell one = K::cell(grid, c);
+      typename K::Eval       e;
+      K::evaluate(one, xi, e);
+      double t[dim][dim];
+      minus_V_sigma<dim>(P, P[L::volume], t);
+      K::scatter_point(one, e, P[L::mass], t, g, M, F);
     }
   };
 
@@ -167,10 +178,16 @@ namespace talus::transfer
   /// is handed to the set's relocation.
   ///
   /// Physics provides
+  ///   PointState                           what update() hands to moved() for one
+  ///                                        point (a local of the walk: pointers to it
+  ///                                        may go to opaque calls without pinning the
+  ///                                        physics' sums in memory)
   ///   increments(cell, e, du, P, grad, dx)  grad du and dx at the point (default:
   ///                                         K::gradient, K::interpolate of du)
-  ///   update(c, cell, P, grad)             constitutive update etc.
-  ///   moved(it, P, x)                      diagnostics at the new position
+  ///   update(c, cell, P, grad, state)      constitutive update etc.
+  ///   moved(it, P, x, state)               diagnostics at the new position
+  /// The new reference location of a point that stayed is kept in `xi_new` for a
+  /// fused P2G op (Fused hands it on instead of reading it back from storage).
   template <int dim, class K, class Physics>
   struct UpdateAndMove
   {
@@ -192,8 +209,11 @@ namespace talus::transfer
     Physics &                  physics;
 
     static constexpr bool prefetch_location = true;
+    /// this op moves points: a fused second op gets the new reference location
+    static constexpr bool moves_points = true;
     typename K::Cell      cell;
     typename K::Field     du;
+    dealii::Point<dim>    xi_new;
 
     inline void
     begin_cell(const unsigned int c)
@@ -210,27 +230,27 @@ namespace talus::transfer
       K::evaluate(cell, it->get_reference_location(), e);
       double gu[dim][dim], dx[dim];
       physics.increments(cell, e, du, P, gu, dx);
-      physics.update(c, cell, P, gu);
+      typename Physics::PointState state;
+      physics.update(c, cell, P, gu, state);
       auto x = it->get_location();
       for (unsigned int d = 0; d < dim; ++d)
         {
           x[d] += dx[d];
           P[L::displacement + d] += dx[d];
         }
-      physics.moved(it, P, x);
+      physics.moved(it, P, x, state);
       // new reference coordinates: same cell if still inside
-      const auto &       cc     = grid.cells[c];
-      bool               inside = true;
-      dealii::Point<dim> nxi;
+      const auto &cc     = grid.cells[c];
+      bool        inside = true;
       for (unsigned int d = 0; d < dim; ++d)
         {
-          nxi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
-          inside = inside && nxi[d] >= 0.0 && nxi[d] <= 1.0;
+          xi_new[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
+          inside    = inside && xi_new[d] >= 0.0 && xi_new[d] <= 1.0;
         }
       it->set_location(x);
       if (inside)
         {
-          it->set_reference_location(nxi);
+          it->set_reference_location(xi_new);
           return true;
         }
       set.leaving(it, c);

@@ -681,8 +681,13 @@ namespace talus::explicit_mpm
     };
     if (prm.numerics.bspline()) // the nodes of the cells' patches (invalid outside the grid: skipped)
       for (const auto &ac : points.active_cells())
-        for (const unsigned int i : grid.patch(ac.cell).dofs)
-          add(i);
+        {
+          const unsigned int *dofs = grid.patch(ac.cell).dofs;
+          for (unsigned int n = 0; n < BSplinePatch<dim>::n_slots; ++n)
+            if (dofs[n * dim] < n_owned && !dof_marker[dofs[n * dim]]) // a node's components: all or none new
+              for (unsigned int d = 0; d < dim; ++d)
+                add(dofs[n * dim + d]);
+        }
     else
       for (const auto &ac : points.active_cells())
         for (const unsigned int i : grid.cells[ac.cell].dofs)
@@ -837,12 +842,15 @@ namespace talus::explicit_mpm
       std::vector<double> &                                          probe_values;
       std::vector<double> &                                          probe_stress;
 
-      Energies                      e        = {};
-      dealii::Tensor<1, dim>        momentum = {};
-      bool                          bad      = false;
-      // from update() to moved() of the same point
-      dealii::SymmetricTensor<2, 3> sigma = {};
-      const materials::Material *   material = nullptr;
+      Energies               e        = {};
+      dealii::Tensor<1, dim> momentum = {};
+      bool                   bad      = false;
+      /// from update() to moved() of one point
+      struct PointState
+      {
+        dealii::SymmetricTensor<2, 3> sigma;
+        const materials::Material *   material;
+      };
 
       inline void
       increments(const typename K::Cell & cell,
@@ -865,7 +873,8 @@ namespace talus::explicit_mpm
       }
 
       inline void
-      update(const unsigned int c, const typename K::Cell &cell, double *P, const double (&gu)[dim][dim])
+      update(const unsigned int c, const typename K::Cell &cell, double *P, const double (&gu)[dim][dim],
+             PointState &state)
       {
         materials::Strain d_eps;
         materials::Spin   d_omega;
@@ -878,11 +887,12 @@ namespace talus::explicit_mpm
             }
         if (smoothing) // §6.7.1: smoothed volumetric part
           smoothing->apply(c, d_eps);
-        material = materials[static_cast<unsigned int>(P[L::material])].get();
-        sigma    = L::get_stress(P);
-        material->update_stress(d_eps, d_omega, h, sigma,
-                                dealii::ArrayView<double>(P + history, material->n_history()));
+        const materials::Material &m     = *materials[static_cast<unsigned int>(P[L::material])];
+        auto                       sigma = L::get_stress(P);
+        m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + history, m.n_history()));
         L::set_stress(sigma, P);
+        state.sigma    = sigma;
+        state.material = &m;
         const double dvol = trace(d_eps);
         P[L::volume] *= (1.0 + dvol); // Eq. 4.50 (density follows as m / V)
         // A point never integrates more than the volume of its cell. Without
@@ -898,7 +908,10 @@ namespace talus::explicit_mpm
       }
 
       inline void
-      moved(const transfer::PointIterator<dim> &it, const double *P, const dealii::Point<dim> &x)
+      moved(const transfer::PointIterator<dim> &it,
+            const double *                      P,
+            const dealii::Point<dim> &          x,
+            const PointState &                  state)
       {
         const double mass = P[L::mass];
         double       v2 = 0, gx = 0;
@@ -912,7 +925,8 @@ namespace talus::explicit_mpm
           momentum[d] += mass * P[L::velocity + d];
         e.gravity_potential -= mass * gx;
         if (need_strain_energy)
-          e.strain += P[L::volume] * material->elastic_energy_density(sigma);
+          e.strain += P[L::volume] * state.material->elastic_energy_density(state.sigma);
+        const auto &sigma = state.sigma;
         if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
             !(P[L::volume] > 0))
           bad = true;
@@ -991,7 +1005,11 @@ namespace talus::explicit_mpm
         p2g.scatter_one(c, xi, P);
       });
     p2g_ready = !sorted && !prm.numerics.extended_p2g();
-    collect_active_dofs();
+    // with B-splines a cell's stencil is 4^dim nodes: recompute the active DoFs
+    // only when the set of cells with points changed (Q1: every step, as the
+    // order of the list follows the cells and bitwise restarts rely on it)
+    if (!prm.numerics.bspline() || points.cell_set_changed())
+      collect_active_dofs();
   }
 
   template <int dim>
