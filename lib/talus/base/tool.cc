@@ -1,4 +1,5 @@
 #include <talus/base/errors.h>
+#include <talus/base/mpi_session.h>
 #include <talus/base/tool.h>
 
 #include <deal.II/base/exceptions.h>
@@ -260,9 +261,12 @@ namespace talus
     return v;
   }
 
+
   int
   run_tool(int argc, char **argv, const ToolDescription &tool)
   {
+    // destroyed after `mpi`: the directory is removed after MPI_Finalize
+    const PrivateMpiSessionBase              session_base;
     dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
     std::vector<std::string>                 args(argv + 1, argv + argc);
     given_options.clear();
