@@ -52,7 +52,7 @@ FORBIDDEN = [
 
 # Open MPI's text when MPI_Init aborts before the tool ran (reported as a start-up failure)
 MPI_STARTUP_MARKERS = ("Local abort before MPI_INIT completed", "orte_init failed", "ompi_rte_init failed",
-                       "orte_ess_init failed", "An error occurred in MPI_Init", "PMIx_Init failed")
+                       "orte_ess_init failed", "An error occurred in MPI_Init", "MPI_INIT failed", "PMIx_Init failed")
 
 # mutation classes every run must contain (fast subset included)
 REQUIRED_CLASSES = ("body partly outside the grid", "output cannot be created", "grid too large")
@@ -487,7 +487,7 @@ def judge(tool_name, mut, rc, out, err, check):
     msg = err.strip()
     if rc is None:
         return [msg]
-    if rc != 0 and any(m in err + out for m in MPI_STARTUP_MARKERS):
+    if rc not in (0, 2) and any(m in err + out for m in MPI_STARTUP_MARKERS):
         return [f"the tool could not start (MPI start-up failure, exit {rc}; not its answer to the input): "
                 f"{msg[-300:]}"]
     if rc < 0:

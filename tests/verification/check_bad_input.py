@@ -64,7 +64,7 @@ clip = tv.prm_set(tv.prm_set(tv.prm_set(base, "body 0/upper corner", "1.25, 0.05
                   "time/end time", "1e-5")
 clip = tv.prm_set(clip, "output/directory", os.path.join(work, "clip_out"))
 rc, out, err = tv.run_tool(tool, clip, work, "clip", expect_rc=None)
-m = re.search(r"clip to grid: (\S+) seeding positions outside the grid dropped, volume lost (\S+)", out)
+m = re.search(r"clip to grid: (\S+) seeding positions outside the grid dropped, volume lost ([0-9.eE+-]+)", out)
 tv.check(rc == 0 and m is not None and float(m.group(1)) == 80 and abs(float(m.group(2)) - 80 * 0.015625 ** 2) < 1e-12,
          f"clip to grid = true: exit {rc}, log: {m.group(0) if m else (out + err)[-300:]}")
 

@@ -11,12 +11,17 @@ entity, nothing written):
   * a grid too large for the machine: talus-critical-dt, talus-fem, talus-mesh (the
     message gives the estimate and the available memory);
   * a child tool whose MPI cannot start (talus-convergence): exit 4 and "could not
-    start", never "refused" (exit 2).
+    start", never "refused" (exit 2);
+  * the cause of those failures is gone: with Open MPI's shared session directory
+    blocked, tools still start (and fail to without the private base: control); 16
+    tools started at once all start; nothing is left in TMPDIR.
 
 Usage: check_faults_tools.py TOOLS_DIR PRM_DIR WORKDIR
 """
 import os
 import re
+import shutil
+import socket
 import subprocess
 import sys
 
@@ -87,7 +92,7 @@ clip = tv.prm_set(mesh, "body 0/clip to grid", "true")
 with open(os.path.join(work, "clip.prm"), "w") as f:
     f.write(clip)
 rc, out, err = run([T("talus-mesh"), os.path.join(work, "clip.prm")], "clip")
-m = re.search(r"clip to grid: (\S+) seeding positions outside the grid dropped, volume lost (\S+)", out)
+m = re.search(r"clip to grid: (\S+) seeding positions outside the grid dropped, volume lost ([0-9.eE+-]+)", out)
 tv.check(rc == 0 and m is not None and float(m.group(1)) == 200 and abs(float(m.group(2)) - 0.5) < 1e-12
          and "400 material points" in out,
          f"talus-mesh clip to grid = true: exit {rc}: {m.group(0) if m else (out + err)[-300:]}")
@@ -123,6 +128,33 @@ tv.check(rc == 4 and "could not start" in err and "MPI start-up failure" in err 
          f"talus-convergence, solver cannot start MPI: exit {rc} (want 4), message: {err[:400]}")
 rc, out, err = run([T("talus-convergence"), "--check", os.path.join(work, "conv.prm")], "startup ok")
 tv.check(rc == 0, f"talus-convergence --check of the unmodified family: exit {rc} {err[:200]}")
+
+# the cause of the start-up failures: Open MPI's session directory <TMPDIR>/ompi.<host>.<uid>,
+# shared by all jobs. Block it (a file in its place): a tool started without mpirun must not
+# need it (it uses a private base); with the private base turned off it cannot start (control)
+tmpb = os.path.join(work, "tmpbase")
+shutil.rmtree(tmpb, ignore_errors=True)
+os.makedirs(tmpb)
+blocker = f"ompi.{socket.gethostname().split('.')[0]}.{os.getuid()}"
+with open(os.path.join(tmpb, blocker), "w") as f:
+    f.write("not a directory\n")
+barprm = os.path.join(work, "bar_ok.prm")
+with open(barprm, "w") as f:
+    f.write(bar)
+rc, out, err = run([T("talus-explicit"), "--check", barprm], "blocked", env=tv.child_env({"TMPDIR": tmpb}))
+tv.check(rc == 0, f"talus-explicit starts with the shared session directory blocked: exit {rc} {err[-200:]}")
+rc, out, err = run([T("talus-explicit"), "--check", barprm], "blocked, shared",
+                   env=tv.child_env({"TMPDIR": tmpb, "TALUS_SHARED_MPI_SESSION": "1"}))
+tv.check(tv.startup_failure(rc, out + err),
+         f"control: with the shared session directory (TALUS_SHARED_MPI_SESSION=1) it cannot start: exit {rc}")
+# 16 tools starting at once, twice: all start, and nothing is left in TMPDIR
+for r in range(2):
+    procs = [subprocess.Popen([T("talus-explicit"), "--check", barprm], cwd=work, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True, env=tv.child_env({"TMPDIR": tmpb}))
+             for _ in range(16)]
+    codes = [p.wait() for p in procs]
+    tv.check(codes == [0] * 16, f"16 concurrent starts (round {r}): exit codes {sorted(set(codes))}")
+tv.check(os.listdir(tmpb) == [blocker], f"nothing left in TMPDIR: {os.listdir(tmpb)}")
 
 tv.check(not os.path.exists(os.path.join(work, "must_not_exist")) and
          not os.path.exists(os.path.join(work, "conv_must_not_exist")) and not os.path.exists("/proc/talus_x"),

@@ -50,7 +50,7 @@ _LAUNCH_NAMES = {"OMPI_UNIVERSE_SIZE", "OMPI_FIRST_RANKS", "OMPI_NUM_APP_CTX", "
                  "OMPI_MCA_shmem_RUNTIME_QUERY_hint", "OMPI_MCA_mpi_oversubscribe"}
 # Text of an Open MPI start-up failure (MPI_Init aborted before the tool ran).
 MPI_STARTUP_MARKERS = ("Local abort before MPI_INIT completed", "orte_init failed", "ompi_rte_init failed",
-                       "orte_ess_init failed", "An error occurred in MPI_Init", "PMIx_Init failed")
+                       "orte_ess_init failed", "An error occurred in MPI_Init", "MPI_INIT failed", "PMIx_Init failed")
 
 
 def child_env(extra=None):
@@ -77,7 +77,7 @@ def mpirun_session(env):
 
 def startup_failure(returncode, text):
     """True if a tool exited because Open MPI could not start (not the tool's answer to its input)."""
-    return returncode != 0 and any(m in text for m in MPI_STARTUP_MARKERS)
+    return returncode not in (0, 2) and any(m in text for m in MPI_STARTUP_MARKERS)
 
 
 def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None):

@@ -913,6 +913,7 @@ namespace talus::mesh
               std::vector<unsigned int> cells(s.cells.begin(), s.cells.end());
               const auto c = clipped_by_box_grid(spec.shape, lo, hi, cells);
               std::ostringstream os;
+              os.precision(10);
               os << where << ", clip to grid: ";
               if (c.counted)
                 os << c.points << " seeding positions outside the grid dropped, volume lost " << c.volume;
@@ -966,6 +967,7 @@ namespace talus::mesh
           if (note.back() == '@')
             {
               std::ostringstream os;
+              os.precision(10);
               os << s.bodies[b].shape.volume() - summary.volume_per_body[b]
                  << " (the shape's volume minus the seeded volume; gmsh grid)";
               note.pop_back();

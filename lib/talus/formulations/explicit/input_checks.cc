@@ -384,9 +384,9 @@ namespace talus::explicit_mpm
     // measured peak resident memory of talus-explicit (docs/reliability.md):
     // a process, a cell (triangulation, p4est, DoFs, cell cache, nodal vectors)
     // and a material point (ParticleHandler entry, properties, scratch)
-    const double per_process = 120e6;
-    const double per_cell    = dim == 2 ? 1.5e3 : 3.0e3;
-    const double per_point   = dim == 2 ? 0.5e3 : 0.7e3;
+    const double per_process = 180e6;
+    const double per_cell    = dim == 2 ? 600 : 1200;
+    const double per_point   = dim == 2 ? 650 : 800;
     return per_process * ranks_on_node + per_cell * n_cells + per_point * n_points;
   }
 
@@ -400,29 +400,30 @@ namespace talus::explicit_mpm
         if (!b.clip_to_grid)
           continue;
         std::ostringstream os;
+        os.precision(10);
         os << "  body " << k << " ('" << b.name << "'), clip to grid: ";
         if (b.shape == BodyDescription<dim>::Shape::file)
           {
             const double n = k < filed.dropped_points.size() ? filed.dropped_points[k] : 0;
             const double v = k < filed.dropped_volume.size() ? filed.dropped_volume[k] : 0;
-            os << fmt(n) << " material points of '" << b.particle_file << "' outside the grid dropped, volume lost "
-               << fmt(v);
+            os << n << " material points of '" << b.particle_file << "' outside the grid dropped, volume lost "
+               << v;
           }
         else if (!p.grid_mesh)
           {
             const auto c = clipped_by_box_grid(b, p.grid_lower, p.grid_upper, p.grid_cells);
             if (c.counted)
-              os << fmt(c.points) << " seeding positions outside the grid dropped, volume lost " << fmt(c.volume);
+              os << c.points << " seeding positions outside the grid dropped, volume lost " << c.volume;
             else
               os << "the positions outside the grid were not counted (more than 5e7)";
           }
         else
           {
             const double v = b.volume();
-            os << "volume lost about " << fmt(v - seeded.volume_per_body[k])
+            os << "volume lost about " << v - seeded.volume_per_body[k]
                << " (the shape's volume minus the seeded volume; grid from a file)";
           }
-        os << "; seeded volume " << fmt(seeded.volume_per_body[k]) << " (" << b.name << ")";
+        os << "; seeded volume " << seeded.volume_per_body[k] << " (" << b.name << ")";
         log() << os.str() << std::endl;
       }
   }
