@@ -4,12 +4,14 @@ Usage: check_bad_input.py TOOL PRM WORKDIR
 """
 import os
 import re
+import shutil
 import subprocess
 import sys
 
 import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1:4]
+shutil.rmtree(work, ignore_errors=True)  # "nothing written" is judged on a fresh directory
 base = tv.prm_set(open(prm_path).read(), "output/directory", "must_not_exist")
 lines = base.splitlines()
 

@@ -28,7 +28,8 @@ import sys
 import talus_verify as tv
 
 tools, prm_dir, work = (os.path.abspath(x) for x in sys.argv[1:4])
-os.makedirs(work, exist_ok=True)
+shutil.rmtree(work, ignore_errors=True)  # "nothing written" is judged on a fresh directory
+os.makedirs(work)
 T = lambda name: os.path.join(tools, name)  # noqa: E731
 bar = tv.prm_set(open(os.path.join(prm_dir, "verification", "bar_vibration.prm")).read(), "output/directory",
                  os.path.join(work, "must_not_exist"))
