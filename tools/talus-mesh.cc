@@ -31,6 +31,14 @@ namespace
 
 
 
+  /// Peak memory of talus-mesh for a box grid of n cells (docs/reliability.md:
+  /// measured in 2D, 170 MB + 156 B per cell; 3D scaled by the vertices per cell).
+  double
+  mesh_memory_bytes(const double n_cells, const unsigned int dim)
+  {
+    return 170e6 + (dim == 2 ? 160.0 : 320.0) * n_cells;
+  }
+
   /// "name = id, name = id" -> normalised name -> id
   std::map<std::string, unsigned int>
   parse_map(const std::string &text, const std::string &where)
@@ -116,6 +124,10 @@ namespace
                           "grid / gmsh: physical groups of dimension dim (names or numeric tags, comma-separated) "
                           "whose cells/elements form the body; empty = all.");
         prm.declare_entry("points per direction", "2", Integer(1, 10), "Material points per cell/element and direction.");
+        prm.declare_entry("clip to grid", "false", Bool(),
+                          "box/ball/polygon: false = a body not wholly inside the grid is refused (naming the "
+                          "coordinate outside and the grid extent); true = its points outside the grid are "
+                          "dropped and the summary states how many and the volume lost.");
         prm.declare_entry("positions", "regular", Selection("regular|gauss"),
                           "regular: centres of n^dim equal sub-cells (triangles: of n^2 sub-triangles; not on "
                           "tetrahedra); gauss: Gauss points. Volumes are |det J| x weight, so they sum to the "
@@ -162,6 +174,12 @@ namespace
             s.cells.push_back(static_cast<unsigned int>(x));
             total *= x;
           }
+        const double need = mesh_memory_bytes(total, dim), avail = available_memory_bytes();
+        require(avail < 0 || need <= avail, "grid/cells",
+                std::to_string(static_cast<unsigned long long>(total)) + " cells need about " +
+                  std::to_string(static_cast<unsigned long long>(need / 1e6)) + " MB for the grid, but only " +
+                  std::to_string(static_cast<unsigned long long>(avail / 1e6)) +
+                  " MB are available (MemAvailable of /proc/meminfo, or the cgroup limit)");
         require(total <= 1e8, "grid/cells", "more than 1e8 cells in total");
       }
     s.grid_options.recombine = prm.get_bool("recombine");
@@ -227,6 +245,21 @@ namespace
         else
           require(prm.get("groups").empty(), where + "/groups", "only for source = grid or gmsh");
         b.n     = prm.get_integer("points per direction");
+        b.shape.clip_to_grid            = prm.get_bool("clip to grid");
+        b.shape.particles_per_direction = b.n;
+        b.shape.name                    = b.name;
+        if (!s.grid_from_gmsh && !b.shape.clip_to_grid &&
+            (b.source == S::box || b.source == S::ball || b.source == S::polygon))
+          {
+            // a box grid is known here: refuse at --check (a gmsh grid: in mesh::prepare)
+            dealii::Point<dim> glo, ghi;
+            for (unsigned int d = 0; d < dim; ++d)
+              glo[d] = s.lower[d], ghi[d] = s.upper[d];
+            const std::string out = outside_extent(b.shape, glo, ghi);
+            require(out.empty(), where + " ('" + b.name + "')",
+                    out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                          "the grid, or set 'clip to grid = true' to drop the points outside)");
+          }
         b.gauss = prm.get("positions") == "gauss";
         b.k0    = prm.get_double("k0");
         b.k0_density = prm.get_double("k0 density");

@@ -7,8 +7,9 @@ Takes every shipped .prm under parameter_files/, finds the tools that read it
 numbers, unknown keys and subsections, unbalanced `end`, garbage lines,
 truncation at random byte offsets, empty file, binary junk, targeted
 inconsistencies such as an undefined material id, a boundary id the grid does
-not have, end time <= 0, zero cells, a body outside the grid, an output path
-below a file) and runs the tools on each mutation with a timeout. Tools that
+not have, end time <= 0, zero cells, a body outside the grid or pushed partly
+outside it, an output path below a file or where nothing can be created
+(/proc), a grid too large for the machine) and runs the tools on each mutation with a timeout. Tools that
 read no .prm (the micro-benchmarks) get their command line fuzzed instead.
 
 Every mutation is run with --check (parse + full validation, nothing runs).
@@ -48,6 +49,13 @@ FORBIDDEN = [
     "An error occurred in line", "Additional information", "Aborting!", "Signal", "Segmentation",
     "AddressSanitizer", "LeakSanitizer", "runtime error:", "core dumped", "std::", "what():",
 ]
+
+# Open MPI's text when MPI_Init aborts before the tool ran (reported as a start-up failure)
+MPI_STARTUP_MARKERS = ("Local abort before MPI_INIT completed", "orte_init failed", "ompi_rte_init failed",
+                       "orte_ess_init failed", "An error occurred in MPI_Init", "MPI_INIT failed", "PMIx_Init failed")
+
+# mutation classes every run must contain (fast subset included)
+REQUIRED_CLASSES = ("body partly outside the grid", "output cannot be created", "grid too large")
 
 NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
@@ -265,6 +273,54 @@ def mutate(prm, rng, n_random):
                 M("body outside the grid", prm.with_value(c, ", ".join(["-500"] * n)), "error",
                   [sub[0], "outside the grid"])
         break
+    # a body pushed partly outside a box grid: one coordinate beyond the grid's extent (issue 16:
+    # refused naming the body, the coordinate and the extent, never clipped silently)
+    g_lo, g_hi = prm.find("grid/lower corner"), prm.find("grid/upper corner")
+    g_src = prm.find("grid/source")
+    if g_lo and g_hi and (g_src is None or g_src[3] == "box") and is_number_list(g_hi[3]):
+        glo = [float(x) for x in g_lo[3].split(",")]
+        ghi = [float(x) for x in g_hi[3].split(",")]
+        for sub in sorted({e[1] for e in prm.entries if len(e[1]) == 1 and e[1][0].startswith("body ")}):
+            shape = prm.find(sub[0] + "/shape") or prm.find(sub[0] + "/source")
+            kind = "box" if shape is None else shape[3]
+            clip = prm.find(sub[0] + "/clip to grid")
+            if clip and clip[3] == "true":
+                continue
+            d = rng.randrange(len(ghi))
+            beyond = ghi[d] + 0.37 * (ghi[d] - glo[d])
+            if kind == "box" and prm.find(sub[0] + "/upper corner"):
+                e = prm.find(sub[0] + "/upper corner")
+                parts = [x.strip() for x in e[3].split(",")]
+                parts[d] = f"{beyond:.6g}"
+                M("body partly outside the grid", prm.with_value(e, ", ".join(parts)), "error",
+                  [sub[0], "outside the grid"])
+            elif kind == "ball" and prm.find(sub[0] + "/center"):
+                e = prm.find(sub[0] + "/center")
+                parts = [x.strip() for x in e[3].split(",")]
+                parts[d] = f"{ghi[d]:.6g}"  # the centre on the grid's face: half the ball outside
+                M("body partly outside the grid", prm.with_value(e, ", ".join(parts)), "error",
+                  [sub[0], "outside the grid"])
+            elif kind == "polygon" and prm.find(sub[0] + "/vertices"):
+                e = prm.find(sub[0] + "/vertices")
+                verts = [v.strip() for v in e[3].split(";") if v.strip()]
+                xy = [x.strip() for x in verts[0].split(",")]
+                xy[d % 2] = f"{beyond:.6g}"
+                verts[0] = ", ".join(xy)
+                M("body partly outside the grid", prm.with_value(e, "; ".join(verts)), "error",
+                  [sub[0], "outside the grid"])
+            break
+    # output that cannot be created: /proc accepts no new directory, not even from root
+    for key in ("directory", "grid file", "particle file", "csv file"):
+        e = prm.find("output/" + key)
+        if e:
+            value = "/proc/talus_fuzz/out" + ("" if key == "directory" else "/x.out")
+            M("output cannot be created: output/" + key, prm.with_value(e, value), "error",
+              ["output/" + key], no_output.get("output/" + key, ()))
+    # a grid far too large for any machine this runs on (refused with the memory estimate)
+    e = prm.find("grid/cells")
+    if e and (g_src is None or g_src[3] == "box"):
+        n = len(e[3].split(","))
+        M("grid too large", prm.with_value(e, ", ".join(["100000"] * n)), "error", ["grid/cells"])
     nb = prm.find("number of bodies")
     if nb and int(nb[3]) > 1:
         M("fewer bodies than subsections", prm.with_value(nb, str(int(nb[3]) - 1)), "error",
@@ -431,6 +487,9 @@ def judge(tool_name, mut, rc, out, err, check):
     msg = err.strip()
     if rc is None:
         return [msg]
+    if rc not in (0, 2) and any(m in err + out for m in MPI_STARTUP_MARKERS):
+        return [f"the tool could not start (MPI start-up failure, exit {rc}; not its answer to the input): "
+                f"{msg[-300:]}"]
     if rc < 0:
         return [f"killed by signal {-rc}: {msg[-400:]}"]
     for f in FORBIDDEN:
@@ -497,6 +556,7 @@ def main():
                   and not {"out", "output"} & set(os.path.relpath(r, args.prm_dir).split(os.sep)))
     jobs = []  # (tool, mutation)
     n_mut = 0
+    required_runs = {c: 0 for c in REQUIRED_CLASSES}
     per_prm = 40
     for path in prms:
         prm = Prm(path)
@@ -528,7 +588,14 @@ def main():
                 by_cat.setdefault(m.category, []).append(m)
             order = sorted(by_cat)
             rng.shuffle(order)
-            muts = [rng.choice(by_cat[c]) for c in order[:args.fast_per_prm]]
+            picked = [rng.choice(by_cat[c]) for c in order[:args.fast_per_prm]]
+            # the fault classes of issue 16 are always in the fast subset, a few of each
+            for cls in REQUIRED_CLASSES:
+                have = [m for m in muts if m.category.startswith(cls) and m not in picked]
+                if have and required_runs[cls] < 4:
+                    picked.append(rng.choice(have))
+                    required_runs[cls] += 1
+            muts = picked
         n_mut += len(muts)
         for i, m in enumerate(muts):
             # fast subset: each mutation through one of the tools reading it (rotating);
@@ -588,6 +655,11 @@ def main():
     print(f"{'category':34s} {'runs':>5s} {'exit 0':>7s} {'exit!=0':>8s}")
     for k in sorted(cats):
         print(f"{k:34s} {cats[k][0]:5d} {cats[k][1]:7d} {cats[k][2]:8d}")
+    for cls in REQUIRED_CLASSES:
+        n = sum(v[0] for k, v in cats.items() if k.startswith(cls))
+        print(f"{cls}: {n} runs")
+        if n == 0:
+            failures.append(f"no mutation of the class '{cls}' was run")
     if args.subset == "full" and n_mut < 200:
         failures.append(f"only {n_mut} mutations (want >= 200)")
     if failures:

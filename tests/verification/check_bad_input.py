@@ -3,11 +3,15 @@
 Usage: check_bad_input.py TOOL PRM WORKDIR
 """
 import os
+import re
+import shutil
+import subprocess
 import sys
 
 import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1:4]
+shutil.rmtree(work, ignore_errors=True)  # "nothing written" is judged on a fresh directory
 base = tv.prm_set(open(prm_path).read(), "output/directory", "must_not_exist")
 lines = base.splitlines()
 
@@ -22,6 +26,23 @@ cases = {
     "body outside grid": (tv.prm_set(tv.prm_set(base, "body 0/lower corner", "5, 5"), "body 0/upper corner", "6, 6"),
                           ["body 0", "no material point"]),
     "unknown boundary id": (tv.prm_set(base, "boundary conditions/roller", "2, 3, 9"), ["boundary id 9"]),
+    # issue 16: a body partly outside the grid (y up to 0.05 in a grid ending at 0.03125) is refused,
+    # naming the body, the coordinate and the grid's extent; so are balls and polygons
+    "box partly outside grid": (tv.prm_set(base, "body 0/upper corner", "1, 0.05"),
+                                ["body 0", "upper corner", "y = 0.05", "y from 0 to 0.03125", "clip to grid"]),
+    "ball partly outside grid": (tv.prm_set(tv.prm_set(tv.prm_set(base, "body 0/shape", "ball"), "body 0/center",
+                                                       "1.2, 0.015"), "body 0/radius", "0.1"),
+                                 ["body 0", "center + radius", "x = 1.3", "x from 0 to 1.25"]),
+    "polygon partly outside grid": (tv.prm_set(tv.prm_set(base, "body 0/shape", "polygon"), "body 0/vertices",
+                                               "-0.1, 0; 1, 0; 1, 0.03"),
+                                    ["body 0", "vertices", "x = -0.1", "x from 0 to 1.25"]),
+    # issue 16: an output directory that cannot be created (root may write everywhere but /proc)
+    "output directory cannot be created": (tv.prm_set(base, "output/directory", "/proc/talus_x"),
+                                           ["output/directory", "/proc/talus_x", "cannot be created"]),
+    # issue 16: a valid integer is not an 'id'; a grid too large for the machine names the memory
+    "grid too large for the memory": (tv.prm_set(base, "grid/cells", "100000, 100000"),
+                                      ["grid/cells", "1e+10 cells", "need about", "available"]),
+    "cells not an integer": (tv.prm_set(base, "grid/cells", "40.5, 1"), ["grid/cells", "'40.5'", "positive integer"]),
     "unknown subsection": (base + "subsection nonsense\n  set a = 1\nend\n", ["nonsense"]),
 }
 for name, (text, needles) in cases.items():
@@ -29,10 +50,30 @@ for name, (text, needles) in cases.items():
     msg = err.strip()
     ok = rc == 2 and all(n in msg for n in needles) and msg.count("\n") < 6
     tv.check(ok, f"{name}: exit {rc}, message: {msg[:300]}")
+    if name in ("output directory cannot be created", "box partly outside grid", "grid too large for the memory"):
+        # --check refuses it too (before any heavy work)
+        prm = os.path.join(work, name.replace(" ", "_") + ".prm")
+        p = subprocess.run([os.path.abspath(tool), "--check", prm], cwd=work, capture_output=True, text=True,
+                           env=tv.child_env())
+        tv.check(p.returncode == 2 and needles[0] in p.stderr, f"{name}: --check exit {p.returncode}")
+tv.check(not any(n.startswith(".talus-probe") for n in os.listdir(work)), "the writability probe leaves nothing")
+
+# 'clip to grid = true' runs the partly outside body, and the log says what was dropped: the body
+# y in [0, 0.05] with 2 points per direction on cells of 0.03125 m has sub-cell centres at
+# y = 0.0078125 + k 0.015625, k = 0..2 inside the body; k = 2 (y = 0.0390625) lies beyond the grid:
+# 40 cells x 2 = 80 positions of 0.015625^2 m^2 each are dropped
+clip = tv.prm_set(tv.prm_set(tv.prm_set(base, "body 0/upper corner", "1.25, 0.05"), "body 0/clip to grid", "true"),
+                  "time/end time", "1e-5")
+clip = tv.prm_set(clip, "output/directory", os.path.join(work, "clip_out"))
+rc, out, err = tv.run_tool(tool, clip, work, "clip", expect_rc=None)
+m = re.search(r"clip to grid: (\S+) seeding positions outside the grid dropped, volume lost ([0-9.eE+-]+)", out)
+tv.check(rc == 0 and m is not None and float(m.group(1)) == 80 and abs(float(m.group(2)) - 80 * 0.015625 ** 2) < 1e-12,
+         f"clip to grid = true: exit {rc}, log: {m.group(0) if m else (out + err)[-300:]}")
 
 rc2 = os.system(f"{os.path.abspath(tool)} /nonexistent/file.prm > /dev/null 2>&1") >> 8
 tv.check(rc2 == 2, f"missing parameter file: exit {rc2}")
 rc3 = os.system(f"{os.path.abspath(tool)} --bogus > /dev/null 2>&1") >> 8
 tv.check(rc3 == 2, f"unknown option: exit {rc3}")
-tv.check(not os.path.exists(os.path.join(work, "must_not_exist")), "no output written for any broken input")
+tv.check(not os.path.exists(os.path.join(work, "must_not_exist")) and not os.path.exists("/proc/talus_x"),
+         "no output written for any broken input")
 tv.finish()

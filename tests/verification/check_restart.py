@@ -30,6 +30,7 @@ import sys
 import time
 
 from talus_verify import check, finish, prm_set, read_csv, run_tool
+import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1], sys.argv[2], sys.argv[3]
 shutil.rmtree(work, ignore_errors=True)
@@ -44,7 +45,7 @@ base = prm_set(base, "output/progress", "false")
 base = prm_set(base, "checkpoint/interval", "0.02")
 base = prm_set(base, "checkpoint/keep", "2")
 
-env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
+env = tv.child_env()
 
 
 def scene(name, **entries):
@@ -134,7 +135,8 @@ check(len(left) <= 2, f"at most 2 checkpoints kept ({len(left)})")
 
 # 3. the killed state restarted on 2 ranks
 cmd = ["mpirun", "--oversubscribe", "-np", "2", os.path.abspath(tool), os.path.join(work, "killed_np2.prm"), "--restart"]
-p = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True)
+with tv.mpirun_session(dict(env)) as e2:
+    p = subprocess.run(cmd, cwd=work, env=e2, capture_output=True, text=True)
 check(p.returncode == 0, f"restart on 2 ranks exits 0 (got {p.returncode}: {p.stderr.strip()[-300:]})")
 d_restart = max_rel_diff("reference", "killed_np2") if p.returncode == 0 else float("inf")
 # 4. 2 ranks, stopped early and restarted on 2 ranks: bitwise

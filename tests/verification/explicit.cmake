@@ -24,7 +24,7 @@ talus_verification(demo_column_collapse_2d check_demo.py demo/column_collapse_2d
 
 # the transfer/relocation unit tests again on 2 ranks (particles cross ranks)
 add_test(NAME unit.test_explicit_transfer_np2
-         COMMAND mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_explicit_transfer)
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/tests/verification/talus_verify.py mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_explicit_transfer)
 set_tests_properties(unit.test_explicit_transfer_np2 PROPERTIES LABELS "unit" ENVIRONMENT "${_env}" PROCESSORS 2 TIMEOUT 600)
 
 talus_verification(explicit_lost_particles check_lost.py verification/block_leaving_grid.prm)
@@ -106,3 +106,9 @@ add_test(NAME verification.explicit_column_collapse_a3_bspline_coarse
                  ${_w}/explicit_column_collapse_a3_bspline_coarse 0.6666666667 8)
 set_tests_properties(verification.explicit_column_collapse_a3_bspline_coarse PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 3000)
+
+# issue 16: bodies partly outside the grid, output that cannot be created, grids too large
+# for the machine and child tools whose MPI cannot start, in every tool
+add_test(NAME verification.faults_tools
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_faults_tools.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR} ${_w}/faults_tools)
+set_tests_properties(verification.faults_tools PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

@@ -2,11 +2,14 @@
 
 Only the Python standard library is used so that the checks run anywhere.
 """
+import contextlib
 import csv
 import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 
 
 def prm_set(text, path, value):
@@ -38,11 +41,51 @@ def prm_set(text, path, value):
     return "\n".join(lines + block) + "\n"
 
 
+# Variables an mpirun (or PMIx launcher) sets for the processes it starts; a
+# child started from such a process must not inherit them, or it takes itself
+# for a rank of the parent's job (docs/reliability.md).
+_LAUNCH_PREFIXES = ("PMIX_", "PMI_", "OMPI_COMM_WORLD_", "OMPI_MCA_orte_", "OMPI_MCA_ess", "OMPI_MCA_pmix")
+_LAUNCH_NAMES = {"OMPI_UNIVERSE_SIZE", "OMPI_FIRST_RANKS", "OMPI_NUM_APP_CTX", "OMPI_APP_CTX_NUM_PROCS",
+                 "OMPI_FILE_LOCATION", "OMPI_COMMAND", "OMPI_ARGV", "OMPI_MCA_initial_wdir",
+                 "OMPI_MCA_shmem_RUNTIME_QUERY_hint", "OMPI_MCA_mpi_oversubscribe"}
+# Text of an Open MPI start-up failure (MPI_Init aborted before the tool ran).
+MPI_STARTUP_MARKERS = ("Local abort before MPI_INIT completed", "orte_init failed", "ompi_rte_init failed",
+                       "orte_ess_init failed", "An error occurred in MPI_Init", "MPI_INIT failed", "PMIx_Init failed")
+
+
+def child_env(extra=None):
+    """os.environ without the variables of a parent mpirun, plus the settings every tool run needs."""
+    env = {k: v for k, v in os.environ.items() if not (k.startswith(_LAUNCH_PREFIXES) or k in _LAUNCH_NAMES)}
+    env.update({"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1", "OMP_NUM_THREADS": "1"})
+    if extra:
+        env.update(extra)
+    return env
+
+
+@contextlib.contextmanager
+def mpirun_session(env):
+    """A private Open MPI session base for one mpirun (set in env, removed afterwards): concurrent jobs
+    otherwise share <TMPDIR>/ompi.<host>.<uid> and race on its creation and removal. Singleton tool
+    starts do this themselves (lib/talus/base/mpi_session.h)."""
+    d = tempfile.mkdtemp(prefix="talus-mpirun-", dir=os.environ.get("TMPDIR") or "/tmp")
+    env["OMPI_MCA_orte_tmpdir_base"] = d
+    try:
+        yield env
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def startup_failure(returncode, text):
+    """True if a tool exited because Open MPI could not start (not the tool's answer to its input)."""
+    return returncode not in (0, 2) and any(m in text for m in MPI_STARTUP_MARKERS)
+
+
 def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None):
     """Write <workdir>/<name>.prm, run the tool (under mpirun if np > 1).
 
     Returns (returncode, stdout, stderr). Fails the test if the return code is
-    not expect_rc (None: accept anything).
+    not expect_rc (None: accept anything), and always if the tool could not
+    start (MPI start-up failure), with a message saying so.
     """
     os.makedirs(workdir, exist_ok=True)
     prm = os.path.join(workdir, name + ".prm")
@@ -51,11 +94,13 @@ def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None):
     cmd = [os.path.abspath(tool), os.path.abspath(prm)]
     if np > 1:
         cmd = ["mpirun", "--oversubscribe", "-np", str(np)] + cmd
-    env = dict(os.environ)
-    env.update({"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1", "OMP_NUM_THREADS": "1"})
-    if extra_env:
-        env.update(extra_env)
-    p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=3000)
+    env = child_env(extra_env)
+    with (mpirun_session(env) if np > 1 else contextlib.nullcontext()):
+        p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=3000)
+    if startup_failure(p.returncode, p.stdout + p.stderr):
+        sys.stderr.write(p.stderr[-3000:])
+        fail(f"{name}: {os.path.basename(tool)} could not start (MPI start-up failure, exit {p.returncode}); "
+             "this is not the tool's answer to its input")
     if expect_rc is not None and p.returncode != expect_rc:
         sys.stdout.write(p.stdout)
         sys.stderr.write(p.stderr)
@@ -164,3 +209,12 @@ def polyfit_noise(xs, ys, deg=4):
     coef = [M[i][n] / M[i][i] for i in range(n)]
     r2 = sum((y - sum(coef[i] * x ** i for i in range(n))) ** 2 for x, y in zip(xs, ys))
     return (r2 / len(xs)) ** 0.5
+
+
+if __name__ == "__main__":
+    # `talus_verify.py mpirun ARGS...`: mpirun ARGS with a private session base (for ctest)
+    if len(sys.argv) < 3 or sys.argv[1] != "mpirun":
+        sys.exit("usage: talus_verify.py mpirun ARGS...")
+    e = child_env()
+    with mpirun_session(e):
+        sys.exit(subprocess.run(["mpirun"] + sys.argv[2:], env=e).returncode)

@@ -1,4 +1,5 @@
 #include <talus/base/errors.h>
+#include <talus/base/mpi_session.h>
 #include <talus/base/tool.h>
 
 #include <deal.II/base/exceptions.h>
@@ -8,6 +9,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -154,6 +157,17 @@ namespace talus
     if (::access(p.c_str(), W_OK | X_OK) != 0)
       throw InputError(where + ": '" + dir + "' cannot be written: directory '" + p.string() +
                        "' is not writable");
+    // access() says yes to root everywhere, also where nothing can be created
+    // (/proc, read-only mounts): create and remove a probe directory there
+    std::string probe = (p / ".talus-probe-XXXXXX").string();
+    if (::mkdtemp(probe.data()) == nullptr)
+      {
+        const std::string why = std::strerror(errno);
+        throw InputError(where + ": '" + dir + "' cannot be " +
+                         (p == fs::path(dir) ? "written" : "created") + ": nothing can be created in '" +
+                         p.string() + "' (" + why + ")");
+      }
+    ::rmdir(probe.c_str());
   }
 
   void
@@ -167,6 +181,28 @@ namespace talus
       throw InputError(where + ": '" + file + "' is a directory, not a file");
     const fs::path parent = fs::path(file).parent_path();
     require_output_directory(parent.empty() ? std::string(".") : parent.string(), where);
+  }
+
+  double
+  available_memory_bytes()
+  {
+    double        avail = -1;
+    std::ifstream f("/proc/meminfo");
+    std::string   key;
+    double        kb;
+    std::string   unit;
+    while (f >> key >> kb)
+      {
+        std::getline(f, unit);
+        if (key == "MemAvailable:")
+          avail = kb * 1024;
+      }
+    // a cgroup (v2) limit below the node's memory (containers, batch jobs)
+    std::ifstream mx("/sys/fs/cgroup/memory.max"), cur("/sys/fs/cgroup/memory.current");
+    double        limit = 0, used = 0;
+    if (mx >> limit && cur >> used && limit > used)
+      avail = avail < 0 ? limit - used : std::min(avail, limit - used);
+    return avail;
   }
 
   const std::vector<std::string> &
@@ -260,9 +296,12 @@ namespace talus
     return v;
   }
 
+
   int
   run_tool(int argc, char **argv, const ToolDescription &tool)
   {
+    // destroyed after `mpi`: the directory is removed after MPI_Finalize
+    const PrivateMpiSessionBase              session_base;
     dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
     std::vector<std::string>                 args(argv + 1, argv + argc);
     given_options.clear();

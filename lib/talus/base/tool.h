@@ -74,6 +74,11 @@ namespace talus
   void require_output_directory(const std::string &dir, const std::string &where);
   /// Same for an output file: not a directory, and its directory usable as above.
   void require_output_file(const std::string &file, const std::string &where);
+  /// Memory available to this process [bytes]: MemAvailable of /proc/meminfo
+  /// (the node this rank runs on), lowered to the cgroup v2 limit
+  /// (memory.max - memory.current) where one is set; < 0 when unknown.
+  double available_memory_bytes();
+
   /// InputError unless x is finite (not NaN, not +-inf).
   void require_finite(double x, const std::string &where);
 

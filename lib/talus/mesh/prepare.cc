@@ -886,6 +886,45 @@ namespace talus::mesh
 
     // ---- points
     std::vector<SeedPoint> pts;
+    // shape bodies must lie wholly inside the grid unless 'clip to grid' (then noted)
+    std::vector<std::string> clip_notes(s.bodies.size());
+    {
+      double glo[3], ghi[3];
+      gb.mesh.bounding_box(glo, ghi);
+      dealii::Point<dim> lo, hi;
+      for (unsigned int d = 0; d < dim; ++d)
+        lo[d] = glo[d], hi[d] = ghi[d];
+      for (unsigned int b = 0; b < s.bodies.size(); ++b)
+        {
+          const auto &spec = s.bodies[b];
+          if (spec.source != BodySpec<dim>::Source::box && spec.source != BodySpec<dim>::Source::ball &&
+              spec.source != BodySpec<dim>::Source::polygon)
+            continue;
+          const std::string where = "body " + std::to_string(b) + " ('" + spec.name + "')";
+          if (!spec.shape.clip_to_grid)
+            {
+              const std::string out = outside_extent(spec.shape, lo, hi);
+              require(out.empty(), where,
+                      out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                            "the grid, or set 'clip to grid = true' to drop the points outside)");
+            }
+          else if (!s.grid_from_gmsh)
+            {
+              std::vector<unsigned int> cells(s.cells.begin(), s.cells.end());
+              const auto c = clipped_by_box_grid(spec.shape, lo, hi, cells);
+              std::ostringstream os;
+              os.precision(10);
+              os << where << ", clip to grid: ";
+              if (c.counted)
+                os << c.points << " seeding positions outside the grid dropped, volume lost " << c.volume;
+              else
+                os << "the positions outside the grid were not counted (more than 5e7)";
+              clip_notes[b] = os.str();
+            }
+          else
+            clip_notes[b] = where + ", clip to grid: volume lost about @"; // completed after seeding
+        }
+    }
     seed_in_grid(s, gb, grid_model.get(), pts);
     for (unsigned int b = 0; b < s.bodies.size(); ++b)
       if (s.bodies[b].source == BodySpec<dim>::Source::gmsh)
@@ -921,6 +960,21 @@ namespace talus::mesh
     for (unsigned int b = 0; b < s.bodies.size(); ++b)
       require(summary.points_per_body[b] > 0, "body " + std::to_string(b) + " ('" + s.bodies[b].name + "')",
               "contains no material point (outside the grid, or smaller than one point spacing)");
+    for (unsigned int b = 0; b < s.bodies.size(); ++b)
+      if (!clip_notes[b].empty())
+        {
+          std::string note = clip_notes[b];
+          if (note.back() == '@')
+            {
+              std::ostringstream os;
+              os.precision(10);
+              os << s.bodies[b].shape.volume() - summary.volume_per_body[b]
+                 << " (the shape's volume minus the seeded volume; gmsh grid)";
+              note.pop_back();
+              note += os.str();
+            }
+          summary.notes.push_back(note);
+        }
     {
       const Locator<dim> locate(gb.mesh, gb.boxes);
       for (std::size_t i = 0; i < pts.size(); ++i)

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <climits>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -117,6 +118,142 @@ namespace talus
           return false; // not seeded by seed_bodies()
       }
     return false;
+  }
+
+  template <int dim>
+  void
+  BodyDescription<dim>::bounding_box(dealii::Point<dim> &lo, dealii::Point<dim> &hi) const
+  {
+    switch (shape)
+      {
+        case Shape::box:
+          lo = lower, hi = upper;
+          return;
+        case Shape::ball:
+          for (unsigned int d = 0; d < dim; ++d)
+            lo[d] = center[d] - radius, hi[d] = center[d] + radius;
+          return;
+        case Shape::polygon:
+          for (unsigned int d = 0; d < dim; ++d)
+            lo[d] = std::numeric_limits<double>::max(), hi[d] = -lo[d];
+          for (const auto &v : polygon)
+            for (unsigned int d = 0; d < dim && d < 2; ++d)
+              lo[d] = std::min(lo[d], v[d]), hi[d] = std::max(hi[d], v[d]);
+          return;
+        case Shape::file:
+          lo = hi = dealii::Point<dim>();
+          return;
+      }
+  }
+
+  template <int dim>
+  double
+  BodyDescription<dim>::volume() const
+  {
+    double v = 0;
+    switch (shape)
+      {
+        case Shape::box:
+          v = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+            v *= upper[d] - lower[d];
+          break;
+        case Shape::ball:
+          v = dim == 2 ? M_PI * radius * radius : 4.0 / 3.0 * M_PI * radius * radius * radius;
+          break;
+        case Shape::polygon:
+          for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
+            v += 0.5 * (polygon[j][0] * polygon[i][1] - polygon[i][0] * polygon[j][1]);
+          v = std::abs(v);
+          break;
+        case Shape::file:
+          break;
+      }
+    return v;
+  }
+
+  template <int dim>
+  std::string
+  outside_extent(const BodyDescription<dim> &b, const dealii::Point<dim> &lo, const dealii::Point<dim> &hi)
+  {
+    using S = typename BodyDescription<dim>::Shape;
+    if (b.shape == S::file)
+      return "";
+    dealii::Point<dim> blo, bhi;
+    b.bounding_box(blo, bhi);
+    const char *axis = "xyz";
+    for (unsigned int d = 0; d < dim; ++d)
+      for (const bool upper : {false, true})
+        {
+          const double tol = 1e-12 * (hi[d] - lo[d]);
+          const double x   = upper ? bhi[d] : blo[d];
+          if (upper ? x <= hi[d] + tol : x >= lo[d] - tol)
+            continue;
+          std::ostringstream os;
+          os << (b.shape == S::box    ? (upper ? "upper corner" : "lower corner") :
+                 b.shape == S::ball   ? (upper ? "center + radius" : "center - radius") :
+                                        (upper ? "vertices (largest)" : "vertices (smallest)"))
+             << ": " << axis[d] << " = " << x << " lies outside the grid (" << axis[d] << " from " << lo[d]
+             << " to " << hi[d] << ")";
+          return os.str();
+        }
+    return "";
+  }
+
+  template <int dim>
+  ClipCount
+  clipped_by_box_grid(const BodyDescription<dim> &b, const dealii::Point<dim> &lo, const dealii::Point<dim> &hi,
+                      const std::vector<unsigned int> &cells)
+  {
+    using S = typename BodyDescription<dim>::Shape;
+    ClipCount          r;
+    const unsigned int n = b.particles_per_direction;
+    dealii::Point<dim> blo, bhi;
+    b.bounding_box(blo, bhi);
+    // lattice x_k = lo + (k + 1/2) s, k integer (also < 0 and beyond the grid)
+    double s[dim], sub_volume = 1, n_all = 1, n_in = 1, visits = 1;
+    long long k0[dim], k1[dim];
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        s[d] = (hi[d] - lo[d]) / (double(cells[d]) * n);
+        sub_volume *= s[d];
+        k0[d] = static_cast<long long>(std::ceil((blo[d] - lo[d]) / s[d] - 0.5 - 1e-12));
+        k1[d] = static_cast<long long>(std::floor((bhi[d] - lo[d]) / s[d] - 0.5 + 1e-12));
+        const double all = std::max(0.0, double(k1[d] - k0[d] + 1));
+        const double in  = std::max(0.0, double(std::min<long long>(k1[d], (long long)cells[d] * n - 1) -
+                                               std::max<long long>(k0[d], 0) + 1));
+        n_all *= all, n_in *= in, visits *= all;
+      }
+    if (b.shape == S::box)
+      r.points = n_all - n_in;
+    else if (visits > 5e7)
+      {
+        r.counted = false;
+        return r;
+      }
+    else
+      {
+        long long k[3] = {0, 0, 0};
+        const long long nk = static_cast<long long>(visits);
+        for (long long i = 0; i < nk; ++i)
+          {
+            long long rem = i;
+            bool      in_grid = true;
+            dealii::Point<dim> x;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const long long len = k1[d] - k0[d] + 1;
+                k[d] = k0[d] + rem % len;
+                rem /= len;
+                x[d] = lo[d] + (k[d] + 0.5) * s[d];
+                in_grid = in_grid && k[d] >= 0 && k[d] < (long long)cells[d] * n;
+              }
+            if (!in_grid && b.contains(x))
+              r.points += 1;
+          }
+      }
+    r.volume = r.points * sub_volume;
+    return r;
   }
 
   template <int dim>
@@ -329,15 +466,31 @@ namespace talus
       }
     if (!owner.empty())
       MPI_Allreduce(MPI_IN_PLACE, owner.data(), owner.size(), MPI_INT, MPI_MIN, grid.comm);
+    result.dropped_points.assign(bodies.size(), 0.0);
+    result.dropped_volume.assign(bodies.size(), 0.0);
     for (std::size_t k = 0; k < rows.size(); ++k)
-      if (owner[k] == INT_MAX)
+      if (owner[k] == INT_MAX && bodies[rows[k].body].clip_to_grid)
         {
+          result.dropped_points[rows[k].body] += 1;
+          result.dropped_volume[rows[k].body] += rows[k].table->volume[rows[k].row];
+        }
+      else if (owner[k] == INT_MAX)
+        {
+          // the grid's extent for the message (all ranks reach this point together)
+          double glo[dim], ghi[dim];
+          for (unsigned int d = 0; d < dim; ++d)
+            glo[d] = -lo[d], ghi[d] = hi[d];
+          MPI_Allreduce(MPI_IN_PLACE, glo, dim, MPI_DOUBLE, MPI_MAX, grid.comm);
+          MPI_Allreduce(MPI_IN_PLACE, ghi, dim, MPI_DOUBLE, MPI_MAX, grid.comm);
           std::ostringstream os;
           os << "body " << rows[k].body << " ('" << bodies[rows[k].body].name << "'): material point " << rows[k].row
              << " of particle file '" << bodies[rows[k].body].particle_file << "' at (";
           for (unsigned int d = 0; d < dim; ++d)
             os << (d ? ", " : "") << rows[k].table->position[rows[k].row * dim + d];
-          os << ") lies outside the grid (was the file made for another grid?)";
+          os << ") lies outside the grid (";
+          for (unsigned int d = 0; d < dim; ++d)
+            os << (d ? ", " : "") << "xyz"[d] << " from " << -glo[d] << " to " << ghi[d];
+          os << "; was the file made for another grid? 'clip to grid = true' in the body drops such points)";
           throw InputError(os.str());
         }
 
@@ -472,6 +625,12 @@ namespace talus
   template struct BodyDescription<2>;
   template struct BodyDescription<3>;
   template class Relocator<2>;
+  template std::string outside_extent(const BodyDescription<2> &, const dealii::Point<2> &, const dealii::Point<2> &);
+  template std::string outside_extent(const BodyDescription<3> &, const dealii::Point<3> &, const dealii::Point<3> &);
+  template ClipCount   clipped_by_box_grid(const BodyDescription<2> &, const dealii::Point<2> &,
+                                           const dealii::Point<2> &, const std::vector<unsigned int> &);
+  template ClipCount   clipped_by_box_grid(const BodyDescription<3> &, const dealii::Point<3> &,
+                                           const dealii::Point<3> &, const std::vector<unsigned int> &);
   template class Relocator<3>;
   template SeedingResult seed_bodies(const BackgroundGrid<2> &, const std::vector<BodyDescription<2>> &,
                                      const std::vector<double> &, const PropertyLayout<2> &,

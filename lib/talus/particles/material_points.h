@@ -118,14 +118,47 @@ namespace talus
     /// optional velocity field v(x) overriding initial_velocity (empty: none)
     std::function<dealii::Tensor<1, dim>(const dealii::Point<dim> &)> velocity_field;
     std::string                    name;
+    /// 'clip to grid': drop the points outside the grid (logged) instead of
+    /// refusing a body that is not wholly inside it
+    bool                           clip_to_grid = false;
 
     bool contains(const dealii::Point<dim> &x) const;
+    /// Bounding box of a box, ball or polygon (in 3D polygons do not exist).
+    void bounding_box(dealii::Point<dim> &lo, dealii::Point<dim> &hi) const;
+    /// Geometric volume (area in 2D) of a box, ball or polygon; 0 for file bodies.
+    double volume() const;
   };
+
+  /// Empty if the box/ball/polygon body `b` lies wholly inside [lo, hi] (to
+  /// 1e-12 of the extent); else the reason, naming the body's first coordinate
+  /// outside and the grid extent in that direction, e.g. "upper corner: y = 5.2
+  /// lies outside the grid (y from 0 to 2.3)". An axis-aligned box contains a
+  /// box, ball or polygon iff it contains its bounding box.
+  template <int dim>
+  std::string outside_extent(const BodyDescription<dim> &b, const dealii::Point<dim> &lo,
+                             const dealii::Point<dim> &hi);
+
+  /// What clipping a body to a box grid [lo, hi] with `cells` per direction
+  /// drops: the seeding positions of the grid's sub-cell lattice (continued
+  /// beyond the grid) inside the body but outside the grid, and the volume they
+  /// would carry (count x sub-cell volume). Box bodies are counted per
+  /// direction; balls and polygons position by position (counted = false when
+  /// more than 5e7 positions would have to be visited).
+  struct ClipCount
+  {
+    double points = 0, volume = 0;
+    bool   counted = true;
+  };
+  template <int dim>
+  ClipCount clipped_by_box_grid(const BodyDescription<dim> &b, const dealii::Point<dim> &lo,
+                                const dealii::Point<dim> &hi, const std::vector<unsigned int> &cells);
 
   struct SeedingResult
   {
     unsigned long long n_particles = 0;
     std::vector<double> volume_per_body;
+    /// file bodies with clip_to_grid: points outside the grid left out, and their volume
+    std::vector<double> dropped_points, dropped_volume;
   };
 
   /// Fill every locally owned cell with n^dim regular points (cell-centred

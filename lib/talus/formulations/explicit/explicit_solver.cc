@@ -223,6 +223,7 @@ namespace talus::explicit_mpm
         prm.declare_entry("vertices", "", Anything(), "Polygon: 'x,y; x,y; ...' [m], at least 3 vertices.");
         prm.declare_entry("particles per direction", "2", Integer(1, 10),
                           "Material points per cell and direction (n^dim per filled cell, regular positions).");
+        declare_clip_to_grid(prm);
         prm.declare_entry("initial velocity", zeros(dim), Anything(), "Uniform initial velocity [m/s].");
         prm.declare_entry("initial velocity function", "", Anything(),
                           "Optional initial velocity field, dim expressions separated by ';' in x, y, z "
@@ -269,7 +270,7 @@ namespace talus::explicit_mpm
       {
         p.grid_lower = parse_point<dim>(prm.get("lower corner"), "grid/lower corner");
         p.grid_upper = parse_point<dim>(prm.get("upper corner"), "grid/upper corner");
-        p.grid_cells = parse_ids(prm.get("cells"), "grid/cells");
+        p.grid_cells = parse_cell_counts(prm.get("cells"), "grid/cells");
         require(p.grid_cells.size() == dim, "grid/cells", "needs exactly " + std::to_string(dim) + " integers");
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -383,6 +384,7 @@ namespace talus::explicit_mpm
             require(b.polygon.size() >= 3, where + "/vertices", "a polygon needs at least 3 vertices");
           }
         b.particles_per_direction = prm.get_integer("particles per direction");
+        b.clip_to_grid            = prm.get_bool("clip to grid");
         b.initial_velocity        = parse_point<dim>(prm.get("initial velocity"), where + "/initial velocity");
         const std::string expr    = prm.get("initial velocity function");
         if (!expr.empty())
@@ -586,6 +588,7 @@ namespace talus::explicit_mpm
       const auto filed  = insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
       for (unsigned int b = 0; b < prm.bodies.size(); ++b)
         seeded.volume_per_body[b] += filed.volume_per_body[b];
+      log_clipping(prm, seeded, filed); // what 'clip to grid' left out (input_checks.h)
       if (fem) // the cells these points occupy get Gauss points instead (fem.h)
         seeded = fem->seed(density);
       for (unsigned int b = 0; b < prm.bodies.size(); ++b)

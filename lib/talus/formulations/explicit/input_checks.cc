@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -31,6 +33,20 @@ namespace talus::explicit_mpm
       for (unsigned int d = 0; d < dim; ++d)
         os << (d ? ", " : "") << x[d];
       os << ")";
+      return os.str();
+    }
+
+    std::string
+    fmt_bytes(const double b)
+    {
+      std::ostringstream os;
+      os.precision(3);
+      if (b >= 1e12)
+        os << b / 1e12 << " TB";
+      else if (b >= 1e9)
+        os << b / 1e9 << " GB";
+      else
+        os << b / 1e6 << " MB";
       return os.str();
     }
 
@@ -109,6 +125,37 @@ namespace talus::explicit_mpm
         const double h = p.grid_mesh->min_edge();
         require(h > 0 && std::isfinite(h), "grid/file", "'" + p.grid_file + "' has a cell with an edge of zero length");
       }
+    {
+      // points of the shape bodies (as below) and file bodies, for the memory estimate
+      double n_points_estimate = 0;
+      for (const auto &b : p.bodies)
+        {
+          if (b.shape == BodyDescription<dim>::Shape::file)
+            continue;
+          dealii::Point<dim> lo, hi;
+          b.bounding_box(lo, hi);
+          double v = 1, cv = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              v *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
+              cv *= (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
+            }
+          n_points_estimate += v / cv * std::pow(double(b.particles_per_direction), dim);
+        }
+      int size = 1;
+      MPI_Comm_size(MPI_COMM_WORLD, &size);
+      // ranks sharing this node: Open MPI says; otherwise assume all (the conservative case)
+      const char *  local  = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+      const unsigned int on_node = local ? std::max(1, std::atoi(local)) : size;
+      const double need  = estimated_memory_bytes(n_cells, n_points_estimate, dim, on_node) * on_node / size;
+      const double avail = available_memory_bytes();
+      require(avail < 0 || need <= avail, "grid/cells",
+              fmt(n_cells) + " cells and about " + fmt(n_points_estimate) + " material points need about " +
+                fmt_bytes(need) + " on this node" + (on_node > 1 ? " (" + std::to_string(on_node) + " ranks)" : "") +
+                ", but only " + fmt_bytes(avail) +
+                " are available (MemAvailable of /proc/meminfo, or the cgroup limit); use fewer cells or "
+                "particles per direction, or a machine with more memory");
+    }
     require(n_cells <= max_grid_cells,
             "grid/cells",
             fmt(n_cells) + " cells in total exceed the limit of " + fmt(max_grid_cells) +
@@ -157,28 +204,7 @@ namespace talus::explicit_mpm
           }
         // bounding box of the body
         dealii::Point<dim> lo, hi;
-        switch (b.shape)
-          {
-            case BodyDescription<dim>::Shape::box:
-              lo = b.lower, hi = b.upper;
-              break;
-            case BodyDescription<dim>::Shape::ball:
-              for (unsigned int d = 0; d < dim; ++d)
-                lo[d] = b.center[d] - b.radius, hi[d] = b.center[d] + b.radius;
-              break;
-            case BodyDescription<dim>::Shape::polygon:
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  lo[d] = std::numeric_limits<double>::max();
-                  hi[d] = -lo[d];
-                }
-              for (const auto &v : b.polygon)
-                for (unsigned int d = 0; d < dim && d < 2; ++d)
-                  lo[d] = std::min(lo[d], v[d]), hi[d] = std::max(hi[d], v[d]);
-              break;
-            case BodyDescription<dim>::Shape::file:
-              break; // handled above
-          }
+        b.bounding_box(lo, hi);
         double overlap = 1;
         for (unsigned int d = 0; d < dim; ++d)
           overlap *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
@@ -186,6 +212,37 @@ namespace talus::explicit_mpm
                 where,
                 "contains no material point: it lies entirely outside the grid (body " + fmt_point(lo) + " to " +
                   fmt_point(hi) + ", grid " + fmt_point(p.grid_lower) + " to " + fmt_point(p.grid_upper) + ")");
+        if (!b.clip_to_grid)
+          {
+            // silently clipped bodies were a trap: the grid must hold the whole body
+            const std::string out = outside_extent(b, p.grid_lower, p.grid_upper);
+            require(out.empty(), where,
+                    out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                          "the grid, or set 'clip to grid = true' in '" + "body " + std::to_string(k) +
+                          "' to drop the points outside)");
+            if (p.grid_mesh && b.shape == BodyDescription<dim>::Shape::box)
+              {
+                // a grid file need not fill its bounding box: the cells must cover the box body
+                const auto &       m  = *p.grid_mesh;
+                const unsigned int nv = m.n_cell_vertices();
+                double             covered = 0, body_volume = 1;
+                for (unsigned int d = 0; d < dim; ++d)
+                  body_volume *= hi[d] - lo[d];
+                for (std::size_t c = 0; c < m.n_cells(); ++c)
+                  {
+                    const auto &a = m.vertices[m.cells[c * nv]], &z = m.vertices[m.cells[c * nv + nv - 1]];
+                    double      v = 1;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      v *= std::max(0.0, std::min(hi[d], z[d]) - std::max(lo[d], a[d]));
+                    covered += v;
+                  }
+                require(covered >= body_volume * (1 - 1e-9), where,
+                        "the box " + fmt_point(lo) + " to " + fmt_point(hi) + " is not covered by the cells of '" +
+                          p.grid_file + "' (" + fmt(body_volume - covered) +
+                          " of its volume lies over no cell); a body must lie wholly inside the grid (allowed: "
+                          "move or shrink the body, or set 'clip to grid = true' to drop the points outside)");
+              }
+          }
         if (b.shape == BodyDescription<dim>::Shape::box && !p.grid_mesh)
           for (unsigned int d = 0; d < dim; ++d)
             require(interval_has_seed(p.grid_lower[d],
@@ -295,6 +352,84 @@ namespace talus::explicit_mpm
       check_files(parse_parameters<3>(prm));
   }
 
+  void
+  declare_clip_to_grid(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("clip to grid", "false", dealii::Patterns::Bool(),
+                      "false: a body not wholly inside the grid is refused (naming the coordinate outside and "
+                      "the grid extent); true: its points outside the grid are dropped and the log states how "
+                      "many and the volume lost.");
+  }
+
+  std::vector<unsigned int>
+  parse_cell_counts(const std::string &text, const std::string &where)
+  {
+    std::vector<unsigned int> r;
+    for (const auto &s : dealii::Utilities::split_string_list(text, ','))
+      {
+        const bool digits = !s.empty() && s.size() <= 10 &&
+                            std::all_of(s.begin(), s.end(), [](const char c) { return c >= '0' && c <= '9'; });
+        const double v = digits ? std::stod(s) : -1;
+        require(digits && v >= 1 && v <= 2147483647.0, where,
+                "'" + s + "' is not a positive integer (cells per direction, 1 to 2147483647; got '" + text + "')");
+        r.push_back(static_cast<unsigned int>(v));
+      }
+    return r;
+  }
+
+  double
+  estimated_memory_bytes(const double n_cells, const double n_points, const unsigned int dim,
+                         const unsigned int ranks_on_node)
+  {
+    // measured peak resident memory of talus-explicit (docs/reliability.md):
+    // a process, a cell (triangulation, p4est, DoFs, cell cache, nodal vectors)
+    // and a material point (ParticleHandler entry, properties, scratch)
+    const double per_process = 180e6;
+    const double per_cell    = dim == 2 ? 600 : 1200;
+    const double per_point   = dim == 2 ? 650 : 800;
+    return per_process * ranks_on_node + per_cell * n_cells + per_point * n_points;
+  }
+
+  template <int dim>
+  void
+  log_clipping(const Parameters<dim> &p, const SeedingResult &seeded, const SeedingResult &filed)
+  {
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      {
+        const auto &b = p.bodies[k];
+        if (!b.clip_to_grid)
+          continue;
+        std::ostringstream os;
+        os.precision(10);
+        os << "  body " << k << " ('" << b.name << "'), clip to grid: ";
+        if (b.shape == BodyDescription<dim>::Shape::file)
+          {
+            const double n = k < filed.dropped_points.size() ? filed.dropped_points[k] : 0;
+            const double v = k < filed.dropped_volume.size() ? filed.dropped_volume[k] : 0;
+            os << n << " material points of '" << b.particle_file << "' outside the grid dropped, volume lost "
+               << v;
+          }
+        else if (!p.grid_mesh)
+          {
+            const auto c = clipped_by_box_grid(b, p.grid_lower, p.grid_upper, p.grid_cells);
+            if (c.counted)
+              os << c.points << " seeding positions outside the grid dropped, volume lost " << c.volume;
+            else
+              os << "the positions outside the grid were not counted (more than 5e7)";
+          }
+        else
+          {
+            const double v = b.volume();
+            os << "volume lost about " << v - seeded.volume_per_body[k]
+               << " (the shape's volume minus the seeded volume; grid from a file)";
+          }
+        os << "; seeded volume " << seeded.volume_per_body[k] << " (" << b.name << ")";
+        log() << os.str() << std::endl;
+      }
+  }
+
+  template void   log_clipping<2>(const Parameters<2> &, const SeedingResult &, const SeedingResult &);
+  template void   log_clipping<3>(const Parameters<3> &, const SeedingResult &, const SeedingResult &);
   template void   check_consistency<2>(const Parameters<2> &);
   template void   check_consistency<3>(const Parameters<3> &);
   template double critical_time_step_of<2>(const Parameters<2> &);

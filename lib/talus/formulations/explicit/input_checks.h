@@ -31,6 +31,25 @@ namespace talus::explicit_mpm
   template <int dim>
   double critical_time_step_of(const Parameters<dim> &p);
 
+  /// The body entry 'clip to grid' (false: a body not wholly inside the grid is refused).
+  void declare_clip_to_grid(dealii::ParameterHandler &prm);
+
+  /// 'grid/cells': dim positive integers (cells per direction); InputError
+  /// naming `where` and the offending item otherwise.
+  std::vector<unsigned int> parse_cell_counts(const std::string &text, const std::string &where);
+
+  /// Memory a run needs on one node, estimated from the cells and material
+  /// points (docs/reliability.md: bytes per process, cell and point measured on
+  /// talus-explicit); compared with available_memory_bytes() (base/tool.h).
+  double estimated_memory_bytes(double n_cells, double n_points, unsigned int dim, unsigned int ranks_on_node);
+
+  /// Log what 'clip to grid' left out of each body: the seeding positions
+  /// outside the grid and their volume (box grid: counted on the grid's
+  /// sub-cell lattice; file bodies: the rows outside and their volumes; a
+  /// shape body on a grid file: the volume of the shape minus what was seeded).
+  template <int dim>
+  void log_clipping(const Parameters<dim> &p, const SeedingResult &seeded, const SeedingResult &filed);
+
   /// The talus-explicit check: parse_parameters() (with check_consistency) for
   /// the file's dimension, and the output directory must be creatable/writable.
   void check_scene(dealii::ParameterHandler &prm, const std::string &prm_file);
