@@ -1,6 +1,6 @@
 #!/bin/bash
 # make bench: the explicit MPM benchmark (3D soft block spreading under gravity,
-# 8 material points per cell, 512k points, fixed number of steps, one rank), with
+# 8 material points per cell, 1.31M points, fixed number of steps, one rank), with
 # linear shape functions and then with quadratic B-splines.
 # Prints ns per particle-step with a breakdown and the fraction of material points
 # that changed cell per step. Build type must be Release (the Makefile's default).
