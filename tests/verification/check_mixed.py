@@ -44,28 +44,8 @@ Ec = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 u_static = -rho * g * H * H / (2 * Ec)
 
 
-def solve(A, b):
-    n = len(b)
-    M = [row[:] + [b[i]] for i, row in enumerate(A)]
-    for c in range(n):
-        p = max(range(c, n), key=lambda r: abs(M[r][c]))
-        M[c], M[p] = M[p], M[c]
-        for r in range(n):
-            if r != c:
-                f = M[r][c] / M[c][c]
-                for k in range(c, n + 1):
-                    M[r][k] -= f * M[c][k]
-    return [M[i][n] / M[i][i] for i in range(n)]
-
-
 def noise(parts):
-    ys, s = parts["pos_y"], parts["stress_yy"]
-    deg = 4
-    A = [[sum(y ** (i + j) for y in ys) for j in range(deg + 1)] for i in range(deg + 1)]
-    b = [sum(v * y ** i for y, v in zip(ys, s)) for i in range(deg + 1)]
-    c = solve(A, b)
-    r2 = sum((v - sum(c[i] * y ** i for i in range(deg + 1))) ** 2 for y, v in zip(ys, s))
-    return (r2 / len(ys)) ** 0.5 / (rho * g * H)
+    return tv.polyfit_noise(parts["pos_y"], parts["stress_yy"]) / (rho * g * H)
 
 
 def time_average(s):
