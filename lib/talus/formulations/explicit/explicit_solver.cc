@@ -2,7 +2,9 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
+#include <talus/formulations/common/time_loop.h>
 #include <talus/io/output.h>
+#include <talus/io/vtu.h>
 #include <talus/io/png_snapshots.h>
 #include <talus/loads/load_control.h>
 #include <talus/shape/bspline2_box.h>
@@ -1074,14 +1076,7 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::advance(const unsigned int n_steps)
   {
-    for (unsigned int i = 0; i < n_steps; ++i)
-      {
-        need_strain_energy = step_number % 10 == 0;
-        step(dt);
-        time += dt;
-        ++step_number;
-        check_stability();
-      }
+    TimeLoop(*this, loop_settings(prm), comm).advance_steps(n_steps);
   }
 
   template <int dim>
@@ -1233,40 +1228,6 @@ namespace talus::explicit_mpm
       }
   }
 
-  namespace
-  {
-    /// VTU piece per rank plus the PVTU record, each written under a temporary
-    /// name and renamed when complete: a killed run never leaves a truncated
-    /// VTU/PVTU. Same file names as DataOutInterface::write_vtu_with_pvtu_record.
-    template <typename DataOutType>
-    std::string
-    write_vtu_atomic(const DataOutType &out,
-                     const std::string &directory,
-                     const std::string &base,
-                     const unsigned int counter,
-                     MPI_Comm           comm)
-    {
-      const unsigned int rank   = dealii::Utilities::MPI::this_mpi_process(comm);
-      const unsigned int n_rank = dealii::Utilities::MPI::n_mpi_processes(comm);
-      const std::string  stem   = base + "_" + dealii::Utilities::int_to_string(counter, 4);
-      {
-        io::AtomicFile f(directory + "/" + stem + "." + std::to_string(rank) + ".vtu");
-        out.write_vtu(f.stream());
-        f.commit();
-      }
-      if (rank == 0)
-        {
-          std::vector<std::string> pieces;
-          for (unsigned int r = 0; r < n_rank; ++r)
-            pieces.push_back(stem + "." + std::to_string(r) + ".vtu");
-          io::AtomicFile f(directory + "/" + stem + ".pvtu");
-          out.write_pvtu_record(f.stream(), pieces);
-          f.commit();
-        }
-      return stem + ".pvtu";
-    }
-  } // namespace
-
   template <int dim>
   void
   Solver<dim>::write_vtu(const unsigned int counter)
@@ -1279,7 +1240,7 @@ namespace talus::explicit_mpm
     flags.time              = time;
     flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
     out.set_flags(flags);
-    const std::string name = write_vtu_atomic(out, prm.output_directory, "particles", counter, comm);
+    const std::string name = io::write_vtu_atomic(out, prm.output_directory, "particles", counter, comm);
     pvd_records.emplace_back(time, name);
     if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
@@ -1292,7 +1253,7 @@ namespace talus::explicit_mpm
         dout.add_data_vector(nodal_mass, std::vector<std::string>(dim, "nodal_mass"), dealii::DataOut<dim>::type_dof_data, interp);
         dout.add_data_vector(nodal_p, std::vector<std::string>(dim, "nodal_velocity"), dealii::DataOut<dim>::type_dof_data, interp);
         dout.build_patches();
-        const std::string gname = write_vtu_atomic(dout, prm.output_directory, "grid", counter, comm);
+        const std::string gname = io::write_vtu_atomic(dout, prm.output_directory, "grid", counter, comm);
         grid_pvd_records.emplace_back(time, gname);
         if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
           io::write_pvd(prm.output_directory + "/grid.pvd", grid_pvd_records);
@@ -1362,144 +1323,100 @@ namespace talus::explicit_mpm
   }
 
   template <int dim>
+  LoopSettings
+  loop_settings(const Parameters<dim> &prm)
+  {
+    LoopSettings s;
+    s.end_time                 = prm.end_time;
+    s.max_steps                = prm.max_steps;
+    s.output_directory         = prm.output_directory;
+    s.series_interval          = prm.series_interval;
+    s.vtu_interval             = prm.vtu_interval;
+    s.checkpoint_interval      = prm.checkpoint_interval;
+    s.checkpoint_wall_interval = prm.checkpoint_wall_interval;
+    s.progress                 = prm.progress;
+    s.stop_on_lost_points      = prm.stop_on_lost_particles;
+    s.max_cut_backs            = 0; // an explicit step always completes
+    return s;
+  }
+
+  template <int dim>
   void
   Solver<dim>::run()
   {
-    const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
-    if (root)
-      {
-        std::filesystem::create_directories(prm.output_directory);
-        // temporaries of a killed run (a complete file was never replaced)
-        for (const auto &e : std::filesystem::directory_iterator(prm.output_directory))
-          if (e.path().extension() == ".part")
-            std::filesystem::remove(e.path());
-      }
-    MPI_Barrier(comm);
-    const bool restored = !restored_from.empty();
-    if (restored)
-      log() << "talus-explicit: restarting from " << restored_from << " (step " << step_number << ", t = " << time
-            << " s)" << std::endl;
-    const double dt_cr = critical_time_step();
-    log() << "talus-explicit: " << dim << "D, " << grid.tria.n_global_active_cells() << " cells, "
-          << grid.dof_handler.n_dofs() << " DoFs, " << n_particles()
-          << (fem ? (fem->updated_lagrangian() ? " Gauss points (ul-fem), " : " Gauss points (fem), ") :
-                    " material points, ")
-          << dealii::Utilities::MPI::n_mpi_processes(comm) << " rank(s)\n"
-          << "  critical time step " << dt_cr << " s (L_min " << grid.min_cell_size() << " m), dt = " << dt
-          << " s (" << dt / dt_cr << " x critical), end time " << prm.end_time << " s\n";
+    TimeLoop(*this, loop_settings(prm), comm).run();
+  }
 
-    // series CSV: written as .part while running, renamed when the run ends
-    std::unique_ptr<io::AtomicFile> series;
-    const char *                    ax[] = {"x", "y", "z"};
-    if (root)
-      {
-        series = std::make_unique<io::AtomicFile>(prm.output_directory + "/series.csv");
-        auto &s = series->stream();
-        s << "time,step,stage,kinetic_energy,strain_energy,gravity_potential_energy,external_work,total_energy";
-        for (unsigned int d = 0; d < dim; ++d)
-          s << ",momentum_" << ax[d];
-        s << ",n_particles,lost_particles";
-        if (control && control->has_convergence())
-          s << ",force_ratio,energy_ratio";
-        if (free_surface)
-          {
-            s << ",free_surface_points";
-            for (unsigned int d = 0; d < dim; ++d)
-              s << ",extent_" << ax[d] << "_min,extent_" << ax[d] << "_max";
-          }
-        for (unsigned int k = 0; k < probe_ids.size(); ++k)
-          {
-            for (unsigned int d = 0; d < dim; ++d)
-              s << ",probe" << k << "_u" << ax[d];
-            for (unsigned int d = 0; d < dim; ++d)
-              s << ",probe" << k << "_v" << ax[d];
-          }
-        // probe stresses after all displacement/velocity columns
-        {
-          const auto names = points.layout.names();
-          for (unsigned int k = 0; k < probe_ids.size(); ++k)
-            for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
-              s << ",probe" << k << "_" << names[PropertyLayout<dim>::stress + q];
-        }
-        s << "\n" << std::setprecision(12);
-        if (restored)
-          {
-            // the rows up to the checkpoint, from the series.csv committed with it
-            std::ifstream old(prm.output_directory + "/series.csv");
-            std::string   line;
-            unsigned int  kept = 0;
-            for (std::getline(old, line); std::getline(old, line);)
-              {
-                const auto c1 = line.find(','), c2 = line.find(',', c1 + 1);
-                if (c1 == std::string::npos || c2 == std::string::npos)
-                  break;
-                if (std::stoull(line.substr(c1 + 1, c2 - c1 - 1)) > step_number)
-                  break;
-                s << line << "\n";
-                ++kept;
-              }
-            if (kept == 0)
-              log() << "  warning: no series.csv rows before the checkpoint were found; series.csv restarts "
-                       "at the checkpoint"
-                    << std::endl;
-          }
-      }
-    // After a step, the update pass has already summed the energies and the
-    // momentum of the new state (strain energy when need_strain_energy was
-    // set); only at t = 0 and after a deal.II sort (points may have been lost)
-    // are they summed by separate passes.
-    const auto write_series_row = [&](const bool from_update_pass) {
-      Energies               e;
-      dealii::Tensor<1, dim> p;
-      if (from_update_pass)
-        {
-          double v[3 + dim] = {local_energies.kinetic, local_energies.strain, local_energies.gravity_potential};
-          for (unsigned int d = 0; d < dim; ++d)
-            v[3 + d] = local_momentum[d];
-          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3 + dim), comm,
-                                      dealii::ArrayView<double>(v, 3 + dim));
-          e = {v[0], v[1], v[2], external_work};
-          for (unsigned int d = 0; d < dim; ++d)
-            p[d] = v[3 + d];
-        }
-      else
-        {
-          e = energies();
-          p = total_momentum();
-        }
-      if (free_surface)
-        free_surface->update();
-      std::vector<double> probes(probe_values.size()), probe_sigma(probe_stress.size());
-      if (!probe_values.empty())
-        {
-          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
-                                      dealii::ArrayView<double>(probes));
-          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_stress), comm,
-                                      dealii::ArrayView<double>(probe_sigma));
-        }
-      if (!root)
-        return;
-      auto &s = series->stream();
-      s << time << "," << step_number << "," << current_stage << "," << e.kinetic << "," << e.strain << "," << e.gravity_potential << ","
-        << e.external_work << "," << e.total();
-      for (unsigned int d = 0; d < dim; ++d)
-        s << "," << p[d];
-      s << "," << n_particles() << "," << points.relocation_stats.lost;
-      if (control && control->has_convergence())
-        s << "," << control->force_ratio << "," << control->energy_ratio;
-      if (free_surface)
-        {
-          s << "," << free_surface->count;
-          for (const double x : free_surface->extent)
-            s << "," << x;
-        }
-      for (const double v : probes)
-        s << "," << v;
-      for (const double v : probe_sigma)
-        s << "," << v;
-      s << "\n";
-    };
-    // probe values at t = 0
+  // ================================================================ Formulation interface
+
+  template <int dim>
+  void
+  Solver<dim>::describe(std::ostream &out) const
+  {
+    const double dt_cr = critical_time_step();
+    out << "talus-explicit: " << dim << "D, " << grid.tria.n_global_active_cells() << " cells, "
+        << grid.dof_handler.n_dofs() << " DoFs, " << n_particles()
+        << (fem ? (fem->updated_lagrangian() ? " Gauss points (ul-fem), " : " Gauss points (fem), ") :
+                  " material points, ")
+        << dealii::Utilities::MPI::n_mpi_processes(comm) << " rank(s)\n"
+        << "  critical time step " << dt_cr << " s (L_min " << grid.min_cell_size() << " m), dt = " << dt
+        << " s (" << dt / dt_cr << " x critical), end time " << prm.end_time << " s\n";
+  }
+
+  template <int dim>
+  unsigned int
+  Solver<dim>::n_stages() const
+  {
+    return control ? control->n_stages() : 1;
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::begin_stage(const unsigned int k, const bool first, const bool resumed)
+  {
+    if (!control)
+      return prm.end_time;
+    // stage 0 of a fresh run was begun by setup()
+    if (first && !resumed && k == 0)
+      return stage_start_time + control->stage(0).duration;
+    return control->begin_stage(*this, k, resumed);
+  }
+
+  template <int dim>
+  bool
+  Solver<dim>::stage_converged(std::string &message)
+  {
+    if (!control || !control->stage_converged())
+      return false;
+    std::ostringstream os;
+    os << std::setprecision(6) << "force ratio " << control->force_ratio << ", energy ratio "
+       << control->energy_ratio;
+    message = os.str();
+    return true;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::before_step(const double, const bool diagnostics_due)
+  {
+    // the stability check uses KE (+ SE when summed), a series row needs SE
+    need_strain_energy = diagnostics_due || step_number % 10 == 0;
+  }
+
+  template <int dim>
+  StepOutcome
+  Solver<dim>::advance_by(const double h)
+  {
+    step(h);
+    return StepOutcome::done;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::prepare_output()
+  {
+    // probe values at the start (after a step, the update pass fills them)
+    using L = PropertyLayout<dim>;
     if (!probe_ids.empty())
       for (const auto &pt : points.handler)
         for (unsigned int k = 0; k < probe_ids.size(); ++k)
@@ -1507,180 +1424,145 @@ namespace talus::explicit_mpm
             {
               for (unsigned int d = 0; d < dim; ++d)
                 {
-                  probe_values[k * 2 * dim + d]       = pt.get_properties()[PropertyLayout<dim>::displacement + d];
-                  probe_values[k * 2 * dim + dim + d] = pt.get_properties()[PropertyLayout<dim>::velocity + d];
+                  probe_values[k * 2 * dim + d]       = pt.get_properties()[L::displacement + d];
+                  probe_values[k * 2 * dim + dim + d] = pt.get_properties()[L::velocity + d];
                 }
-              for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
-                probe_stress[k * PropertyLayout<dim>::n_stress + q] =
-                  pt.get_properties()[PropertyLayout<dim>::stress + q];
+              for (unsigned int q = 0; q < L::n_stress; ++q)
+                probe_stress[k * L::n_stress + q] = pt.get_properties()[L::stress + q];
             }
+  }
 
-    unsigned int &      vtu_counter   = counters.vtu_counter;
-    unsigned long long &lost_reported = counters.lost_reported;
-    double &            next_series = counters.next_series, &next_vtu = counters.next_vtu;
-    if (!restored)
+  template <int dim>
+  std::vector<std::string>
+  Solver<dim>::series_columns() const
+  {
+    const char *             ax[] = {"x", "y", "z"};
+    std::vector<std::string> c    = {"kinetic_energy", "strain_energy", "gravity_potential_energy",
+                                     "external_work",  "total_energy"};
+    for (unsigned int d = 0; d < dim; ++d)
+      c.push_back(std::string("momentum_") + ax[d]);
+    c.push_back("n_particles");
+    c.push_back("lost_particles");
+    if (control && control->has_convergence())
       {
-        write_series_row(false);
-        write_vtu(vtu_counter++);
-        next_series               = prm.series_interval;
-        next_vtu                  = prm.vtu_interval;
-        counters.next_checkpoint  = prm.checkpoint_interval;
+        c.push_back("force_ratio");
+        c.push_back("energy_ratio");
+      }
+    if (free_surface)
+      {
+        c.push_back("free_surface_points");
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            c.push_back(std::string("extent_") + ax[d] + "_min");
+            c.push_back(std::string("extent_") + ax[d] + "_max");
+          }
+      }
+    for (unsigned int k = 0; k < probe_ids.size(); ++k)
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          c.push_back("probe" + std::to_string(k) + "_u" + ax[d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          c.push_back("probe" + std::to_string(k) + "_v" + ax[d]);
+      }
+    // probe stresses after all displacement/velocity columns
+    const auto names = points.layout.names();
+    for (unsigned int k = 0; k < probe_ids.size(); ++k)
+      for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
+        c.push_back("probe" + std::to_string(k) + "_" + names[PropertyLayout<dim>::stress + q]);
+    return c;
+  }
+
+  template <int dim>
+  std::vector<double>
+  Solver<dim>::series_values(const bool after_step)
+  {
+    // After a step, the update pass has already summed the energies and the
+    // momentum of the new state (strain energy when need_strain_energy was
+    // set); only at the start and after a deal.II sort (points may have been
+    // lost) are they summed by separate passes.
+    Energies               e;
+    dealii::Tensor<1, dim> p;
+    if (after_step && !points.relocator().sorted_last)
+      {
+        double v[3 + dim] = {local_energies.kinetic, local_energies.strain, local_energies.gravity_potential};
+        for (unsigned int d = 0; d < dim; ++d)
+          v[3 + d] = local_momentum[d];
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3 + dim), comm,
+                                    dealii::ArrayView<double>(v, 3 + dim));
+        e = {v[0], v[1], v[2], external_work};
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] = v[3 + d];
       }
     else
       {
-        // the series up to the checkpoint (a VTU written after it is rewritten)
-        if (root)
-          io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
-        if (root && prm.write_grid)
-          io::write_pvd(prm.output_directory + "/grid.pvd", grid_pvd_records);
+        e = energies();
+        p = total_momentum();
       }
-    auto       t_checkpoint = Clock::now();
-    const auto checkpoint_due = [&](const bool last) {
-      if (last)
-        return false;
-      bool due = prm.checkpoint_interval > 0 && time >= counters.next_checkpoint - 1e-9 * dt;
-      if (prm.checkpoint_wall_interval > 0)
-        {
-          // rank 0's clock decides, so that every rank takes part
-          int w = seconds_since(t_checkpoint) >= prm.checkpoint_wall_interval ? 1 : 0;
-          MPI_Bcast(&w, 1, MPI_INT, 0, comm);
-          due = due || w;
-        }
-      return due;
-    };
+    if (free_surface)
+      free_surface->update();
+    std::vector<double> probes(probe_values.size()), probe_sigma(probe_stress.size());
+    if (!probe_values.empty())
+      {
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
+                                    dealii::ArrayView<double>(probes));
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_stress), comm,
+                                    dealii::ArrayView<double>(probe_sigma));
+      }
+    std::vector<double> r = {e.kinetic, e.strain, e.gravity_potential, e.external_work, e.total()};
+    for (unsigned int d = 0; d < dim; ++d)
+      r.push_back(p[d]);
+    r.push_back(static_cast<double>(n_particles()));
+    r.push_back(static_cast<double>(points.relocation_stats.lost));
+    if (control && control->has_convergence())
+      {
+        r.push_back(control->force_ratio);
+        r.push_back(control->energy_ratio);
+      }
+    if (free_surface)
+      {
+        r.push_back(free_surface->count);
+        for (const double x : free_surface->extent)
+          r.push_back(x);
+      }
+    r.insert(r.end(), probes.begin(), probes.end());
+    r.insert(r.end(), probe_sigma.begin(), probe_sigma.end());
+    return r;
+  }
 
-    const auto   t_start   = Clock::now();
-    auto         t_report  = t_start;
-    bool         unstable  = false, stopped = false;
-    std::string  instability;
-    // stages (one without a staged .prm); a restarted run resumes in current_stage
-    const unsigned int n_stages    = control ? control->n_stages() : 1;
-    const bool         resumed     = restored;
-    bool               run_stopped = false;
-    bool               first_stage = true;
-    for (; current_stage < n_stages && !unstable && !stopped && !run_stopped; ++current_stage)
-      {
-    double end_time = prm.end_time;
-    if (control) // stage 0 was begun by setup()
-      end_time = (first_stage && !resumed && current_stage == 0)
-                   ? stage_start_time + control->stage(0).duration
-                   : control->begin_stage(*this, current_stage, resumed && first_stage);
-    first_stage = false;
-    const double eps_t      = 1e-9 * dt;
-    bool         stage_done = false;
-    while (!stage_done && time < end_time - eps_t && (prm.max_steps == 0 || step_number < prm.max_steps))
-      {
-        const double h = std::min(dt, end_time - time);
-        bool         last_step =
-          !(time + h < end_time - eps_t) || (prm.max_steps && step_number + 1 >= prm.max_steps);
-        bool series_due =
-          prm.series_interval == 0 || time + h >= next_series - eps_t || last_step;
-        // the stability check uses KE (+ SE when summed), a series row needs SE
-        need_strain_energy = series_due || step_number % 10 == 0;
-        step(h);
-        time += h;
-        ++step_number;
-        try
-          {
-            check_stability();
-            if (points.relocation_stats.lost > lost_reported)
-              {
-                std::ostringstream os;
-                os << "step " << step_number << " (t = " << time << " s): "
-                   << points.relocation_stats.lost - lost_reported << " material point(s) left the grid ("
-                   << points.relocation_stats.lost << " in total)";
-                lost_reported = points.relocation_stats.lost;
-                if (prm.stop_on_lost_particles)
-                  throw RunStopped(os.str() + "; 'stability/lost particles = stop'. Enlarge the grid or "
-                                                    "add boundary conditions.");
-                log() << "  warning: " << os.str() << "; removed" << std::endl;
-              }
-          }
-        catch (const InstabilityError &e)
-          {
-            unstable    = true;
-            instability = e.what();
-            break;
-          }
-        catch (const RunStopped &e)
-          {
-            stopped     = true;
-            instability = e.what();
-            break;
-          }
-        if (control && control->stage_converged())
-          {
-            stage_done = last_step = series_due = true;
-            log() << std::setprecision(6) << "  stage " << current_stage << " converged at step " << step_number
-                  << " (t = " << time << " s): force ratio " << control->force_ratio << ", energy ratio "
-                  << control->energy_ratio << std::endl;
-          }
-        auto t0 = Clock::now();
-        if (series_due)
-          {
-            write_series_row(!points.relocator().sorted_last);
-            while (next_series <= time + eps_t)
-              next_series += prm.series_interval > 0 ? prm.series_interval : dt;
-          }
-        if ((prm.vtu_interval > 0 && time >= next_vtu - eps_t) || last_step)
-          {
-            write_vtu(vtu_counter++);
-            while (prm.vtu_interval > 0 && next_vtu <= time + eps_t)
-              next_vtu += prm.vtu_interval;
-          }
-        if (checkpoint_due(last_step))
-          {
-            while (prm.checkpoint_interval > 0 && counters.next_checkpoint <= time + eps_t)
-              counters.next_checkpoint += prm.checkpoint_interval;
-            if (root)
-              {
-                // series.csv up to now, committed with the checkpoint
-                series->stream().flush();
-                const std::string out = prm.output_directory + "/series.csv";
-                std::filesystem::copy_file(out + ".part", out + ".copy.part",
-                                           std::filesystem::copy_options::overwrite_existing);
-                std::filesystem::rename(out + ".copy.part", out);
-              }
-            const std::string name = write_checkpoint();
-            t_checkpoint           = Clock::now();
-            if (prm.progress)
-              log() << "  checkpoint " << name << " (step " << step_number << ", t = " << time << " s)" << std::endl;
-          }
-        timings.output += seconds_since(t0);
-        if (prm.progress && seconds_since(t_report) > 2.0)
-          {
-            t_report            = Clock::now();
-            const double el     = seconds_since(t_start);
-            const double frac   = std::max(time / prm.end_time,
-                                         prm.max_steps ? double(step_number) / prm.max_steps : 0.0);
-            log() << "  step " << step_number << "  t = " << std::setprecision(4) << time << " s  ("
-                  << std::setprecision(3) << 100 * frac << " %)  elapsed " << el << " s  ETA "
-                  << el * (1 - frac) / std::max(frac, 1e-12) << " s" << std::endl;
-          }
-      }
-    if (prm.max_steps && step_number >= prm.max_steps)
-      run_stopped = true;
-      }
-    if (current_stage >= n_stages)
-      current_stage = n_stages - 1; // the last stage stays the current one after the run
-    timings.total = seconds_since(t_start);
-    if (root)
-      series->commit();
-    if (unstable)
-      throw InstabilityError(instability + " Output up to the last stable step is in " + prm.output_directory + ".");
-    if (stopped)
-      throw RunStopped(instability + " Output up to the previous step is in " + prm.output_directory + ".");
+  template <int dim>
+  void
+  Solver<dim>::rewrite_records()
+  {
+    if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
+    if (prm.write_grid)
+      io::write_pvd(prm.output_directory + "/grid.pvd", grid_pvd_records);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::finish(const std::string &series_csv)
+  {
     if (prm.final_particles_csv)
       write_final_particles();
     if (!prm.results_file.empty())
-      write_results(prm.output_directory + "/series.csv");
+      write_results(series_csv);
+  }
 
+  template <int dim>
+  void
+  Solver<dim>::summary(const LoopTimings &loop_timings)
+  {
+    timings.output = loop_timings.output;
+    timings.total  = loop_timings.total;
     const double ns = 1e9 * timings.total / std::max(1.0, double(step_number) * double(n_particles()));
+    const auto & rs = points.relocation_stats;
     log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid
           << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves "
-          << points.relocation_stats.seconds_moves << ", sorts " << points.relocation_stats.seconds_sorts << "), output "
-          << timings.output << "; particles moved cell " << points.relocation_stats.moved_locally << ", full sorts "
-          << points.relocation_stats.global_sorts << ", memory-order sorts " << points.relocation_stats.storage_sorts << ", lost " << points.relocation_stats.lost << "\n";
+          << rs.seconds_moves << ", sorts " << rs.seconds_sorts << "), output " << timings.output
+          << "; particles moved cell " << rs.moved_locally << ", full sorts " << rs.global_sorts
+          << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost << "\n";
     log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "
           << timings.total << " s, " << std::setprecision(3) << ns << " ns/particle-step, output in "
           << prm.output_directory << "/ (particles.pvd, series.csv)" << std::endl;
@@ -1712,6 +1594,8 @@ namespace talus::explicit_mpm
   template struct Parameters<3>;
   template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
   template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  template LoopSettings loop_settings<2>(const Parameters<2> &);
+  template LoopSettings loop_settings<3>(const Parameters<3> &);
   template class Solver<2>;
   template class Solver<3>;
 } // namespace talus::explicit_mpm

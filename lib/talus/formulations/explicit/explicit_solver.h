@@ -3,6 +3,7 @@
 // update), Jaumann-rate stress update, volume update, relocation.
 #pragma once
 
+#include <talus/formulations/common/formulation.h>
 #include <talus/formulations/explicit/fem.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
@@ -107,8 +108,15 @@ namespace talus::explicit_mpm
     double total() const { return kinetic + strain + gravity_potential - external_work; }
   };
 
+  /// The loop settings of an explicit .prm (time, output, checkpoint, stability).
   template <int dim>
-  class Solver
+  LoopSettings loop_settings(const Parameters<dim> &prm);
+
+  /// The explicit formulation: its step, diagnostics and files; the time loop
+  /// (formulations/common/time_loop.h) drives it. The run state (time, dt,
+  /// step_number, stage, output counters) is the RunState base.
+  template <int dim>
+  class Solver : public Formulation
   {
   public:
     Solver(const Parameters<dim> &prm, MPI_Comm comm);
@@ -116,7 +124,7 @@ namespace talus::explicit_mpm
 
     /// Grid, DoFs, boundary conditions, particles, time step. Collective.
     void setup();
-    /// Time loop with output until end time; throws InstabilityError.
+    /// The time loop with output until the end time; throws InstabilityError.
     void run();
     /// One explicit step of size dt (§4.3.7). Collective.
     void step(const double dt);
@@ -166,26 +174,31 @@ namespace talus::explicit_mpm
     /// ranks contribute to: the only nodes the grid update visits.
     std::vector<unsigned int>                     active_dofs;
     Timings                                       timings;
-    double                                        time = 0, dt = 0;
-    unsigned int                                  step_number = 0;
     Energies                                      initial_energies;
-    /// Time-loop and output counters a restart resumes (saved in checkpoints).
-    struct RunCounters
-    {
-      unsigned int       vtu_counter     = 0;
-      double             next_series     = 0, next_vtu = 0, next_checkpoint = 0;
-      unsigned long long lost_reported   = 0;
-    };
-    RunCounters                                   counters;
-    /// Stage of a staged calculation (saved in checkpoints).
-    unsigned int                                  current_stage = 0;
-    /// Set by setup() when the state came from a checkpoint (its path).
-    std::string                                   restored_from;
 
     /// Write the complete state to <checkpoint dir>/checkpoint-<step>.h5
     /// (written as .part, renamed when complete; older ones beyond `keep`
     /// removed). Collective. Returns the file name.
-    std::string write_checkpoint();
+    std::string write_checkpoint() override;
+
+    // ---- the Formulation interface (the time loop's view)
+    std::string              tool_name() const override { return "talus-explicit"; }
+    void                     describe(std::ostream &out) const override;
+    unsigned int             n_stages() const override;
+    double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
+    bool                     stage_converged(std::string &message) override;
+    void                     before_step(const double h, const bool diagnostics_due) override;
+    StepOutcome              advance_by(const double h) override;
+    void                     check_stability() const override;
+    unsigned long long       lost_points() const override { return points.relocation_stats.lost; }
+    void                     prepare_output() override;
+    std::vector<std::string> series_columns() const override;
+    std::vector<double>      series_values(const bool after_step) override;
+    void                     write_vtu(const unsigned int counter) override;
+    void                     rewrite_records() override;
+    void                     finish(const std::string &series_csv) override;
+    void                     summary(const LoopTimings &loop_timings) override;
+
     /// Checkpoint files in the directory, newest first (rank 0 lists, all get it).
     std::vector<std::string> list_checkpoints() const;
     /// Strain energy is summed in the update pass only when a series row or a
@@ -199,8 +212,6 @@ namespace talus::explicit_mpm
     /// Mass scaling factor beta of the running stage (seed 000 §6.5): nodal
     /// accelerations f / (beta m); critical_time_step() includes sqrt(beta).
     double                                        mass_scaling = 1.0;
-    /// Simulated time at which the running stage started (saved in checkpoints).
-    double                                        stage_start_time = 0;
     /// Loads/friction/damping/convergence/K0/stages; null when none is used.
     std::unique_ptr<loads::LoadControl<dim>>      control;
 
@@ -248,8 +259,6 @@ namespace talus::explicit_mpm
     void g2p_update_with(const double dt);
     template <class Kernel>
     void relocate_with();
-    void check_stability() const;
-    void write_vtu(unsigned int counter);
     void write_final_particles() const;
 
     bool p2g_ready = false; ///< nodal mass/force of the current state accumulated
