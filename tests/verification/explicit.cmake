@@ -112,3 +112,8 @@ set_tests_properties(verification.explicit_column_collapse_a3_bspline_coarse PRO
 add_test(NAME verification.faults_tools
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_faults_tools.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR} ${_w}/faults_tools)
 set_tests_properties(verification.faults_tools PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# issue 15: load balancing by material points (1 vs 2 ranks with rebalancing, the
+# imbalance after rebalancing, bitwise restart across rebalances on 2 ranks)
+talus_verification(explicit_load_balance check_load_balance.py verification/load_balance_collapse.prm)
+set_tests_properties(verification.explicit_load_balance PROPERTIES PROCESSORS 2)

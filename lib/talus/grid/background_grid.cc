@@ -19,9 +19,12 @@
 namespace talus
 {
   template <int dim>
-  BackgroundGrid<dim>::BackgroundGrid(MPI_Comm comm_)
+  BackgroundGrid<dim>::BackgroundGrid(MPI_Comm comm_, const bool canonical)
     : comm(comm_)
-    , tria(comm_)
+    , tria(comm_,
+           dealii::Triangulation<dim>::none,
+           canonical ? dealii::parallel::distributed::Triangulation<dim>::mesh_reconstruction_after_repartitioning :
+                       dealii::parallel::distributed::Triangulation<dim>::default_setting)
     , fe(dealii::FE_Q<dim>(1), dim)
     , dof_handler(tria)
   {}
@@ -396,6 +399,20 @@ namespace talus
           return nc.locally_owned ? n : dealii::numbers::invalid_unsigned_int;
       }
     return dealii::numbers::invalid_unsigned_int;
+  }
+
+  template <int dim>
+  void
+  BackgroundGrid<dim>::repartition(const CellWeight &weight)
+  {
+    // the 9.4 'weight' signal: the sum of the connected functions is a cell's
+    // whole weight (no implicit base weight)
+    const auto connection = tria.signals.weight.connect(
+      [&](const typename dealii::Triangulation<dim>::cell_iterator &cell,
+          const typename dealii::Triangulation<dim>::CellStatus) -> unsigned int { return weight(cell); });
+    tria.repartition();
+    connection.disconnect();
+    setup();
   }
 
   template class BackgroundGrid<2>;

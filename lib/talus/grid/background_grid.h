@@ -12,6 +12,7 @@
 #include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/lac/la_parallel_vector.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -82,7 +83,10 @@ namespace talus
   class BackgroundGrid
   {
   public:
-    explicit BackgroundGrid(MPI_Comm comm);
+    /// `canonical`: rebuild the local mesh from scratch after every repartition,
+    /// so that its cell and DoF numbering depend only on the partition, not on
+    /// the history of repartitions (load balancing with bitwise restarts).
+    explicit BackgroundGrid(MPI_Comm comm, bool canonical = false);
 
     /// Axis-aligned box with n_cells[d] cells per direction; boundary ids
     /// 0..2dim-1 for the faces x-, x+, y-, y+, z-, z+.
@@ -124,6 +128,13 @@ namespace talus
       return xi;
     }
 
+    /// Partition weight of a locally owned cell (repartition()).
+    using CellWeight = std::function<unsigned int(const typename dealii::Triangulation<dim>::cell_iterator &)>;
+    /// Repartition the cells among the ranks so that every rank holds about the
+    /// same total weight (p4est along its space-filling curve), then rebuild
+    /// DoFs and caches (setup()). Collective. Data attached to cells (material
+    /// points) must be packed before and unpacked after by the caller.
+    void repartition(const CellWeight &weight);
     /// Smallest cell edge over the whole grid (all ranks).
     double min_cell_size() const { return global_min_h; }
 

@@ -70,6 +70,16 @@ namespace talus::loads
 
     /// The convergence criterion of the stage was met (and ends the stage).
     bool stage_converged() const { return converged; }
+    /// After a repartition of the grid (load balancing): the nodal vectors and
+    /// node lists on the new partition.
+    void grid_changed(Solver &s)
+    {
+      for (Vector *v : {&trac, &vt, &lift})
+        if (v->size() > 0)
+          s.grid.reinit_vector(*v);
+      if (current) // else the stage about to begin builds them
+        build_node_lists(s);
+    }
     /// Last evaluated ratios (NaN before the first evaluation of the stage).
     double force_ratio  = std::numeric_limits<double>::quiet_NaN();
     double energy_ratio = std::numeric_limits<double>::quiet_NaN();

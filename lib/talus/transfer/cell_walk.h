@@ -71,6 +71,44 @@ namespace talus::transfer
       }
   }
 
+  /// An op made of three callables (begin_cell(c), point(c, it), end_cell(c)),
+  /// for the walks of features off the hot path (MPM-MIXED, contact, FEM,
+  /// results): the walk stays this one; the feature keeps its arithmetic.
+  template <class Begin, class Point, class End>
+  struct CellOps
+  {
+    Begin                 begin;
+    Point                 at_point;
+    End                   end;
+    static constexpr bool prefetch_location = false;
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      begin(c);
+    }
+    template <class It>
+    inline bool
+    point(const unsigned int c, It &it)
+    {
+      at_point(c, it);
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int c)
+    {
+      end(c);
+    }
+  };
+
+  /// The walk with an op given as three callables.
+  template <int dim, class Begin, class Point, class End>
+  inline void
+  for_each_active_cell(MaterialPointSet<dim> &set, Begin &&begin, Point &&point, End &&end)
+  {
+    CellOps<Begin &, Point &, End &> op{begin, point, end};
+    for_each_active_cell(set, op);
+  }
+
   /// Two ops in one pass: `first` runs on every point; `second` only on those
   /// for which first.point returned true (e.g. the points that stayed in their
   /// cell after an update, which the fused P2G of the next step then adds).

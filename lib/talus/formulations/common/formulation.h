@@ -94,6 +94,8 @@ namespace talus
     virtual StepOutcome advance_by(const double h) = 0;
     /// After each step: throws InstabilityError when the run went unstable.
     virtual void check_stability() const = 0;
+    /// After each completed and checked step (e.g. rebalance the partition).
+    virtual void after_step() {}
     /// Material points removed so far because they left the grid.
     virtual unsigned long long lost_points() const { return 0; }
 

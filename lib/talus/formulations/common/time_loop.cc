@@ -214,6 +214,7 @@ namespace talus
                 ++f.step_number;
                 f.check_stability();
                 report_lost_points();
+                f.after_step();
               }
             catch (const InstabilityError &e)
               {

@@ -3,6 +3,7 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/numerics.h>
+#include <talus/transfer/cell_walk.h>
 #include <talus/shape/q1.h>
 
 #include <cmath>
@@ -319,12 +320,9 @@ namespace talus::explicit_mpm
     zero(s.nodal_p);
     for (auto &f : fields)
       zero(f.momentum);
-    auto pt = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[c];
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-          {
+    const CellCache<dim> *cell = nullptr;
+    const auto            at_point = [&](const unsigned int, auto &pt) {
+            const auto &       cc = *cell;
             double *           P = pt->get_properties().data();
             const unsigned int b = static_cast<unsigned int>(P[L::body]);
             const double *     A = fields[b].force.begin();
@@ -347,8 +345,9 @@ namespace talus::explicit_mpm
                   Pn[cc.dofs[v * dim + d]] += q;
                   Pb[cc.dofs[v * dim + d]] += q;
                 }
-          }
-      }
+    };
+    transfer::for_each_active_cell(
+      s.points, [&](const unsigned int c) { cell = &s.grid.cells[c]; }, at_point, [](const unsigned int) {});
     s.nodal_p.compress(dealii::VectorOperation::add);
     for (auto &f : fields)
       f.momentum.compress(dealii::VectorOperation::add);

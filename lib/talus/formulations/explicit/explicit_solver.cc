@@ -43,31 +43,6 @@ namespace talus::explicit_mpm
       return std::chrono::duration<double>(Clock::now() - t0).count();
     }
 
-    std::string
-    zeros(const unsigned int dim, const std::string &last = "0")
-    {
-      std::string s;
-      for (unsigned int d = 0; d + 1 < dim; ++d)
-        s += "0, ";
-      return s + last;
-    }
-
-
-
-    std::vector<unsigned int>
-    parse_ids(const std::string &text, const std::string &where)
-    {
-      std::vector<unsigned int> r;
-      for (const auto &s : dealii::Utilities::split_string_list(text, ','))
-        {
-          const auto v = parse_doubles(s, where);
-          require(v.size() == 1 && v[0] >= 0 && v[0] == std::floor(v[0]) && v[0] < 65535,
-                  where,
-                  "'" + s + "' is not a non-negative integer id");
-          r.push_back(static_cast<unsigned int>(v[0]));
-        }
-      return r;
-    }
   } // namespace
 
   // ================================================================ parameters
@@ -81,18 +56,12 @@ namespace talus::explicit_mpm
   declare_parameters_with_integration(dealii::ParameterHandler &prm, const std::string &prm_file,
                                       const std::string &default_integration)
   {
-    const unsigned int dim = dealii::Utilities::string_to_int(
-      peek_entry(prm_file, "", "dimension", "2", Selection("2|3")));
-    const unsigned int n_materials = dealii::Utilities::string_to_int(
-      peek_entry(prm_file, "", "number of materials", "1", Integer(1, 64)));
-    const unsigned int n_bodies = dealii::Utilities::string_to_int(
-      peek_entry(prm_file, "", "number of bodies", "1", Integer(1, 64)));
-
-    prm.declare_entry("dimension", "2", Selection("2|3"),
-                      "Spatial dimension: 2 (plane strain, per unit thickness) or 3.");
+    const SceneCounts counts = peek_scene_counts(prm_file);
+    declare_scene_parameters(prm, counts);
+    declare_run_parameters(prm);
+    // the explicit family's entries in the shared subsections
     prm.enter_subsection("time");
     {
-      prm.declare_entry("end time", "1.0", Double(0), "Simulated duration [s], > 0 (must be set).", /*has_to_be_set=*/true);
       prm.declare_entry("courant number", "0.5", Double(0, 1),
                         "Time step as a fraction of the critical time step L_min/c (seed 000 Eq. 4.120), "
                         "used when 'time step' is 0. Range (0, 1].");
@@ -101,140 +70,30 @@ namespace talus::explicit_mpm
                         "critical time step is refused unless 'force time step' is true.");
       prm.declare_entry("force time step", "false", Bool(),
                         "Accept a 'time step' above the critical one (stability studies).");
-      prm.declare_entry("maximum steps", "0", Integer(0), "Stop after this many steps; 0 = no limit.");
     }
     prm.leave_subsection();
-
-    prm.enter_subsection("grid");
-    {
-      prm.declare_entry("source", "box", Selection("box|file"),
-                        "Background grid: 'box' (lower corner, upper corner, cells below) or 'file' (the grid "
-                        "file written by talus-mesh, entry 'file'; see docs/mesh.md). A grid from a file must "
-                        "consist of axis-aligned rectangles/boxes (MPM limitation); its boundary ids and "
-                        "material ids come from the file.");
-      prm.declare_entry("file", "", Anything(),
-                        "grid/source = file: grid file (gmsh MSH 2.2 ASCII as written by talus-mesh).");
-      prm.declare_entry("lower corner", zeros(dim), Anything(),
-                        "Lower corner of the box background grid [m], dim comma-separated numbers.");
-      prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(),
-                        "Upper corner of the box background grid [m].");
-      prm.declare_entry("cells", dim == 2 ? "10, 10" : "10, 10, 10", Anything(),
-                        "Number of cells per direction (dim positive integers). Boundary ids: "
-                        "0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+.");
-    }
-    prm.leave_subsection();
-
-    prm.enter_subsection("boundary conditions");
-    {
-      prm.declare_entry("fixed", "", Anything(),
-                        "Boundary ids (comma-separated) on which every velocity component is zero.");
-      prm.declare_entry("roller", "", Anything(),
-                        "Boundary ids on which the velocity component normal to the boundary is zero.");
-    }
-    prm.leave_subsection();
-
-    prm.enter_subsection("gravity");
-    prm.declare_entry("acceleration", zeros(dim, "-9.81"), Anything(),
-                      "Gravitational acceleration vector [m/s^2].");
-    prm.leave_subsection();
-
     prm.enter_subsection("stability");
     prm.declare_entry("energy growth limit", "10", Double(1),
                       "The run is stopped as unstable when kinetic + strain energy exceed this factor times "
                       "the energy available (initial kinetic + strain energy + released potential energy + "
                       "external work), or when any state becomes non-finite.");
-    prm.declare_entry("lost particles", "remove", Selection("remove|stop"),
-                      "Material points that leave the grid: 'remove' them (counted in the log and in "
-                      "series.csv, column lost_particles) and go on, or 'stop' the run with an error (exit 3).");
     prm.leave_subsection();
-
-    prm.enter_subsection("output");
-    {
-      prm.declare_entry("directory", "output", Anything(), "Output directory (created if missing).");
-      prm.declare_entry("vtu interval", "0", Double(0),
-                        "Simulated time between particle VTU/PVTU outputs (PVD series); 0 = first and last only.");
-      prm.declare_entry("series interval", "0", Double(0),
-                        "Simulated time between rows of series.csv (energies, momentum, probes); 0 = every step.");
-      prm.declare_entry("write grid", "false", Bool(), "Also write the background grid with nodal mass and velocity.");
-      prm.declare_entry("final particles csv", "false", Bool(),
-                        "Write particles_final.csv (id, position, displacement, velocity, stress, volume), "
-                        "gathered on rank 0 and sorted by id: for tests and comparisons of small runs.");
-      prm.declare_entry("progress", "true", Bool(), "Print progress with an ETA every few seconds.");
-      prm.declare_entry("probes", "", Anything(),
-                        "Points 'x,y[,z]; x,y[,z]; ...': the material point nearest to each at t = 0 is tracked; "
-                        "its displacement, velocity and stress go to series.csv (and the results file).");
-      prm.declare_entry("results file", "", Anything(),
-                        "HDF5 results written at the end of the run (for talus-compare and post-processing), "
-                        "relative to the output directory unless absolute; empty = none. Holds the columns of "
-                        "series.csv (energies, momentum, probes over time), the probe displacements, velocities "
-                        "and stresses over time, the final material point fields and the final fields mapped to "
-                        "the grid nodes (lumped projection). Layout in docs/fem.md.");
-      io::declare_png_snapshot_parameters(prm);
-    }
-    prm.leave_subsection();
-
-    declare_numerics_parameters(prm, default_integration);
-    prm.enter_subsection("checkpoint");
-    {
-      prm.declare_entry("interval", "0", Double(0),
-                        "Simulated time between checkpoints (HDF5, complete state); 0 = off.");
-      prm.declare_entry("wall clock interval", "0", Double(0),
-                        "Wall-clock seconds between checkpoints (for batch time limits); 0 = off.");
-      prm.declare_entry("keep", "2", Integer(1, 1000), "Number of newest checkpoints kept.");
-      prm.declare_entry("directory", "", Anything(), "Checkpoint directory; empty = <output directory>/checkpoints.");
-      prm.declare_entry("restart", "false", Selection("false|true|if available"),
-                        "Resume from the newest valid checkpoint in the directory: 'true' (an error if there is "
-                        "none), 'if available' (else start at t = 0), 'false'. The command-line option --restart "
-                        "means 'true'. The .prm must describe the same scene (grid, materials, bodies); the end "
-                        "time and output settings may change.");
-    }
-    prm.leave_subsection();
-    declare_liquid_output(prm);
-
-    prm.declare_entry("number of materials", "1", Integer(1, 64),
-                      "Number of 'material k' subsections (k = 0..n-1).");
-    for (unsigned int k = 0; k < n_materials; ++k)
+    for (unsigned int k = 0; k < counts.n_materials; ++k)
       {
         prm.enter_subsection("material " + std::to_string(k));
-        materials::declare_material_parameters(prm);
         declare_pore_liquid(prm);
         prm.leave_subsection();
       }
-
-    prm.declare_entry("number of bodies", "1", Integer(1, 64), "Number of 'body k' subsections (k = 0..n-1).");
-    loads::declare_parameters(prm, prm_file, dim, n_bodies);
-    for (unsigned int k = 0; k < n_bodies; ++k)
+    for (unsigned int k = 0; k < counts.n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
-        prm.declare_entry("name", "body " + std::to_string(k), Anything(), "Name used in messages.");
-        prm.declare_entry("material", "0", Integer(0), "Material id (index of a 'material k' subsection).");
-        prm.declare_entry("shape", "box", Selection("box|ball|polygon|file"),
-                          "Region filled with material points: box (lower/upper corner), ball (disk in 2D, "
-                          "sphere in 3D: center, radius), polygon (2D: vertices), or file: the material points "
-                          "of a particle file written by talus-mesh ('particle file', 'file body id'), with "
-                          "their positions, volumes, material ids (the entry 'material' is then not used) and "
-                          "initial stresses if the file has them.");
-        prm.declare_entry("particle file", "", Anything(), "shape = file: the particle file (HDF5, talus-mesh).");
-        prm.declare_entry("file body id", "-1", Integer(-1, 65535),
-                          "shape = file: take the rows of the file with this body id; -1 = the index k of this "
-                          "'body k' subsection.");
-        prm.declare_entry("lower corner", zeros(dim), Anything(), "Box: lower corner [m].");
-        prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(), "Box: upper corner [m].");
-        prm.declare_entry("center", zeros(dim), Anything(), "Ball: center [m].");
-        prm.declare_entry("radius", "0", Double(0), "Ball: radius [m].");
-        prm.declare_entry("vertices", "", Anything(), "Polygon: 'x,y; x,y; ...' [m], at least 3 vertices.");
-        prm.declare_entry("particles per direction", "2", Integer(1, 10),
-                          "Material points per cell and direction (n^dim per filled cell, regular positions).");
-        declare_clip_to_grid(prm);
-        prm.declare_entry("initial velocity", zeros(dim), Anything(), "Uniform initial velocity [m/s].");
-        prm.declare_entry("initial velocity function", "", Anything(),
-                          "Optional initial velocity field, dim expressions separated by ';' in x, y, z "
-                          "(muparser syntax, e.g. '0.1*sin(pi*x/2); 0'); overrides 'initial velocity'.");
-        prm.declare_entry("function constants", "", Anything(),
-                          "Constants for the function, 'name=value, name=value'.");
-        declare_body_traction(prm, dim);
+        declare_body_traction(prm, counts.dim);
         prm.leave_subsection();
       }
+    // the explicit family's own subsections
+    declare_numerics_parameters(prm, default_integration);
+    declare_liquid_output(prm);
+    loads::declare_parameters(prm, prm_file, counts.dim, counts.n_bodies);
   }
 
   template <int dim>
@@ -242,187 +101,34 @@ namespace talus::explicit_mpm
   parse_parameters(dealii::ParameterHandler &prm)
   {
     Parameters<dim> p;
+    parse_run_parameters<dim>(prm, p);
     prm.enter_subsection("time");
-    p.end_time        = prm.get_double("end time");
     p.courant         = prm.get_double("courant number");
     p.time_step       = prm.get_double("time step");
     p.force_time_step = prm.get_bool("force time step");
-    p.max_steps       = prm.get_integer("maximum steps");
     require(p.courant > 0, "time/courant number", "must be > 0");
-    require(p.end_time > 0, "time/end time", "must be > 0");
     prm.leave_subsection();
-
-    prm.enter_subsection("grid");
-    if (prm.get("source") == "file")
-      {
-        p.grid_file = prm.get("file");
-        require_input_file(p.grid_file, "grid/file");
-        auto mesh = std::make_shared<io::GridMesh>(io::read_msh(p.grid_file, dim));
-        io::normalise_boxes(*mesh, "grid/file '" + p.grid_file + "'");
-        io::check_faces(*mesh, "grid/file '" + p.grid_file + "'");
-        double lo[3], hi[3];
-        mesh->bounding_box(lo, hi);
-        p.grid_cells.assign(dim, 1);
-        p.grid_cells[0] = mesh->n_cells();
-        for (unsigned int d = 0; d < dim; ++d)
-          p.grid_lower[d] = lo[d], p.grid_upper[d] = hi[d];
-        p.grid_mesh = mesh;
-      }
-    else
-      {
-        p.grid_lower = parse_point<dim>(prm.get("lower corner"), "grid/lower corner");
-        p.grid_upper = parse_point<dim>(prm.get("upper corner"), "grid/upper corner");
-        p.grid_cells = parse_cell_counts(prm.get("cells"), "grid/cells");
-        require(p.grid_cells.size() == dim, "grid/cells", "needs exactly " + std::to_string(dim) + " integers");
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            require(p.grid_cells[d] > 0, "grid/cells", "every entry must be > 0");
-            require(p.grid_upper[d] > p.grid_lower[d], "grid/upper corner",
-                    "must exceed 'lower corner' in every direction");
-          }
-      }
-    prm.leave_subsection();
-
-    prm.enter_subsection("boundary conditions");
-    for (const auto id : parse_ids(prm.get("fixed"), "boundary conditions/fixed"))
-      p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::fixed});
-    for (const auto id : parse_ids(prm.get("roller"), "boundary conditions/roller"))
-      p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::roller});
-    prm.leave_subsection();
-
-    prm.enter_subsection("gravity");
-    p.gravity = parse_point<dim>(prm.get("acceleration"), "gravity/acceleration");
-    prm.leave_subsection();
-
     prm.enter_subsection("stability");
-    p.energy_growth_limit    = prm.get_double("energy growth limit");
-    p.stop_on_lost_particles = prm.get("lost particles") == "stop";
+    p.energy_growth_limit = prm.get_double("energy growth limit");
     prm.leave_subsection();
 
-    prm.enter_subsection("output");
-    p.output_directory    = prm.get("directory");
-    p.vtu_interval        = prm.get_double("vtu interval");
-    p.series_interval     = prm.get_double("series interval");
-    p.write_grid          = prm.get_bool("write grid");
-    p.final_particles_csv = prm.get_bool("final particles csv");
-    p.progress            = prm.get_bool("progress");
-    require(!p.output_directory.empty(), "output/directory", "must not be empty");
-    for (const auto &s : dealii::Utilities::split_string_list(prm.get("probes"), ';'))
-      p.probes.push_back(parse_point<dim>(s, "output/probes"));
-    p.results_file = prm.get("results file");
-    if (!p.results_file.empty() && p.results_file.front() != '/')
-      p.results_file = p.output_directory + "/" + p.results_file;
-    io::check_png_snapshot_parameters(prm);
-    prm.leave_subsection();
-
-    prm.enter_subsection("checkpoint");
-    p.checkpoint_interval      = prm.get_double("interval");
-    p.checkpoint_wall_interval = prm.get_double("wall clock interval");
-    p.checkpoint_keep          = prm.get_integer("keep");
-    p.checkpoint_directory     = prm.get("directory");
-    {
-      const std::string r = prm.get("restart");
-      p.restart = r == "true" ? Parameters<dim>::Restart::yes :
-                  r == "if available" ? Parameters<dim>::Restart::if_available :
-                                        Parameters<dim>::Restart::no;
-    }
-    if (tool_option_given("--restart"))
-      p.restart = Parameters<dim>::Restart::yes;
-    prm.leave_subsection();
+    parse_scene_parameters<dim>(prm, p);
     parse_liquid_output(prm, p.liquid);
-
-    const unsigned int n_materials = prm.get_integer("number of materials");
-    for (unsigned int k = 0; k < n_materials; ++k)
+    for (unsigned int k = 0; k < p.materials.size(); ++k)
       {
         const std::string where = "material " + std::to_string(k);
         prm.enter_subsection(where);
-        std::shared_ptr<const materials::Material> m = materials::create_material(prm, where, k);
-        p.liquid.pore_liquid.push_back(parse_pore_liquid(prm, where, m));
-        p.materials.push_back(m);
+        p.liquid.pore_liquid.push_back(parse_pore_liquid(prm, where, p.materials[k]));
         prm.leave_subsection();
       }
-
-    const unsigned int n_bodies = prm.get_integer("number of bodies");
-    for (unsigned int k = 0; k < n_bodies; ++k)
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
       {
         const std::string where = "body " + std::to_string(k);
         prm.enter_subsection(where);
-        BodyDescription<dim> b;
-        b.name        = prm.get("name");
-        b.material_id = prm.get_integer("material");
-        require(b.material_id < n_materials, where + "/material",
-                "material " + std::to_string(b.material_id) + " is not defined (number of materials = " +
-                  std::to_string(n_materials) + ", allowed 0.." + std::to_string(n_materials - 1) + ")");
-        const std::string shape = prm.get("shape");
-        if (shape == "box")
-          {
-            b.shape = BodyDescription<dim>::Shape::box;
-            b.lower = parse_point<dim>(prm.get("lower corner"), where + "/lower corner");
-            b.upper = parse_point<dim>(prm.get("upper corner"), where + "/upper corner");
-            for (unsigned int d = 0; d < dim; ++d)
-              require(b.upper[d] > b.lower[d], where + "/upper corner", "must exceed 'lower corner' in every direction");
-          }
-        else if (shape == "ball")
-          {
-            b.shape  = BodyDescription<dim>::Shape::ball;
-            b.center = parse_point<dim>(prm.get("center"), where + "/center");
-            b.radius = prm.get_double("radius");
-            require(b.radius > 0, where + "/radius", "must be > 0 for shape = ball");
-          }
-        else if (shape == "file")
-          {
-            b.shape         = BodyDescription<dim>::Shape::file;
-            b.particle_file = prm.get("particle file");
-            require_input_file(b.particle_file, where + "/particle file");
-            const int id    = prm.get_integer("file body id");
-            b.file_body_id  = id < 0 ? k : static_cast<unsigned int>(id);
-          }
-        else
-          {
-            require(dim == 2, where + "/shape", "polygon bodies exist in 2D only (allowed in 3D: box|ball|file)");
-            b.shape = BodyDescription<dim>::Shape::polygon;
-            for (const auto &s : dealii::Utilities::split_string_list(prm.get("vertices"), ';'))
-              b.polygon.push_back(parse_point<2>(s, where + "/vertices"));
-            require(b.polygon.size() >= 3, where + "/vertices", "a polygon needs at least 3 vertices");
-          }
-        b.particles_per_direction = prm.get_integer("particles per direction");
-        b.clip_to_grid            = prm.get_bool("clip to grid");
-        b.initial_velocity        = parse_point<dim>(prm.get("initial velocity"), where + "/initial velocity");
-        const std::string expr    = prm.get("initial velocity function");
-        if (!expr.empty())
-          {
-            std::map<std::string, double> constants = {{"pi", M_PI}, {"Pi", M_PI}};
-            for (const auto &c : dealii::Utilities::split_string_list(prm.get("function constants"), ','))
-              {
-                const auto kv = dealii::Utilities::split_string_list(c, '=');
-                const auto v = kv.size() == 2 ? parse_doubles(kv[1], where + "/function constants") : std::vector<double>();
-                require(v.size() == 1, where + "/function constants", "'" + c + "' is not of the form name=value");
-                constants[kv[0]] = v[0];
-              }
-            auto fp = std::make_shared<dealii::FunctionParser<dim>>(dim);
-            try
-              {
-                fp->initialize(dealii::FunctionParser<dim>::default_variable_names(), expr, constants);
-                fp->value(dealii::Point<dim>(), 0); // force a parse of every component
-                for (unsigned int d = 0; d < dim; ++d)
-                  fp->value(dealii::Point<dim>(), d);
-              }
-            catch (const std::exception &e)
-              {
-                throw InputError(where + "/initial velocity function: cannot parse '" + expr + "' (need " +
-                                 std::to_string(dim) + " expressions separated by ';'): " + exception_text(e));
-              }
-            b.velocity_field = [fp](const dealii::Point<dim> &x) {
-              dealii::Tensor<1, dim> v;
-              for (unsigned int d = 0; d < dim; ++d)
-                v[d] = fp->value(x, d);
-              return v;
-            };
-          }
         p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
         prm.leave_subsection();
-        p.bodies.push_back(b);
       }
+    const unsigned int n_bodies = p.bodies.size();
     p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
     if (p.loads.staged)
       {
@@ -456,6 +162,19 @@ namespace talus::explicit_mpm
           require(p.grid_cells[d] >= shape::BSpline2<dim>::min_cells, "grid/cells",
                   "quadratic B-splines need at least 3 cells per direction (the wall treatment)");
       }
+    if (p.balance.enabled())
+      {
+        // these features keep per-cell or per-node data that a repartition does not carry yet
+        const std::string why = " is not available with load balancing yet (allowed with it: the 1-phase MPM "
+                                "step with loads, damping, stages, free-surface output); set load balancing/"
+                                "interval = 0, or ";
+        require(!p.numerics.fem(), "load balancing/interval", "numerics/integration = fem | ul-fem" + why + "integration = mpm");
+        require(!p.numerics.contact(), "load balancing/interval", "contact" + why + "no contact pairs");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "load balancing/interval",
+                "strain smoothing" + why + "strain smoothing = none");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "load balancing/interval",
+                "the 2-phase step (coupled materials, body tractions)" + why + "1-phase materials");
+      }
     if (p.numerics.fem())
       {
         const std::string mode = p.numerics.integration == NumericsOptions::Integration::fem ? "fem" : "ul-fem";
@@ -483,7 +202,7 @@ namespace talus::explicit_mpm
   Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
     : prm(p)
     , comm(c)
-    , grid(c)
+    , grid(c, p.balance.enabled())
     , points(grid, "points")
     , gravity(p.gravity)
   {}
@@ -656,7 +375,17 @@ namespace talus::explicit_mpm
         energy_scale     = dealii::Utilities::MPI::sum(local_scale, comm);
         initial_energies = energies();
       }
-    collect_active_cells();
+    // load balancing: partition by points from the start (a restart on as many
+    // ranks has recreated its saved partition instead)
+    if (prm.balance.enabled() && dealii::Utilities::MPI::n_mpi_processes(comm) > 1 && !restored_partition)
+      {
+        const double before = imbalance();
+        rebalance();
+        log() << "  load balancing: points per rank max/mean " << std::setprecision(4) << before << " -> "
+              << imbalance() << std::endl;
+      }
+    else
+      collect_active_cells();
   }
 
   template <int dim>
@@ -708,6 +437,98 @@ namespace talus::explicit_mpm
       dof_marker[i] = 0;
   }
 
+  // ---------------------------------------------------------------- load balancing
+  template <int dim>
+  double
+  Solver<dim>::imbalance() const
+  {
+    const double       n   = points.handler.n_locally_owned_particles();
+    const double       mx  = dealii::Utilities::MPI::max(n, comm);
+    const double       sum = dealii::Utilities::MPI::sum(n, comm);
+    const unsigned int nr  = dealii::Utilities::MPI::n_mpi_processes(comm);
+    return sum > 0 ? mx * nr / sum : 1.0;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::repartition_with(const std::vector<double> &rows)
+  {
+    // rows: the 4 words of CellId::to_binary and the weight
+    std::map<dealii::CellId::binary_type, unsigned int> weight_of;
+    for (std::size_t r = 0; r + 5 <= rows.size(); r += 5)
+      {
+        dealii::CellId::binary_type key;
+        for (unsigned int k = 0; k < 4; ++k)
+          key[k] = static_cast<unsigned int>(rows[r + k]);
+        weight_of[key] = static_cast<unsigned int>(rows[r + 4]);
+      }
+    grid.repartition([&](const typename dealii::Triangulation<dim>::cell_iterator &cell) {
+      const auto it = weight_of.find(cell->id().template to_binary<dim>());
+      return it == weight_of.end() ? prm.balance.cell_weight : it->second;
+    });
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::rebalance()
+  {
+    // the weights of this partition, kept for checkpoints (a bitwise restart
+    // recreates the same partition before it inserts the points)
+    balance_weights.clear();
+    for (const auto &cell : grid.tria.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          const unsigned int n = points.handler.n_particles_in_cell(cell);
+          if (n == 0)
+            continue;
+          for (const unsigned int w : cell->id().template to_binary<dim>())
+            balance_weights.push_back(w);
+          balance_weights.push_back(prm.balance.cell_weight + prm.balance.point_weight * n);
+        }
+    points.handler.prepare_for_coarsening_and_refinement();
+    grid.repartition([&](const typename dealii::Triangulation<dim>::cell_iterator &cell) {
+      return prm.balance.cell_weight +
+             prm.balance.point_weight * static_cast<unsigned int>(points.handler.n_particles_in_cell(cell));
+    });
+    points.handler.unpack_after_coarsening_and_refinement();
+    grid_changed();
+    ++n_rebalances;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::grid_changed()
+  {
+    constrained = grid.constrained_dofs(prm.boundary_conditions);
+    grid.reinit_vector(nodal_mass);
+    grid.reinit_vector(nodal_a);
+    grid.reinit_vector(nodal_p);
+    dof_marker.clear();
+    if (free_surface)
+      free_surface->grid_changed();
+    collect_active_cells();
+    if (control)
+      control->grid_changed(*this); // nodes of prescribed velocities and friction
+    p2g_ready = false;               // the next step starts with a full P2G
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::after_step()
+  {
+    if (!prm.balance.enabled() || step_number % prm.balance.interval != 0 ||
+        dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
+      return;
+    const double before = imbalance();
+    if (before <= prm.balance.threshold)
+      return;
+    rebalance();
+    const double after = imbalance();
+    if (prm.progress)
+      log() << "  step " << step_number << ": rebalanced, points per rank max/mean " << std::setprecision(4)
+            << before << " -> " << after << std::endl;
+  }
+
   template <int dim>
   void
   Solver<dim>::zero_on_active(Vector &v) const
@@ -718,6 +539,17 @@ namespace talus::explicit_mpm
     double *x = v.begin();
     for (const unsigned int i : active_dofs)
       x[i] = 0.0;
+  }
+
+  template <int dim>
+  template <class F>
+  void
+  Solver<dim>::with_kernel(F &&f)
+  {
+    if (prm.numerics.bspline())
+      f(shape::BSpline2Box<dim>());
+    else
+      f(shape::Q1Box<dim>());
   }
 
   // ---------------------------------------------------------------- P2G (A)
@@ -737,21 +569,12 @@ namespace talus::explicit_mpm
         p2g_ready = true;
         return;
       }
-    if (prm.numerics.bspline())
-      p2g_mass_and_force_with<shape::BSpline2Box<dim>>();
-    else
-      p2g_mass_and_force_with<shape::Q1Box<dim>>();
-  }
-
-  template <int dim>
-  template <class K>
-  void
-  Solver<dim>::p2g_mass_and_force_with()
-  {
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
-    transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-    transfer::for_each_active_cell(points, p2g);
+    with_kernel([&](auto kernel) {
+      transfer::ScatterMassForce<dim, decltype(kernel)> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+      transfer::for_each_active_cell(points, p2g);
+    });
     p2g_ready = true;
   }
 
@@ -778,20 +601,11 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::g2p_velocity_p2g_momentum(const double h)
   {
-    if (prm.numerics.bspline())
-      g2p_velocity_p2g_momentum_with<shape::BSpline2Box<dim>>(h);
-    else
-      g2p_velocity_p2g_momentum_with<shape::Q1Box<dim>>(h);
-  }
-
-  template <int dim>
-  template <class K>
-  void
-  Solver<dim>::g2p_velocity_p2g_momentum_with(const double h)
-  {
     zero_on_active(nodal_p);
-    transfer::UpdateVelocityScatterMomentum<dim, K> op{grid, nodal_a.begin(), nodal_p.begin(), h};
-    transfer::for_each_active_cell(points, op);
+    with_kernel([&](auto kernel) {
+      transfer::UpdateVelocityScatterMomentum<dim, decltype(kernel)> op{grid, nodal_a.begin(), nodal_p.begin(), h};
+      transfer::for_each_active_cell(points, op);
+    });
     nodal_p.compress(dealii::VectorOperation::add);
   }
 
@@ -800,15 +614,10 @@ namespace talus::explicit_mpm
   Solver<dim>::scatter_point_momentum(Vector &v)
   {
     zero_on_active(v);
-    const auto walk = [&](auto kernel) {
-      using K = decltype(kernel);
-      transfer::ScatterMomentum<dim, K> op(grid, v.begin());
+    with_kernel([&](auto kernel) {
+      transfer::ScatterMomentum<dim, decltype(kernel)> op(grid, v.begin());
       transfer::for_each_active_cell(points, op);
-    };
-    if (prm.numerics.bspline())
-      walk(shape::BSpline2Box<dim>());
-    else
-      walk(shape::Q1Box<dim>());
+    });
     v.compress(dealii::VectorOperation::add);
   }
 
@@ -955,16 +764,13 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::g2p_update(const double h)
   {
-    if (prm.numerics.bspline())
-      g2p_update_with<shape::BSpline2Box<dim>>(h);
-    else
-      g2p_update_with<shape::Q1Box<dim>>(h);
+    with_kernel([&](auto kernel) { g2p_update_with(kernel, h); });
   }
 
   template <int dim>
   template <class K>
   void
-  Solver<dim>::g2p_update_with(const double h)
+  Solver<dim>::g2p_update_with(K, const double h)
   {
     std::fill(probe_values.begin(), probe_values.end(), 0.0);
     std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
@@ -997,18 +803,19 @@ namespace talus::explicit_mpm
   }
 
   template <int dim>
-  template <class K>
   void
-  Solver<dim>::relocate_with()
+  Solver<dim>::relocate()
   {
     // moved points add their mass and force to the next step's sums; a deal.II
     // sort recomputes reference locations and may move points to other ranks:
     // the fused P2G is then redone from scratch
-    transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-    const bool                         sorted =
-      points.relocate([&](const unsigned int c, const dealii::Point<dim> &xi, const double *P) {
+    bool sorted = false;
+    with_kernel([&](auto kernel) {
+      transfer::ScatterMassForce<dim, decltype(kernel)> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+      sorted = points.relocate([&](const unsigned int c, const dealii::Point<dim> &xi, const double *P) {
         p2g.scatter_one(c, xi, P);
       });
+    });
     p2g_ready = !sorted && !prm.numerics.extended_p2g();
     // with B-splines a cell's stencil is 4^dim nodes: recompute the active DoFs
     // only when the set of cells with points changed (Q1: every step, as the
@@ -1065,10 +872,7 @@ namespace talus::explicit_mpm
     g2p_update(h);
     timings.g2p += seconds_since(t0);
     t0 = Clock::now();
-    if (prm.numerics.bspline())
-      relocate_with<shape::BSpline2Box<dim>>();
-    else
-      relocate_with<shape::Q1Box<dim>>();
+    relocate();
     timings.relocation += seconds_since(t0);
   }
 
@@ -1076,7 +880,9 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::advance(const unsigned int n_steps)
   {
-    TimeLoop(*this, loop_settings(prm), comm).advance_steps(n_steps);
+    LoopSettings s  = loop_settings(prm);
+    s.max_cut_backs = 0;
+    TimeLoop(*this, s, comm).advance_steps(n_steps);
   }
 
   template <int dim>
@@ -1323,28 +1129,12 @@ namespace talus::explicit_mpm
   }
 
   template <int dim>
-  LoopSettings
-  loop_settings(const Parameters<dim> &prm)
-  {
-    LoopSettings s;
-    s.end_time                 = prm.end_time;
-    s.max_steps                = prm.max_steps;
-    s.output_directory         = prm.output_directory;
-    s.series_interval          = prm.series_interval;
-    s.vtu_interval             = prm.vtu_interval;
-    s.checkpoint_interval      = prm.checkpoint_interval;
-    s.checkpoint_wall_interval = prm.checkpoint_wall_interval;
-    s.progress                 = prm.progress;
-    s.stop_on_lost_points      = prm.stop_on_lost_particles;
-    s.max_cut_backs            = 0; // an explicit step always completes
-    return s;
-  }
-
-  template <int dim>
   void
   Solver<dim>::run()
   {
-    TimeLoop(*this, loop_settings(prm), comm).run();
+    LoopSettings s  = loop_settings(prm);
+    s.max_cut_backs = 0; // an explicit step always completes
+    TimeLoop(*this, s, comm).run();
   }
 
   // ================================================================ Formulation interface
@@ -1443,6 +1233,8 @@ namespace talus::explicit_mpm
       c.push_back(std::string("momentum_") + ax[d]);
     c.push_back("n_particles");
     c.push_back("lost_particles");
+    if (prm.balance.enabled())
+      c.push_back("imbalance");
     if (control && control->has_convergence())
       {
         c.push_back("force_ratio");
@@ -1513,6 +1305,8 @@ namespace talus::explicit_mpm
       r.push_back(p[d]);
     r.push_back(static_cast<double>(n_particles()));
     r.push_back(static_cast<double>(points.relocation_stats.lost));
+    if (prm.balance.enabled())
+      r.push_back(imbalance());
     if (control && control->has_convergence())
       {
         r.push_back(control->force_ratio);
@@ -1562,7 +1356,10 @@ namespace talus::explicit_mpm
           << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves "
           << rs.seconds_moves << ", sorts " << rs.seconds_sorts << "), output " << timings.output
           << "; particles moved cell " << rs.moved_locally << ", full sorts " << rs.global_sorts
-          << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost << "\n";
+          << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost;
+    if (prm.balance.enabled())
+      log() << ", rebalances " << n_rebalances;
+    log() << "\n";
     log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "
           << timings.total << " s, " << std::setprecision(3) << ns << " ns/particle-step, output in "
           << prm.output_directory << "/ (particles.pvd, series.csv)" << std::endl;
@@ -1594,8 +1391,6 @@ namespace talus::explicit_mpm
   template struct Parameters<3>;
   template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
   template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
-  template LoopSettings loop_settings<2>(const Parameters<2> &);
-  template LoopSettings loop_settings<3>(const Parameters<3> &);
   template class Solver<2>;
   template class Solver<3>;
 } // namespace talus::explicit_mpm

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/explicit/fem.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
@@ -29,51 +30,17 @@ namespace talus::loads
 
 namespace talus::explicit_mpm
 {
+  /// The .prm of talus-explicit: the shared scene and run sections
+  /// (formulations/common/scene_parameters.h) and the explicit family's own.
   template <int dim>
-  struct Parameters
+  struct Parameters : SceneParameters<dim>, RunParameters<dim>
   {
-    // time
-    double       end_time        = 1.0;
-    double       courant         = 0.5;
-    double       time_step       = 0.0; ///< 0: courant x critical
-    bool         force_time_step = false;
-    unsigned int max_steps       = 0; ///< 0: no limit
-    // grid: a box from grid_lower/upper/cells, or (grid/source = file) the mesh
-    // of a grid file, read and checked while parsing (grid_lower/upper are then
-    // its bounding box, grid_cells = {number of cells, 1, ...})
-    dealii::Point<dim>        grid_lower, grid_upper;
-    std::vector<unsigned int> grid_cells;
-    std::string                              grid_file;
-    std::shared_ptr<const io::GridMesh>      grid_mesh;
-    std::vector<BoundaryCondition> boundary_conditions;
-    dealii::Tensor<1, dim>    gravity;
+    // time step
+    double courant         = 0.5;
+    double time_step       = 0.0; ///< 0: courant x critical
+    bool   force_time_step = false;
     // stability
     double energy_growth_limit = 10.0;
-    bool   stop_on_lost_particles = false; ///< else: remove them, count, go on
-    // output
-    std::string                     output_directory = "output";
-    double                          vtu_interval     = 0.0; ///< simulated time, 0: off
-    double                          series_interval  = 0.0; ///< 0: every step
-    bool                            write_grid       = false;
-    bool                            final_particles_csv = false;
-    bool                            progress            = true;
-    std::vector<dealii::Point<dim>> probes;
-    std::string                     results_file; ///< HDF5 results at the end ("": none)
-    // checkpoint / restart
-    double       checkpoint_interval      = 0; ///< simulated time, 0: off
-    double       checkpoint_wall_interval = 0; ///< seconds of wall time, 0: off
-    unsigned int checkpoint_keep          = 2;
-    std::string  checkpoint_directory;        ///< default <output>/checkpoints
-    enum class Restart
-    {
-      no,
-      yes,         ///< resume from the newest valid checkpoint, error if none
-      if_available ///< resume if there is one, else start from t = 0
-    };
-    Restart restart = Restart::no;
-    // scene
-    std::vector<std::shared_ptr<const materials::Material>> materials;
-    std::vector<BodyDescription<dim>>                        bodies;
     // loads, friction, damping, convergence, mass scaling, K0, stages
     loads::Settings<dim> loads;
     // MPM-MIXED, strain smoothing, contact (seed 000 chapter 6; numerics.h)
@@ -107,10 +74,6 @@ namespace talus::explicit_mpm
     double kinetic = 0, strain = 0, gravity_potential = 0, external_work = 0;
     double total() const { return kinetic + strain + gravity_potential - external_work; }
   };
-
-  /// The loop settings of an explicit .prm (time, output, checkpoint, stability).
-  template <int dim>
-  LoopSettings loop_settings(const Parameters<dim> &prm);
 
   /// The explicit formulation: its step, diagnostics and files; the time loop
   /// (formulations/common/time_loop.h) drives it. The run state (time, dt,
@@ -181,6 +144,14 @@ namespace talus::explicit_mpm
     /// removed). Collective. Returns the file name.
     std::string write_checkpoint() override;
 
+    /// Largest over mean number of material points per rank (collective).
+    double imbalance() const;
+    /// Repartition the cells by weight (load balancing/cell weight + point
+    /// weight x points in the cell) and move the points with their cells;
+    /// rebuilds everything that depends on the partition. Collective.
+    void rebalance();
+    unsigned int n_rebalances = 0;
+
     // ---- the Formulation interface (the time loop's view)
     std::string              tool_name() const override { return "talus-explicit"; }
     void                     describe(std::ostream &out) const override;
@@ -198,6 +169,7 @@ namespace talus::explicit_mpm
     void                     rewrite_records() override;
     void                     finish(const std::string &series_csv) override;
     void                     summary(const LoopTimings &loop_timings) override;
+    void                     after_step() override; ///< the load-balance check
 
     /// Checkpoint files in the directory, newest first (rank 0 lists, all get it).
     std::vector<std::string> list_checkpoints() const;
@@ -244,21 +216,31 @@ namespace talus::explicit_mpm
     void collect_active_dofs();
 
     void zero_on_active(Vector &v) const;
+    /// After the partition changed: boundary flags, nodal vectors, cell lists,
+    /// active DoFs and the features' grid data.
+    void grid_changed();
+    /// (coarse cell id, weight) of the owned cells at the last rebalance: a
+    /// restart on as many ranks recreates the same partition from them.
+    std::vector<double> balance_weights;
+    /// Repartition with given (coarse cell id, weight) rows (restart).
+    void repartition_with(const std::vector<double> &id_weight_rows);
+    /// Set by restore_checkpoint() when it recreated the saved partition.
+    bool restored_partition = false;
     std::vector<unsigned char> dof_marker;
-    // the walks of the step (transfer/ ops), templated on the shape kernel
+    /// Call f(kernel) with the shape kernel of the run (numerics/shape
+    /// function): the walks of the step are templates on it.
+    template <class F>
+    void with_kernel(F &&f);
+    // the walks of the step (transfer/ ops)
     void p2g_mass_and_force();
-    template <class Kernel>
-    void p2g_mass_and_force_with();
     void nodal_acceleration();
     void g2p_velocity_p2g_momentum(const double dt);
-    template <class Kernel>
-    void g2p_velocity_p2g_momentum_with(const double dt);
     void nodal_velocity();
     void g2p_update(const double dt);
     template <class Kernel>
-    void g2p_update_with(const double dt);
-    template <class Kernel>
-    void relocate_with();
+    void g2p_update_with(Kernel, const double dt);
+    /// Relocation; moved points add their mass and force to the next step's sums.
+    void relocate();
     void write_final_particles() const;
 
     bool p2g_ready = false; ///< nodal mass/force of the current state accumulated

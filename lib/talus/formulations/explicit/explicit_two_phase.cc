@@ -766,6 +766,14 @@ namespace talus::explicit_mpm
 
   template <int dim>
   void
+  FreeSurface<dim>::grid_changed()
+  {
+    s.grid.reinit_vector(mass);
+    s.grid.reinit_vector(volume);
+  }
+
+  template <int dim>
+  void
   FreeSurface<dim>::update()
   {
     using L                   = PropertyLayout<dim>;

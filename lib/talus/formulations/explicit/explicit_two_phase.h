@@ -137,6 +137,8 @@ namespace talus::explicit_mpm
   public:
     FreeSurface(Solver<dim> &s, const double factor);
     void extend_layout(PropertyLayout<dim> &layout);
+    /// After a repartition of the grid: the nodal vectors on the new partition.
+    void grid_changed();
     /// Flags the points (property "free_surface") and sums the count and the
     /// extent of the particles (collective). Returns {count, extent (min, max per axis)}.
     void update();

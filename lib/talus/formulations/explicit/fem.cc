@@ -3,6 +3,7 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/fem.h>
 #include <talus/shape/q1_iso.h>
+#include <talus/transfer/cell_walk.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -10,6 +11,23 @@
 
 namespace talus::explicit_mpm
 {
+  namespace
+  {
+    /// A cell's lumped mass and internal force sums onto its nodes, gravity added.
+    template <int dim, unsigned int nv>
+    inline void
+    scatter_cell(const CellCache<dim> &cc, const double (&lm)[nv], const double (&f)[nv][dim],
+                 const dealii::Tensor<1, dim> &g, double *M, double *F)
+    {
+      for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const unsigned int i = cc.dofs[v * dim + d];
+            M[i] += lm[v];
+            F[i] += f[v][d] + lm[v] * g[d];
+          }
+    }
+  } // namespace
 
   template <int dim>
   FemIntegration<dim>::FemIntegration(Solver<dim> &solver, const bool updated_lagrangian)
@@ -158,15 +176,13 @@ namespace talus::explicit_mpm
     const auto    g        = s.gravity;
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
-    auto pt = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[c];
-        double      X[nv][dim];
-        current_vertices(c, X);
-        double lm[nv] = {}, f[nv][dim] = {};
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-          {
+    double X[nv][dim], lm[nv], f[nv][dim]; // the cell's vertices and sums
+    const auto begin_cell = [&](const unsigned int c) {
+      current_vertices(c, X);
+      std::fill(lm, lm + nv, 0.0);
+      std::fill(&f[0][0], &f[0][0] + nv * dim, 0.0);
+    };
+    const auto at_point = [&](const unsigned int, auto &pt) {
             const double *P = pt->get_properties().data();
             double        N[nv], dN[nv][dim], G[nv][dim], t[dim][dim];
             shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
@@ -179,15 +195,9 @@ namespace talus::explicit_mpm
                   for (unsigned int b = 0; b < dim; ++b)
                     f[v][a] += t[a][b] * G[v][b];
               }
-          }
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              const unsigned int i = cc.dofs[v * dim + d];
-              M[i] += lm[v];
-              F[i] += f[v][d] + lm[v] * g[d];
-            }
-      }
+    };
+    transfer::for_each_active_cell(s.points, begin_cell, at_point,
+                                   [&](const unsigned int c) { scatter_cell(s.grid.cells[c], lm, f, g, M, F); });
   }
 
   template <int dim>
@@ -208,21 +218,22 @@ namespace talus::explicit_mpm
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
-    auto pt = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[c];
-        double      X0[nv][dim], X1[nv][dim], du[nv][dim];
-        current_vertices(c, X0);
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // seed 000 Eq. 4.49
-              X1[v][d] = X0[v][d] + (ul ? du[v][d] : 0.0);
-            }
-        double lm[nv] = {}, f[nv][dim] = {};
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+    // the cell's vertices at the start and end of the step, the nodal
+    // displacement increments, and the next step's mass and force sums
+    double     X0[nv][dim], X1[nv][dim], du[nv][dim], lm[nv], f[nv][dim];
+    const auto begin_cell = [&](const unsigned int c) {
+      const auto &cc = s.grid.cells[c];
+      current_vertices(c, X0);
+      for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
           {
+            du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // seed 000 Eq. 4.49
+            X1[v][d] = X0[v][d] + (ul ? du[v][d] : 0.0);
+          }
+      std::fill(lm, lm + nv, 0.0);
+      std::fill(&f[0][0], &f[0][0] + nv * dim, 0.0);
+    };
+    const auto at_point = [&](const unsigned int, auto &pt) {
             double *     P = pt->get_properties().data();
             double       N[nv], dN[nv][dim], G[nv][dim];
             shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
@@ -303,15 +314,9 @@ namespace talus::explicit_mpm
                   for (unsigned int b = 0; b < dim; ++b)
                     f[v][a] += t[a][b] * G[v][b];
               }
-          }
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              const unsigned int i = cc.dofs[v * dim + d];
-              M[i] += lm[v];
-              F[i] += f[v][d] + lm[v] * g[d];
-            }
-      }
+    };
+    transfer::for_each_active_cell(s.points, begin_cell, at_point,
+                                   [&](const unsigned int c) { scatter_cell(s.grid.cells[c], lm, f, g, M, F); });
     if (ul)
       {
         // move the nodes of the cells with points (owned and ghost entries:

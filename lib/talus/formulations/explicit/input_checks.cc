@@ -352,31 +352,6 @@ namespace talus::explicit_mpm
       check_files(parse_parameters<3>(prm));
   }
 
-  void
-  declare_clip_to_grid(dealii::ParameterHandler &prm)
-  {
-    prm.declare_entry("clip to grid", "false", dealii::Patterns::Bool(),
-                      "false: a body not wholly inside the grid is refused (naming the coordinate outside and "
-                      "the grid extent); true: its points outside the grid are dropped and the log states how "
-                      "many and the volume lost.");
-  }
-
-  std::vector<unsigned int>
-  parse_cell_counts(const std::string &text, const std::string &where)
-  {
-    std::vector<unsigned int> r;
-    for (const auto &s : dealii::Utilities::split_string_list(text, ','))
-      {
-        const bool digits = !s.empty() && s.size() <= 10 &&
-                            std::all_of(s.begin(), s.end(), [](const char c) { return c >= '0' && c <= '9'; });
-        const double v = digits ? std::stod(s) : -1;
-        require(digits && v >= 1 && v <= 2147483647.0, where,
-                "'" + s + "' is not a positive integer (cells per direction, 1 to 2147483647; got '" + text + "')");
-        r.push_back(static_cast<unsigned int>(v));
-      }
-    return r;
-  }
-
   double
   estimated_memory_bytes(const double n_cells, const double n_points, const unsigned int dim,
                          const unsigned int ranks_on_node)

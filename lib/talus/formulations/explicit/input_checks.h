@@ -31,13 +31,6 @@ namespace talus::explicit_mpm
   template <int dim>
   double critical_time_step_of(const Parameters<dim> &p);
 
-  /// The body entry 'clip to grid' (false: a body not wholly inside the grid is refused).
-  void declare_clip_to_grid(dealii::ParameterHandler &prm);
-
-  /// 'grid/cells': dim positive integers (cells per direction); InputError
-  /// naming `where` and the offending item otherwise.
-  std::vector<unsigned int> parse_cell_counts(const std::string &text, const std::string &where);
-
   /// Memory a run needs on one node, estimated from the cells and material
   /// points (docs/reliability.md: bytes per process, cell and point measured on
   /// talus-explicit); compared with available_memory_bytes() (base/tool.h).

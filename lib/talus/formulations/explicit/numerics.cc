@@ -4,6 +4,7 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/mixed_integration.h>
 #include <talus/formulations/explicit/numerics.h>
+#include <talus/transfer/cell_walk.h>
 #include <talus/shape/q1.h>
 
 #include <deal.II/base/utilities.h>
@@ -190,16 +191,15 @@ namespace talus::explicit_mpm
         }
     CellStressFit<dim> stress_fit; // MPM-MIXED: linear cell stress (mixed_integration.h)
 
-    auto pt = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[c];
-        double      lm[nv] = {}, T[dim][F::npairs][dim] = {};
-        if (mixed)
-          stress_fit.clear();
-        touched.clear();
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-          {
+    double lm[nv], T[dim][F::npairs][dim]; // the cell's sums
+    const auto begin_cell = [&](const unsigned int) {
+      std::fill(lm, lm + nv, 0.0);
+      std::fill(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, 0.0);
+      if (mixed)
+        stress_fit.clear();
+      touched.clear();
+    };
+    const auto at_point = [&](const unsigned int, auto &pt) {
             const double *P  = pt->get_properties().data();
             const auto    xi = pt->get_reference_location();
             double        N[nv], w[dim][F::npairs];
@@ -231,8 +231,10 @@ namespace talus::explicit_mpm
                   }
                 F::add_moments(t, w, a.T);
               }
-          }
-        double cell_volume = 1.0;
+    };
+    const auto end_cell = [&](const unsigned int c) {
+        const auto &cc          = s.grid.cells[c];
+        double      cell_volume = 1.0;
         for (unsigned int d = 0; d < dim; ++d)
           cell_volume *= cc.h[d];
         // §6.6: a filled cell (Eq. 6.33) is integrated at its 2^dim Gauss points
@@ -283,7 +285,8 @@ namespace talus::explicit_mpm
                     }
                 }
             }
-      }
+    };
+    transfer::for_each_active_cell(s.points, begin_cell, at_point, end_cell);
   }
 
   // ================================================================ smoothing

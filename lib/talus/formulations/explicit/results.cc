@@ -5,6 +5,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/transfer/cell_walk.h>
 #include <talus/io/hdf5.h>
 #include <talus/io/results.h>
 #include <talus/shape/q1.h>
@@ -173,13 +174,11 @@ namespace talus::explicit_mpm
       std::vector<Vector>    w(3 + n_sv);                  // weights (m, V), u, v, stress blocks
       for (auto &vec : w)
         grid.reinit_vector(vec);
-      auto pt = points.handler.begin();
-      for (const auto [c, n_in_cell] : points.active_cells())
-        {
-          const auto &cc = grid.cells[c];
-          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-            {
-              const auto P = pt->get_properties();
+      // (linear hats whatever the run's shape function: a post-processing projection)
+      const CellCache<dim> *cell     = nullptr;
+      const auto            at_point = [&](const unsigned int, auto &pt) {
+              const auto &cc = *cell;
+              const auto  P  = pt->get_properties();
               double     N[nv];
               shape::Q1<dim>::values(pt->get_reference_location(), N);
               for (unsigned int v = 0; v < nv; ++v)
@@ -195,8 +194,10 @@ namespace talus::explicit_mpm
                   for (unsigned int q = 0; q < nst; ++q)
                     w[3 + q / dim].local_element(cc.dofs[v * dim + q % dim]) += VN * P[L::stress + q];
                 }
-            }
-        }
+      };
+      // the walk takes a mutable set (it hands out particle iterators); this one only reads
+      transfer::for_each_active_cell(
+        const_cast<MaterialPointSet<dim> &>(points), [&](const unsigned int c) { cell = &grid.cells[c]; }, at_point, [](const unsigned int) {});
       for (auto &vec : w)
         vec.compress(dealii::VectorOperation::add);
       const unsigned int         n_owned = nodal_mass.locally_owned_size();

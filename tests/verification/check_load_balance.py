@@ -1,0 +1,83 @@
+"""Load balancing by material points (issue 15) — verification.
+
+The scene (load_balance_collapse.prm) is a column collapsing in the corner of a
+wide grid: partitioned by cells, one rank holds nearly all points. Checks:
+  1. partitioned by points from the start: the initial imbalance (max/mean points
+     per rank) printed in the log is above 1.5 before and below the threshold
+     (1.05) after the first rebalance, and the imbalance column of series.csv
+     stays below 1.25 over the run with rebalancing every 20 steps;
+  2. 2 ranks rebalancing every 20 steps whenever the imbalance exceeds 1.0 (so
+     at nearly every check: >= 20 rebalances) give the same particle results as
+     1 rank to 1e-10 relative (undamped run);
+  3. a checkpoint taken after rebalances, restarted on 2 ranks, continues
+     bitwise identically (particles_final.csv byte for byte) through further
+     rebalances;
+  4. load balancing together with a feature whose grid data a repartition does
+     not carry yet (FEM integration) is refused with exit 2 naming the entry.
+Usage: check_load_balance.py TOOL PRM WORKDIR
+"""
+import filecmp
+import re
+import shutil
+import sys
+
+import talus_verify as tv
+
+tool, prm_path, work = sys.argv[1:4]
+base = open(prm_path).read()
+
+
+def particles(out):
+    return tv.read_csv(f"{work}/{out}/particles_final.csv")
+
+
+def worst_difference(a, b):
+    tv.check(a["id"] == b["id"], f"same particle ids ({len(a['id'])} points)")
+    worst = 0.0
+    for col in a:
+        if col == "id":
+            continue
+        scale = max(abs(v) for v in a[col]) or 1.0
+        worst = max(worst, max(abs(x - y) for x, y in zip(a[col], b[col])) / scale)
+    return worst
+
+
+# 1. the corner scene on 2 ranks with the .prm's settings
+text = tv.prm_set(base, "output/directory", "out_balanced")
+_, log, _ = tv.run_tool(tool, text, work, "balanced", np=2)
+m = re.search(r"load balancing: points per rank max/mean ([\d.]+) -> ([\d.]+)", log)
+tv.check(m is not None, "the initial rebalance is reported in the log")
+before, after = float(m.group(1)), float(m.group(2))
+tv.check(before > 1.5, f"partitioned by cells the points sit on one rank: imbalance {before:.3f} > 1.5")
+tv.check(after < 1.05, f"after the initial rebalance: imbalance {after:.4f} < threshold 1.05")
+s = tv.read_csv(f"{work}/out_balanced/series.csv")
+tv.check("imbalance" in s, "series.csv has the imbalance column")
+tv.check(max(s["imbalance"]) < 1.25, f"imbalance over the run at most {max(s['imbalance']):.4f} < 1.25 "
+         f"(rebalanced when above 1.05 at the checks every 20 steps)")
+
+# 2. 1 vs 2 ranks with a rebalance at nearly every check
+eager = tv.prm_set(base, "load balancing/imbalance threshold", "1.0")
+tv.run_tool(tool, tv.prm_set(eager, "output/directory", "out_np1"), work, "np1")
+_, log2, _ = tv.run_tool(tool, tv.prm_set(eager, "output/directory", "out_np2"), work, "np2", np=2)
+n_rebalances = int(re.search(r"rebalances (\d+)", log2).group(1))
+tv.check(n_rebalances >= 20, f"rebalances during the 2-rank run: {n_rebalances} >= 20")
+worst = worst_difference(particles("out_np1"), particles("out_np2"))
+tv.check(worst <= 1e-10, f"1 rank vs 2 ranks rebalancing every 20 steps agree to 1e-10 relative (worst {worst:.2e})")
+
+# 3. restart across rebalances: bitwise on 2 ranks
+restart = tv.prm_set(eager, "output/directory", "out_restart")
+restart = tv.prm_set(restart, "checkpoint/interval", "0.1")
+tv.run_tool(tool, restart, work, "restart_full", np=2)
+shutil.copy(f"{work}/out_restart/particles_final.csv", f"{work}/uninterrupted.csv")
+_, log3, _ = tv.run_tool(tool, tv.prm_set(restart, "checkpoint/restart", "true"), work, "restart_cont", np=2)
+m = re.search(r"restarting from \S+ \(step (\d+)", log3)
+tv.check(m is not None and int(m.group(1)) > 500, f"restarted from the checkpoint at step {m.group(1) if m else '?'}")
+n_after = int(re.search(r"rebalances (\d+)", log3).group(1))
+tv.check(n_after >= 5, f"the continuation rebalances again ({n_after} times)")
+tv.check(filecmp.cmp(f"{work}/uninterrupted.csv", f"{work}/out_restart/particles_final.csv", shallow=False),
+         "the continuation is bitwise identical to the uninterrupted run (particles_final.csv)")
+
+# 4. refused combination
+rc, out, err = tv.run_tool(tool, tv.prm_set(base, "numerics/integration", "fem"), work, "refused", expect_rc=2)
+tv.check("load balancing/interval" in out + err, "load balancing with FEM integration is refused naming the entry")
+tv.finish()
