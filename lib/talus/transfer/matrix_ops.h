@@ -26,6 +26,7 @@
 #include <bitset>
 #include <tuple>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 namespace talus::transfer
@@ -257,7 +258,8 @@ namespace talus::transfer
       , Al(max_rows * max_rows)
       , bl(max_rows)
     {
-      Assert(space.n_components() == nc, dealii::ExcMessage("AssembleSystem: nc differs from the space's"));
+      if (space.n_components() != nc)
+        throw std::logic_error("transfer::AssembleSystem: nc differs from the space's number of components");
       std::fill(std::begin(local_of_slot), std::end(local_of_slot), dealii::numbers::invalid_unsigned_int);
     }
     const BackgroundGrid<dim> &              grid;
