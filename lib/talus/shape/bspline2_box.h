@@ -107,6 +107,25 @@ namespace talus::shape
       W::template interpolate<dim>(e, u, val, grad);
     }
 
+    /// The nodes one point touches, for matrix assembly (transfer/matrix_ops.h):
+    /// the point's 3^dim window as patch slots, with values and real-space
+    /// gradients (a window node is always inside the grid).
+    static constexpr unsigned int n_point_nodes = n_window;
+    static inline void
+    point_stencil(const Cell &              c,
+                  const dealii::Point<dim> &xi,
+                  unsigned int (&slot)[n_point_nodes],
+                  double (&N)[n_point_nodes],
+                  double (&G)[n_point_nodes][dim])
+    {
+      Eval e;
+      evaluate(c, xi, e);
+      W::values_and_gradients(e, N, G);
+      const unsigned int first = W::first_slot(e);
+      for (unsigned int w = 0; w < n_point_nodes; ++w)
+        slot[w] = first + W::window_offset(w);
+    }
+
     /// Lumped mass and internal force of a cell's points on the patch.
     struct MassForce
     {

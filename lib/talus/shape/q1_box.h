@@ -13,6 +13,8 @@
 //   K::MassForce                    per-cell sums of lumped mass and internal
 //                                   force (-V sigma grad N), scattered once per cell
 //   K::Momentum                     per-cell sums of m N v, scattered once per cell
+//   K::point_stencil(cell, xi, ...) the nodes a point touches (stencil slots) with
+//                                   values and gradients (matrix assembly)
 //
 // Q1Box is today's sum-factorised Q1 (shape/q1.h): gradients from per-cell
 // nodal differences and the internal force from per-cell pair moments.
@@ -103,6 +105,22 @@ namespace talus::shape
     {
       gradient(c, f, e, grad);
       interpolate(f, e, val);
+    }
+
+    /// The nodes one point touches, for matrix assembly (transfer/matrix_ops.h):
+    /// stencil slot, value and real-space gradient of each (Q1: the cell's 2^dim
+    /// vertices, slot = vertex).
+    static constexpr unsigned int n_point_nodes = n_nodes;
+    static inline void
+    point_stencil(const Cell &              c,
+                  const dealii::Point<dim> &xi,
+                  unsigned int (&slot)[n_point_nodes],
+                  double (&N)[n_point_nodes],
+                  double (&G)[n_point_nodes][dim])
+    {
+      Q1<dim>::values_and_gradients(xi, c.cc->inv_h, N, G);
+      for (unsigned int v = 0; v < n_point_nodes; ++v)
+        slot[v] = v;
     }
 
     /// Lumped mass (Eq. 4.32) and internal force (Eq. 4.41) of a cell's points

@@ -1,0 +1,139 @@
+// talus — nodal spaces and the active region of the implicit families.
+//
+// NodalSpace: a Q1 nodal space of n components (n = dim: displacement/velocity;
+// n = 1: e.g. pore pressure) on the BackgroundGrid's triangulation, with its own
+// DoFHandler, index sets and vector partitioner, and the map from the nodes of
+// a kernel's stencil (named by the grid's DoF of component 0, the index every
+// kernel Cell carries) to this space's DoFs.
+//
+// ActiveSet: what the material points of one or more sets touch through a
+// kernel's per-point stencil (Q1: the cell's 2^dim vertices; quadratic
+// B-spline: the point's 3^dim window of the cell's patch). A DoF is active if
+// some point's shape value or gradient at it is non-zero; inactive DoFs are
+// pinned to zero. The Trilinos sparsity couples the DoFs of nodes that share a
+// point's stencil (all components with all components), plus the diagonal of
+// every row; so an inactive row holds its diagonal only.
+#pragma once
+
+#include <talus/grid/background_grid.h>
+
+#include <deal.II/base/index_set.h>
+#include <deal.II/lac/affine_constraints.h>
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace dealii::TrilinosWrappers
+{
+  class SparseMatrix;
+  class SparsityPattern;
+}
+
+namespace talus
+{
+  template <int dim>
+  class MaterialPointSet;
+
+  template <int dim>
+  class NodalSpace
+  {
+  public:
+    using size_type = dealii::types::global_dof_index;
+
+    /// A space of n_components Q1 fields on grid's triangulation; setup() after
+    /// grid.setup() (and again after the grid changed).
+    NodalSpace(const BackgroundGrid<dim> &grid, unsigned int n_components);
+
+    /// Distribute DoFs, build the index sets, the partitioner and the node map.
+    void setup();
+
+    unsigned int n_components() const { return n_comp; }
+    const dealii::DoFHandler<dim> &dof_handler() const { return dofs; }
+    const dealii::IndexSet &       locally_owned_dofs() const { return owned; }
+    const dealii::IndexSet &       locally_relevant_dofs() const { return relevant; }
+    const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &partitioner() const { return part; }
+    void reinit_vector(Vector &v) const { v.reinit(part); }
+
+    /// Global DoF of component k at the node whose grid DoF of component 0 has
+    /// the local (owned + ghost) index i: grid.cells[c].dofs[v * dim] or a
+    /// B-spline patch's dofs[s * dim].
+    size_type node_dof(const unsigned int i, const unsigned int k) const { return node_dofs[i * n_comp + k]; }
+
+    /// Position and component of the DoF with local (owned + ghost) index i.
+    const dealii::Point<dim> &position(const unsigned int i) const { return positions[i]; }
+    unsigned int              component(const unsigned int i) const { return components[i]; }
+
+    /// Constraints (on the locally relevant DoFs, closed) u_i = value for every
+    /// DoF where `prescribed(x, component, value)` returns true: Dirichlet
+    /// conditions and rollers given by node position.
+    dealii::AffineConstraints<double>
+    constraints_where(const std::function<bool(const dealii::Point<dim> &, unsigned int, double &)> &prescribed) const;
+
+    /// Per component, the DoFs of that component (constant modes for ML AMG).
+    std::vector<std::vector<bool>> constant_modes() const;
+
+    const BackgroundGrid<dim> &grid;
+
+  private:
+    unsigned int                                               n_comp;
+    dealii::FESystem<dim>                                      fe;
+    dealii::DoFHandler<dim>                                    dofs;
+    dealii::IndexSet                                           owned, relevant;
+    std::shared_ptr<const dealii::Utilities::MPI::Partitioner> part;
+    std::vector<size_type>                                     node_dofs; // by grid local index (comp 0)
+    std::vector<dealii::Point<dim>>                            positions; // by local index
+    std::vector<unsigned char>                                 components;
+  };
+
+  template <int dim>
+  class ActiveSet
+  {
+  public:
+    using size_type = dealii::types::global_dof_index;
+
+    explicit ActiveSet(const NodalSpace<dim> &space);
+    ~ActiveSet();
+
+    /// The active region of the points of `sets` (one pass over each) with the
+    /// stencil of kernel K (shape::Q1Box<dim> or shape::BSpline2Box<dim>; the
+    /// latter needs grid.setup_bspline_patches()). Collective.
+    template <class K>
+    void reinit(const std::vector<MaterialPointSet<dim> *> &sets);
+
+    /// Locally owned cells holding points of any set (active_cell_index, ascending).
+    const std::vector<unsigned int> &cells() const { return active_cells; }
+    /// Active DoFs among the owned and among the relevant ones.
+    const dealii::IndexSet &active_owned_dofs() const { return active_owned; }
+    const dealii::IndexSet &active_relevant_dofs() const { return active_relevant; }
+    /// Whether a locally relevant DoF is active.
+    bool is_active(const size_type i) const { return active_relevant.is_element(i); }
+    size_type n_active_dofs() const { return n_active_global; }
+
+    /// Inactive relevant DoFs pinned to zero (closed).
+    const dealii::AffineConstraints<double> &constraints() const { return inactive; }
+    /// The inactive constraints together with Dirichlet constraints (e.g. from
+    /// NodalSpace::constraints_where). Where both constrain a DoF the pin to zero
+    /// wins: no point sees an inactive node's value. The sparsity fits any such
+    /// merge whose Dirichlet lines do not couple DoFs (fixed values, rollers).
+    dealii::AffineConstraints<double> constraints_with(const dealii::AffineConstraints<double> &dirichlet) const;
+
+    /// The pattern over the active region (owned rows, compressed).
+    const dealii::TrilinosWrappers::SparsityPattern &sparsity() const { return *pattern; }
+    void reinit_matrix(dealii::TrilinosWrappers::SparseMatrix &A) const;
+
+    /// For transfer ops: per grid local index (component-0 DoF of a node) whether
+    /// the node is active.
+    bool node_active(const unsigned int grid_local) const { return active_node[grid_local] != 0; }
+
+    const NodalSpace<dim> &space;
+
+  private:
+    std::vector<unsigned int>                 active_cells;
+    std::vector<unsigned char>                active_node;
+    dealii::IndexSet                          active_owned, active_relevant;
+    size_type                                 n_active_global = 0;
+    dealii::AffineConstraints<double>         inactive;
+    std::unique_ptr<dealii::TrilinosWrappers::SparsityPattern> pattern;
+  };
+} // namespace talus

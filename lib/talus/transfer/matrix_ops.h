@@ -1,0 +1,424 @@
+// talus — point ops for matrices over a NodalSpace (the implicit families), on
+// the walk of cell_walk.h. The kernel K tells which nodes a point touches
+// (K::point_stencil: stencil slots, values, real-space gradients); a node is
+// named by the grid DoF of its component 0 (K::Cell::dofs[slot * dim]) and
+// NodalSpace::node_dof maps it to the space's DoFs.
+//
+//   CollectCouplings   the nodes every point touches and which of them share a
+//                      point (ActiveSet::reinit builds its sparsity from it)
+//   AssembleSystem     per cell a local matrix and vector summed over the cell's
+//                      points by an Integrand, distributed with constraints at
+//                      end_cell (the Integrands below: consistent mass, linear
+//                      elastic stiffness, body force, and sums of them)
+//   InterpolateField   G2P of a nodal field's value and gradient per point
+//
+// `assemble(...)` runs AssembleSystem over several point sets and finishes the
+// matrix (inactive rows get a diagonal of the matrix's scale).
+#pragma once
+
+#include <talus/grid/nodal_space.h>
+#include <talus/particles/material_points.h>
+#include <talus/transfer/cell_walk.h>
+
+#include <deal.II/base/numbers.h>
+#include <deal.II/base/tensor.h>
+
+#include <bitset>
+#include <tuple>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace talus::transfer
+{
+  /// A point's share of a node: shape value or gradient non-zero (a Q1 point on
+  /// a face still has a gradient at the far nodes; a B-spline window node can
+  /// carry exactly zero when the point sits on a half-cell line).
+  template <int dim>
+  inline bool
+  touches(const double N, const double (&G)[dim])
+  {
+    bool t = N != 0.0;
+    for (unsigned int d = 0; d < dim; ++d)
+      t = t || G[d] != 0.0;
+    return t;
+  }
+
+  /// The nodes of each cell that points touch and the node pairs that share a
+  /// point. `Sink` is called once per cell as sink(c, cell, touched, pairs)
+  /// with std::bitsets over stencil slots (pairs: bit a * K::n_nodes + b).
+  template <int dim, class K, class Sink>
+  struct CollectCouplings
+  {
+    CollectCouplings(const BackgroundGrid<dim> &grid, Sink &sink)
+      : grid(grid)
+      , sink(sink)
+    {}
+    const BackgroundGrid<dim> &grid;
+    Sink &                     sink;
+
+    static constexpr unsigned int                  n_nodes           = K::n_nodes;
+    static constexpr bool                          prefetch_location = false;
+    typename K::Cell                               cell;
+    std::bitset<n_nodes>                           touched;
+    std::bitset<n_nodes * n_nodes>                 pairs;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      touched.reset();
+      pairs.reset();
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      unsigned int slot[K::n_point_nodes], t[K::n_point_nodes], n = 0;
+      double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+      K::point_stencil(cell, it->get_reference_location(), slot, N, G);
+      for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+        if (touches<dim>(N[w], G[w]))
+          t[n++] = slot[w];
+      for (unsigned int a = 0; a < n; ++a)
+        {
+          touched.set(t[a]);
+          for (unsigned int b = 0; b < n; ++b)
+            pairs.set(t[a] * n_nodes + t[b]);
+        }
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int c)
+    {
+      sink(c, cell, touched, pairs);
+    }
+  };
+
+  /// The nodes one point touches, as indices into the cell's local system, with
+  /// their shape values and real-space gradients.
+  template <int dim, unsigned int max_nodes>
+  struct PointNodes
+  {
+    unsigned int n = 0;
+    unsigned int local[max_nodes];
+    double       N[max_nodes];
+    double       G[max_nodes][dim];
+  };
+
+  /// A cell's local matrix (row-major, `stride` columns) and vector; row of
+  /// component k at local node a: a * nc + k.
+  struct LocalSystem
+  {
+    double *     A;
+    double *     b;
+    unsigned int stride;
+    double &     a(const unsigned int i, const unsigned int j) { return A[i * stride + j]; }
+  };
+
+  // ------------------------------------------------------------------ integrands
+  // An integrand adds one point's contribution (properties P) to the local
+  // system: add<dim, nc>(P, nodes, local). `matrix` / `vector` say what it fills.
+
+  /// Consistent mass factor * m_p N_i N_j (every component); factor = 1/(beta h^2)
+  /// gives the Newmark inertia term.
+  struct ConsistentMass
+  {
+    double                factor = 1.0;
+    static constexpr bool matrix = true, vector = false;
+    template <int dim, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      const double m = factor * P[PropertyLayout<dim>::mass];
+      for (unsigned int i = 0; i < p.n; ++i)
+        for (unsigned int j = 0; j < p.n; ++j)
+          {
+            const double v = m * p.N[i] * p.N[j];
+            for (unsigned int k = 0; k < nc; ++k)
+              ls.a(p.local[i] * nc + k, p.local[j] * nc + k) += v;
+          }
+    }
+  };
+
+  /// Small-strain isotropic linear elasticity B^T C B V_p with C from Lame's
+  /// lambda and mu (in 2D the in-plane block of the 3D C: plane strain).
+  struct LinearElasticStiffness
+  {
+    double                lambda = 0, mu = 0;
+    static constexpr bool matrix = true, vector = false;
+    static LinearElasticStiffness
+    from_E_nu(const double E, const double nu)
+    {
+      return {E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))};
+    }
+    template <int dim, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      static_assert(nc == dim, "LinearElasticStiffness: a vector space (nc = dim)");
+      const double V = P[PropertyLayout<dim>::volume];
+      for (unsigned int i = 0; i < p.n; ++i)
+        for (unsigned int j = 0; j < p.n; ++j)
+          {
+            const auto &Gi = p.G[i];
+            const auto &Gj = p.G[j];
+            double      gg = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              gg += Gi[d] * Gj[d];
+            for (unsigned int c = 0; c < dim; ++c)
+              for (unsigned int d = 0; d < dim; ++d)
+                ls.a(p.local[i] * dim + c, p.local[j] * dim + d) +=
+                  V * (lambda * Gi[c] * Gj[d] + mu * Gi[d] * Gj[c] + (c == d ? mu * gg : 0.0));
+          }
+    }
+  };
+
+  /// Body force m_p g N_i.
+  template <int dim>
+  struct BodyForce
+  {
+    dealii::Tensor<1, dim> g;
+    static constexpr bool  matrix = false, vector = true;
+    template <int d_, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      static_assert(nc == dim && d_ == dim, "BodyForce: a vector space (nc = dim)");
+      const double m = P[PropertyLayout<dim>::mass];
+      for (unsigned int i = 0; i < p.n; ++i)
+        for (unsigned int c = 0; c < dim; ++c)
+          ls.b[p.local[i] * dim + c] += m * p.N[i] * g[c];
+    }
+  };
+
+  /// The sum of integrands.
+  template <class... T>
+  struct Sum
+  {
+    std::tuple<T...>      terms;
+    static constexpr bool matrix = (T::matrix || ...), vector = (T::vector || ...);
+    template <int dim, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      std::apply([&](const auto &...t) { (t.template add<dim, nc>(P, p, ls), ...); }, terms);
+    }
+  };
+  template <class... T>
+  Sum(T...) -> Sum<T...>;
+  template <class... T>
+  Sum<T...>
+  sum(const T &...t)
+  {
+    return Sum<T...>{std::tuple<T...>(t...)};
+  }
+
+  /// Distribute a local system (m x m, row-major with `stride`) with the
+  /// constraints into A and/or b (either may be null); global indices `dofs`.
+  /// (Out of line: keeps deal.II's Trilinos and constraint templates in a .cc.)
+  void distribute_local(const dealii::AffineConstraints<double> &       constraints,
+                        const unsigned int                              m,
+                        const double *                                  A_local,
+                        const double *                                  b_local,
+                        const unsigned int                              stride,
+                        const std::vector<dealii::types::global_dof_index> &dofs,
+                        dealii::TrilinosWrappers::SparseMatrix *        A,
+                        Vector *                                        b);
+
+  /// After a walk: compress A and b; give every locally owned inactive row the
+  /// diagonal `mean |diagonal|` of all local matrices (diag_sum / diag_count
+  /// over all ranks), so that the system stays regular and well scaled.
+  /// Collective.
+  template <int dim>
+  void finish_assembly(const ActiveSet<dim> &                  active,
+                       double                                  diag_sum,
+                       double                                  diag_count,
+                       dealii::TrilinosWrappers::SparseMatrix *A,
+                       Vector *                                b);
+
+  /// Assembly of A and/or b over a cell's points (the integrand's sums),
+  /// distributed at end_cell with `constraints` (ActiveSet::constraints() or
+  /// constraints_with(Dirichlet)). nc = the space's components.
+  template <int dim, class K, unsigned int nc, class Integrand>
+  struct AssembleSystem
+  {
+    static constexpr unsigned int max_rows = K::n_nodes * nc;
+
+    AssembleSystem(const ActiveSet<dim> &                   active,
+                   const dealii::AffineConstraints<double> &constraints,
+                   const Integrand &                        integrand,
+                   dealii::TrilinosWrappers::SparseMatrix * A,
+                   Vector *                                 b)
+      : grid(active.space.grid)
+      , space(active.space)
+      , constraints(constraints)
+      , integrand(integrand)
+      , A(A)
+      , b(b)
+      , Al(max_rows * max_rows)
+      , bl(max_rows)
+    {
+      if (space.n_components() != nc)
+        throw std::logic_error("transfer::AssembleSystem: nc differs from the space's number of components");
+      std::fill(std::begin(local_of_slot), std::end(local_of_slot), dealii::numbers::invalid_unsigned_int);
+    }
+    const BackgroundGrid<dim> &              grid;
+    const NodalSpace<dim> &                  space;
+    const dealii::AffineConstraints<double> &constraints;
+    const Integrand                          integrand;
+    dealii::TrilinosWrappers::SparseMatrix * A;
+    Vector *                                 b;
+
+    static constexpr bool prefetch_location = false;
+    typename K::Cell      cell;
+    /// local node of each stencil slot used in this cell, and the slots in order
+    unsigned int                                 local_of_slot[K::n_nodes];
+    unsigned int                                 slot_of_local[K::n_nodes];
+    unsigned int                                 n_local = 0;
+    std::vector<double>                          Al, bl;
+    std::vector<dealii::types::global_dof_index> dofs;
+    /// sum of |diagonal| and count of the local matrices (the scale of inactive rows)
+    double diag_sum = 0, diag_count = 0;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      for (unsigned int a = 0; a < n_local; ++a)
+        local_of_slot[slot_of_local[a]] = dealii::numbers::invalid_unsigned_int;
+      n_local = 0;
+    }
+    /// local node of slot s; a new one gets zero rows and columns
+    inline unsigned int
+    local_node(const unsigned int s)
+    {
+      if (local_of_slot[s] != dealii::numbers::invalid_unsigned_int)
+        return local_of_slot[s];
+      const unsigned int a = n_local++;
+      local_of_slot[s]     = a;
+      slot_of_local[a]     = s;
+      const unsigned int r0 = a * nc, r1 = r0 + nc;
+      for (unsigned int i = 0; i < r1; ++i)
+        for (unsigned int j = (i < r0 ? r0 : 0); j < r1; ++j) // new columns; new rows in full
+          Al[i * max_rows + j] = 0.0;
+      for (unsigned int i = r0; i < r1; ++i)
+        bl[i] = 0.0;
+      return a;
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      unsigned int slot[K::n_point_nodes];
+      double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+      K::point_stencil(cell, it->get_reference_location(), slot, N, G);
+      PointNodes<dim, K::n_point_nodes> p;
+      for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+        if (touches<dim>(N[w], G[w]))
+          {
+            const unsigned int k = p.n++;
+            p.local[k]           = local_node(slot[w]);
+            p.N[k]               = N[w];
+            for (unsigned int d = 0; d < dim; ++d)
+              p.G[k][d] = G[w][d];
+          }
+      LocalSystem ls{Al.data(), bl.data(), max_rows};
+      integrand.template add<dim, nc>(it->get_properties().data(), p, ls);
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {
+      if (n_local == 0)
+        return;
+      const unsigned int m = n_local * nc;
+      dofs.resize(m);
+      for (unsigned int a = 0; a < n_local; ++a)
+        for (unsigned int k = 0; k < nc; ++k)
+          dofs[a * nc + k] = space.node_dof(cell.dofs[slot_of_local[a] * dim], k);
+      if (Integrand::matrix)
+        for (unsigned int i = 0; i < m; ++i)
+          diag_sum += std::abs(Al[i * max_rows + i]);
+      diag_count += m;
+      distribute_local(constraints,
+                       m,
+                       Integrand::matrix ? Al.data() : nullptr,
+                       Integrand::vector ? bl.data() : nullptr,
+                       max_rows,
+                       dofs,
+                       Integrand::matrix ? A : nullptr,
+                       Integrand::vector ? b : nullptr);
+    }
+  };
+
+  /// A += and/or b += the integrand summed over the points of all `sets`, then
+  /// finish_assembly. A (reinit by ActiveSet::reinit_matrix) and b (the space's
+  /// partitioner) are not zeroed here; either may be null. Collective.
+  template <int dim, class K, unsigned int nc, class Integrand>
+  void
+  assemble(const std::vector<MaterialPointSet<dim> *> &sets,
+           const ActiveSet<dim> &                      active,
+           const dealii::AffineConstraints<double> &   constraints,
+           const Integrand &                           integrand,
+           dealii::TrilinosWrappers::SparseMatrix *    A,
+           Vector *                                    b)
+  {
+    AssembleSystem<dim, K, nc, Integrand> op(active, constraints, integrand, A, b);
+    for (auto *set : sets)
+      for_each_active_cell(*set, op);
+    finish_assembly(active, op.diag_sum, op.diag_count, Integrand::matrix ? A : nullptr, b);
+  }
+
+  /// G2P of a nodal field u of the space (ghost values up to date): per point
+  /// callback(it, val[nc], grad[nc][dim]) with grad[c][k] = d u_c / d x_k.
+  template <int dim, class K, unsigned int nc, class Callback>
+  struct InterpolateField
+  {
+    InterpolateField(const NodalSpace<dim> &space, const Vector &u, Callback &callback)
+      : grid(space.grid)
+      , space(space)
+      , u(u)
+      , callback(callback)
+    {}
+    const BackgroundGrid<dim> &grid;
+    const NodalSpace<dim> &    space;
+    const Vector &             u;
+    Callback &                 callback;
+
+    static constexpr bool prefetch_location = false;
+    typename K::Cell      cell;
+    double                un[K::n_nodes][nc];
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      for (unsigned int s = 0; s < K::n_nodes; ++s)
+        for (unsigned int k = 0; k < nc; ++k)
+          {
+            const unsigned int i = cell.dofs[s * dim];
+            un[s][k] = i == dealii::numbers::invalid_unsigned_int ? 0.0 : u(space.node_dof(i, k));
+          }
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      unsigned int slot[K::n_point_nodes];
+      double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+      K::point_stencil(cell, it->get_reference_location(), slot, N, G);
+      double val[nc] = {}, grad[nc][dim] = {};
+      for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+        for (unsigned int k = 0; k < nc; ++k)
+          {
+            const double v = un[slot[w]][k];
+            val[k] += N[w] * v;
+            for (unsigned int d = 0; d < dim; ++d)
+              grad[k][d] += G[w][d] * v;
+          }
+      callback(it, val, grad);
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {}
+  };
+} // namespace talus::transfer
