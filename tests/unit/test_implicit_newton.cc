@@ -7,6 +7,7 @@
 //  * the Newton driver on small nonlinear systems: quadratic order with the
 //    exact tangent, linear order with a wrong one, line search against an
 //    overshooting arctan residual, divergence, failures -> cut_back.
+#include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/implicit/newmark.h>
 #include <talus/formulations/implicit/newton.h>
 
@@ -16,6 +17,7 @@
 
 #include <cmath>
 #include <complex>
+#include <sstream>
 #include <vector>
 
 namespace
@@ -605,5 +607,80 @@ namespace
     EXPECT_LE(max_it, 3u);
     EXPECT_LT(max_drift, 1e-2);
     EXPECT_GT(max_drift, 1e-6); // nonlinear: not conserved to round-off
+  }
+
+  /// A stand-in implicit formulation for the cut-back contract: the state x
+  /// follows x' = 1; each step solves atan(s (z - x - h)) = 0 by Newton from
+  /// the predictor z = x, which converges only when s h < 1.39. The committed
+  /// state x changes only after convergence (as point history will).
+  struct ArctanStep : Formulation
+  {
+    double       x = 0, s = 10;
+    unsigned int newton_failures = 0;
+    std::string  last_message;
+
+    std::string tool_name() const override { return "talus-test"; }
+    void        describe(std::ostream &) const override {}
+    double      begin_stage(const unsigned int, const bool, const bool) override { return 1e9; }
+    StepOutcome advance_by(const double h) override
+    {
+      double        z = x, dz = 0, r = 0, drdz = 1;
+      NewtonProblem p;
+      p.assemble = [&](const bool) {
+        r    = std::atan(s * (z - x - h));
+        drdz = s / (1 + s * s * (z - x - h) * (z - x - h));
+        return std::abs(r);
+      };
+      p.solve = [&] {
+        dz = -r / drdz;
+        return std::abs(dz);
+      };
+      p.apply          = [&](const double alpha) { z += alpha * dz; };
+      NewtonSettings ns;
+      ns.residual_relative = 1e-12;
+      const auto res       = NewtonSolver(ns).solve(p);
+      if (res.converged)
+        x = z;
+      else
+        {
+          ++newton_failures;
+          last_message = res.message;
+        }
+      return res.outcome();
+    }
+    void check_stability() const override
+    {
+      if (!std::isfinite(x))
+        throw InstabilityError("x is not finite");
+    }
+    std::vector<std::string> series_columns() const override { return {"x"}; }
+    std::vector<double>      series_values(const bool) override { return {x}; }
+    void                     write_vtu(const unsigned int) override {}
+    std::string              write_checkpoint() override { return ""; }
+    void                     summary(const LoopTimings &) override {}
+  };
+
+  TEST(ImplicitNewton, FailedNewtonCutsBackInTheTimeLoop)
+  {
+    ArctanStep f;
+    f.dt = 0.5; // s h: 5 and 2.5 fail, 1.25 converges
+    LoopSettings ls;
+    ls.progress = false;
+    TimeLoop(f, ls, MPI_COMM_SELF).advance_steps(4);
+    std::printf("  cut-backs: t = %g after 4 steps, %u cut-backs; a failure: %s\n", f.time, f.cut_backs,
+                f.last_message.c_str());
+    EXPECT_NEAR(f.time, 4 * 0.125, 1e-15);
+    EXPECT_EQ(f.cut_backs, 8u);
+    EXPECT_EQ(f.newton_failures, 8u);
+    EXPECT_NEAR(f.x, f.time, 1e-12); // failed attempts left no trace
+    EXPECT_FALSE(f.last_message.empty());
+
+    // a step that never converges: the loop's cut-back limit ends the run
+    ArctanStep never;
+    never.dt = 0.5;
+    never.s  = 1e6; // needs h < 1.4e-6: more than 6 halvings
+    EXPECT_THROW(TimeLoop(never, ls, MPI_COMM_SELF).advance_steps(1), InstabilityError);
+    EXPECT_EQ(never.x, 0.0);
+    EXPECT_EQ(never.newton_failures, ls.max_cut_backs + 1);
   }
 } // namespace
