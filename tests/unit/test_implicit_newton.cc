@@ -385,6 +385,19 @@ namespace
     EXPECT_LE(ri.history.back().increment, 1e-4 * ri.history.back().step_increment);
     EXPECT_GT(ri.history[ri.iterations - 1].increment, 1e-4 * ri.history[ri.iterations - 1].step_increment);
 
+    // without step_increment_norm the first increment is the reference; with
+    // it, its value is (a huge |Du| passes the test at once)
+    s.criterion = NewtonCriterion::increment;
+    Springs first, huge;
+    NewtonProblem pf = first.problem(), ph = huge.problem();
+    pf.step_increment_norm = nullptr;
+    ph.step_increment_norm = [] { return 1e8; };
+    const auto rf = NewtonSolver(s).solve(pf), rh = NewtonSolver(s).solve(ph);
+    ASSERT_TRUE(rf.converged && rh.converged);
+    EXPECT_LE(rf.history.back().increment, 1e-4 * rf.history[1].increment);
+    EXPECT_TRUE(std::isnan(rf.history.back().step_increment));
+    EXPECT_EQ(rh.iterations, 1u);
+
     // "and" needs at least as many iterations as either test alone
     s.criterion = NewtonCriterion::residual_and_increment;
     Springs both;
@@ -448,6 +461,10 @@ namespace
   struct Arctan
   {
     double x = 2.0, dx = 0, r = 0, drdx = 1;
+    /// x at each solve; where the tangent in use was assembled
+    std::vector<double> x_at_solve;
+    double              x_tangent = 0;
+    unsigned int        stale_tangents = 0;
     NewtonProblem
     problem()
     {
@@ -455,10 +472,15 @@ namespace
       p.assemble = [this](const bool with_tangent) {
         r = std::atan(x);
         if (with_tangent)
-          drdx = 1 / (1 + x * x);
+          {
+            drdx      = 1 / (1 + x * x);
+            x_tangent = x;
+          }
         return std::abs(r);
       };
       p.solve = [this] {
+        stale_tangents += (x_tangent != x);
+        x_at_solve.push_back(x);
         dx = -r / drdx;
         return std::abs(dx);
       };
@@ -491,6 +513,14 @@ namespace
     EXPECT_LT(rl.history[1].alpha, 1.0);
     EXPECT_EQ(rl.history.back().alpha, 1.0); // full steps near the root
     EXPECT_GE(rl.observed_order, 1.8);       // atan has r'' = 0 at the root: even cubic
+    // every solve used the tangent of its own iterate (re-assembled after a
+    // halved trial), and the history's increment is the step actually taken
+    EXPECT_EQ(ls.stale_tangents, 0u);
+    ls.x_at_solve.push_back(ls.x);
+    ASSERT_EQ(ls.x_at_solve.size(), rl.iterations + 1);
+    for (unsigned int k = 1; k <= rl.iterations; ++k)
+      EXPECT_NEAR(std::abs(ls.x_at_solve[k] - ls.x_at_solve[k - 1]), rl.history[k].increment,
+                  1e-14 * (1 + rl.history[k].increment));
   }
 
   TEST(ImplicitNewton, FailuresMapToCutBack)
@@ -526,7 +556,13 @@ namespace
     p.assemble = [&](const bool) { return nan.assemblies++ ? std::nan("") : 1.0; };
     const auto rn = NewtonSolver().solve(p);
     EXPECT_EQ(rn.status, NewtonStatus::non_finite);
+    EXPECT_EQ(rn.iterations, 1u);
     EXPECT_EQ(rn.outcome(), StepOutcome::cut_back);
+    p.assemble     = [](const bool) { return std::nan(""); }; // already at the predictor
+    const auto rn0 = NewtonSolver().solve(p);
+    EXPECT_EQ(rn0.status, NewtonStatus::non_finite);
+    EXPECT_EQ(rn0.iterations, 0u);
+    EXPECT_EQ(rn0.outcome(), StepOutcome::cut_back);
 
     // a linear solver that gives up
     Springs fail;

@@ -305,8 +305,6 @@ namespace talus::implicit_mpm
                 r            = trial(false);
                 have_tangent = false;
               }
-          if (halvings == 0)
-            have_tangent = true;
 
           const double inc  = alpha * du;
           const double step = p.step_increment_norm ? p.step_increment_norm() : nan;
