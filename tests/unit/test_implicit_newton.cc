@@ -324,6 +324,10 @@ namespace
     EXPECT_EQ(s.increment_relative, 1e-4);
     EXPECT_EQ(s.increment_absolute, 1e-9);
     EXPECT_EQ(s.criterion, NewtonCriterion::residual);
+    for (const auto c : {NewtonCriterion::residual, NewtonCriterion::increment,
+                         NewtonCriterion::residual_and_increment, NewtonCriterion::residual_or_increment})
+      EXPECT_EQ(parse_newton_criterion(to_string(c)), c);
+    EXPECT_THROW(parse_newton_criterion("residual_and_increment"), InputError);
     s.max_iterations = 0;
     EXPECT_THROW(NewtonSolver{s}, InputError);
     s                   = NewtonSettings();

@@ -45,6 +45,37 @@ namespace talus::implicit_mpm
     residual_or_increment   ///< either
   };
 
+  /// .prm spelling: "residual", "increment", "residual and increment",
+  /// "residual or increment".
+  inline std::string
+  to_string(const NewtonCriterion c)
+  {
+    switch (c)
+      {
+        case NewtonCriterion::residual:
+          return "residual";
+        case NewtonCriterion::increment:
+          return "increment";
+        case NewtonCriterion::residual_and_increment:
+          return "residual and increment";
+        case NewtonCriterion::residual_or_increment:
+          return "residual or increment";
+      }
+    return "unknown";
+  }
+
+  /// Inverse of to_string(NewtonCriterion); InputError names the allowed values.
+  inline NewtonCriterion
+  parse_newton_criterion(const std::string &s)
+  {
+    for (const auto c : {NewtonCriterion::residual, NewtonCriterion::increment,
+                         NewtonCriterion::residual_and_increment, NewtonCriterion::residual_or_increment})
+      if (s == to_string(c))
+        return c;
+    throw InputError("Newton convergence criterion '" + s +
+                     "': allowed are residual | increment | residual and increment | residual or increment");
+  }
+
   /// Settings of the driver. Defaults: the Kratos MPM inputs quoted in the
   /// seed001 notes §1.9 (the thesis gives none).
   struct NewtonSettings
