@@ -160,7 +160,8 @@ namespace talus::implicit_mpm
 
     // ---- vector forms on entries [0, n)
     /// v_new[i], a_new[i] from du[i], v_n[i], a_n[i] (Eqs. 2.11-2.12). With du
-    /// = 0 this is the predictor of Eq. 2.10. Output may alias no input.
+    /// = 0 this is the predictor of Eq. 2.10. Each entry is read before it is
+    /// written, so v_new may be v_n and a_new may be a_n (in-place update).
     template <typename Du, typename Vn, typename An, typename Vout, typename Aout>
     void
     update(const std::size_t n, const Du &du, const Vn &v_n, const An &a_n, Vout &&v_new, Aout &&a_new) const
