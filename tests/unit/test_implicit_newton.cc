@@ -135,6 +135,14 @@ namespace
             EXPECT_NEAR(Vp[i], nm.velocity(0.0, double(V[i]), double(A[i])), 1e-12);
             EXPECT_NEAR(Ap[i], nm.acceleration(0.0, double(V[i]), double(A[i])), 1e-9);
           }
+        // in place: v, a overwritten by v^{n+1}, a^{n+1}
+        auto Vi = V, Ai = A;
+        nm.update(n, dU, Vi, Ai, Vi, Ai);
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            EXPECT_EQ(Vi[i], Vn[i]);
+            EXPECT_EQ(Ai[i], An[i]);
+          }
         std::vector<double> vp = {1.0, 2.0}, a_old = {3.0, -1.0}, a_new = {0.5, 0.25};
         nm.update_point_velocities(2, vp, a_old, a_new);
         EXPECT_NEAR(vp[0], 1.0 + dt * ((1 - g) * 3.0 + g * 0.5), 1e-15);
