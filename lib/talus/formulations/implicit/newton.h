@@ -149,7 +149,7 @@ namespace talus::implicit_mpm
     std::function<double()> step_increment_norm;
     /// Optional: a force scale of the step (e.g. |f_ext| + |f_inertia|) so that
     /// a step starting in equilibrium to round-off is not judged relative to
-    /// its round-off residual.
+    /// its round-off residual. Called once, after the first assembly.
     std::function<double()> residual_reference;
   };
 
