@@ -67,6 +67,7 @@ namespace talus::implicit_mpm
       beta_  = beta;
     }
 
+    /// Call at the start of every step: a cut-back changes the step.
     void
     set_time_step(const double dt)
     {
