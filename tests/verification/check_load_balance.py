@@ -13,7 +13,11 @@ wide grid: partitioned by cells, one rank holds nearly all points. Checks:
      bitwise identically (particles_final.csv byte for byte) through further
      rebalances;
   4. load balancing together with a feature whose grid data a repartition does
-     not carry yet (FEM integration) is refused with exit 2 naming the entry.
+     not carry yet (FEM integration) is refused with exit 2 naming the entry;
+  5. points crossing the rank boundary (translating_bar.prm on 2 ranks, no load
+     balancing) are sent to their new owner point to point: no collective full
+     sort in the whole run (the log's count), points did move to the other
+     rank, and the particle results equal the 1-rank run to 1e-12 relative.
 Usage: check_load_balance.py TOOL PRM WORKDIR
 """
 import filecmp
@@ -80,4 +84,18 @@ tv.check(filecmp.cmp(f"{work}/uninterrupted.csv", f"{work}/out_restart/particles
 # 4. refused combination
 rc, out, err = tv.run_tool(tool, tv.prm_set(base, "numerics/integration", "fem"), work, "refused", expect_rc=2)
 tv.check("load balancing/interval" in out + err, "load balancing with FEM integration is refused naming the entry")
+
+# 5. points crossing ranks every few steps: no full sort
+import os
+bar = open(os.path.join(os.path.dirname(prm_path), "translating_bar.prm")).read()
+bar = tv.prm_set(bar, "output/final particles csv", "true")
+tv.run_tool(tool, tv.prm_set(bar, "output/directory", "out_bar_np1"), work, "bar_np1")
+_, logb, _ = tv.run_tool(tool, tv.prm_set(bar, "output/directory", "out_bar_np2"), work, "bar_np2", np=2)
+m = re.search(r"\(to other ranks (\d+)\), full sorts (\d+)", logb)
+tv.check(m is not None, "the log reports the moves to other ranks and the full sorts")
+sent, sorts = int(m.group(1)), int(m.group(2))
+tv.check(sent >= 8, f"material points moved to the other rank: {sent}")
+tv.check(sorts == 0, f"collective full sorts in the 2-rank run: {sorts} (expected 0)")
+worst = worst_difference(particles("out_bar_np1"), particles("out_bar_np2"))
+tv.check(worst <= 1e-12, f"1 vs 2 ranks with points crossing ranks agree to 1e-12 relative (worst {worst:.2e})")
 tv.finish()

@@ -379,6 +379,28 @@ namespace talus
 
   template <int dim>
   unsigned int
+  BackgroundGrid<dim>::find_cell_near(const unsigned int c, const dealii::Point<dim> &x, dealii::Point<dim> &xi) const
+  {
+    const auto &cc = cells[c];
+    for (unsigned int k = cc.neighbours_begin; k < cc.neighbours_end; ++k)
+      {
+        const unsigned int n  = neighbours[k];
+        const auto &       nc = cells[n];
+        bool               in = true;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double r = (x[d] - nc.lower[d]) * nc.inv_h[d];
+            in             = in && (r >= 0.0) && (r <= 1.0);
+            xi[d]          = r;
+          }
+        if (in)
+          return n;
+      }
+    return dealii::numbers::invalid_unsigned_int;
+  }
+
+  template <int dim>
+  unsigned int
   BackgroundGrid<dim>::find_owned_cell_near(const unsigned int        c,
                                             const dealii::Point<dim> &x,
                                             dealii::Point<dim> &      xi) const

@@ -117,6 +117,9 @@ namespace talus
     unsigned int find_owned_cell_near(const unsigned int        c,
                                       const dealii::Point<dim> &x,
                                       dealii::Point<dim> &      xi) const;
+    /// The same for any cached cell (owned or ghost): the index of the cell
+    /// among c and its vertex neighbours that contains x, or invalid.
+    unsigned int find_cell_near(const unsigned int c, const dealii::Point<dim> &x, dealii::Point<dim> &xi) const;
 
     /// Reference coordinates of x in cell c (box map).
     dealii::Point<dim> reference_point(const unsigned int c, const dealii::Point<dim> &x) const

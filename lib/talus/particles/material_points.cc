@@ -559,20 +559,43 @@ namespace talus
     sorted_last = false;
     const unsigned int n_props = particles.n_properties_per_particle();
     bool               need_sort = false;
+    const bool parallel = dealii::Utilities::MPI::n_mpi_processes(grid.comm) > 1;
+    for (auto &o : outgoing)
+      o.second.clear();
+    unsigned long long n_sent = 0;
     for (std::size_t k = 0; k < pending.size(); ++k)
       {
         const auto &       it = pending[k].it;
         dealii::Point<dim> xi;
         const auto         x = it->get_location();
-        const unsigned int n = grid.find_owned_cell_near(pending[k].cell, x, xi);
+        const unsigned int n = grid.find_cell_near(pending[k].cell, x, xi);
         if (n == dealii::numbers::invalid_unsigned_int)
           {
-            need_sort = true;
+            need_sort = true; // jumped past the neighbours or left the grid
             continue;
           }
         const auto p = it->get_properties();
-        moves.push_back({x, xi, it->get_id(), n, static_cast<unsigned int>(props.size())});
-        props.insert(props.end(), p.begin(), p.end());
+        if (grid.cells[n].locally_owned)
+          {
+            moves.push_back({x, xi, it->get_id(), n, static_cast<unsigned int>(props.size())});
+            props.insert(props.end(), p.begin(), p.end());
+          }
+        else
+          {
+            // a neighbour cell of another rank: send the point to its owner
+            // (point to point, no collective sort)
+            const auto &cell = grid.cell_iterators[n];
+            auto &      buf  = outgoing[cell->subdomain_id()];
+            for (const unsigned int w : cell->id().template to_binary<dim>())
+              buf.push_back(w);
+            buf.push_back(static_cast<double>(it->get_id()));
+            for (unsigned int d = 0; d < dim; ++d)
+              buf.push_back(x[d]);
+            for (unsigned int d = 0; d < dim; ++d)
+              buf.push_back(xi[d]);
+            buf.insert(buf.end(), p.begin(), p.end());
+            ++n_sent;
+          }
         to_remove.push_back(k);
       }
     // remove backwards: pending is in ascending order within each cell, and
@@ -593,8 +616,43 @@ namespace talus
                                 grid.cell_iterators[m.cell],
                                 dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
       }
-    stats.moved_locally += moves.size();
-    moved_since_sort += moves.size();
+    // the points other ranks sent into my cells, in rank order (deterministic)
+    unsigned long long n_received = 0;
+    if (parallel)
+      {
+        for (auto o = outgoing.begin(); o != outgoing.end();)
+          o = o->second.empty() ? outgoing.erase(o) : std::next(o);
+        const auto         received = dealii::Utilities::MPI::some_to_some(grid.comm, outgoing);
+        const unsigned int stride   = 4 + 1 + 2 * dim + n_props;
+        for (const auto &from : received)
+          for (std::size_t o = 0; o + stride <= from.second.size(); o += stride)
+            {
+              const double *              q = from.second.data() + o;
+              dealii::CellId::binary_type key;
+              for (unsigned int w = 0; w < 4; ++w)
+                key[w] = static_cast<unsigned int>(q[w]);
+              const auto cell = grid.tria.create_cell_iterator(dealii::CellId(key));
+              AssertThrow(cell->is_active() && cell->is_locally_owned(),
+                          dealii::ExcMessage("a material point was sent to a rank that does not own its cell"));
+              const unsigned int c = cell->active_cell_index();
+              dealii::Point<dim> x, xi;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  x[d]  = q[5 + d];
+                  xi[d] = q[5 + dim + d];
+                }
+              const double *P = q + 5 + 2 * dim;
+              if (moved)
+                moved(c, xi, P);
+              inserted_into.push_back(c);
+              particles.insert_particle(x, xi, static_cast<dealii::types::particle_index>(q[4]),
+                                        grid.cell_iterators[c], dealii::ArrayView<const double>(P, n_props));
+              ++n_received;
+            }
+      }
+    stats.moved_locally += moves.size() + n_sent;
+    stats.sent_to_ranks += n_sent;
+    moved_since_sort += moves.size() + n_received;
     pending.clear();
 
     // one reduction decides both: a needed sort and a memory-order sort

@@ -12,6 +12,7 @@
 #include <functional>
 
 #include <string>
+#include <map>
 #include <vector>
 
 namespace talus
@@ -191,6 +192,7 @@ namespace talus
   struct RelocationStats
   {
     unsigned long long moved_locally = 0; ///< changed cell, found among neighbours
+    unsigned long long sent_to_ranks = 0; ///< of those: entered a neighbour owned by another rank (sent there)
     unsigned long long global_sorts  = 0; ///< full deal.II sorts needed
     unsigned long long lost          = 0; ///< left the grid (removed)
     unsigned long long storage_sorts = 0; ///< sorts done to restore memory order
@@ -263,6 +265,9 @@ namespace talus
     };
     std::vector<Move>        moves;
     std::vector<double>      props;
+    /// per destination rank: the points that entered one of its cells (CellId
+    /// words, id, x, xi, properties per point)
+    std::map<unsigned int, std::vector<double>> outgoing;
     std::vector<std::size_t> to_remove;
   };
 } // namespace talus

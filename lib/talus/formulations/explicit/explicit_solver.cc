@@ -1352,10 +1352,14 @@ namespace talus::explicit_mpm
     timings.total  = loop_timings.total;
     const double ns = 1e9 * timings.total / std::max(1.0, double(step_number) * double(n_particles()));
     const auto & rs = points.relocation_stats;
+    // moves are counted per rank: the totals
+    const unsigned long long moved = dealii::Utilities::MPI::sum(rs.moved_locally, comm),
+                             sent  = dealii::Utilities::MPI::sum(rs.sent_to_ranks, comm);
     log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid
           << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves "
           << rs.seconds_moves << ", sorts " << rs.seconds_sorts << "), output " << timings.output
-          << "; particles moved cell " << rs.moved_locally << ", full sorts " << rs.global_sorts
+          << "; particles moved cell " << moved << " (to other ranks " << sent
+          << "), full sorts " << rs.global_sorts
           << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost;
     if (prm.balance.enabled())
       log() << ", rebalances " << n_rebalances;
