@@ -19,6 +19,20 @@
 //   particle_velocities  prescribed material point velocities (momentum corrected)
 //   v = p / m (solver)
 //   nodal_velocities     prescribed values, no penetration / stick at friction nodes
+//
+// The 2-phase single-point step (explicit_two_phase.cc, seed 000 §4.5.7) calls
+// the same hooks at the same places, and they act on both phases there:
+//   before_nodal_solve   the same; v^t is the solid nodal momentum of its P2G
+//   nodal_forces_two_phase  tractions on the mixture (total stress); the
+//                        convergence ratios over the mixture and the liquid
+//                        (no seepage left); local/viscous damping and mass
+//                        scaling are applied by the 2-phase nodal solve itself
+//                        (local_damping(), viscous_damping(), s.mass_scaling)
+//   nodal_accelerations  prescribed nodes: both phases get vbar; friction nodes:
+//                        the solid as above, the liquid cannot flow into the
+//                        (impermeable) wall and has no tangential friction
+//   particle_velocities  body conditions set the solid and liquid point velocities
+//   nodal_velocities     prescribed values for both phases; no penetration
 #pragma once
 
 #include <talus/grid/background_grid.h>
@@ -62,8 +76,30 @@ namespace talus::loads
     /// (restart inside a stage). Returns the absolute end time of the stage.
     double begin_stage(Solver &s, const unsigned int k, const bool resume);
 
-    void before_nodal_solve(Solver &s, const double h);
+    /// `momentum_t`: the solid nodal momentum at t when the caller has it (the
+    /// 2-phase P2G), else the points' momentum is projected here when needed.
+    /// With `momentum_t` the caller also sums the work of the tractions itself
+    /// (f_p . dx_p over the step, point_force()); else it is f_p . v_p^t dt here.
+    void before_nodal_solve(Solver &s, const double h, const Vector *momentum_t = nullptr);
+    /// Traction force of a point at the time of the last before_nodal_solve
+    /// (0 without tractions).
+    void point_force(const double *P, double (&f)[dim]) const
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        f[d] = 0;
+      if (!have_tractions)
+        return;
+      for (unsigned int j = 0; j < factor.size(); ++j)
+        for (unsigned int d = 0; d < dim; ++d)
+          f[d] += factor[j] * P[force_offset + j * dim + d];
+    }
+    bool any_traction() const { return have_tractions; }
     void nodal_forces(Solver &s);
+    /// 2-phase form of nodal_forces (see above), before the 2-phase nodal solve.
+    void nodal_forces_two_phase(Solver &s);
+    /// Local damping alpha and viscous damping alpha_v of the running stage.
+    double local_damping() const { return current->damping; }
+    double viscous_damping() const { return current->viscous_damping; }
     void nodal_accelerations(Solver &s);
     void particle_velocities(Solver &s);
     void nodal_velocities(Solver &s);
@@ -87,6 +123,7 @@ namespace talus::loads
     double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
 
     bool need_vt = false, have_tractions = false;
+    std::vector<double> factor; ///< time factors of the stage's tractions at t
     Vector trac, vt;
     std::vector<int> component; ///< of each local DoF (-1: none)
     std::vector<unsigned char> excluded; ///< DoFs left out of the force ratio
@@ -99,6 +136,7 @@ namespace talus::loads
       double        area;
       double        h; ///< cell size normal to the wall
       unsigned char state; ///< 0 free/separating, 1 stick, 2 slip
+      bool          liquid_stopped; ///< 2-phase: liquid normal velocity into the wall removed
     };
     std::vector<FrictionNode> friction_nodes;
     /// Per grid cell: bit f set if face f lies on a friction boundary.
@@ -127,5 +165,8 @@ namespace talus::loads
     void set_time_step(Solver &s);
     /// the convergence ratios are evaluated in this step
     bool check_step(const Solver &s) const;
+    /// Ratios from the local sums v = {|f_unbalanced|^2, |f_ext|^2, grid KE,
+    /// gravity potential} (reduced here over the ranks); sets `converged`.
+    void evaluate_convergence(const Solver &s, double (&v)[4]);
   };
 } // namespace talus::loads

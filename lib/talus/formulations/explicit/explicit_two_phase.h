@@ -20,6 +20,12 @@
 #include <string>
 #include <vector>
 
+namespace talus::loads
+{
+  template <int dim>
+  class LoadControl;
+}
+
 namespace talus::explicit_mpm
 {
   template <int dim>
@@ -107,21 +113,24 @@ namespace talus::explicit_mpm
   {
   public:
     explicit TwoPhase(Solver<dim> &s);
-    /// porosity, pore pressure, liquid velocity (coupled), external force (tractions)
+    /// porosity, pore pressure, liquid velocity (coupled)
     void extend_layout(PropertyLayout<dim> &layout);
-    /// after seeding: solid masses (1-n) rho_S V, porosity, liquid velocity,
-    /// traction forces of the boundary points
+    /// after seeding: solid masses (1-n) rho_S V, porosity, liquid velocity
     void initialize_particles();
-    /// One step of §4.5.7. Collective.
+    /// One step of §4.5.7, with the hooks of the loads (Solver::control) at
+    /// the places of the 1-phase step (load_control.h). Collective.
     void step(const double dt);
     Energies energies() const;
     /// sum m_S v_S + m_L v_L (collective)
     dealii::Tensor<1, dim> total_momentum() const;
+    /// Liquid mass n rho_L V of a point (0 unless it is of a coupled material).
+    double liquid_mass(const double *P) const;
 
-    unsigned int porosity = 0, pore_pressure = 0, liquid_velocity = 0, external_force = 0;
-    bool         coupled = false, tractions = false;
+    unsigned int porosity = 0, pore_pressure = 0, liquid_velocity = 0;
+    bool         coupled = false;
 
   private:
+    friend class loads::LoadControl<dim>;
     Solver<dim> &s;
     // lumped nodal quantities: liquid mass without / with porosity, drag,
     // liquid force and momentum (solid: the solver's nodal_mass, nodal_a, nodal_p)
