@@ -26,3 +26,6 @@ set_tests_properties(verification.two_phase_np1_np2 PROPERTIES PROCESSORS 2)
 talus_liquid_case(two_phase_terzaghi_3d verify check_terzaghi.py verification/terzaghi_consolidation.prm 3d)
 talus_liquid_case(two_phase_local_damping fast check_local_damping.py verification/elastic_column_gravity.prm)
 talus_liquid_case(liquid_bingham_slump verify check_bingham_slump.py verification/bingham_slump.prm)
+# the shared loads in the 2-phase step (issue 12 item 2)
+talus_liquid_case(two_phase_staged_consolidation fast check_two_phase_staged.py
+                  verification/two_phase_staged_consolidation.prm)
