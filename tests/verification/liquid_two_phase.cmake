@@ -29,3 +29,9 @@ talus_liquid_case(liquid_bingham_slump verify check_bingham_slump.py verificatio
 # the shared loads in the 2-phase step (issue 12 item 2)
 talus_liquid_case(two_phase_staged_consolidation fast check_two_phase_staged.py
                   verification/two_phase_staged_consolidation.prm)
+add_test(NAME verification.two_phase_shared_loads
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_two_phase_loads.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/hydrostatic_2phase.prm
+                 ${TALUS_PRM_DIR}/verification/terzaghi_consolidation.prm
+                 ${TALUS_PRM_DIR}/verification/block_friction.prm ${_w}/two_phase_shared_loads)
+set_tests_properties(verification.two_phase_shared_loads PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 1800)
