@@ -447,16 +447,18 @@ namespace talus::loads
       }
     else if (vt_now) // nodal momentum p^t of the points (the shape functions of the run)
       s.scatter_point_momentum(vt);
-    if (!have_tractions && !any_friction)
+    // with momentum_t (the 2-phase step) the caller has scattered the tractions
+    // in its own P2G pass (begin/end_traction_scatter)
+    const bool scatter = have_tractions && !momentum_t;
+    if (!scatter && !any_friction)
       return;
-    double *const T   = have_tractions ? trac.begin() : nullptr;
-    if (have_tractions)
-      s.zero_on_active(trac);
-    // time factors of the tractions at t
-    const unsigned int nt = current->tractions.size();
-    factor.resize(nt);
-    for (unsigned int j = 0; j < nt; ++j)
-      factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
+    double *const T   = scatter ? trac.begin() : nullptr;
+    if (scatter)
+      {
+        s.zero_on_active(trac);
+        update_factors(s);
+      }
+    const unsigned int nt  = current->tractions.size();
     const unsigned int off = force_offset;
     double             work = 0;
     // frictional walls: the material's displacement away from the wall at each
@@ -487,7 +489,7 @@ namespace talus::loads
                         l                    = std::min(l, away);
                       }
                   }
-            if (have_tractions)
+            if (scatter)
               {
                 double f[dim] = {};
                 bool   any    = false;
@@ -505,20 +507,49 @@ namespace talus::loads
                     for (unsigned int v = 0; v < nv; ++v)
                       for (unsigned int d = 0; d < dim; ++d)
                         T[cc.dofs[v * dim + d]] += N[v] * f[d]; // Eq. 5.3
-                    if (!momentum_t)
-                      for (unsigned int d = 0; d < dim; ++d)
-                        work += f[d] * P[L::velocity + d] * h;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      work += f[d] * P[L::velocity + d] * h;
                   }
               }
           }
       }
-    if (have_tractions)
+    if (scatter)
       {
         trac.compress(dealii::VectorOperation::add);
         s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
       }
     if (any_friction)
       lift.compress(dealii::VectorOperation::min);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::update_factors(const Solver &s)
+  {
+    // time factors of the tractions at t
+    const unsigned int nt = current->tractions.size();
+    factor.resize(nt);
+    for (unsigned int j = 0; j < nt; ++j)
+      factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
+  }
+
+  template <int dim>
+  double *
+  LoadControl<dim>::begin_traction_scatter(Solver &s)
+  {
+    if (!have_tractions)
+      return nullptr;
+    update_factors(s);
+    s.zero_on_active(trac);
+    return trac.begin();
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::end_traction_scatter()
+  {
+    if (have_tractions)
+      trac.compress(dealii::VectorOperation::add);
   }
 
   template <int dim>

@@ -78,9 +78,17 @@ namespace talus::loads
 
     /// `momentum_t`: the solid nodal momentum at t when the caller has it (the
     /// 2-phase P2G), else the points' momentum is projected here when needed.
-    /// With `momentum_t` the caller also sums the work of the tractions itself
-    /// (f_p . dx_p over the step, point_force()); else it is f_p . v_p^t dt here.
+    /// With `momentum_t` the caller has also scattered the traction point forces
+    /// in its own P2G pass (begin/end_traction_scatter, point_force()) and sums
+    /// their work itself (f_p . dx_p over the step); else both are done here
+    /// (work f_p . v_p^t dt).
     void before_nodal_solve(Solver &s, const double h, const Vector *momentum_t = nullptr);
+    /// For a caller that fuses the traction scatter into its P2G pass: time
+    /// factors at t, the nodal traction vector zeroed and returned (local
+    /// array; nullptr without tractions); add sum_p N_i f_p to it, then call
+    /// end_traction_scatter().
+    double *begin_traction_scatter(Solver &s);
+    void    end_traction_scatter();
     /// Traction force of a point at the time of the last before_nodal_solve
     /// (0 without tractions).
     void point_force(const double *P, double (&f)[dim]) const
@@ -161,6 +169,7 @@ namespace talus::loads
       return global ? t_abs : t_abs - stage_t0;
     }
     void assign_tractions(Solver &s);
+    void update_factors(const Solver &s);
     void build_node_lists(Solver &s);
     void set_time_step(Solver &s);
     /// the convergence ratios are evaluated in this step

@@ -458,6 +458,8 @@ namespace talus::explicit_mpm
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         s.zero_on_active(*v);
+    // traction point forces (loads/traction, at t) scattered in this pass
+    double *const T = control ? control->begin_traction_scatter(s) : nullptr;
     {
       auto pt = s.points.handler.begin();
       for (const auto [c, n_in_cell] : s.points.active_cells())
@@ -483,6 +485,18 @@ namespace talus::explicit_mpm
                   for (unsigned int i = 0; i < 3; ++i)
                     sig[i][i] -= p; // total stress (Eq. 4.117)
                 }
+              double fp[dim] = {};
+              bool   loaded  = false;
+              if (T)
+                {
+                  control->point_force(P, fp);
+                  for (unsigned int d = 0; d < dim; ++d)
+                    loaded = loaded || fp[d] != 0.0;
+                }
+              if (loaded) // Eq. 5.3, added to the mixture force by nodal_forces_two_phase
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    T[cc.dofs[v * dim + d]] += N[v] * fp[d];
               for (unsigned int v = 0; v < nv; ++v)
                 for (unsigned int d = 0; d < dim; ++d)
                   {
@@ -510,6 +524,8 @@ namespace talus::explicit_mpm
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         v->compress(dealii::VectorOperation::add);
+    if (control)
+      control->end_traction_scatter();
 
     // loads (load_control.h): tractions on the mixture, nodal v^t (the solid
     // momentum of this P2G), friction lift; convergence ratios of both phases
