@@ -187,7 +187,8 @@ namespace talus::explicit_mpm
     prm.declare_entry("traction face", "none", Selection(dim == 2 ? "none|x-|x+|y-|y+" : "none|x-|x+|y-|y+|z-|z+"),
                       "Box bodies: face whose outermost layer of material points carries 'traction' "
                       "(seed 000 §4.3.2: each point carries traction x its share of the face), constant in "
-                      "time. Honoured by the separate (unfused) step used for 2-phase scenes.");
+                      "time. An alias of a global 'loads/traction k' with apply to = body face (the same "
+                      "forces); it also selects the separate (unfused) step, as the 2-phase scenes use.");
     prm.declare_entry("traction", dim == 2 ? "0, 0" : "0, 0, 0", dealii::Patterns::Anything(),
                       "Traction vector [Pa] on 'traction face' (e.g. '0, -10000' presses a top face down).");
   }
@@ -233,9 +234,9 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
     prm.enter_subsection("two phase");
     prm.declare_entry("local damping", "0", Double(0, 1),
-                      "Minimal local damping of the separate 2-phase step (seed 000 §6.3): the nodal "
-                      "unbalanced force of each phase is reduced by alpha |f| sign(v), 0 <= alpha < 1. "
-                      "For quasi-static states (hydrostatic columns); 0 = off.");
+                      "Alias of the top-level 'damping/local damping' (seed 000 §6.3; in the 2-phase step "
+                      "each phase is damped with its own unbalanced force, Eqs. 6.24-6.28), 0 <= alpha < 1; "
+                      "0 = off. Giving both with different values is an error.");
     prm.leave_subsection();
   }
 

@@ -1,13 +1,14 @@
 // talus — explicit MPM: pore liquid of a material (drained | undrained effective
 // stress | coupled 2-phase, seed 000 §3.4, §4.3.8, §4.5), the 2-phase single-point
-// time step (§4.5.6-4.5.7), tractions carried by boundary material points
-// (minimal, §4.3.2), the critical time steps of every phase (§4.6, Eqs. 4.120-4.129)
-// and the liquid free-surface detection (§6.8).
+// time step (§4.5.6-4.5.7) with the shared loads of lib/talus/loads (their 2-phase
+// meaning: load_control.h), the critical time steps of every phase (§4.6, Eqs.
+// 4.120-4.129) and the liquid free-surface detection (§6.8).
 //
 // The 1-phase solver (explicit_solver.cc) keeps its fused hot loop; a scene with a
-// coupled material or a traction switches Solver::step() to TwoPhase::step(), a
-// separate set of unfused passes. An undrained material is a 1-phase material (a
-// wrapper adding the pore pressure of Eq. 4.52) and costs the hot loop nothing.
+// coupled material or a body 'traction face' switches Solver::step() to
+// TwoPhase::step(), a separate set of unfused passes. An undrained material is a
+// 1-phase material (a wrapper adding the pore pressure of Eq. 4.52) and costs the
+// hot loop nothing.
 #pragma once
 
 #include <talus/materials/material.h>
@@ -53,9 +54,9 @@ namespace talus::explicit_mpm
     double darcy_permeability() const { return intrinsic_permeability * density * gravity / viscosity; }
   };
 
-  /// Traction carried by the boundary material points of a box body
-  /// ("body k/traction face", "body k/traction"): the points of the outermost
-  /// layer at that face carry traction x their share of the face (§4.3.2).
+  /// "body k/traction face", "body k/traction": an alias of a constant global
+  /// loads/traction on that face of a box body (added by loads::parse_parameters);
+  /// kept here for the checks and the selection of the separate step.
   template <int dim>
   struct BodyTraction
   {
@@ -69,7 +70,7 @@ namespace talus::explicit_mpm
     std::vector<PoreLiquid>        pore_liquid; ///< per material
     std::vector<BodyTraction<dim>> tractions;   ///< per body
     double                         free_surface_factor = 0; ///< F_FreeSurf of Eq. 6.40; 0: off
-    double                         local_damping       = 0; ///< alpha of §6.3 in the 2-phase step
+    double                         local_damping       = 0; ///< 'two phase/local damping' (alias of damping/local damping)
     bool                           any_coupled() const;
     bool                           any_traction() const;
   };
