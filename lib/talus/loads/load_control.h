@@ -22,7 +22,8 @@
 //
 // The 2-phase single-point step (explicit_two_phase.cc, seed 000 §4.5.7) calls
 // the same hooks at the same places, and they act on both phases there:
-//   before_nodal_solve   the same; v^t is the solid nodal momentum of its P2G
+//   (its P2G pass)       traction point forces -> f_trac (begin/end_traction_scatter)
+//   before_nodal_solve   v^t = the solid nodal momentum of that P2G; friction lift
 //   nodal_forces_two_phase  tractions on the mixture (total stress); the
 //                        convergence ratios over the mixture and the liquid
 //                        (no seepage left); local/viscous damping and mass
