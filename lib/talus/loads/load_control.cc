@@ -49,6 +49,11 @@ namespace talus::loads
   LoadControl<dim>::initial_state(Solver &s)
   {
     using L = PropertyLayout<dim>;
+    // 2-phase points get their solid mass (1 - n0) rho_S V, porosity and liquid
+    // velocity now (setup() repeats it after the history initialisation), so that
+    // the stage-0 baselines below (potential energy of both masses) are right
+    if (s.two_phase)
+      s.two_phase->initialize_particles();
     const auto             g  = settings.stages[0].gravity;
     const double           gn = g.norm();
     dealii::Tensor<1, dim> e; // up: against gravity
