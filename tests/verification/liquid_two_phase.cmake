@@ -35,3 +35,9 @@ add_test(NAME verification.two_phase_shared_loads
                  ${TALUS_PRM_DIR}/verification/terzaghi_consolidation.prm
                  ${TALUS_PRM_DIR}/verification/block_friction.prm ${_w}/two_phase_shared_loads)
 set_tests_properties(verification.two_phase_shared_loads PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 1800)
+add_test(NAME verification.loads_np1_np2
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_loads_ranks.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/hydrostatic_2phase.prm
+                 ${TALUS_PRM_DIR}/verification/elastic_column_gravity.prm ${_w}/loads_np1_np2)
+set_tests_properties(verification.loads_np1_np2 PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)

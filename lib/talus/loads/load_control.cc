@@ -418,8 +418,12 @@ namespace talus::loads
               }
           }
       }
-    need_vt = !friction_nodes.empty() || !prescribed_dofs.empty() || current->damping > 0 || current->viscous_damping > 0 ||
-              dealii::Utilities::MPI::logical_or(!friction_nodes.empty() || !prescribed_dofs.empty(), s.comm);
+    // the collectives first, on every rank: inside a short-circuit || they ran
+    // only on the ranks without friction/prescribed nodes of their own, which then
+    // reduced against the other ranks' next collective (ExcMPI on one rank, a hang
+    // on the others: a prescribed base velocity on 2 ranks)
+    any_prescribed = dealii::Utilities::MPI::logical_or(!prescribed_dofs.empty(), s.comm);
+    need_vt = any_friction || any_prescribed || current->damping > 0 || current->viscous_damping > 0;
     if ((need_vt || current->convergence.enabled) && vt.size() == 0)
       s.grid.reinit_vector(vt);
     if (have_tractions && trac.size() == 0)
@@ -697,7 +701,11 @@ namespace talus::loads
   void
   LoadControl<dim>::nodal_accelerations(Solver &s)
   {
-    if (friction_nodes.empty() && prescribed_dofs.empty())
+    // every rank takes the same path: the work of the reactions is summed over
+    // the ranks below, also by a rank that owns none of the prescribed nodes (a
+    // rank-local test here left the other ranks waiting in the sum: a prescribed
+    // base velocity hung on 2 ranks)
+    if (!any_friction && !any_prescribed)
       return;
     double *const       A  = s.nodal_a.begin();
     const double *const M  = s.nodal_mass.begin();
@@ -795,7 +803,7 @@ namespace talus::loads
         work += beta * m * (anew - A[p.dof]) * vbar * h;
         A[p.dof] = anew;
       }
-    if (!prescribed_dofs.empty() || settings.staged)
+    if (any_prescribed)
       s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
   }
 

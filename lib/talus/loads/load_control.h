@@ -162,6 +162,7 @@ namespace talus::loads
       unsigned int dof, condition, component;
     };
     std::vector<PrescribedDof> prescribed_dofs;
+    bool                       any_prescribed = false; ///< on any rank
     std::vector<unsigned int>  particle_conditions; ///< indices of body velocity conditions
 
     double load_time(const unsigned int index, const bool global, const double t_abs) const
