@@ -1,7 +1,10 @@
 // Loads (issue 5): time functions; K0 initial stresses are exact at setup
 // (sigma_h / sigma_v = K0 to round-off, sigma_v = -rho g depth); K0 = 1 - sin phi
 // for Mohr-Coulomb; traction point forces sum to traction x area; mass scaling
-// scales the critical time step by sqrt(beta).
+// scales the critical time step by sqrt(beta). With a coupled 2-phase material
+// (issue 12 item 2): K0 gives the effective stress of the buoyant weight and a
+// hydrostatic pore pressure; 'traction face' and 'two phase/local damping' are
+// the shared entries; mass scaling below 1 is refused.
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/loads/load_control.h>
@@ -191,4 +194,125 @@ TEST(Loads, MassScalingScalesCriticalTimeStep)
   with_solver("subsection mass scaling\n set factor = 1\nend\n",
               [&](explicit_mpm::Solver<2> &s) { dt1 = s.critical_time_step(); });
   EXPECT_NEAR(dt16 / dt1, 4.0, 1e-12);
+}
+
+// Issue 12 item 2: the loads with a coupled 2-phase material.
+namespace
+{
+  const char *coupled_prm = R"(
+set dimension = 2
+subsection grid
+  set upper corner = 0.05, 1.0
+  set cells        = 2, 40
+end
+subsection boundary conditions
+  set roller = 0, 1, 2
+end
+subsection gravity
+  set acceleration = 0, -9.81
+end
+subsection output
+  set progress = false
+end
+set number of materials = 1
+subsection material 0
+  set model   = linear elastic
+  set density = 2650
+  subsection pore liquid
+    set drainage               = coupled
+    set porosity               = 0.4
+    set liquid density         = 1000
+    set hydraulic conductivity = 1e-3
+  end
+end
+set number of bodies = 1
+subsection body 0
+  set upper corner  = 0.05, 0.8
+  set traction face = y+
+  set traction      = 0, -2000
+  subsection initial stress
+    set K0 procedure = true
+    set K0           = 0.6
+    set surcharge    = 500
+  end
+end
+)";
+
+  template <typename F>
+  void
+  with_coupled(const std::string &extra, F &&f)
+  {
+    const std::string name = "talus_test_loads_coupled.prm";
+    if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      {
+        std::ofstream out(name);
+        out << coupled_prm << extra;
+      }
+    MPI_Barrier(MPI_COMM_WORLD);
+    dealii::ParameterHandler prm;
+    explicit_mpm::declare_parameters(prm, name);
+    prm.parse_input(name);
+    const auto              p = explicit_mpm::parse_parameters<2>(prm);
+    explicit_mpm::Solver<2> s(p, MPI_COMM_WORLD);
+    s.setup();
+    f(s);
+  }
+} // namespace
+
+TEST(Loads, K0CoupledEffectiveStressAndHydrostaticPorePressure)
+{
+  with_coupled("", [](explicit_mpm::Solver<2> &s) {
+    using L = PropertyLayout<2>;
+    ASSERT_TRUE(s.two_phase && s.two_phase->coupled);
+    const double n = 0.4, g = 9.81, top = 0.8, q = 500;
+    double       worst_sv = 0, worst_p = 0, worst_k0 = 0;
+    for (const auto &pt : s.points.handler)
+      {
+        const auto   P     = pt.get_properties();
+        const double depth = top - pt.get_location()[1];
+        const double sv    = -((1 - n) * (2650 - 1000) * g * depth + q); // buoyant weight
+        worst_sv           = std::max(worst_sv, std::abs(P[L::stress + 1] - sv) / std::abs(sv));
+        worst_p = std::max(worst_p, std::abs(P[s.two_phase->pore_pressure] - 1000 * g * depth) / (1000 * g * top));
+        worst_k0 = std::max(worst_k0, std::abs(P[L::stress + 0] / P[L::stress + 1] - 0.6));
+        EXPECT_NEAR(P[L::mass], (1 - n) * 2650 * P[L::volume], 1e-12); // solid mass
+      }
+    EXPECT_LT(worst_sv, 1e-12);
+    EXPECT_LT(worst_p, 1e-12);
+    EXPECT_LT(worst_k0, 1e-14);
+  });
+}
+
+TEST(Loads, CoupledAliasesBecomeSharedEntries)
+{
+  // 'traction face' is a constant global loads/traction on the body face,
+  // 'two phase/local damping' the top-level damping/local damping
+  with_coupled("subsection two phase\n set local damping = 0.3\nend\n", [](explicit_mpm::Solver<2> &s) {
+    ASSERT_TRUE(s.control);
+    const auto &st = s.prm.loads.stages.at(0);
+    ASSERT_EQ(st.tractions.size(), 1u);
+    EXPECT_EQ(st.n_global_tractions, 1u);
+    EXPECT_EQ(st.tractions[0].target, loads::Traction<2>::Target::body_face);
+    EXPECT_EQ(st.tractions[0].axis, 1u);
+    EXPECT_EQ(st.tractions[0].side, 1);
+    EXPECT_EQ(st.tractions[0].traction[1], -2000.0);
+    EXPECT_EQ(st.damping, 0.3);
+    EXPECT_EQ(s.control->local_damping(), 0.3);
+    // the point forces of the face sum to traction x width
+    double fy = 0;
+    for (const auto &pt : s.points.handler)
+      fy += pt.get_properties()[s.control->point_force_offset() + 1];
+    EXPECT_NEAR(dealii::Utilities::MPI::sum(fy, MPI_COMM_WORLD), -2000 * 0.05, 1e-9);
+  });
+}
+
+TEST(Loads, CoupledMassScalingBelowOneRefused)
+{
+  EXPECT_THROW(with_coupled("subsection mass scaling\n set factor = 0.5\nend\n", [](explicit_mpm::Solver<2> &) {}),
+               InputError);
+  // >= 1 runs, and the critical step scales by sqrt(beta) (conservative for Eq. 4.129)
+  double dt1 = 0, dt4 = 0;
+  with_coupled("", [&](explicit_mpm::Solver<2> &s) { dt1 = s.critical_time_step(); });
+  with_coupled("subsection mass scaling\n set factor = 4\nend\n",
+               [&](explicit_mpm::Solver<2> &s) { dt4 = s.critical_time_step(); });
+  EXPECT_NEAR(dt4 / dt1, 2.0, 1e-12);
 }

@@ -26,3 +26,18 @@ set_tests_properties(verification.two_phase_np1_np2 PROPERTIES PROCESSORS 2)
 talus_liquid_case(two_phase_terzaghi_3d verify check_terzaghi.py verification/terzaghi_consolidation.prm 3d)
 talus_liquid_case(two_phase_local_damping fast check_local_damping.py verification/elastic_column_gravity.prm)
 talus_liquid_case(liquid_bingham_slump verify check_bingham_slump.py verification/bingham_slump.prm)
+# the shared loads in the 2-phase step (issue 12 item 2)
+talus_liquid_case(two_phase_staged_consolidation fast check_two_phase_staged.py
+                  verification/two_phase_staged_consolidation.prm)
+add_test(NAME verification.two_phase_shared_loads
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_two_phase_loads.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/hydrostatic_2phase.prm
+                 ${TALUS_PRM_DIR}/verification/terzaghi_consolidation.prm
+                 ${TALUS_PRM_DIR}/verification/block_friction.prm ${_w}/two_phase_shared_loads)
+set_tests_properties(verification.two_phase_shared_loads PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 1800)
+add_test(NAME verification.loads_np1_np2
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_loads_ranks.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/hydrostatic_2phase.prm
+                 ${TALUS_PRM_DIR}/verification/elastic_column_gravity.prm ${_w}/loads_np1_np2)
+set_tests_properties(verification.loads_np1_np2 PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)

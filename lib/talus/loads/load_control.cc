@@ -49,6 +49,11 @@ namespace talus::loads
   LoadControl<dim>::initial_state(Solver &s)
   {
     using L = PropertyLayout<dim>;
+    // 2-phase points get their solid mass (1 - n0) rho_S V, porosity and liquid
+    // velocity now (setup() repeats it after the history initialisation), so that
+    // the stage-0 baselines below (potential energy of both masses) are right
+    if (s.two_phase)
+      s.two_phase->initialize_particles();
     const auto             g  = settings.stages[0].gravity;
     const double           gn = g.norm();
     dealii::Tensor<1, dim> e; // up: against gravity
@@ -84,8 +89,20 @@ namespace talus::loads
           continue;
         const auto &k      = settings.k0[b];
         const double level = std::isnan(k.surface_level) ? top[b] : k.surface_level;
-        const double rho   = P[L::mass] / P[L::volume];
+        double       rho   = P[L::mass] / P[L::volume];
         const double depth = std::max(0.0, level - pt.get_location() * e);
+        // 2-phase point (solid grains + pore liquid, saturated up to the surface
+        // level): K0 gives the effective stress from the buoyant weight
+        // (1 - n0)(rho_S - rho_L) g depth, the pore pressure is hydrostatic
+        // rho_L g depth (compression positive); total stress sigma' - p I.
+        const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+        if (s.two_phase && s.two_phase->coupled &&
+            s.prm.liquid.pore_liquid[mat].drainage == explicit_mpm::Drainage::coupled)
+          {
+            const auto &pl = s.prm.liquid.pore_liquid[mat];
+            rho            = (1 - pl.porosity) * (s.prm.materials[mat]->density() - pl.density);
+            P[s.two_phase->pore_pressure] = pl.density * gn * depth;
+          }
         const double sv    = -(rho * gn * depth + k.surcharge);
         const double sh    = k.K0 * sv;
         dealii::SymmetricTensor<2, 3> sigma;
@@ -332,6 +349,7 @@ namespace talus::loads
                     n.area  = 0;
                     n.h     = cc.h[axis];
                     n.state = 0;
+                    n.liquid_stopped = false;
                     it      = node_of.emplace(key, friction_nodes.size()).first;
                     friction_nodes.push_back(n);
                   }
@@ -400,8 +418,12 @@ namespace talus::loads
               }
           }
       }
-    need_vt = !friction_nodes.empty() || !prescribed_dofs.empty() || current->damping > 0 || current->viscous_damping > 0 ||
-              dealii::Utilities::MPI::logical_or(!friction_nodes.empty() || !prescribed_dofs.empty(), s.comm);
+    // the collectives first, on every rank: inside a short-circuit || they ran
+    // only on the ranks without friction/prescribed nodes of their own, which then
+    // reduced against the other ranks' next collective (ExcMPI on one rank, a hang
+    // on the others: a prescribed base velocity on 2 ranks)
+    any_prescribed = dealii::Utilities::MPI::logical_or(!prescribed_dofs.empty(), s.comm);
+    need_vt = any_friction || any_prescribed || current->damping > 0 || current->viscous_damping > 0;
     if ((need_vt || current->convergence.enabled) && vt.size() == 0)
       s.grid.reinit_vector(vt);
     if (have_tractions && trac.size() == 0)
@@ -419,24 +441,33 @@ namespace talus::loads
 
   template <int dim>
   void
-  LoadControl<dim>::before_nodal_solve(Solver &s, const double step)
+  LoadControl<dim>::before_nodal_solve(Solver &s, const double step, const Vector *momentum_t)
   {
     using L                   = PropertyLayout<dim>;
     constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     h                         = step;
     const bool vt_now         = need_vt || check_step(s);
-    if (vt_now) // nodal momentum p^t of the points (the shape functions of the run)
+    if (vt_now && momentum_t) // the caller's nodal momentum at t (owned entries)
+      {
+        const double *src = momentum_t->begin();
+        double *      dst = vt.begin();
+        for (const unsigned int i : s.active_dofs)
+          dst[i] = src[i];
+      }
+    else if (vt_now) // nodal momentum p^t of the points (the shape functions of the run)
       s.scatter_point_momentum(vt);
-    if (!have_tractions && !any_friction)
+    // with momentum_t (the 2-phase step) the caller has scattered the tractions
+    // in its own P2G pass (begin/end_traction_scatter)
+    const bool scatter = have_tractions && !momentum_t;
+    if (!scatter && !any_friction)
       return;
-    double *const T   = have_tractions ? trac.begin() : nullptr;
-    if (have_tractions)
-      s.zero_on_active(trac);
-    // time factors of the tractions at t
-    const unsigned int  nt = current->tractions.size();
-    std::vector<double> factor(nt);
-    for (unsigned int j = 0; j < nt; ++j)
-      factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
+    double *const T   = scatter ? trac.begin() : nullptr;
+    if (scatter)
+      {
+        s.zero_on_active(trac);
+        update_factors(s);
+      }
+    const unsigned int nt  = current->tractions.size();
     const unsigned int off = force_offset;
     double             work = 0;
     // frictional walls: the material's displacement away from the wall at each
@@ -467,7 +498,7 @@ namespace talus::loads
                         l                    = std::min(l, away);
                       }
                   }
-            if (have_tractions)
+            if (scatter)
               {
                 double f[dim] = {};
                 bool   any    = false;
@@ -491,13 +522,43 @@ namespace talus::loads
               }
           }
       }
-    if (have_tractions)
+    if (scatter)
       {
         trac.compress(dealii::VectorOperation::add);
         s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
       }
     if (any_friction)
       lift.compress(dealii::VectorOperation::min);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::update_factors(const Solver &s)
+  {
+    // time factors of the tractions at t
+    const unsigned int nt = current->tractions.size();
+    factor.resize(nt);
+    for (unsigned int j = 0; j < nt; ++j)
+      factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
+  }
+
+  template <int dim>
+  double *
+  LoadControl<dim>::begin_traction_scatter(Solver &s)
+  {
+    if (!have_tractions)
+      return nullptr;
+    update_factors(s);
+    s.zero_on_active(trac);
+    return trac.begin();
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::end_traction_scatter()
+  {
+    if (have_tractions)
+      trac.compress(dealii::VectorOperation::add);
   }
 
   template <int dim>
@@ -513,7 +574,6 @@ namespace talus::loads
           F[i] += T[i];
       }
     // quasi-static convergence (seed 000 §6.4), on the unbalanced force before damping
-    const auto &conv = current->convergence;
     if (check_step(s))
       {
         const double *T  = have_tractions ? trac.begin() : nullptr;
@@ -534,15 +594,7 @@ namespace talus::loads
           if (M[i] > 0)
             v[2] += 0.5 * Pm[i] * Pm[i] / M[i];
         v[3] = s.local_energies.gravity_potential;
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 4), s.comm, dealii::ArrayView<double>(v, 4));
-        const double w_ext = (potential0 - v[3]) + (s.external_work - work_loads) + 0.0;
-        force_ratio        = std::sqrt(v[0]) / std::max(std::sqrt(v[1]), 1e-300);
-        const double ke    = current->mass_scaling * v[2]; // of the scaled inertia
-        energy_ratio       = w_ext > 0 ? ke / w_ext : (ke > 0 ? std::numeric_limits<double>::infinity() : 0.0);
-        const double t_stage = s.time - stage_t0;
-        if (conv.end_stage && t_stage >= settle_time - 1e-9 * s.dt && force_ratio < conv.force_tolerance &&
-            energy_ratio < conv.energy_tolerance)
-          converged = true;
+        evaluate_convergence(s, v);
       }
     // local damping (Eq. 6.23) with the nodal velocity at t
     if (current->damping > 0)
@@ -573,9 +625,87 @@ namespace talus::loads
 
   template <int dim>
   void
+  LoadControl<dim>::evaluate_convergence(const Solver &s, double (&v)[4])
+  {
+    const auto &conv = current->convergence;
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 4), s.comm, dealii::ArrayView<double>(v, 4));
+    const double w_ext = (potential0 - v[3]) + (s.external_work - work_loads) + 0.0;
+    force_ratio        = std::sqrt(v[0]) / std::max(std::sqrt(v[1]), 1e-300);
+    const double ke    = current->mass_scaling * v[2]; // of the scaled inertia
+    energy_ratio       = w_ext > 0 ? ke / w_ext : (ke > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+    const double t_stage = s.time - stage_t0;
+    if (conv.end_stage && t_stage >= settle_time - 1e-9 * s.dt && force_ratio < conv.force_tolerance &&
+        energy_ratio < conv.energy_tolerance)
+      converged = true;
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::nodal_forces_two_phase(Solver &s)
+  {
+    // s.nodal_a holds the mixture force f = f_trac + f_grav - f_int (total
+    // stress, both masses), the 2-phase step's f_liquid the liquid force of the
+    // equation divided by n (pressure gradient + gravity, no drag)
+    double *const       F  = s.nodal_a.begin();
+    const double *const MS = s.nodal_mass.begin();
+    if (have_tractions) // a traction on the surface of the mixture is a total stress
+      {
+        const double *T = trac.begin();
+        for (const unsigned int i : s.active_dofs)
+          F[i] += T[i];
+      }
+    if (!check_step(s))
+      return;
+    // Static equilibrium of both phases: the mixture force and the liquid's
+    // unbalanced force f_w (Eq. 6.24 without the drag) must vanish. During
+    // consolidation the accelerations are ~0 but f_w, balanced by the drag of
+    // the seepage, is not: a criterion on the mixture alone would end a stage in
+    // undrained equilibrium, long before the excess pore pressure has gone.
+    // f_w enters with the nodal porosity n = Mbar_L / M_L (force on the liquid
+    // mass itself), its external part is the liquid's weight Mbar_L g.
+    const auto *  tp  = s.two_phase.get();
+    const bool    cp  = tp->coupled;
+    const double *T   = have_tractions ? trac.begin() : nullptr;
+    const double *mLt = cp ? tp->m_liquid.begin() : nullptr, *mLn = cp ? tp->m_liquid_n.begin() : nullptr;
+    const double *FL = cp ? tp->f_liquid.begin() : nullptr, *PL = cp ? tp->p_liquid.begin() : nullptr;
+    double        v[4] = {0, 0, 0, 0};
+    for (const unsigned int i : s.active_dofs)
+      if (!excluded[i] && component[i] >= 0)
+        {
+          const double g    = s.gravity[component[i]];
+          const double mL   = cp ? mLn[i] : 0.0;
+          const double fext = (MS[i] + mL) * g + (T ? T[i] : 0.0);
+          v[0] += F[i] * F[i];
+          v[1] += fext * fext;
+          if (cp && mLt[i] > 0)
+            {
+              const double fw = mLn[i] / mLt[i] * FL[i];
+              v[0] += fw * fw;
+              v[1] += mL * g * mL * g;
+            }
+        }
+    // kinetic energy of the grid motion of both phases
+    const double *Pm = vt.begin();
+    for (const unsigned int i : s.active_dofs)
+      {
+        if (MS[i] > 0)
+          v[2] += 0.5 * Pm[i] * Pm[i] / MS[i];
+        if (cp && mLn[i] > 0)
+          v[2] += 0.5 * PL[i] * PL[i] / mLn[i];
+      }
+    v[3] = s.local_energies.gravity_potential; // of both masses (TwoPhase::step)
+    evaluate_convergence(s, v);
+  }
+
+  template <int dim>
+  void
   LoadControl<dim>::nodal_accelerations(Solver &s)
   {
-    if (friction_nodes.empty() && prescribed_dofs.empty())
+    // every rank takes the same path: the work of the reactions is summed over
+    // the ranks below, also by a rank that owns none of the prescribed nodes (a
+    // rank-local test here left the other ranks waiting in the sum: a prescribed
+    // base velocity hung on 2 ranks)
+    if (!any_friction && !any_prescribed)
       return;
     double *const       A  = s.nodal_a.begin();
     const double *const M  = s.nodal_mass.begin();
@@ -631,22 +761,49 @@ namespace talus::loads
           if (!s.constrained[n.dofs[d]])
             A[n.dofs[d]] = (vs[d] - v0[d]) / h;
       }
-    // prescribed nodal velocities: a = (vbar(t + dt) - v^t) / dt; the work of
-    // the reaction goes to the external work
+    // 2-phase: the pore liquid (nodal momentum at t, acceleration, mass Mbar_L)
+    const bool    cp  = s.two_phase && s.two_phase->coupled;
+    double *const AL  = cp ? s.two_phase->a_liquid.begin() : nullptr;
+    const double *PL  = cp ? s.two_phase->p_liquid.begin() : nullptr;
+    const double *mLn = cp ? s.two_phase->m_liquid_n.begin() : nullptr;
+    // the rigid wall is impermeable: the liquid cannot flow into it (same
+    // predictor test as the solid) but slides freely along it (a Darcy liquid
+    // carries no shear stress); where the material has lifted off, nothing
+    for (auto &n : friction_nodes)
+      {
+        n.liquid_stopped = false;
+        const unsigned int i = n.dofs[n.axis];
+        if (!cp || !(mLn[i] > 0) || s.constrained[i])
+          continue;
+        const double v0 = PL[i] / mLn[i];
+        if (n.side * (v0 + h * AL[i]) > 0 && !(lift.local_element(i) > lift_tolerance * n.h))
+          {
+            AL[i]            = -v0 / h;
+            n.liquid_stopped = true;
+          }
+      }
+    // prescribed nodal velocities: a = (vbar(t + dt) - v^t) / dt (both phases of
+    // a 2-phase node); the work of the reaction goes to the external work
     double work = 0;
     for (const auto &p : prescribed_dofs)
       {
         const double m = M[p.dof];
-        if (!(m > 0))
-          continue;
         const auto & pv   = current->velocities[p.condition];
         const double t    = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
         const double vbar = pv.velocity[p.component] * pv.function.value(t);
+        if (cp && mLn[p.dof] > 0)
+          {
+            const double anew = (vbar - PL[p.dof] / mLn[p.dof]) / h;
+            work += beta * mLn[p.dof] * (anew - AL[p.dof]) * vbar * h;
+            AL[p.dof] = anew;
+          }
+        if (!(m > 0))
+          continue;
         const double anew = (vbar - Pm[p.dof] / m) / h;
         work += beta * m * (anew - A[p.dof]) * vbar * h;
         A[p.dof] = anew;
       }
-    if (!prescribed_dofs.empty() || settings.staged)
+    if (any_prescribed)
       s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
   }
 
@@ -659,6 +816,8 @@ namespace talus::loads
     using L                   = PropertyLayout<dim>;
     constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     double *const          Pn = s.nodal_p.begin();
+    const bool             cp = s.two_phase && s.two_phase->coupled;
+    double *const          PL = cp ? s.two_phase->p_liquid.begin() : nullptr;
     double                 work = 0;
     auto                   pt   = s.points.handler.begin();
     for (const auto [c, n_in_cell] : s.points.active_cells())
@@ -675,22 +834,38 @@ namespace talus::loads
                   continue;
                 const double t = (j < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
                 const double f = pv.function.value(t);
-                double       dv[dim];
+                double       dv[dim], dvL[dim] = {};
                 for (unsigned int d = 0; d < dim; ++d)
                   {
                     dv[d] = pv.component[d] ? pv.velocity[d] * f - P[L::velocity + d] : 0.0;
                     P[L::velocity + d] += dv[d];
                     work += P[L::mass] * dv[d] * P[L::velocity + d];
                   }
+                // 2-phase point: its pore liquid moves with the body as well
+                const double mL = cp ? s.two_phase->liquid_mass(P) : 0.0;
+                if (mL > 0)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      double &vl = P[s.two_phase->liquid_velocity + d];
+                      dvL[d]     = pv.component[d] ? pv.velocity[d] * f - vl : 0.0;
+                      vl += dvL[d];
+                      work += mL * dvL[d] * vl;
+                    }
                 double N[nv];
                 shape::Q1<dim>::values(pt->get_reference_location(), N);
                 for (unsigned int v = 0; v < nv; ++v)
                   for (unsigned int d = 0; d < dim; ++d)
-                    Pn[cc.dofs[v * dim + d]] += P[L::mass] * N[v] * dv[d];
+                    {
+                      Pn[cc.dofs[v * dim + d]] += P[L::mass] * N[v] * dv[d];
+                      if (mL > 0)
+                        PL[cc.dofs[v * dim + d]] += mL * N[v] * dvL[d];
+                    }
               }
           }
       }
     s.nodal_p.compress(dealii::VectorOperation::add);
+    if (cp)
+      s.two_phase->p_liquid.compress(dealii::VectorOperation::add);
     s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
   }
 
@@ -708,11 +883,19 @@ namespace talus::loads
             for (unsigned int d = 0; d < dim; ++d)
               V[n.dofs[d]] = 0; // stick
         }
+    // 2-phase: the liquid's nodal velocities (after the division by Mbar_L)
+    double *const VL = (s.two_phase && s.two_phase->coupled) ? s.two_phase->p_liquid.begin() : nullptr;
+    if (VL)
+      for (const auto &n : friction_nodes)
+        if (n.liquid_stopped && n.side * VL[n.dofs[n.axis]] > 0)
+          VL[n.dofs[n.axis]] = 0; // no flow into the wall
     for (const auto &p : prescribed_dofs)
       {
         const auto & pv = current->velocities[p.condition];
         const double t  = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
         V[p.dof]        = pv.velocity[p.component] * pv.function.value(t);
+        if (VL)
+          VL[p.dof] = V[p.dof];
       }
   }
 

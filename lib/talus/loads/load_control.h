@@ -19,6 +19,21 @@
 //   particle_velocities  prescribed material point velocities (momentum corrected)
 //   v = p / m (solver)
 //   nodal_velocities     prescribed values, no penetration / stick at friction nodes
+//
+// The 2-phase single-point step (explicit_two_phase.cc, seed 000 §4.5.7) calls
+// the same hooks at the same places, and they act on both phases there:
+//   (its P2G pass)       traction point forces -> f_trac (begin/end_traction_scatter)
+//   before_nodal_solve   v^t = the solid nodal momentum of that P2G; friction lift
+//   nodal_forces_two_phase  tractions on the mixture (total stress); the
+//                        convergence ratios over the mixture and the liquid
+//                        (no seepage left); local/viscous damping and mass
+//                        scaling are applied by the 2-phase nodal solve itself
+//                        (local_damping(), viscous_damping(), s.mass_scaling)
+//   nodal_accelerations  prescribed nodes: both phases get vbar; friction nodes:
+//                        the solid as above, the liquid cannot flow into the
+//                        (impermeable) wall and has no tangential friction
+//   particle_velocities  body conditions set the solid and liquid point velocities
+//   nodal_velocities     prescribed values for both phases; no penetration
 #pragma once
 
 #include <talus/grid/background_grid.h>
@@ -62,8 +77,38 @@ namespace talus::loads
     /// (restart inside a stage). Returns the absolute end time of the stage.
     double begin_stage(Solver &s, const unsigned int k, const bool resume);
 
-    void before_nodal_solve(Solver &s, const double h);
+    /// `momentum_t`: the solid nodal momentum at t when the caller has it (the
+    /// 2-phase P2G), else the points' momentum is projected here when needed.
+    /// With `momentum_t` the caller has also scattered the traction point forces
+    /// in its own P2G pass (begin/end_traction_scatter, point_force()) and sums
+    /// their work itself (f_p . dx_p over the step); else both are done here
+    /// (work f_p . v_p^t dt).
+    void before_nodal_solve(Solver &s, const double h, const Vector *momentum_t = nullptr);
+    /// For a caller that fuses the traction scatter into its P2G pass: time
+    /// factors at t, the nodal traction vector zeroed and returned (local
+    /// array; nullptr without tractions); add sum_p N_i f_p to it, then call
+    /// end_traction_scatter().
+    double *begin_traction_scatter(Solver &s);
+    void    end_traction_scatter();
+    /// Traction force of a point at the time of the last before_nodal_solve
+    /// (0 without tractions).
+    void point_force(const double *P, double (&f)[dim]) const
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        f[d] = 0;
+      if (!have_tractions)
+        return;
+      for (unsigned int j = 0; j < factor.size(); ++j)
+        for (unsigned int d = 0; d < dim; ++d)
+          f[d] += factor[j] * P[force_offset + j * dim + d];
+    }
+    bool any_traction() const { return have_tractions; }
     void nodal_forces(Solver &s);
+    /// 2-phase form of nodal_forces (see above), before the 2-phase nodal solve.
+    void nodal_forces_two_phase(Solver &s);
+    /// Local damping alpha and viscous damping alpha_v of the running stage.
+    double local_damping() const { return current->damping; }
+    double viscous_damping() const { return current->viscous_damping; }
     void nodal_accelerations(Solver &s);
     void particle_velocities(Solver &s);
     void nodal_velocities(Solver &s);
@@ -97,6 +142,7 @@ namespace talus::loads
     double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
 
     bool need_vt = false, have_tractions = false;
+    std::vector<double> factor; ///< time factors of the stage's tractions at t
     Vector trac, vt;
     std::vector<int> component; ///< of each local DoF (-1: none)
     std::vector<unsigned char> excluded; ///< DoFs left out of the force ratio
@@ -109,6 +155,7 @@ namespace talus::loads
       double        area;
       double        h; ///< cell size normal to the wall
       unsigned char state; ///< 0 free/separating, 1 stick, 2 slip
+      bool          liquid_stopped; ///< 2-phase: liquid normal velocity into the wall removed
     };
     std::vector<FrictionNode> friction_nodes;
     /// Per grid cell: bit f set if face f lies on a friction boundary.
@@ -125,6 +172,7 @@ namespace talus::loads
       unsigned int dof, condition, component;
     };
     std::vector<PrescribedDof> prescribed_dofs;
+    bool                       any_prescribed = false; ///< on any rank
     std::vector<unsigned int>  particle_conditions; ///< indices of body velocity conditions
 
     double load_time(const unsigned int index, const bool global, const double t_abs) const
@@ -133,9 +181,13 @@ namespace talus::loads
       return global ? t_abs : t_abs - stage_t0;
     }
     void assign_tractions(Solver &s);
+    void update_factors(const Solver &s);
     void build_node_lists(Solver &s);
     void set_time_step(Solver &s);
     /// the convergence ratios are evaluated in this step
     bool check_step(const Solver &s) const;
+    /// Ratios from the local sums v = {|f_unbalanced|^2, |f_ext|^2, grid KE,
+    /// gravity potential} (reduced here over the ranks); sets `converged`.
+    void evaluate_convergence(const Solver &s, double (&v)[4]);
   };
 } // namespace talus::loads

@@ -262,6 +262,34 @@ namespace talus::loads
       require(s.convergence.interval > 0, pre + "convergence/check interval", "must be > 0");
       prm.leave_subsection();
     }
+    /// The body entries 'traction face' / 'traction' (declared with the 2-phase
+    /// entries, explicit_two_phase.cc) are aliases: a constant global traction
+    /// on that face of a box body, exactly 'loads/traction k' with apply to =
+    /// body face. Other body shapes are refused later (input_checks.cc).
+    template <int dim>
+    void
+    parse_two_phase_aliases(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies,
+                            std::vector<Traction<dim>> &tractions)
+    {
+      for (unsigned int k = 0; k < bodies.size(); ++k)
+        {
+          const std::string where = "body " + std::to_string(k);
+          prm.enter_subsection(where);
+          const std::string f = prm.get("traction face"), v = prm.get("traction");
+          prm.leave_subsection();
+          if (f == "none" || bodies[k].shape != BodyDescription<dim>::Shape::box)
+            continue;
+          Traction<dim> t;
+          t.where    = where + "/traction face";
+          t.target   = Traction<dim>::Target::body_face;
+          t.body     = k;
+          t.axis     = static_cast<unsigned int>(f[0] - 'x');
+          t.side     = f[1] == '+' ? +1 : -1;
+          t.traction = parse_point<dim>(v, where + "/traction");
+          t.function = TimeFunction::parse("constant", t.where);
+          tractions.push_back(t);
+        }
+    }
   } // namespace
 
   template <int dim>
@@ -361,9 +389,23 @@ namespace talus::loads
                 "boundary " + std::to_string(id) + " is also fixed/roller; give each boundary one condition");
     prm.leave_subsection();
     parse_loads<dim>(prm, "", bodies, top.tractions, top.velocities);
+    parse_two_phase_aliases<dim>(prm, bodies, top.tractions);
     top.n_global_tractions  = top.tractions.size();
     top.n_global_velocities = top.velocities.size();
     parse_switches<dim>(prm, "", top, nullptr);
+    {
+      // 'two phase/local damping' is an alias of the top-level 'damping/local
+      // damping' (the same alpha, the 2-phase form of §6.3.2 in the 2-phase step)
+      prm.enter_subsection("two phase");
+      const double a2 = prm.get_double("local damping");
+      prm.leave_subsection();
+      if (a2 > 0)
+        {
+          require(top.damping == 0 || top.damping == a2, "two phase/local damping",
+                  "is an alias of 'damping/local damping', which is set to another value; give only one of them");
+          top.damping = a2;
+        }
+    }
 
     // K0 per body
     for (unsigned int k = 0; k < bodies.size(); ++k)

@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
+#include <talus/loads/load_control.h>
 #include <talus/shape/q1.h>
 
 #include <deal.II/base/mpi.h>
@@ -186,7 +187,8 @@ namespace talus::explicit_mpm
     prm.declare_entry("traction face", "none", Selection(dim == 2 ? "none|x-|x+|y-|y+" : "none|x-|x+|y-|y+|z-|z+"),
                       "Box bodies: face whose outermost layer of material points carries 'traction' "
                       "(seed 000 §4.3.2: each point carries traction x its share of the face), constant in "
-                      "time. Honoured by the separate (unfused) step used for 2-phase scenes.");
+                      "time. An alias of a global 'loads/traction k' with apply to = body face (the same "
+                      "forces); it also selects the separate (unfused) step, as the 2-phase scenes use.");
     prm.declare_entry("traction", dim == 2 ? "0, 0" : "0, 0, 0", dealii::Patterns::Anything(),
                       "Traction vector [Pa] on 'traction face' (e.g. '0, -10000' presses a top face down).");
   }
@@ -232,9 +234,9 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
     prm.enter_subsection("two phase");
     prm.declare_entry("local damping", "0", Double(0, 1),
-                      "Minimal local damping of the separate 2-phase step (seed 000 §6.3): the nodal "
-                      "unbalanced force of each phase is reduced by alpha |f| sign(v), 0 <= alpha < 1. "
-                      "For quasi-static states (hydrostatic columns); 0 = off.");
+                      "Alias of the top-level 'damping/local damping' (seed 000 §6.3; in the 2-phase step "
+                      "each phase is damped with its own unbalanced force, Eqs. 6.24-6.28), 0 <= alpha < 1; "
+                      "0 = off. Giving both with different values is an error.");
     prm.leave_subsection();
   }
 
@@ -325,8 +327,17 @@ namespace talus::explicit_mpm
   TwoPhase<dim>::TwoPhase(Solver<dim> &solver)
     : s(solver)
   {
-    coupled   = s.prm.liquid.any_coupled();
-    tractions = s.prm.liquid.any_traction();
+    coupled = s.prm.liquid.any_coupled();
+  }
+
+  template <int dim>
+  double
+  TwoPhase<dim>::liquid_mass(const double *P) const
+  {
+    if (!coupled)
+      return 0.0;
+    const auto &pl = s.prm.liquid.pore_liquid[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
+    return pl.drainage == Drainage::coupled ? P[porosity] * pl.density * P[PropertyLayout<dim>::volume] : 0.0;
   }
 
   template <int dim>
@@ -345,8 +356,6 @@ namespace talus::explicit_mpm
         s.grid.reinit_vector(p_liquid);
         s.grid.reinit_vector(a_liquid);
       }
-    if (tractions)
-      external_force = layout.add_extra("external_force", dim, true);
   }
 
   template <int dim>
@@ -367,23 +376,6 @@ namespace talus::explicit_mpm
             for (unsigned int d = 0; d < dim; ++d)
               P[liquid_velocity + d] = P[L::velocity + d];
           }
-        if (tractions)
-          {
-            const unsigned int b = static_cast<unsigned int>(P[L::body]);
-            const auto &       t = s.prm.liquid.tractions[b];
-            if (t.face < 0)
-              continue;
-            const auto &body = s.prm.bodies[b];
-            require(body.shape == BodyDescription<dim>::Shape::box, "body " + std::to_string(b) + "/traction face",
-                    "tractions are supported on box bodies only");
-            const unsigned int axis = t.face / 2;
-            const auto &       cc   = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
-            const double       sp   = cc.h[axis] / body.particles_per_direction; // point spacing
-            const double       xf   = (t.face % 2) ? body.upper[axis] : body.lower[axis];
-            if (std::abs(pt.get_location()[axis] - xf) < 0.5 * sp * (1 + 1e-9) + 1e-12)
-              for (unsigned int d = 0; d < dim; ++d)
-                P[external_force + d] = t.traction[d] * P[L::volume] / sp;
-          }
       }
   }
 
@@ -403,7 +395,7 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           {
             v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += s.prm.gravity[d] * pt.get_location()[d];
+            gx += s.gravity[d] * pt.get_location()[d]; // of the running stage
           }
         e.strain += P[L::volume] * m.elastic_energy_density(L::get_stress(P.data()));
         if (coupled && pl[mat].drainage == Drainage::coupled)
@@ -450,8 +442,9 @@ namespace talus::explicit_mpm
     using Q                   = shape::Q1<dim>;
     constexpr unsigned int nv = Q::n_vertices;
     const auto &           pl = s.prm.liquid.pore_liquid;
-    const auto             g  = s.prm.gravity;
+    const auto             g  = s.gravity; // of the running stage
     const auto             t0 = std::chrono::steady_clock::now();
+    auto *const            control = s.control.get();
 
     // ---- 1. P2G at time t: masses, drag, forces, momenta of both phases
     Vector &MSv = s.nodal_mass, &FSv = s.nodal_a, &PSv = s.nodal_p;
@@ -466,6 +459,8 @@ namespace talus::explicit_mpm
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         s.zero_on_active(*v);
+    // traction point forces (loads/traction, at t) scattered in this pass
+    double *const T = control ? control->begin_traction_scatter(s) : nullptr;
     {
       auto pt = s.points.handler.begin();
       for (const auto [c, n_in_cell] : s.points.active_cells())
@@ -491,10 +486,18 @@ namespace talus::explicit_mpm
                   for (unsigned int i = 0; i < 3; ++i)
                     sig[i][i] -= p; // total stress (Eq. 4.117)
                 }
-              double fe[dim] = {};
-              if (tractions)
-                for (unsigned int d = 0; d < dim; ++d)
-                  fe[d] = P[external_force + d];
+              double fp[dim] = {};
+              bool   loaded  = false;
+              if (T)
+                {
+                  control->point_force(P, fp);
+                  for (unsigned int d = 0; d < dim; ++d)
+                    loaded = loaded || fp[d] != 0.0;
+                }
+              if (loaded) // Eq. 5.3, added to the mixture force by nodal_forces_two_phase
+                for (unsigned int v = 0; v < nv; ++v)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    T[cc.dofs[v * dim + d]] += N[v] * fp[d];
               for (unsigned int v = 0; v < nv; ++v)
                 for (unsigned int d = 0; d < dim; ++d)
                   {
@@ -503,7 +506,7 @@ namespace talus::explicit_mpm
                     for (unsigned int e = 0; e < dim; ++e)
                       fi -= V * sig[d][e] * G[v][e];
                     MS[i] += mS * N[v];
-                    FS[i] += fi + (mS + mL) * N[v] * g[d] + N[v] * fe[d];
+                    FS[i] += fi + (mS + mL) * N[v] * g[d];
                     PS[i] += mS * N[v] * P[L::velocity + d];
                     if (cp)
                       {
@@ -522,16 +525,32 @@ namespace talus::explicit_mpm
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         v->compress(dealii::VectorOperation::add);
+    if (control)
+      control->end_traction_scatter();
+
+    // loads (load_control.h): tractions on the mixture, nodal v^t (the solid
+    // momentum of this P2G), friction lift; convergence ratios of both phases
+    if (control)
+      {
+        control->before_nodal_solve(s, h, &PSv);
+        control->nodal_forces_two_phase(s);
+      }
 
     // ---- 2-3. nodal accelerations: liquid (Eq. 4.106), then solid (4.107)
     {
       const auto & con   = s.constrained;
-      const double alpha = s.prm.liquid.local_damping;
+      const double alpha = control ? control->local_damping() : 0.0;
+      const double av    = control ? control->viscous_damping() : 0.0;
+      const double beta  = s.mass_scaling;
       // local damping, 2-phase form of §6.3.2 (Eqs. 6.24-6.28): water
       // f_w^damp = -alpha |f_w| sign(v_L) with f_w its unbalanced force (traction,
       // gravity, internal; no drag); solid f_s^damp = -alpha |f - n f_w| sign(v_S);
       // the mixture receives f_s^damp + n f_w^damp (the liquid equation here is the
-      // one divided by n, so its forces enter the mixture with the nodal n = Mbar_L / M_L)
+      // one divided by n, so its forces enter the mixture with the nodal n = Mbar_L / M_L).
+      // Viscous damping -alpha_v m v acts on each phase's own mass the same way
+      // (liquid: -alpha_v M_L v_L in the equation divided by n). Mass scaling
+      // (Eq. 6.31): the inertia of both phases is beta M, the forces and the drag
+      // keep their size.
       const auto damping = [alpha](const double f, const double v) {
         return (alpha > 0 && v != 0) ? -alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : 0.0;
       };
@@ -545,14 +564,18 @@ namespace talus::explicit_mpm
                 {
                   const double vL = PL_[i] / mLn_[i];
                   n_i             = mLn_[i] / mLt_[i];
-                  dL              = damping(FL_[i], vL);
-                  aL              = (FL_[i] - Q_[i] * (vL - vS) + dL) / mLt_[i];
+                  dL              = damping(FL_[i], vL) - av * mLt_[i] * vL;
+                  aL              = (FL_[i] - Q_[i] * (vL - vS) + dL) / (beta * mLt_[i]);
                 }
               AL_[i] = aL;
             }
-          const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS);
-          FS[i] = (MS[i] > 0 && !con[i]) ? (FS[i] - (coupled ? mLn_[i] * aL : 0.0) + dS + n_i * dL) / MS[i] : 0.0;
+          const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS) - av * MS[i] * vS;
+          FS[i]           = (MS[i] > 0 && !con[i]) ?
+                              (FS[i] - (coupled ? beta * mLn_[i] * aL : 0.0) + dS + n_i * dL) / (beta * MS[i]) :
+                              0.0;
         }
+      if (control) // prescribed velocities and rigid-wall friction, both phases
+        control->nodal_accelerations(s);
       FSv.update_ghost_values();
       if (coupled)
         a_liquid.update_ghost_values();
@@ -601,6 +624,8 @@ namespace talus::explicit_mpm
     PSv.compress(dealii::VectorOperation::add);
     if (coupled)
       p_liquid.compress(dealii::VectorOperation::add);
+    if (control)
+      control->particle_velocities(s); // prescribed point velocities (both phases)
     for (const unsigned int i : s.active_dofs)
       {
         const bool free = !s.constrained[i];
@@ -608,6 +633,8 @@ namespace talus::explicit_mpm
         if (coupled)
           PL_[i] = (mLn_[i] > 0 && free) ? PL_[i] / mLn_[i] : 0.0;
       }
+    if (control)
+      control->nodal_velocities(s); // prescribed values, no penetration at friction walls
     PSv.update_ghost_values();
     if (coupled)
       p_liquid.update_ghost_values();
@@ -619,6 +646,7 @@ namespace talus::explicit_mpm
     dealii::Tensor<1, dim> momentum;
     bool                   bad  = false;
     double                 work = 0; // of the tractions over this step
+    const bool             loaded = control && control->any_traction();
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     {
@@ -684,9 +712,13 @@ namespace talus::explicit_mpm
               if (P[L::volume] > cell_volume)
                 P[L::volume] = cell_volume;
 
-              if (tractions)
-                for (unsigned int d = 0; d < dim; ++d)
-                  work += P[external_force + d] * dx[d];
+              if (loaded)
+                {
+                  double f[dim];
+                  control->point_force(P, f);
+                  for (unsigned int d = 0; d < dim; ++d)
+                    work += f[d] * dx[d];
+                }
               auto x = pt->get_location();
               for (unsigned int d = 0; d < dim; ++d)
                 {
@@ -737,7 +769,7 @@ namespace talus::explicit_mpm
     s.local_energies = e;
     s.local_momentum = momentum;
     s.local_bad      = bad;
-    if (tractions)
+    if (loaded)
       s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
     s.timings.g2p += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 

@@ -1,13 +1,14 @@
 // talus — explicit MPM: pore liquid of a material (drained | undrained effective
 // stress | coupled 2-phase, seed 000 §3.4, §4.3.8, §4.5), the 2-phase single-point
-// time step (§4.5.6-4.5.7), tractions carried by boundary material points
-// (minimal, §4.3.2), the critical time steps of every phase (§4.6, Eqs. 4.120-4.129)
-// and the liquid free-surface detection (§6.8).
+// time step (§4.5.6-4.5.7) with the shared loads of lib/talus/loads (their 2-phase
+// meaning: load_control.h), the critical time steps of every phase (§4.6, Eqs.
+// 4.120-4.129) and the liquid free-surface detection (§6.8).
 //
 // The 1-phase solver (explicit_solver.cc) keeps its fused hot loop; a scene with a
-// coupled material or a traction switches Solver::step() to TwoPhase::step(), a
-// separate set of unfused passes. An undrained material is a 1-phase material (a
-// wrapper adding the pore pressure of Eq. 4.52) and costs the hot loop nothing.
+// coupled material or a body 'traction face' switches Solver::step() to
+// TwoPhase::step(), a separate set of unfused passes. An undrained material is a
+// 1-phase material (a wrapper adding the pore pressure of Eq. 4.52) and costs the
+// hot loop nothing.
 #pragma once
 
 #include <talus/materials/material.h>
@@ -19,6 +20,12 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+namespace talus::loads
+{
+  template <int dim>
+  class LoadControl;
+}
 
 namespace talus::explicit_mpm
 {
@@ -47,9 +54,9 @@ namespace talus::explicit_mpm
     double darcy_permeability() const { return intrinsic_permeability * density * gravity / viscosity; }
   };
 
-  /// Traction carried by the boundary material points of a box body
-  /// ("body k/traction face", "body k/traction"): the points of the outermost
-  /// layer at that face carry traction x their share of the face (§4.3.2).
+  /// "body k/traction face", "body k/traction": an alias of a constant global
+  /// loads/traction on that face of a box body (added by loads::parse_parameters);
+  /// kept here for the checks and the selection of the separate step.
   template <int dim>
   struct BodyTraction
   {
@@ -63,7 +70,7 @@ namespace talus::explicit_mpm
     std::vector<PoreLiquid>        pore_liquid; ///< per material
     std::vector<BodyTraction<dim>> tractions;   ///< per body
     double                         free_surface_factor = 0; ///< F_FreeSurf of Eq. 6.40; 0: off
-    double                         local_damping       = 0; ///< alpha of §6.3 in the 2-phase step
+    double                         local_damping       = 0; ///< 'two phase/local damping' (alias of damping/local damping)
     bool                           any_coupled() const;
     bool                           any_traction() const;
   };
@@ -107,21 +114,24 @@ namespace talus::explicit_mpm
   {
   public:
     explicit TwoPhase(Solver<dim> &s);
-    /// porosity, pore pressure, liquid velocity (coupled), external force (tractions)
+    /// porosity, pore pressure, liquid velocity (coupled)
     void extend_layout(PropertyLayout<dim> &layout);
-    /// after seeding: solid masses (1-n) rho_S V, porosity, liquid velocity,
-    /// traction forces of the boundary points
+    /// after seeding: solid masses (1-n) rho_S V, porosity, liquid velocity
     void initialize_particles();
-    /// One step of §4.5.7. Collective.
+    /// One step of §4.5.7, with the hooks of the loads (Solver::control) at
+    /// the places of the 1-phase step (load_control.h). Collective.
     void step(const double dt);
     Energies energies() const;
     /// sum m_S v_S + m_L v_L (collective)
     dealii::Tensor<1, dim> total_momentum() const;
+    /// Liquid mass n rho_L V of a point (0 unless it is of a coupled material).
+    double liquid_mass(const double *P) const;
 
-    unsigned int porosity = 0, pore_pressure = 0, liquid_velocity = 0, external_force = 0;
-    bool         coupled = false, tractions = false;
+    unsigned int porosity = 0, pore_pressure = 0, liquid_velocity = 0;
+    bool         coupled = false;
 
   private:
+    friend class loads::LoadControl<dim>;
     Solver<dim> &s;
     // lumped nodal quantities: liquid mass without / with porosity, drag,
     // liquid force and momentum (solid: the solver's nodal_mass, nodal_a, nodal_p)

@@ -263,39 +263,22 @@ namespace talus::explicit_mpm
                     "; allowed here: none)");
         n_points += overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
       }
-    // the separate 2-phase / body-traction step (explicit_two_phase.cc) does not
-    // call the hooks of lib/talus/loads: refuse them instead of ignoring them
-    if (p.liquid.any_coupled() || p.liquid.any_traction())
-      {
-        std::string used;
-        if (p.loads.staged)
-          used = "number of stages";
-        for (unsigned int k = 0; k < p.loads.k0.size() && used.empty(); ++k)
-          if (p.loads.k0[k].enabled)
-            used = "body " + std::to_string(k) + "/initial stress";
-        for (const auto &st : p.loads.stages)
-          if (used.empty())
-            {
-              if (!st.friction_ids.empty())
-                used = "boundary conditions/friction";
-              else if (!st.tractions.empty())
-                used = "loads/traction";
-              else if (!st.velocities.empty())
-                used = "loads/velocity";
-              else if (st.damping > 0)
-                used = "damping/local damping";
-              else if (st.viscous_damping > 0)
-                used = "damping/viscous damping";
-              else if (st.mass_scaling != 1.0)
-                used = "mass scaling/factor";
-              else if (st.convergence.enabled)
-                used = "convergence/enabled";
-            }
-        require(used.empty(), used,
-                "is not available with coupled 2-phase materials or body tractions ('traction face'): the "
-                "2-phase step has its own tractions ('body k/traction face', 'traction') and damping ('two "
-                "phase/local damping'); remove this entry (allowed here: its default)");
-      }
+    // The 2-phase step calls the hooks of lib/talus/loads (stages, K0, tractions,
+    // prescribed velocities, friction, damping, mass scaling, convergence; their
+    // 2-phase meaning in docs/explicit-liquid-two-phase.md). One restriction is
+    // left: mass scaling below 1 with coupled materials. Scaling the inertia of
+    // both phases by beta changes the relaxation time of the relative (seepage)
+    // velocity, beta (1 - n) rho_S k / (n rho g), by beta, not by sqrt(beta):
+    // the step sqrt(beta) dt_cr of Eq. 6.31 is safe for beta >= 1 (the coupled
+    // limit Eq. 4.129 grows at least as fast) and unstable for a drag-controlled
+    // column with beta < 1.
+    if (p.liquid.any_coupled())
+      for (unsigned int k = 0; k < p.loads.stages.size(); ++k)
+        require(p.loads.stages[k].mass_scaling >= 1.0,
+                p.loads.staged ? "stage " + std::to_string(k) + "/mass scaling/factor" : std::string("mass scaling/factor"),
+                "must be >= 1 with coupled 2-phase materials: a factor beta < 1 shortens the drag relaxation time of "
+                "the seepage by beta, and the time step sqrt(beta) x critical (Eq. 6.31) would be unstable "
+                "(allowed: >= 1)");
     require(n_points <= max_material_points,
             "bodies",
             "about " + fmt(n_points) + " material points would be seeded, more than the limit of " +
