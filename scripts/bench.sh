@@ -3,7 +3,11 @@
 # 8 material points per cell, 1.31M points, fixed number of steps, one rank), with
 # linear shape functions and then with quadratic B-splines.
 # Prints ns per particle-step with a breakdown and the fraction of material points
-# that changed cell per step. Build type must be Release (the Makefile's default).
+# that changed cell per step. Then the parallel figures (issue 15) of the 3D block
+# and of a 2D column collapse in the corner of a wide box: 1 rank, two concurrent
+# 1-rank runs (the memory-bandwidth ceiling of 2 ranks), 2 ranks (and 2 ranks with
+# load balancing for the corner scene): speed-up, efficiency against the ceiling,
+# full sorts, peak memory per point. Build type must be Release (the Makefile's default).
 set -euo pipefail
 BUILD=${1:-build}
 LOG=$(mktemp)
@@ -29,3 +33,63 @@ print("  %-30s %7.1f ns/particle-step" % ("total", 1e9 * wall / ps))
 print("  material points changing cell per step: %.1f %%" % (100.0 * int(b.group(6)) / ps))
 PY
 done
+
+# ---- parallel figures (issue 15): 2 ranks against the hardware ceiling.
+# The ceiling: two independent 1-rank runs side by side share the memory
+# bandwidth; each slows down by a factor s, so 2 ranks can at best reach a
+# speed-up of 2/s. Efficiency = speed-up / ceiling.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMP_NUM_THREADS=1
+TMPD=$(mktemp -d)
+trap 'rm -f "$LOG"; rm -rf "$TMPD"' EXIT
+wall() { grep -o "wall [0-9.e+-]* s" "$1" | awk '{print $2}'; }
+points() { grep -o "done: [0-9]* steps, [0-9]* particles" "$1" | awk '{print $2, $4}'; }
+prm_with() { # prm_with FILE OUTDIR [load balancing interval]: a copy with another output directory
+  sed -e "s#set directory *= .*#set directory = $2#" "$1" > "$TMPD/$(basename "$2").prm"
+  if [ -n "${3:-}" ]; then
+    sed -i "s#set interval *= *0 .*#set interval = $3#" "$TMPD/$(basename "$2").prm"
+  fi
+  echo "$TMPD/$(basename "$2").prm"
+}
+parallel_figures() { # parallel_figures NAME PRM [load balancing interval for the balanced run]
+  local name=$1 prm=$2 lb=${3:-}
+  local one two a b
+  one=$(prm_with "$prm" "$TMPD/out_${name}_1")
+  /usr/bin/time -f "%M" -o "$TMPD/${name}_rss" "$BUILD/tools/talus-explicit" "$one" > "$TMPD/${name}_1.log"
+  "$BUILD/tools/talus-explicit" "$(prm_with "$prm" "$TMPD/out_${name}_a")" > "$TMPD/${name}_a.log" &
+  "$BUILD/tools/talus-explicit" "$(prm_with "$prm" "$TMPD/out_${name}_b")" > "$TMPD/${name}_b.log" &
+  wait
+  mpirun -np 2 "$BUILD/tools/talus-explicit" "$(prm_with "$prm" "$TMPD/out_${name}_2")" > "$TMPD/${name}_2.log"
+  if [ -n "$lb" ]; then
+    mpirun -np 2 "$BUILD/tools/talus-explicit" "$(prm_with "$prm" "$TMPD/out_${name}_2lb" "$lb")" > "$TMPD/${name}_2lb.log"
+  fi
+  python3 - "$TMPD" "$name" "$lb" <<'PY'
+import re, sys
+d, name, lb = sys.argv[1], sys.argv[2], sys.argv[3]
+def run(tag):
+    t = open(f"{d}/{name}_{tag}.log").read()
+    m = re.search(r"done: (\d+) steps, (\d+) particles, wall ([\d.e+-]+) s", t)
+    s = re.search(r"full sorts (\d+)", t)
+    return int(m.group(1)), int(m.group(2)), float(m.group(3)), int(s.group(1)) if s else -1, t
+steps, n, t1, _, _ = run("1")
+ta, tb = run("a")[2], run("b")[2]
+slow = (ta + tb) / 2 / t1
+ceiling = 2 / slow
+rss = int(open(f"{d}/{name}_rss").read().split()[-1]) * 1024
+print(f"\nbench parallel: {name}, {n} material points, {steps} steps")
+print(f"  1 rank                         {1e9 * t1 / (steps * n):7.1f} ns/point-step (wall {t1:.1f} s)")
+print(f"  2 concurrent 1-rank runs       slow-down {slow:.2f} x each -> ceiling speed-up {ceiling:.2f}")
+for tag, label in (("2", "2 ranks"), ("2lb", "2 ranks, load balancing")):
+    try:
+        _, _, t2, sorts, text = run(tag)
+    except FileNotFoundError:
+        continue
+    sp = t1 / t2
+    imb = re.search(r"load balancing: points per rank max/mean ([\d.]+) -> ([\d.]+)", text)
+    extra = f", imbalance {imb.group(1)} -> {imb.group(2)}" if imb else ""
+    print(f"  {label:30s} {1e9 * t2 / (steps * n):7.1f} ns/point-step of wall time, speed-up {sp:.2f}, "
+          f"efficiency {100 * sp / ceiling:.0f} % of the ceiling, full sorts {sorts}{extra}")
+print(f"  memory: peak RSS {rss / 1e6:.0f} MB on 1 rank = {rss / n:.0f} bytes per point (process base included)")
+PY
+}
+parallel_figures block_3d parameter_files/bench/block_spreading_3d.prm
+parallel_figures corner_2d parameter_files/bench/corner_collapse_2d.prm 50

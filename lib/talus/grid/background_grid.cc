@@ -405,22 +405,9 @@ namespace talus
                                             const dealii::Point<dim> &x,
                                             dealii::Point<dim> &      xi) const
   {
-    const auto &cc = cells[c];
-    for (unsigned int k = cc.neighbours_begin; k < cc.neighbours_end; ++k)
-      {
-        const unsigned int n  = neighbours[k];
-        const auto &       nc = cells[n];
-        bool               in = true;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const double r = (x[d] - nc.lower[d]) * nc.inv_h[d];
-            in             = in && (r >= 0.0) && (r <= 1.0);
-            xi[d]          = r;
-          }
-        if (in)
-          return nc.locally_owned ? n : dealii::numbers::invalid_unsigned_int;
-      }
-    return dealii::numbers::invalid_unsigned_int;
+    const unsigned int n = find_cell_near(c, x, xi);
+    return n != dealii::numbers::invalid_unsigned_int && cells[n].locally_owned ? n :
+                                                                                   dealii::numbers::invalid_unsigned_int;
   }
 
   template <int dim>
