@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/loads/k0.h>
 #include <talus/loads/load_control.h>
 #include <talus/loads/local_damping.h>
 #include <talus/shape/q1.h>
@@ -103,8 +104,8 @@ namespace talus::loads
             rho            = (1 - pl.porosity) * (s.prm.materials[mat]->density() - pl.density);
             P[s.two_phase->pore_pressure] = pl.density * gn * depth;
           }
-        const double sv    = -(rho * gn * depth + k.surcharge);
-        const double sh    = k.K0 * sv;
+        const auto   k0    = k0_stress(rho * gn, depth, k.surcharge, k.K0);
+        const double sv = k0.vertical, sh = k0.horizontal;
         dealii::SymmetricTensor<2, 3> sigma;
         for (unsigned int i = 0; i < 3; ++i)
           for (unsigned int j = i; j < 3; ++j)

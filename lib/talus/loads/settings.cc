@@ -1,5 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/loads/k0.h>
 #include <talus/loads/settings.h>
 
 #include <deal.II/base/utilities.h>
@@ -440,7 +441,7 @@ namespace talus::loads
                 require(phi >= 0, where + "/K0",
                         "'auto' (1 - sin phi) needs a Mohr-Coulomb material; " + mat + " is '" + model +
                           "': give K0 as a number");
-                z.K0 = 1.0 - std::sin(phi * M_PI / 180.0);
+                z.K0 = jaky_k0(phi);
               }
             else
               z.K0 = parse_doubles(k0, where + "/K0").at(0);

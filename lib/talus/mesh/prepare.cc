@@ -1,5 +1,6 @@
 // talus — mesh preparation (prepare.h).
 #include <talus/base/errors.h>
+#include <talus/loads/k0.h>
 #include <talus/mesh/prepare.h>
 
 #include <deal.II/base/quadrature_lib.h>
@@ -1053,8 +1054,9 @@ namespace talus::mesh
         if (spec.k0 > 0)
           {
             const double level = std::isnan(spec.surface_level) ? top[p.body] : spec.surface_level;
-            const double sv    = -spec.k0_density * spec.k0_gravity * std::max(0.0, level - p.x[dim - 1]);
-            const double sh    = spec.k0 * sv;
+            const auto   k0    = loads::k0_stress(spec.k0_density * spec.k0_gravity,
+                                               std::max(0.0, level - p.x[dim - 1]), 0.0, spec.k0);
+            const double sv = k0.vertical, sh = k0.horizontal;
             sig[0] = sig[1] = sig[2] = sh;
             sig[dim - 1]             = sv;
           }

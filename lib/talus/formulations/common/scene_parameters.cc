@@ -7,6 +7,8 @@
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
+#include <iostream>
+#include <sstream>
 #include <cmath>
 #include <map>
 
@@ -349,15 +351,22 @@ namespace talus
                 constants[kv[0]] = v[0];
               }
             auto fp = std::make_shared<dealii::FunctionParser<dim>>(dim);
+            // deal.II 9.4 prints muparser's diagnosis to std::cerr before it
+            // throws: keep it out of the tool's stderr (the InputError below
+            // carries the same text, naming the entry)
+            std::ostringstream   parser_noise;
+            std::streambuf *const cerr_buffer = std::cerr.rdbuf(parser_noise.rdbuf());
             try
               {
                 fp->initialize(dealii::FunctionParser<dim>::default_variable_names(), expr, constants);
                 fp->value(dealii::Point<dim>(), 0); // force a parse of every component
                 for (unsigned int d = 0; d < dim; ++d)
                   fp->value(dealii::Point<dim>(), d);
+                std::cerr.rdbuf(cerr_buffer);
               }
             catch (const std::exception &e)
               {
+                std::cerr.rdbuf(cerr_buffer);
                 throw InputError(where + "/initial velocity function: cannot parse '" + expr + "' (need " +
                                  std::to_string(dim) + " expressions separated by ';'): " + exception_text(e));
               }
