@@ -37,13 +37,7 @@ def particles(out):
 
 def worst_difference(a, b):
     tv.check(a["id"] == b["id"], f"same particle ids ({len(a['id'])} points)")
-    worst = 0.0
-    for col in a:
-        if col == "id":
-            continue
-        scale = max(abs(v) for v in a[col]) or 1.0
-        worst = max(worst, max(abs(x - y) for x, y in zip(a[col], b[col])) / scale)
-    return worst
+    return max(tv.relative_differences(a, b).values())
 
 
 # 1. the corner scene on 2 ranks with the .prm's settings

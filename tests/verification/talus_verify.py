@@ -123,6 +123,16 @@ def read_csv(path):
     return {h: [value(r[i]) for r in data] for i, h in enumerate(header)}
 
 
+def relative_differences(a, b, columns=None):
+    """Per column of two equally ordered tables (read_csv): max |a - b| / max |a| (the scale is 1
+    for a column of zeros). Default columns: every column of a but 'id'."""
+    out = {}
+    for col in columns if columns is not None else [c for c in a if c != "id"]:
+        scale = max(abs(v) for v in a[col]) or 1.0
+        out[col] = max(abs(x - y) for x, y in zip(a[col], b[col])) / scale
+    return out
+
+
 def zero_crossings(t, y, direction=0):
     """Times where y crosses 0 (linear interpolation). direction: +1 up, -1 down, 0 both."""
     out = []

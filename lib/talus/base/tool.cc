@@ -509,6 +509,15 @@ namespace talus
     return r;
   }
 
+  std::string
+  zeros_text(const unsigned int dim, const std::string &last)
+  {
+    std::string s;
+    for (unsigned int d = 0; d + 1 < dim; ++d)
+      s += "0, ";
+    return s + last;
+  }
+
   template <int dim>
   dealii::Point<dim>
   parse_point(const std::string &text, const std::string &where)

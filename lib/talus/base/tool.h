@@ -7,6 +7,7 @@
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
 
+#include <chrono>
 #include <functional>
 #include <string>
 #include <utility>
@@ -89,6 +90,16 @@ namespace talus
   /// Instantiated for dim = 1, 2, 3.
   template <int dim>
   dealii::Point<dim> parse_point(const std::string &text, const std::string &where);
+  /// The default text of a dim-vector entry: "0, 0, <last>" (dim entries).
+  std::string zeros_text(unsigned int dim, const std::string &last = "0");
+
+  /// Wall-clock timing of phases (timers, progress, checkpoint cadence).
+  using Clock = std::chrono::steady_clock;
+  inline double
+  seconds_since(const Clock::time_point &t0)
+  {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  }
 
   /// main() of a tool: `return talus::run_tool(argc, argv, description);`
   /// Command line: [--help] [--print-parameters] [--check] [tool options] FILE.prm.

@@ -17,11 +17,6 @@ namespace talus::loads
 
   namespace
   {
-    std::string
-    zeros(const unsigned int dim)
-    {
-      return dim == 2 ? "0, 0" : "0, 0, 0";
-    }
 
 
 
@@ -67,9 +62,9 @@ namespace talus::loads
           prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body face).");
           prm.declare_entry("face", dim == 2 ? "y+" : "z+", Selection(face_names),
                             "Loaded face: its outward normal axis and side.");
-          prm.declare_entry("region lower corner", zeros(dim), Anything(), "Region: lower corner [m].");
-          prm.declare_entry("region upper corner", zeros(dim), Anything(), "Region: upper corner [m].");
-          prm.declare_entry("traction", zeros(dim), Anything(),
+          prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
+          prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
+          prm.declare_entry("traction", zeros_text(dim), Anything(),
                             "Traction vector [Pa], force per unit initial area of the face (e.g. 0, -1e4 pushes down); direction and size do not follow the deformation (seed 000 §5.2).");
           prm.declare_entry("time function", "constant", Anything(),
                             "Factor f(t): constant | step T | ramp T1 | ramp T0 T1 | table t0:f0, t1:f1, ... | "
@@ -83,12 +78,12 @@ namespace talus::loads
                             "'boundary': every grid node of 'boundary id'; 'region': the grid nodes inside the "
                             "region box; 'body': the material points of 'body'.");
           prm.declare_entry("boundary id", "0", Integer(0), "Boundary id (apply to = boundary).");
-          prm.declare_entry("region lower corner", zeros(dim), Anything(), "Region: lower corner [m].");
-          prm.declare_entry("region upper corner", zeros(dim), Anything(), "Region: upper corner [m].");
+          prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
+          prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
           prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body).");
           prm.declare_entry("components", "all", Anything(),
                             "Prescribed components: 'all' or a list of x, y, z.");
-          prm.declare_entry("velocity", zeros(dim), Anything(), "Velocity vector [m/s] (unprescribed components ignored).");
+          prm.declare_entry("velocity", zeros_text(dim), Anything(), "Velocity vector [m/s] (unprescribed components ignored).");
           prm.declare_entry("time function", "constant", Anything(), "Factor f(t), as for tractions.");
           prm.leave_subsection();
         }

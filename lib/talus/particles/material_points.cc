@@ -560,8 +560,9 @@ namespace talus
     const unsigned int n_props = particles.n_properties_per_particle();
     bool               need_sort = false;
     const bool parallel = dealii::Utilities::MPI::n_mpi_processes(grid.comm) > 1;
-    for (auto &o : outgoing)
-      o.second.clear();
+    // per destination rank: the points that entered one of its cells (CellId
+    // words, id, x, xi, properties per point); only ranks that get points have an entry
+    std::map<unsigned int, std::vector<double>> outgoing;
     unsigned long long n_sent = 0;
     for (std::size_t k = 0; k < pending.size(); ++k)
       {
@@ -605,23 +606,11 @@ namespace talus
         removed_from.push_back(pending[*k].cell);
         particles.remove_particle(pending[*k].it);
       }
-    for (const auto &m : moves)
-      {
-        if (moved)
-          moved(m.cell, m.xi, props.data() + m.prop_offset);
-        inserted_into.push_back(m.cell);
-        particles.insert_particle(m.x,
-                                m.xi,
-                                m.id,
-                                grid.cell_iterators[m.cell],
-                                dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
-      }
-    // the points other ranks sent into my cells, in rank order (deterministic)
-    unsigned long long n_received = 0;
+    // the points other ranks sent into my cells, in rank order (deterministic),
+    // join the local moves
+    const std::size_t n_local_moves = moves.size();
     if (parallel)
       {
-        for (auto o = outgoing.begin(); o != outgoing.end();)
-          o = o->second.empty() ? outgoing.erase(o) : std::next(o);
         const auto         received = dealii::Utilities::MPI::some_to_some(grid.comm, outgoing);
         const unsigned int stride   = 4 + 1 + 2 * dim + n_props;
         for (const auto &from : received)
@@ -634,25 +623,31 @@ namespace talus
               const auto cell = grid.tria.create_cell_iterator(dealii::CellId(key));
               AssertThrow(cell->is_active() && cell->is_locally_owned(),
                           dealii::ExcMessage("a material point was sent to a rank that does not own its cell"));
-              const unsigned int c = cell->active_cell_index();
-              dealii::Point<dim> x, xi;
+              Move m{{}, {}, static_cast<dealii::types::particle_index>(q[4]), cell->active_cell_index(),
+                     static_cast<unsigned int>(props.size())};
               for (unsigned int d = 0; d < dim; ++d)
                 {
-                  x[d]  = q[5 + d];
-                  xi[d] = q[5 + dim + d];
+                  m.x[d]  = q[5 + d];
+                  m.xi[d] = q[5 + dim + d];
                 }
-              const double *P = q + 5 + 2 * dim;
-              if (moved)
-                moved(c, xi, P);
-              inserted_into.push_back(c);
-              particles.insert_particle(x, xi, static_cast<dealii::types::particle_index>(q[4]),
-                                        grid.cell_iterators[c], dealii::ArrayView<const double>(P, n_props));
-              ++n_received;
+              moves.push_back(m);
+              props.insert(props.end(), q + 5 + 2 * dim, q + stride);
             }
       }
-    stats.moved_locally += moves.size() + n_sent;
+    for (const auto &m : moves)
+      {
+        if (moved)
+          moved(m.cell, m.xi, props.data() + m.prop_offset);
+        inserted_into.push_back(m.cell);
+        particles.insert_particle(m.x,
+                                m.xi,
+                                m.id,
+                                grid.cell_iterators[m.cell],
+                                dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
+      }
+    stats.moved_locally += n_local_moves + n_sent;
     stats.sent_to_ranks += n_sent;
-    moved_since_sort += moves.size() + n_received;
+    moved_since_sort += moves.size(); // local and received: both sit in recycled slots
     pending.clear();
 
     // one reduction decides both: a needed sort and a memory-order sort

@@ -12,7 +12,6 @@
 #include <functional>
 
 #include <string>
-#include <map>
 #include <vector>
 
 namespace talus
@@ -265,9 +264,6 @@ namespace talus
     };
     std::vector<Move>        moves;
     std::vector<double>      props;
-    /// per destination rank: the points that entered one of its cells (CellId
-    /// words, id, x, xi, properties per point)
-    std::map<unsigned int, std::vector<double>> outgoing;
     std::vector<std::size_t> to_remove;
   };
 } // namespace talus

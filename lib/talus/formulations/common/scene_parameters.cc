@@ -20,19 +20,6 @@ namespace talus
   using dealii::Patterns::Integer;
   using dealii::Patterns::Selection;
 
-  namespace
-  {
-    /// "0, 0, <last>" with dim entries
-    std::string
-    zeros(const unsigned int dim, const std::string &last = "0")
-    {
-      std::string s;
-      for (unsigned int d = 0; d + 1 < dim; ++d)
-        s += "0, ";
-      return s + last;
-    }
-  } // namespace
-
   std::vector<unsigned int>
   parse_ids(const std::string &text, const std::string &where)
   {
@@ -98,7 +85,7 @@ namespace talus
                         "material ids come from the file.");
       prm.declare_entry("file", "", Anything(),
                         "grid/source = file: grid file (gmsh MSH 2.2 ASCII as written by talus-mesh).");
-      prm.declare_entry("lower corner", zeros(dim), Anything(),
+      prm.declare_entry("lower corner", zeros_text(dim), Anything(),
                         "Lower corner of the box background grid [m], dim comma-separated numbers.");
       prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(),
                         "Upper corner of the box background grid [m].");
@@ -118,7 +105,7 @@ namespace talus
     prm.leave_subsection();
 
     prm.enter_subsection("gravity");
-    prm.declare_entry("acceleration", zeros(dim, "-9.81"), Anything(), "Gravitational acceleration vector [m/s^2].");
+    prm.declare_entry("acceleration", zeros_text(dim, "-9.81"), Anything(), "Gravitational acceleration vector [m/s^2].");
     prm.leave_subsection();
 
     prm.declare_entry("number of materials", "1", Integer(1, 64), "Number of 'material k' subsections (k = 0..n-1).");
@@ -145,15 +132,15 @@ namespace talus
         prm.declare_entry("file body id", "-1", Integer(-1, 65535),
                           "shape = file: take the rows of the file with this body id; -1 = the index k of this "
                           "'body k' subsection.");
-        prm.declare_entry("lower corner", zeros(dim), Anything(), "Box: lower corner [m].");
+        prm.declare_entry("lower corner", zeros_text(dim), Anything(), "Box: lower corner [m].");
         prm.declare_entry("upper corner", (dim == 2 ? "1, 1" : "1, 1, 1"), Anything(), "Box: upper corner [m].");
-        prm.declare_entry("center", zeros(dim), Anything(), "Ball: center [m].");
+        prm.declare_entry("center", zeros_text(dim), Anything(), "Ball: center [m].");
         prm.declare_entry("radius", "0", Double(0), "Ball: radius [m].");
         prm.declare_entry("vertices", "", Anything(), "Polygon: 'x,y; x,y; ...' [m], at least 3 vertices.");
         prm.declare_entry("particles per direction", "2", Integer(1, 10),
                           "Material points per cell and direction (n^dim per filled cell, regular positions).");
         declare_clip_to_grid(prm);
-        prm.declare_entry("initial velocity", zeros(dim), Anything(), "Uniform initial velocity [m/s].");
+        prm.declare_entry("initial velocity", zeros_text(dim), Anything(), "Uniform initial velocity [m/s].");
         prm.declare_entry("initial velocity function", "", Anything(),
                           "Optional initial velocity field, dim expressions separated by ';' in x, y, z "
                           "(muparser syntax, e.g. '0.1*sin(pi*x/2); 0'); overrides 'initial velocity'.");

@@ -17,13 +17,6 @@ namespace talus
 {
   namespace
   {
-    using Clock = std::chrono::steady_clock;
-    double
-    seconds_since(const Clock::time_point &t0)
-    {
-      return std::chrono::duration<double>(Clock::now() - t0).count();
-    }
-
     /// The step number of a series.csv row (its second column), or -1.
     long long
     row_step(const std::string &line)

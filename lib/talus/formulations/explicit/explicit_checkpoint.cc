@@ -197,7 +197,7 @@ namespace talus::explicit_mpm
     const unsigned int         n_props = points.layout.n_properties();
     const std::size_t          n_local = points.handler.n_locally_owned_particles();
     std::vector<std::uint64_t> ids, cells;
-    std::vector<double>        loc, ref, props, cell_ids;
+    std::vector<double>        loc, ref, props;
     ids.reserve(n_local);
     cells.reserve(n_local);
     loc.reserve(n_local * dim);
@@ -207,9 +207,6 @@ namespace talus::explicit_mpm
       {
         ids.push_back(pt.get_id());
         cells.push_back(pt.get_surrounding_cell()->active_cell_index());
-        if (prm.balance.enabled())
-          for (const unsigned int w : pt.get_surrounding_cell()->id().template to_binary<dim>())
-            cell_ids.push_back(w);
         const auto x = pt.get_location(), xi = pt.get_reference_location();
         for (unsigned int d = 0; d < dim; ++d)
           loc.push_back(x[d]);
@@ -220,10 +217,6 @@ namespace talus::explicit_mpm
       }
     f.write_rows("particles/id", ids, 1);
     f.write_rows("particles/cell", cells, 1);
-    // after repartitions the local cell numbering depends on the history of the
-    // local mesh: the cells are saved by CellId as well (4 words)
-    if (prm.balance.enabled())
-      f.write_rows("particles/cell_id", cell_ids, 4);
     f.write_rows("particles/location", loc, dim);
     f.write_rows("particles/reference", ref, dim);
     f.write_rows("particles/properties", props, n_props);
@@ -366,24 +359,7 @@ namespace talus::explicit_mpm
               begin += counts[r];
             const std::uint64_t end   = begin + counts[rank];
             const auto          ids   = f.read_rows_u64("particles/id", begin, end);
-            auto                cells = f.read_rows_u64("particles/cell", begin, end);
-            if (f.exists("particles/cell_id"))
-              {
-                // a repartitioned run: map the saved CellIds to this mesh's cell indices
-                std::map<dealii::CellId::binary_type, unsigned int> index_of;
-                for (const auto &cell : grid.tria.active_cell_iterators())
-                  if (cell->is_locally_owned())
-                    index_of[cell->id().template to_binary<dim>()] = cell->active_cell_index();
-                const auto words = f.read_rows("particles/cell_id", begin, end);
-                for (std::size_t i = 0; i < cells.size(); ++i)
-                  {
-                    dealii::CellId::binary_type key;
-                    for (unsigned int k = 0; k < 4; ++k)
-                      key[k] = static_cast<unsigned int>(words[4 * i + k]);
-                    const auto it = index_of.find(key);
-                    cells[i]      = it == index_of.end() ? grid.cell_iterators.size() : it->second;
-                  }
-              }
+            const auto          cells = f.read_rows_u64("particles/cell", begin, end);
             const auto          loc   = f.read_rows("particles/location", begin, end);
             const auto          ref   = f.read_rows("particles/reference", begin, end);
             const auto          props = f.read_rows("particles/properties", begin, end);

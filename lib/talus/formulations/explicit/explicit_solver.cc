@@ -27,23 +27,8 @@
 
 namespace talus::explicit_mpm
 {
-  using dealii::Patterns::Anything;
   using dealii::Patterns::Bool;
   using dealii::Patterns::Double;
-  using dealii::Patterns::Integer;
-  using dealii::Patterns::List;
-  using dealii::Patterns::Selection;
-
-  namespace
-  {
-    using Clock = std::chrono::steady_clock;
-    double
-    seconds_since(const Clock::time_point &t0)
-    {
-      return std::chrono::duration<double>(Clock::now() - t0).count();
-    }
-
-  } // namespace
 
   // ================================================================ parameters
   void
@@ -472,8 +457,8 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::rebalance()
   {
-    // the weights of this partition, kept for checkpoints (a bitwise restart
-    // recreates the same partition before it inserts the points)
+    // the weights of the cells with points (the others weigh 'cell weight'),
+    // kept for checkpoints: a bitwise restart recreates the partition from them
     balance_weights.clear();
     for (const auto &cell : grid.tria.active_cell_iterators())
       if (cell->is_locally_owned())
@@ -486,10 +471,7 @@ namespace talus::explicit_mpm
           balance_weights.push_back(prm.balance.cell_weight + prm.balance.point_weight * n);
         }
     points.handler.prepare_for_coarsening_and_refinement();
-    grid.repartition([&](const typename dealii::Triangulation<dim>::cell_iterator &cell) {
-      return prm.balance.cell_weight +
-             prm.balance.point_weight * static_cast<unsigned int>(points.handler.n_particles_in_cell(cell));
-    });
+    repartition_with(balance_weights);
     points.handler.unpack_after_coarsening_and_refinement();
     grid_changed();
     ++n_rebalances;
@@ -880,9 +862,7 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::advance(const unsigned int n_steps)
   {
-    LoopSettings s  = loop_settings(prm);
-    s.max_cut_backs = 0;
-    TimeLoop(*this, s, comm).advance_steps(n_steps);
+    TimeLoop(*this, loop_settings(prm), comm).advance_steps(n_steps);
   }
 
   template <int dim>
@@ -1132,9 +1112,7 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::run()
   {
-    LoopSettings s  = loop_settings(prm);
-    s.max_cut_backs = 0; // an explicit step always completes
-    TimeLoop(*this, s, comm).run();
+    TimeLoop(*this, loop_settings(prm), comm).run();
   }
 
   // ================================================================ Formulation interface
