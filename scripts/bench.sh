@@ -93,3 +93,23 @@ PY
 }
 parallel_figures block_3d parameter_files/bench/block_spreading_3d.prm
 parallel_figures corner_2d parameter_files/bench/corner_collapse_2d.prm 50
+
+# ---- implicit family (issue 13): time per step, per Newton iteration, assembly
+# ns per point and linear-solve time, a 2D (KLU) and a 3D (CG + ML AMG) scene
+for PRM in parameter_files/bench/implicit_cantilever_2d.prm parameter_files/bench/implicit_block_3d.prm; do
+  echo "bench: $PRM (single rank)"
+  "$BUILD/tools/talus-implicit" "$(prm_with "$PRM" "$TMPD/out_$(basename "$PRM" .prm)")" | tee "$LOG"
+  python3 - "$LOG" <<'PY'
+import re, sys
+t = open(sys.argv[1]).read()
+d = re.search(r"done: (\d+) steps, (\d+) particles, wall ([\d.e+-]+) s; Newton iterations (\d+)", t)
+b = re.search(r"assembly ([\d.e+-]+) \((\d+)\), linear solve ([\d.e+-]+) \((\d+)\), convective phase ([\d.e+-]+)", t)
+steps, n, wall, its = int(d.group(1)), int(d.group(2)), float(d.group(3)), int(d.group(4))
+ta, na, ts, ns, tc = float(b.group(1)), int(b.group(2)), float(b.group(3)), int(b.group(4)), float(b.group(5))
+print(f"\nbench implicit: {n} material points, {steps} steps, {its} Newton iterations, wall {wall:.2f} s")
+print(f"  per step {wall / steps:.3f} s; per Newton iteration {wall / max(its, 1):.3f} s")
+print(f"  assembly (residual + tangent) {1e9 * ta / (na * n):.0f} ns per point ({na} assemblies, {ta:.2f} s)")
+print(f"  linear solve {ts / max(ns, 1):.3f} s per solve ({ns} solves)")
+print(f"  convective phase {1e9 * tc / (steps * n):.0f} ns per point-step")
+PY
+done

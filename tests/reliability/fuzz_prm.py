@@ -558,8 +558,20 @@ def main():
     n_mut = 0
     required_runs = {c: 0 for c in REQUIRED_CLASSES}
     per_prm = 40
+    # every shipped file through every tool with --check, in parallel (the jobs of
+    # this phase are independent; each in its own directory)
+    parsed = {path: Prm(path) for path in prms}
+
+    def original(j):
+        k, (path, t) = j
+        m = Mutation("original", parsed[path].text, "any", base=parsed[path])
+        return path, t, runner.run(t, m, True, f"orig{k:04d}_" + os.path.basename(t))
+
+    pairs = [(path, t) for path in prms if not generated_inputs(parsed[path].text) for t in prm_tools]
+    with cf.ThreadPoolExecutor(max_workers=args.jobs) as ex:
+        originals = {(path, t): r for path, t, r in ex.map(original, enumerate(pairs))}
     for path in prms:
-        prm = Prm(path)
+        prm = parsed[path]
         rel = os.path.relpath(path, args.prm_dir)
         missing = generated_inputs(prm.text)
         if missing:
@@ -567,8 +579,7 @@ def main():
             continue
         readers = []
         for t in prm_tools:
-            rc, out, err, probs, _ = runner.run(t, Mutation("original", prm.text, "any", base=prm), True,
-                                                "orig_" + os.path.basename(t))
+            rc, out, err, probs, _ = originals[(path, t)]
             if rc == 0:
                 readers.append(t)
             if probs:

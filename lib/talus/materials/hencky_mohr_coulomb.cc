@@ -231,12 +231,18 @@ namespace talus::materials
                                    ArrayView<double> history) const
   {
     const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
-    sigma = tau / history[6];
+    sigma = tau / kirchhoff_jacobian(history);
   }
 
   double
   HenckyMohrCoulomb::elastic_energy_density(const Stress &s) const
   {
     return isotropic_elastic_energy_density(E, nu, s);
+  }
+
+  double
+  HenckyMohrCoulomb::kirchhoff_jacobian(ArrayView<const double> history) const
+  {
+    return history[6];
   }
 } // namespace talus::materials

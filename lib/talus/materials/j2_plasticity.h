@@ -44,6 +44,8 @@ namespace talus::materials
                        ArrayView<double> history) const override;
 
     bool has_finite_strain_form() const override { return true; }
+
+    double kirchhoff_jacobian(ArrayView<const double> history) const override;
     void finite_strain_update(const dealii::Tensor<2, 3> &dF,
                               ArrayView<const double>     history_old,
                               ArrayView<double>           history_new,

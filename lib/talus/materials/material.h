@@ -89,6 +89,11 @@ namespace talus::materials
                                       Stress &                    tau,
                                       dealii::Tensor<4, 3> *      dtau_ddF) const;
 
+    /// det F of the total deformation that the Kirchhoff stress of
+    /// finite_strain_update() refers to, read from the history: sigma = tau / J.
+    /// (Initial stresses make it differ from the driver's volume ratio.)
+    virtual double kirchhoff_jacobian(ArrayView<const double> /*history*/) const { return 1.0; }
+
     /// Strain energy density increment is computed by the driver from stresses;
     /// this returns the elastic strain energy density of a stress state (for energy
     /// diagnostics), W = 1/2 sigma : C^-1 : sigma. Zero when not meaningful.

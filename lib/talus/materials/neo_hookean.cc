@@ -261,8 +261,7 @@ namespace talus::materials
                             ArrayView<double> history) const
   {
     const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
-    const double J = std::sqrt(determinant(fs::load_sym(history, 0)));
-    sigma          = tau / J;
+    sigma            = tau / kirchhoff_jacobian(history);
   }
 
   double
@@ -270,5 +269,11 @@ namespace talus::materials
   {
     // small-strain estimate, W = 1/2 sigma : C^-1 : sigma
     return isotropic_elastic_energy_density(E, nu, s);
+  }
+
+  double
+  NeoHookean::kirchhoff_jacobian(ArrayView<const double> history) const
+  {
+    return std::sqrt(determinant(fs::load_sym(history, 0)));
   }
 } // namespace talus::materials

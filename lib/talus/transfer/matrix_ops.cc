@@ -88,20 +88,23 @@ namespace talus::transfer
                                                       const dealii::AffineConstraints<double> &,              \
                                                       const ConsistentMass &,                                 \
                                                       dealii::TrilinosWrappers::SparseMatrix *,               \
-                                                      Vector *);                                              \
+                                                      Vector *,                                               \
+                                                      const Vector *);                                        \
   template void assemble<dim, K, 1, ConsistentMass>(const std::vector<MaterialPointSet<dim> *> &,            \
                                                     const ActiveSet<dim> &,                                   \
                                                     const dealii::AffineConstraints<double> &,                \
                                                     const ConsistentMass &,                                   \
                                                     dealii::TrilinosWrappers::SparseMatrix *,                 \
-                                                    Vector *);                                                \
+                                                    Vector *,                                                 \
+                                                    const Vector *);                                          \
   template void assemble<dim, K, dim, Sum<LinearElasticStiffness, BodyForce<dim>>>(                          \
     const std::vector<MaterialPointSet<dim> *> &,                                                             \
     const ActiveSet<dim> &,                                                                                   \
     const dealii::AffineConstraints<double> &,                                                                \
     const Sum<LinearElasticStiffness, BodyForce<dim>> &,                                                      \
     dealii::TrilinosWrappers::SparseMatrix *,                                                                 \
-    Vector *);
+    Vector *,                                                                                                 \
+    const Vector *);
 
   TALUS_MATRIX_OPS(2, shape::Q1Box<2>)
   TALUS_MATRIX_OPS(3, shape::Q1Box<3>)

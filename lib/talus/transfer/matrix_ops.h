@@ -106,12 +106,14 @@ namespace talus::transfer
   };
 
   /// A cell's local matrix (row-major, `stride` columns) and vector; row of
-  /// component k at local node a: a * nc + k.
+  /// component k at local node a: a * nc + k. `u`: the values of the field the
+  /// assembly gathers (AssembleSystem's `field`) at the same indices, or null.
   struct LocalSystem
   {
-    double *     A;
-    double *     b;
-    unsigned int stride;
+    double *       A;
+    double *       b;
+    unsigned int   stride;
+    const double * u = nullptr;
     double &     a(const unsigned int i, const unsigned int j) { return A[i * stride + j]; }
   };
 
@@ -238,7 +240,10 @@ namespace talus::transfer
 
   /// Assembly of A and/or b over a cell's points (the integrand's sums),
   /// distributed at end_cell with `constraints` (ActiveSet::constraints() or
-  /// constraints_with(Dirichlet)). nc = the space's components.
+  /// constraints_with(Dirichlet)). nc = the space's components. With `field`
+  /// (a vector of the space with ghost values) the integrand also sees that
+  /// field's values at the cell's nodes (LocalSystem::u): a residual that
+  /// depends on the iterate (the implicit families' Newton step).
   template <int dim, class K, unsigned int nc, class Integrand>
   struct AssembleSystem
   {
@@ -248,15 +253,18 @@ namespace talus::transfer
                    const dealii::AffineConstraints<double> &constraints,
                    const Integrand &                        integrand,
                    dealii::TrilinosWrappers::SparseMatrix * A,
-                   Vector *                                 b)
+                   Vector *                                 b,
+                   const Vector *                           field = nullptr)
       : grid(active.space.grid)
       , space(active.space)
       , constraints(constraints)
       , integrand(integrand)
       , A(A)
       , b(b)
+      , field(field)
       , Al(max_rows * max_rows)
       , bl(max_rows)
+      , ul(field ? max_rows : 0)
     {
       if (space.n_components() != nc)
         throw std::logic_error("transfer::AssembleSystem: nc differs from the space's number of components");
@@ -268,6 +276,7 @@ namespace talus::transfer
     const Integrand                          integrand;
     dealii::TrilinosWrappers::SparseMatrix * A;
     Vector *                                 b;
+    const Vector *                           field;
 
     static constexpr bool prefetch_location = false;
     typename K::Cell      cell;
@@ -275,7 +284,7 @@ namespace talus::transfer
     unsigned int                                 local_of_slot[K::n_nodes];
     unsigned int                                 slot_of_local[K::n_nodes];
     unsigned int                                 n_local = 0;
-    std::vector<double>                          Al, bl;
+    std::vector<double>                          Al, bl, ul;
     std::vector<dealii::types::global_dof_index> dofs;
     /// sum of |diagonal| and count of the local matrices (the scale of inactive rows)
     double diag_sum = 0, diag_count = 0;
@@ -303,6 +312,9 @@ namespace talus::transfer
           Al[i * max_rows + j] = 0.0;
       for (unsigned int i = r0; i < r1; ++i)
         bl[i] = 0.0;
+      if (field)
+        for (unsigned int k = 0; k < nc; ++k)
+          ul[r0 + k] = (*field)(space.node_dof(cell.dofs[s * dim], k));
       return a;
     }
     inline bool
@@ -321,7 +333,7 @@ namespace talus::transfer
             for (unsigned int d = 0; d < dim; ++d)
               p.G[k][d] = G[w][d];
           }
-      LocalSystem ls{Al.data(), bl.data(), max_rows};
+      LocalSystem ls{Al.data(), bl.data(), max_rows, field ? ul.data() : nullptr};
       integrand.template add<dim, nc>(it->get_properties().data(), p, ls);
       return true;
     }
@@ -352,7 +364,8 @@ namespace talus::transfer
 
   /// A += and/or b += the integrand summed over the points of all `sets`, then
   /// finish_assembly. A (reinit by ActiveSet::reinit_matrix) and b (the space's
-  /// partitioner) are not zeroed here; either may be null. Collective.
+  /// partitioner) are not zeroed here; either may be null. `field`: see
+  /// AssembleSystem. Collective.
   template <int dim, class K, unsigned int nc, class Integrand>
   void
   assemble(const std::vector<MaterialPointSet<dim> *> &sets,
@@ -360,9 +373,10 @@ namespace talus::transfer
            const dealii::AffineConstraints<double> &   constraints,
            const Integrand &                           integrand,
            dealii::TrilinosWrappers::SparseMatrix *    A,
-           Vector *                                    b)
+           Vector *                                    b,
+           const Vector *                              field = nullptr)
   {
-    AssembleSystem<dim, K, nc, Integrand> op(active, constraints, integrand, A, b);
+    AssembleSystem<dim, K, nc, Integrand> op(active, constraints, integrand, A, b, field);
     for (auto *set : sets)
       for_each_active_cell(*set, op);
     finish_assembly(active, op.diag_sum, op.diag_count, Integrand::matrix ? A : nullptr, b);

@@ -2,6 +2,7 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
+#include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/io/output.h>
 #include <talus/io/vtu.h>
@@ -1020,16 +1021,7 @@ namespace talus::explicit_mpm
   {
     if (free_surface)
       free_surface->update();
-    dealii::Particles::DataOut<dim> out;
-    out.build_patches(points.handler, points.layout.names(), points.layout.interpretations());
-    dealii::DataOutBase::VtkFlags flags;
-    flags.time              = time;
-    flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
-    out.set_flags(flags);
-    const std::string name = io::write_vtu_atomic(out, prm.output_directory, "particles", counter, comm);
-    pvd_records.emplace_back(time, name);
-    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-      io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
+    write_point_vtu(points, prm.output_directory, "particles", counter, time, pvd_records, comm);
     if (prm.write_grid)
       {
         dealii::DataOut<dim> dout;
@@ -1050,62 +1042,8 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::write_final_particles() const
   {
-    using L = PropertyLayout<dim>;
-    std::vector<std::vector<double>> rows;
-    for (const auto &pt : points.handler)
-      {
-        std::vector<double> r = {static_cast<double>(pt.get_id())};
-        const auto          P = pt.get_properties();
-        // fem: the point stays at its Gauss point; its position is that plus u
-        const bool fixed = fem && !fem->updated_lagrangian();
-        for (unsigned int d = 0; d < dim; ++d)
-          r.push_back(pt.get_location()[d] + (fixed ? P[L::displacement + d] : 0.0));
-        for (unsigned int d = 0; d < dim; ++d)
-          r.push_back(P[L::displacement + d]);
-        for (unsigned int d = 0; d < dim; ++d)
-          r.push_back(P[L::velocity + d]);
-        for (unsigned int k = 0; k < L::n_stress; ++k)
-          r.push_back(P[L::stress + k]);
-        r.push_back(P[L::volume]);
-        for (const auto &e : points.layout.extras)
-          for (unsigned int i = 0; i < e.size; ++i)
-            r.push_back(P[e.offset + i]);
-        rows.push_back(r);
-      }
-    const auto all = dealii::Utilities::MPI::gather(comm, rows, 0);
-    if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
-      return;
-    std::vector<std::vector<double>> merged;
-    for (const auto &r : all)
-      merged.insert(merged.end(), r.begin(), r.end());
-    std::sort(merged.begin(), merged.end());
-    std::vector<std::string> header = {"id"};
-    const char *             ax[]   = {"x", "y", "z"};
-    for (unsigned int d = 0; d < dim; ++d)
-      header.push_back(std::string("pos_") + ax[d]);
-    for (unsigned int d = 0; d < dim; ++d)
-      header.push_back(std::string("u_") + ax[d]);
-    for (unsigned int d = 0; d < dim; ++d)
-      header.push_back(std::string("v_") + ax[d]);
-    const auto names = points.layout.names();
-    for (unsigned int k = 0; k < L::n_stress; ++k)
-      header.push_back(names[L::stress + k]);
-    header.push_back("volume");
-    for (const auto &e : points.layout.extras)
-      for (unsigned int i = 0; i < e.size; ++i)
-        header.push_back(e.size == 1 ? e.name : e.name + "_" + std::string(ax[i < 3 ? i : 0]));
-    io::AtomicFile f(prm.output_directory + "/particles_final.csv");
-    for (unsigned int k = 0; k < header.size(); ++k)
-      f.stream() << (k ? "," : "") << header[k];
-    f.stream() << "\n" << std::setprecision(17);
-    for (const auto &r : merged)
-      {
-        f.stream() << static_cast<unsigned long long>(r[0]);
-        for (unsigned int k = 1; k < r.size(); ++k)
-          f.stream() << "," << r[k];
-        f.stream() << "\n";
-      }
-    f.commit();
+    // fem: the point stays at its Gauss point; its position is that plus u
+    write_final_points_csv(points, prm.output_directory, comm, fem && !fem->updated_lagrangian());
   }
 
   template <int dim>

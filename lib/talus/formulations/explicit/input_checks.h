@@ -5,18 +5,14 @@
 // points are seeded or any output is written.
 #pragma once
 
+#include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 
 namespace talus::explicit_mpm
 {
-  /// Largest box grid (cells in total) and number of material points a scene
-  /// may ask for: beyond these the run would not fit any machine talus targets;
-  /// the limit turns a typo (an extra zero in 'cells') into an error instead of
-  /// an out-of-memory kill.
-  inline constexpr double max_grid_cells      = 1e8;
-  inline constexpr double max_material_points = 2e9;
-
-  /// Throws InputError (naming the entry or entity and the allowed values) for:
+  /// check_scene_consistency (formulations/common/scene_checks.h), then the
+  /// explicit family's own: tractions on box bodies only, mass scaling >= 1
+  /// with coupled 2-phase materials. The scene check throws InputError for:
   /// boundary ids that a box grid does not have (allowed 0..2 dim-1); a grid
   /// with too many cells; a body lying entirely outside the grid or, for a box
   /// body, between the seeding positions (no material point); too many material
@@ -30,11 +26,6 @@ namespace talus::explicit_mpm
   /// edge of the box grid over the fastest material's wave speed).
   template <int dim>
   double critical_time_step_of(const Parameters<dim> &p);
-
-  /// Memory a run needs on one node, estimated from the cells and material
-  /// points (docs/reliability.md: bytes per process, cell and point measured on
-  /// talus-explicit); compared with available_memory_bytes() (base/tool.h).
-  double estimated_memory_bytes(double n_cells, double n_points, unsigned int dim, unsigned int ranks_on_node);
 
   /// Log what 'clip to grid' left out of each body: the seeding positions
   /// outside the grid and their volume (box grid: counted on the grid's

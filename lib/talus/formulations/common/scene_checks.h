@@ -1,0 +1,24 @@
+// talus — validation of the shared scene sections (grid, boundary conditions,
+// bodies) before any heavy work, for every family's --check and run: boundary
+// ids that exist, a grid that fits the memory and the cell limit, bodies
+// inside the grid that hold material points. InputError names the entry.
+#pragma once
+
+#include <talus/formulations/common/scene_parameters.h>
+
+namespace talus
+{
+  /// Largest box grid (cells in total) and number of material points a scene
+  /// may ask for: beyond these the run would not fit any machine talus targets;
+  /// the limit turns a typo (an extra zero in 'cells') into an error instead of
+  /// an out-of-memory kill.
+  inline constexpr double max_grid_cells      = 1e8;
+  inline constexpr double max_material_points = 2e9;
+
+  template <int dim>
+  void check_scene_consistency(const SceneParameters<dim> &p);
+
+  /// Estimated peak memory of one node [bytes] for a scene of n_cells and
+  /// n_points run on ranks_on_node ranks (measured figures, docs/reliability.md).
+  double estimated_memory_bytes(double n_cells, double n_points, unsigned int dim, unsigned int ranks_on_node);
+} // namespace talus

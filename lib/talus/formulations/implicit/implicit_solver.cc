@@ -1,0 +1,667 @@
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/common/point_output.h>
+#include <talus/formulations/common/scene_checks.h>
+#include <talus/formulations/common/time_loop.h>
+#include <talus/formulations/implicit/implicit_solver.h>
+#include <talus/shape/q1_box.h>
+#include <talus/transfer/updated_lagrangian_ops.h>
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace talus::implicit_mpm
+{
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Integer;
+  using dealii::Patterns::Selection;
+
+  // ================================================================ parameters
+  void
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
+  {
+    const SceneCounts counts = peek_scene_counts(prm_file);
+    declare_scene_parameters(prm, counts);
+    declare_run_parameters(prm);
+    prm.enter_subsection("time");
+    prm.declare_entry("time step", "0", Double(0),
+                      "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
+                      "> 0, required. Not limited by the explicit critical step; a step whose Newton "
+                      "iteration fails is halved and retried (at most 6 times in a row).");
+    prm.leave_subsection();
+    prm.enter_subsection("implicit");
+    {
+      prm.declare_entry("analysis", "dynamic", Selection("static|dynamic"),
+                        "dynamic: Newmark time integration with inertia (seed 001 §2.4.1); static: "
+                        "equilibrium without inertia, time is a load parameter.");
+      prm.declare_entry("newmark gamma", "0.5", Double(0.5, 1), "Newmark gamma in [1/2, 1] (thesis: 1/2).");
+      prm.declare_entry("newmark beta", "0.25", Double(0, 0.5),
+                        "Newmark beta in (0, 1/2] (thesis: 1/4, the trapezoidal rule).");
+      prm.declare_entry("rayleigh alpha", "0", Double(0),
+                        "Mass-proportional Rayleigh damping C = alpha M [1/s] (dynamic only; the column "
+                        "collapse of thesis §6.1 uses 1.5).");
+      prm.declare_entry("mass matrix", "lumped", Selection("lumped"),
+                        "Inertia with the lumped mass M_ii = sum_p m_p N_i(x_p) (Kratos MPM's choice; "
+                        "docs/implicit.md says why).");
+      prm.declare_entry("ramp loads", "true", Bool(),
+                        "static: body forces grow linearly from 0 at t = 0 to their full value at the end "
+                        "time (load stepping); false: full loads from the first step.");
+      prm.declare_entry("geometry", "plane strain", Selection("plane strain"),
+                        "2D: plane strain (dF_zz = 1). 3D ignores it.");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("newton");
+    {
+      prm.declare_entry("max iterations", "20", Integer(1), "Linear solves per step before the step is cut back.");
+      prm.declare_entry("residual relative", "1e-4", Double(0),
+                        "Converged when |r| <= max(residual relative x |r_0|, residual absolute); r_0: the "
+                        "residual at the predictor (or the external force scale when larger).");
+      prm.declare_entry("residual absolute", "1e-9", Double(0), "Absolute residual tolerance [N].");
+      prm.declare_entry("increment relative", "1e-4", Double(0),
+                        "Increment test: |du| <= max(increment relative x |Du|, increment absolute).");
+      prm.declare_entry("increment absolute", "1e-9", Double(0), "Absolute increment tolerance [m].");
+      prm.declare_entry("criterion", "residual",
+                        Selection("residual|increment|residual and increment|residual or increment"),
+                        "Which tests must pass.");
+      prm.declare_entry("line search", "false", Bool(), "Backtracking line search on the residual norm.");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("linear solver");
+    {
+      prm.declare_entry("method", "direct", Selection("direct|cg amg"),
+                        "direct: Amesos KLU; cg amg: conjugate gradients with ML algebraic multigrid "
+                        "(symmetric tangents only: elastic models).");
+      prm.declare_entry("relative tolerance", "1e-10", Double(0, 1), "cg amg: |b - A x| <= tol |b|.");
+      prm.declare_entry("max iterations", "1000", Integer(1), "cg amg: iteration limit.");
+    }
+    prm.leave_subsection();
+  }
+
+  template <int dim>
+  Parameters<dim>
+  parse_parameters(dealii::ParameterHandler &prm)
+  {
+    Parameters<dim> p;
+    parse_run_parameters<dim>(prm, p);
+    parse_scene_parameters<dim>(prm, p);
+    prm.enter_subsection("time");
+    p.time_step = prm.get_double("time step");
+    prm.leave_subsection();
+    require(p.time_step > 0, "time/time step", "must be > 0 (the implicit step is chosen by the user)");
+    prm.enter_subsection("implicit");
+    p.analysis       = prm.get("analysis") == "static" ? Parameters<dim>::Analysis::quasi_static
+                                                       : Parameters<dim>::Analysis::dynamic;
+    p.gamma          = prm.get_double("newmark gamma");
+    p.beta           = prm.get_double("newmark beta");
+    p.rayleigh_alpha = prm.get_double("rayleigh alpha");
+    p.ramp_loads     = prm.get_bool("ramp loads");
+    prm.leave_subsection();
+    require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
+    Newmark(p.gamma, p.beta); // validates the pair
+    prm.enter_subsection("newton");
+    p.newton.max_iterations     = prm.get_integer("max iterations");
+    p.newton.residual_relative  = prm.get_double("residual relative");
+    p.newton.residual_absolute  = prm.get_double("residual absolute");
+    p.newton.increment_relative = prm.get_double("increment relative");
+    p.newton.increment_absolute = prm.get_double("increment absolute");
+    p.newton.criterion          = parse_newton_criterion(prm.get("criterion"));
+    p.newton.line_search        = prm.get_bool("line search");
+    prm.leave_subsection();
+    p.newton.validate();
+    prm.enter_subsection("linear solver");
+    p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
+                                                    : LinearSolverOptions::Method::cg_amg;
+    p.linear.relative_tolerance = prm.get_double("relative tolerance");
+    p.linear.max_iterations     = prm.get_integer("max iterations");
+    prm.leave_subsection();
+
+    for (unsigned int k = 0; k < p.materials.size(); ++k)
+      {
+        const auto &m = *p.materials[k];
+        require(m.has_finite_strain_form(), "material " + std::to_string(k) + "/model",
+                "'" + m.model_name() +
+                  "' has no finite-strain form; talus-implicit needs one of: neo hookean, j2 plasticity, "
+                  "hencky mohr coulomb, nor sand");
+        require(m.n_history() <= 64, "material " + std::to_string(k), "more than 64 history variables");
+      }
+    // what the implicit family does not offer yet: refused, not ignored
+    const auto not_yet = [](const bool used, const std::string &entry) {
+      require(!used, entry, "not available in talus-implicit yet (issue 13); remove the entry");
+    };
+    not_yet(p.checkpoint_interval > 0 || p.checkpoint_wall_interval > 0, "checkpoint/interval");
+    not_yet(p.restart != Parameters<dim>::Restart::no, "checkpoint/restart");
+    not_yet(!p.results_file.empty(), "output/results file");
+    not_yet(!p.probes.empty(), "output/probes");
+    not_yet(p.write_grid, "output/write grid");
+    not_yet(p.balance.enabled(), "load balancing/interval");
+    not_yet(bool(p.grid_mesh), "grid/source");
+    check_scene_consistency(p); // grid, boundary ids, memory, bodies
+    require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_alpha == 0, "implicit/rayleigh alpha",
+            "damping needs 'analysis = dynamic'");
+    require(p.analysis == Parameters<dim>::Analysis::dynamic || !p.boundary_conditions.empty(),
+            "boundary conditions", "a static analysis needs at least one fixed or roller wall (without, the "
+            "bodies can move as rigid bodies and the stiffness is singular)");
+    return p;
+  }
+
+  void
+  check_scene(dealii::ParameterHandler &prm, const std::string &)
+  {
+    std::string out;
+    if (prm.get_integer("dimension") == 2)
+      out = parse_parameters<2>(prm).output_directory;
+    else
+      out = parse_parameters<3>(prm).output_directory;
+    require_output_directory(out, "output/directory");
+  }
+
+  // ================================================================ solver
+  template <int dim>
+  Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
+    : prm(p)
+    , comm(c)
+    , grid(c)
+    , points(grid, "points")
+    , space(grid, dim)
+    , active(space)
+    , newmark(p.gamma, p.beta)
+  {}
+
+  template <int dim>
+  Solver<dim>::~Solver() = default;
+
+  template <int dim>
+  void
+  Solver<dim>::setup()
+  {
+    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
+    grid.setup();
+    space.setup();
+    boundary_flags = grid.constrained_dofs(prm.boundary_conditions);
+
+    unsigned int n_history = 0;
+    for (const auto &m : prm.materials)
+      n_history = std::max(n_history, m->n_history());
+    points.layout.n_history = n_history;
+    acceleration_offset     = points.layout.add_extra("acceleration", dim, true);
+    points.initialize();
+
+    std::vector<double> density;
+    for (const auto &m : prm.materials)
+      density.push_back(m->density());
+    auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
+    const auto filed  = insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
+    for (unsigned int b = 0; b < prm.bodies.size(); ++b)
+      require(seeded.volume_per_body[b] + filed.volume_per_body[b] > 0,
+              "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
+              "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+    using L = PropertyLayout<dim>;
+    for (auto &pt : points.handler)
+      {
+        auto        P = pt.get_properties();
+        const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+        m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + L::history, m.n_history()));
+        for (unsigned int d = 0; d < dim; ++d)
+          P[acceleration_offset + d] = 0.0;
+      }
+    points.collect_active_cells();
+    dt = prm.time_step;
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
+      space.reinit_vector(*v);
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::load_factor(const double t) const
+  {
+    if (dynamic() || !prm.ramp_loads)
+      return 1.0;
+    return std::min(1.0, t / prm.end_time);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::prepare_step()
+  {
+    active.template reinit<shape::Q1Box<dim>>({&points});
+    // the walls' fixed and roller DoFs (grid DoFs by vertex) as homogeneous
+    // constraints on the increment, merged with the pins of the inactive DoFs
+    dealii::AffineConstraints<double> dirichlet;
+    dirichlet.reinit(space.locally_relevant_dofs());
+    for (const auto &cell : grid.tria.active_cell_iterators())
+      if (!cell->is_artificial())
+      for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+        for (unsigned int k = 0; k < dim; ++k)
+          {
+            const auto &       cc = grid.cells[cell->active_cell_index()];
+            const unsigned int g  = cc.dofs[v * dim + k];
+            if (g == dealii::numbers::invalid_unsigned_int || !boundary_flags[g])
+              continue;
+            const auto i = space.node_dof(cc.dofs[v * dim], k);
+            if (!dirichlet.is_constrained(i))
+              dirichlet.add_line(i);
+          }
+    active.reinit_matrix(tangent);
+    project_to_grid();
+    mass.update_ghost_values();
+    dirichlet.close();
+    constraints = active.constraints_with(dirichlet);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::project_to_grid()
+  {
+    using L = PropertyLayout<dim>;
+    std::vector<MaterialPointSet<dim> *> sets = {&points};
+    const auto &pins = active.constraints(); // inactive DoFs only: walls keep their mass
+    mass = 0;
+    transfer::assemble<dim, shape::Q1Box<dim>, dim>(sets, active, pins, transfer::NodalProjection<dim>{}, nullptr, &mass);
+    if (!dynamic())
+      return;
+    v_n = 0;
+    a_n = 0;
+    transfer::assemble<dim, shape::Q1Box<dim>, dim>(sets, active, pins, transfer::NodalProjection<dim>{L::velocity},
+                                                    nullptr, &v_n);
+    transfer::assemble<dim, shape::Q1Box<dim>, dim>(sets, active, pins,
+                                                    transfer::NodalProjection<dim>{acceleration_offset}, nullptr, &a_n);
+    for (unsigned int i = 0; i < mass.locally_owned_size(); ++i)
+      {
+        const double m = mass.local_element(i);
+        v_n.local_element(i) = m > 0 ? v_n.local_element(i) / m : 0.0;
+        a_n.local_element(i) = m > 0 ? a_n.local_element(i) / m : 0.0;
+      }
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g)
+  {
+    const auto start = Clock::now();
+    transfer::PointFailure                     failure;
+    transfer::UpdatedLagrangianForce<dim>      force;
+    force.materials      = &prm.materials;
+    force.history_offset = PropertyLayout<dim>::history;
+    force.gravity        = g;
+    force.tangent        = with_tangent;
+    force.failure        = &failure;
+    residual             = 0;
+    if (with_tangent)
+      tangent = 0;
+    transfer::assemble<dim, shape::Q1Box<dim>, dim>({&points}, active, constraints, force,
+                                                    with_tangent ? &tangent : nullptr, &residual, &du);
+    const bool any_failed = dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0;
+    if (any_failed)
+      throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
+    if (dynamic())
+      {
+        // lumped inertia and mass-proportional damping at the nodes:
+        // r_i += m_i (a_i + alpha v_i), tangent_ii += m_i (1/(beta h^2) + alpha gamma/(beta h))
+        const double coef = newmark.tangent_factors(prm.rayleigh_alpha, 0).mass;
+        const auto & owned = space.locally_owned_dofs();
+        for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
+          {
+            const auto i = owned.nth_index_in_set(k);
+            const double m = mass.local_element(k);
+            if (m == 0 || constraints.is_constrained(i))
+              continue;
+            const double u = du.local_element(k), v = v_n.local_element(k), a = a_n.local_element(k);
+            residual.local_element(k) +=
+              m * (newmark.acceleration(u, v, a) + prm.rayleigh_alpha * newmark.velocity(u, v, a));
+            if (with_tangent)
+              tangent.add(i, i, m * coef);
+          }
+        if (with_tangent)
+          tangent.compress(dealii::VectorOperation::add);
+      }
+    seconds_assembly += seconds_since(start);
+    ++n_assemblies;
+    return residual.l2_norm();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::nodal_acceleration(Vector &a) const
+  {
+    for (unsigned int k = 0; k < a.locally_owned_size(); ++k)
+      a.local_element(k) = mass.local_element(k) > 0
+                             ? newmark.acceleration(du.local_element(k), v_n.local_element(k), a_n.local_element(k))
+                             : 0.0;
+    a.update_ghost_values();
+  }
+
+  template <int dim>
+  StepOutcome
+  Solver<dim>::advance_by(const double h)
+  {
+    newmark.set_time_step(h);
+    h_step = h;
+    prepare_step();
+    const dealii::Tensor<1, dim> g = load_factor(time + h) * prm.gravity;
+    // the external force scale |f_ext| (lumped nodal masses times g)
+    double f2 = 0;
+    for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
+      {
+        const unsigned int c = space.component(k);
+        f2 += std::pow(mass.local_element(k) * g[c], 2);
+      }
+    const double f_ext = std::sqrt(dealii::Utilities::MPI::sum(f2, comm));
+
+    du = 0;
+    du.update_ghost_values();
+    unsigned int  linear_iterations = 0;
+    double        worst_linear_residual = 0;
+    NewtonProblem problem;
+    problem.assemble = [&](const bool with_tangent) { return assemble(with_tangent, g); };
+    problem.solve    = [&]() {
+      const auto start = Clock::now();
+      Vector      rhs(residual);
+      rhs *= -1.0;
+      delta = 0;
+      LinearSolveInfo info;
+      try
+        {
+          info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes());
+        }
+      catch (const std::exception &e)
+        {
+          throw NewtonFailure(std::string("linear solve failed: ") + e.what());
+        }
+      // a singular tangent (a body free to move as a rigid body in a static
+      // analysis, a point set cut loose) gives a direct solve without error but
+      // a solution that does not solve the system
+      if (!(info.relative_residual <= 1e-6))
+        {
+          std::ostringstream os;
+          os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
+             << " after the " << info.method
+             << " solve): are rigid-body motions of every body prevented by boundary conditions?";
+          throw NewtonFailure(os.str());
+        }
+      linear_iterations += info.iterations;
+      worst_linear_residual = std::max(worst_linear_residual, info.relative_residual);
+      constraints.set_zero(delta);
+      delta.update_ghost_values();
+      seconds_solve += seconds_since(start);
+      ++n_solves;
+      return delta.l2_norm();
+    };
+    problem.apply = [&](const double alpha) {
+      du.add(alpha, delta);
+      du.update_ghost_values();
+    };
+    problem.step_increment_norm = [&]() { return du.l2_norm(); };
+    problem.residual_reference  = [&]() { return f_ext; };
+    const NewtonResult result = NewtonSolver(prm.newton).solve(problem);
+
+    last                   = StepReport();
+    last.iterations        = result.iterations;
+    last.linear_iterations = linear_iterations;
+    last.observed_order    = result.observed_order;
+    {
+      // the order seen in the increments |du_k| (the error of iterate k-1): the
+      // residual norm of a stiff structure mixes stiff and soft modes and hits
+      // its round-off floor first (docs/implicit.md); increments at round-off
+      // level (below 1e-13 |Du|) are left out
+      std::vector<double> inc;
+      for (unsigned int k = 1; k < result.history.size(); ++k)
+        if (result.history[k].increment > 1e-13 * du.l2_norm())
+          inc.push_back(result.history[k].increment);
+      last.increment_order = observed_order(inc);
+    }
+    if (!result.history.empty())
+      {
+        last.residual_first = result.history.front().residual;
+        last.residual_last  = result.history.back().residual;
+      }
+    std::ostringstream hist;
+    hist << std::setprecision(3);
+    for (unsigned int k = 0; k < result.history.size(); ++k)
+      hist << (k ? " " : "") << result.history[k].residual;
+    hist << "; |du|";
+    for (unsigned int k = 1; k < result.history.size(); ++k)
+      hist << " " << result.history[k].increment;
+    last.history = hist.str();
+    total_iterations += result.iterations;
+    total_linear_iterations += linear_iterations;
+    if (!result.converged)
+      {
+        log() << "  step " << step_number + 1 << " (t = " << time + h << "): Newton " << to_string(result.status)
+              << " after " << result.iterations << " iterations (|r|: " << last.history << "); " << result.message
+              << std::endl;
+        return StepOutcome::cut_back;
+      }
+
+    // convective phase
+    const auto start = Clock::now();
+    if (dynamic())
+      nodal_acceleration(a_new);
+    transfer::PointFailure failure;
+    transfer::CommitUpdatedLagrangian<dim, shape::Q1Box<dim>> commit(points, space, du, dynamic() ? &a_new : nullptr,
+                                                                     prm.materials, acceleration_offset, h,
+                                                                     newmark.gamma(), failure);
+    transfer::for_each_active_cell(points, commit);
+    if (dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0)
+      throw InstabilityError("the constitutive update of the converged step failed: " +
+                             (failure.failed ? failure.what : std::string("on another rank")));
+    points.relocate();
+    seconds_commit += seconds_since(start);
+    log() << "  step " << step_number + 1 << " t = " << std::setprecision(6) << time + h << ": " << result.iterations
+ << " Newton iterations, |r| " << last.history << ", order (|r|) " << std::setprecision(3)
+          << result.observed_order << ", (|du|) " << last.increment_order << ", " << linear_iterations << " linear iterations (largest |b - A x|/|b| "
+          << worst_linear_residual << ")" << std::endl;
+    return StepOutcome::done;
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::tangent_error(const double h, const double scale, const double eps)
+  {
+    newmark.set_time_step(h);
+    prepare_step();
+    const dealii::Tensor<1, dim> g = load_factor(time + h) * prm.gravity;
+    const auto &                 owned = space.locally_owned_dofs();
+    Vector                       v;
+    space.reinit_vector(v);
+    for (unsigned int k = 0; k < du.locally_owned_size(); ++k)
+      {
+        const auto i = owned.nth_index_in_set(k);
+        // deterministic, rank-independent values from the global index
+        du.local_element(k) = scale * std::sin(1.3 * double(i) + 0.7);
+        v.local_element(k)  = std::cos(2.1 * double(i) + 0.3);
+      }
+    constraints.set_zero(du);
+    constraints.set_zero(v);
+    const Vector u0(du);
+    du.update_ghost_values();
+    assemble(true, g);
+    Vector Kv;
+    space.reinit_vector(Kv);
+    tangent.vmult(Kv, v);
+    Vector r_plus, fd;
+    space.reinit_vector(r_plus);
+    space.reinit_vector(fd);
+    du = u0;
+    du.add(eps, v);
+    du.update_ghost_values();
+    assemble(false, g);
+    r_plus = residual;
+    du = u0;
+    du.add(-eps, v);
+    du.update_ghost_values();
+    assemble(false, g);
+    fd = r_plus;
+    fd.add(-1.0, residual);
+    fd *= 1.0 / (2 * eps);
+    fd.add(-1.0, Kv);
+    constraints.set_zero(fd); // constrained rows hold the matrix's diagonal, not the residual's derivative
+    Vector Kv_free(Kv);
+    constraints.set_zero(Kv_free);
+    du = 0;
+    return fd.l2_norm() / Kv_free.l2_norm();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::check_stability() const
+  {
+    bool bad = false;
+    using L  = PropertyLayout<dim>;
+    for (const auto &pt : points.handler)
+      {
+        const auto P = pt.get_properties();
+        for (unsigned int k = 0; k < L::history; ++k)
+          bad = bad || !std::isfinite(P[k]);
+      }
+    if (dealii::Utilities::MPI::max(bad ? 1 : 0, comm) > 0)
+      throw InstabilityError("a material point holds a non-finite value after step " + std::to_string(step_number));
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::kinetic_energy() const
+  {
+    using L  = PropertyLayout<dim>;
+    double e = 0;
+    for (const auto &pt : points.handler)
+      {
+        const auto P = pt.get_properties();
+        for (unsigned int d = 0; d < dim; ++d)
+          e += 0.5 * P[L::mass] * P[L::velocity + d] * P[L::velocity + d];
+      }
+    return dealii::Utilities::MPI::sum(e, comm);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::describe(std::ostream &out) const
+  {
+    out << "  grid: " << grid.tria.n_global_active_cells() << " cells; " << n_points() << " material points" << std::endl;
+    out << "  analysis: " << (dynamic() ? "dynamic (Newmark gamma = " : "static (")
+        << (dynamic() ? std::to_string(prm.gamma) + ", beta = " + std::to_string(prm.beta) + ", lumped mass" +
+                          (prm.rayleigh_alpha > 0 ? ", Rayleigh alpha = " + std::to_string(prm.rayleigh_alpha) : "")
+                      : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
+        << "), time step " << dt << std::endl;
+    out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
+        << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
+        << " iterations; linear solver "
+        << (prm.linear.method == LinearSolverOptions::Method::direct ? "direct (KLU)" : "CG + ML AMG") << std::endl;
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::begin_stage(const unsigned int, const bool, const bool)
+  {
+    return prm.end_time;
+  }
+
+  template <int dim>
+  std::vector<std::string>
+  Solver<dim>::series_columns() const
+  {
+    std::vector<std::string> c = {"newton_iterations", "residual_first",    "residual_last",
+                                  "newton_order",      "increment_order",   "linear_iterations",
+                                  "load_factor",       "kinetic_energy"};
+    const char *ax[] = {"x", "y", "z"};
+    for (unsigned int d = 0; d < dim; ++d)
+      c.push_back(std::string("centre_of_mass_") + ax[d]);
+    return c;
+  }
+
+  template <int dim>
+  std::vector<double>
+  Solver<dim>::series_values(const bool after_step)
+  {
+    const double        ke = kinetic_energy();
+    std::vector<double> v  = {0, 0, 0, 0, 0, 0, load_factor(time), ke};
+    if (after_step)
+      v = {double(last.iterations), last.residual_first,        last.residual_last, last.observed_order,
+           last.increment_order,    double(last.linear_iterations), load_factor(time), ke};
+    // centre of mass (mass-weighted mean position)
+    std::vector<double> sums(dim + 1, 0.0);
+    for (const auto &pt : points.handler)
+      {
+        const double m = pt.get_properties()[PropertyLayout<dim>::mass];
+        for (unsigned int d = 0; d < dim; ++d)
+          sums[d] += m * pt.get_location()[d];
+        sums[dim] += m;
+      }
+    dealii::Utilities::MPI::sum(sums, comm, sums);
+    for (unsigned int d = 0; d < dim; ++d)
+      v.push_back(sums[d] / sums[dim]);
+    return v;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::write_vtu(const unsigned int counter)
+  {
+    write_point_vtu(points, prm.output_directory, "particles", counter, time, pvd_records, comm);
+  }
+
+  template <int dim>
+  std::string
+  Solver<dim>::write_checkpoint()
+  {
+    throw std::logic_error("talus-implicit: checkpoints are refused when the parameters are read");
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::finish(const std::string &)
+  {
+    if (prm.final_particles_csv)
+      write_final_points_csv(points, prm.output_directory, comm);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::summary(const LoopTimings &t)
+  {
+    log() << "done: " << step_number << " steps, " << n_points() << " particles, wall " << std::setprecision(4)
+          << t.total << " s; Newton iterations " << total_iterations << " (cut-backs " << cut_backs
+          << "), linear iterations " << total_linear_iterations << std::endl;
+    log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
+          << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
+          << std::endl;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::run()
+  {
+    TimeLoop(*this, loop_settings(prm), comm).run();
+  }
+
+  int
+  run(dealii::ParameterHandler &prm, const std::string &)
+  {
+    if (prm.get_integer("dimension") == 2)
+      {
+        const auto p = parse_parameters<2>(prm);
+        Solver<2>  s(p, MPI_COMM_WORLD);
+        s.setup();
+        s.run();
+      }
+    else
+      {
+        const auto p = parse_parameters<3>(prm);
+        Solver<3>  s(p, MPI_COMM_WORLD);
+        s.setup();
+        s.run();
+      }
+    return exit_ok;
+  }
+
+  template struct Parameters<2>;
+  template struct Parameters<3>;
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  template class Solver<2>;
+  template class Solver<3>;
+} // namespace talus::implicit_mpm

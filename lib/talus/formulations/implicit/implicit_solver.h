@@ -1,0 +1,138 @@
+// talus — implicit updated-Lagrangian MPM (seed 001, Iaconeta 2019; Kratos MPM):
+// every step the grid is reset, mass, velocity and acceleration are projected
+// from the points, Newton-Raphson solves the Newmark-discretised momentum
+// balance for the nodal displacement increment, and the converged increment is
+// carried back to the points (Algorithm 1). Static analysis drops the inertia.
+// The time loop (formulations/common/time_loop.h) drives it; a step whose
+// Newton iteration fails is cut back by the loop.
+#pragma once
+
+#include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/scene_parameters.h>
+#include <talus/formulations/implicit/newmark.h>
+#include <talus/formulations/implicit/newton.h>
+#include <talus/grid/background_grid.h>
+#include <talus/grid/nodal_space.h>
+#include <talus/particles/material_point_set.h>
+#include <talus/solvers/linear_solver.h>
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace talus::implicit_mpm
+{
+  /// The .prm of talus-implicit: the shared scene and run sections and the
+  /// subsections 'implicit', 'newton' and 'linear solver'.
+  template <int dim>
+  struct Parameters : SceneParameters<dim>, RunParameters<dim>
+  {
+    enum class Analysis
+    {
+      quasi_static, ///< no inertia; time is a load parameter
+      dynamic       ///< Newmark
+    };
+    Analysis analysis  = Analysis::dynamic;
+    double   time_step = 0; ///< > 0 (required)
+    double   gamma = 0.5, beta = 0.25;
+    double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
+    /// static: body forces grow linearly from 0 at t = 0 to full at the end time
+    bool           ramp_loads = true;
+    NewtonSettings newton;
+    LinearSolverOptions linear;
+  };
+
+  /// Declare the complete .prm of talus-implicit (`prm_file` gives the counts).
+  void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file);
+  /// Read and validate (InputError naming the entry).
+  template <int dim>
+  Parameters<dim> parse_parameters(dealii::ParameterHandler &prm);
+  /// --check: parse and validate everything without building the scene.
+  void check_scene(dealii::ParameterHandler &prm, const std::string &prm_file);
+  /// Run the tool (dispatch on the dimension); returns the exit code.
+  int run(dealii::ParameterHandler &prm, const std::string &prm_file);
+
+  /// Newton figures of the last step (log, series.csv).
+  struct StepReport
+  {
+    unsigned int iterations = 0, linear_iterations = 0;
+    double       residual_first = 0, residual_last = 0, observed_order = 0;
+    double       increment_order = 0; ///< observed order of the increments |du_k|
+    std::string  history; ///< residual norms of the iterations, for the log
+  };
+
+  template <int dim>
+  class Solver : public Formulation
+  {
+  public:
+    Solver(const Parameters<dim> &prm, MPI_Comm comm);
+    ~Solver();
+
+    /// Grid, spaces, points, constraints. Collective.
+    void setup();
+    /// The time loop with output until the end time.
+    void run();
+
+    unsigned long long n_points() const { return points.handler.n_global_particles(); }
+
+    /// For tests: the tangent against central differences of the residual at
+    /// the iterate du = `scale` x a pseudo-random field (constrained DoFs 0), in
+    /// a pseudo-random direction, for a step of size h from the current state:
+    /// |K v - (r(du + eps v) - r(du - eps v)) / (2 eps)| / |K v|. Collective.
+    double tangent_error(const double h, const double scale, const double eps);
+    double             kinetic_energy() const;
+
+    // ---- the Formulation interface
+    std::string              tool_name() const override { return "talus-implicit"; }
+    void                     describe(std::ostream &out) const override;
+    double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
+    StepOutcome              advance_by(const double h) override;
+    void                     check_stability() const override;
+    unsigned long long       lost_points() const override { return points.relocation_stats.lost; }
+    std::vector<std::string> series_columns() const override;
+    std::vector<double>      series_values(const bool after_step) override;
+    void                     write_vtu(const unsigned int counter) override;
+    std::string              write_checkpoint() override;
+    void                     finish(const std::string &series_csv) override;
+    void                     summary(const LoopTimings &timings) override;
+
+    const Parameters<dim> &prm;
+    MPI_Comm               comm;
+    BackgroundGrid<dim>    grid;
+    MaterialPointSet<dim>  points;
+    NodalSpace<dim>        space;
+    ActiveSet<dim>         active;
+    Newmark                newmark;
+    StepReport             last;
+
+  private:
+    bool dynamic() const { return prm.analysis == Parameters<dim>::Analysis::dynamic; }
+    /// The load factor at time t (static with ramp: t / end time; else 1).
+    double load_factor(const double t) const;
+    /// Active set, constraints and matrix layout of the points' current cells.
+    void prepare_step();
+    /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
+    /// (Eqs. 2.6-2.9) onto the active DoFs.
+    void project_to_grid();
+    /// Residual (and tangent) at the iterate du (ghosts up to date); returns |r|.
+    double assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g);
+    /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
+    void nodal_acceleration(Vector &a) const;
+
+    unsigned int                            acceleration_offset = 0;
+    dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
+    std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
+    dealii::TrilinosWrappers::SparseMatrix  tangent;
+    Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
+    double                                  h_step = 0;
+    std::vector<std::pair<double, std::string>> pvd_records;
+    // totals for the summary
+    unsigned long long total_iterations = 0, total_linear_iterations = 0;
+    double             seconds_assembly = 0, seconds_solve = 0, seconds_commit = 0;
+    unsigned int       n_assemblies = 0, n_solves = 0;
+  };
+} // namespace talus::implicit_mpm

@@ -1,0 +1,80 @@
+// The implicit updated-Lagrangian step (formulations/implicit): the assembled
+// tangent must be the derivative of the assembled residual (material +
+// geometric stiffness, lumped inertia), checked against central differences
+// at a deformed iterate, for elastic and plastic finite-strain models, static
+// and dynamic, 2D and 3D, on 1 and 2 ranks.
+#include <talus/formulations/common/time_loop.h>
+#include <talus/formulations/implicit/implicit_solver.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+namespace
+{
+  using namespace talus;
+
+  /// A block of points in a box grid clamped at x = 0, with the given model
+  /// subsection text; parsed exactly as talus-implicit parses its .prm.
+  template <int dim>
+  double
+  tangent_error(const std::string &model, const std::string &analysis, const double scale,
+                const unsigned int steps_before = 0, const double gravity = 9.81)
+  {
+    std::ostringstream prm_text;
+    prm_text << "set dimension = " << dim << "\n"
+             << "subsection time\n set end time = 1\n set time step = 0.5\nend\n"
+             << "subsection implicit\n set analysis = " << analysis << "\nend\n"
+             << "subsection grid\n set lower corner = 0, 0" << (dim == 3 ? ", 0" : "")
+             << "\n set upper corner = 2, 1" << (dim == 3 ? ", 1" : "") << "\n set cells = 4, 2"
+             << (dim == 3 ? ", 2" : "") << "\nend\n"
+             << "subsection boundary conditions\n set fixed = 0\nend\n"
+             << "subsection gravity\n set acceleration = 0, " << (dim == 3 ? "0, " : "") << -gravity << "\nend\n"
+             << "subsection output\n set directory = test_implicit_out\n set progress = false\nend\n"
+             << "set number of materials = 1\nsubsection material 0\n set density = 1000\n"
+             << model << "end\n"
+             << "set number of bodies = 1\nsubsection body 0\n set shape = box\n set lower corner = 0, 0"
+             << (dim == 3 ? ", 0" : "") << "\n set upper corner = 1.6, 0.5" << (dim == 3 ? ", 0.5" : "")
+             << "\n set particles per direction = 2\nend\n";
+    const std::string file = "test_implicit_solver_" + std::to_string(dim) + ".prm";
+    if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      std::ofstream(file) << prm_text.str();
+    MPI_Barrier(MPI_COMM_WORLD);
+    dealii::ParameterHandler prm;
+    implicit_mpm::declare_parameters(prm, file);
+    prm.parse_input(file);
+    const auto                    p = implicit_mpm::parse_parameters<dim>(prm);
+    implicit_mpm::Solver<dim>     s(p, MPI_COMM_WORLD);
+    s.setup();
+    // a deformed, stressed state (b_n != I, points off their seeding positions)
+    TimeLoop(s, loop_settings(p), MPI_COMM_WORLD).advance_steps(steps_before);
+    // central differences: truncation ~ eps^2, round-off ~ 1e-16 |r| / eps
+    const double e = s.tangent_error(0.01, scale, 1e-6);
+    std::printf("tangent error %.3e\n", e);
+    return e;
+  }
+
+  const std::string neo_hookean = " set model = neo hookean\n subsection neo hookean\n  set young modulus = 1e6\n"
+                                  "  set poisson ratio = 0.3\n end\n";
+  const std::string hencky_mc = " set model = hencky mohr coulomb\n subsection hencky mohr coulomb\n"
+                                "  set young modulus = 1e6\n  set poisson ratio = 0.3\n  set cohesion = 1e3\n"
+                                "  set friction angle = 30\n  set dilatancy angle = 5\n end\n";
+  const std::string j2 = " set model = j2 plasticity\n subsection j2 plasticity\n  set young modulus = 1e6\n"
+                         "  set poisson ratio = 0.3\n  set yield stress = 5e3\n  set hardening modulus = 1e4\n end\n";
+
+  // increments of 1e-2 m over 0.25 m cells: strains of a few percent, rotations
+  // of the same order (geometric stiffness matters; plastic models yield)
+  TEST(ImplicitTangent, NeoHookeanStatic2D) { EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2), 1e-6); }
+  TEST(ImplicitTangent, NeoHookeanDynamic2D) { EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2), 1e-6); }
+  TEST(ImplicitTangent, NeoHookeanStatic3D) { EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2), 1e-6); }
+  TEST(ImplicitTangent, HenckyMohrCoulombPlastic2D) { EXPECT_LT(tangent_error<2>(hencky_mc, "static", 1e-2), 1e-5); }
+  TEST(ImplicitTangent, NeoHookeanAfterLoadSteps2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-3, 2, 200.0), 1e-6);
+  }
+  TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
+} // namespace

@@ -1,0 +1,70 @@
+"""Bad input and failing runs of talus-implicit (issue 13): one clear message,
+the right exit code, no NaN written.
+  * input errors (exit 2, one message starting 'talus-implicit: error:' naming
+    the entry, nothing written): a model without a finite-strain form, a zero
+    time step, gamma out of range, nu = 0.5, an entry of a feature not built yet;
+  * Newton that cannot converge (max iterations 1 with a tolerance no single
+    iteration meets): every step is cut back max_cut_backs times, then the run
+    stops with exit 3 and says so; series.csv holds only finite values;
+  * a singular system (static analysis of a body touching no fixed wall): the
+    run stops with exit 3 naming the failed linear solve, no NaN written.
+Usage: check_implicit_bad_input.py TOOLS_DIR PRM WORKDIR
+"""
+import math
+import os
+import shutil
+import sys
+
+import talus_verify as tv
+
+tools, prm_path, work = sys.argv[1:4]
+tool = f"{tools}/talus-implicit"
+shutil.rmtree(work, ignore_errors=True)
+base = tv.prm_set(open(prm_path).read(), "output/directory", "must_not_exist")
+cases = {
+    "no finite-strain form": (tv.prm_set(base, "material 0/model", "linear elastic"),
+                              ["material 0/model", "linear elastic", "finite-strain", "neo hookean"]),
+    "zero time step": (tv.prm_set(base, "time/time step", "0"), ["time/time step", "> 0"]),
+    "gamma out of range": (tv.prm_set(base, "implicit/newmark gamma", "0.4"), ["newmark gamma", "0.4"]),
+    "incompressible": (tv.prm_set(base, "material 0/neo hookean/poisson ratio", "0.5"), ["poisson ratio", "0.5"]),
+    "feature not built yet": (tv.prm_set(base, "checkpoint/interval", "0.1"), ["checkpoint/interval", "not available"]),
+    "damping in a static run": (tv.prm_set(base, "implicit/rayleigh alpha", "1"), ["rayleigh alpha", "dynamic"]),
+    "static without supports": (tv.prm_set(base, "boundary conditions/fixed", ""), ["boundary conditions", "static",
+                                                                                   "singular"]),
+}
+for name, (text, needles) in cases.items():
+    rc, out, err = tv.run_tool(tool, text, work, name.replace(" ", "_"), expect_rc=None)
+    msg = err.strip()
+    ok = rc == 2 and all(n in msg for n in needles) and msg.count("\n") < 6 and msg.startswith("talus-implicit: error:")
+    tv.check(ok, f"{name}: exit {rc}, message: {msg[:300]}")
+tv.check(not os.path.exists(os.path.join(work, "must_not_exist")), "input errors wrote nothing")
+
+
+def finite_series(path):
+    s = tv.read_csv(path)
+    return all(math.isfinite(v) for col in s.values() for v in col), len(s["time"])
+
+
+# Newton that cannot converge: exit 3 after the cut-backs, finite series
+text = tv.prm_set(base, "output/directory", "newton")
+text = tv.prm_set(text, "newton/max iterations", "1")
+text = tv.prm_set(text, "newton/residual relative", "1e-14")
+text = tv.prm_set(text, "newton/residual absolute", "0")
+rc, out, err = tv.run_tool(tool, text, work, "newton_fails", expect_rc=None)
+tv.check(rc == 3, f"Newton failure: exit {rc} (expected 3)")
+tv.check("cut back" in (out + err) and "max iterations" in (out + err), "the log reports the cut-backs and why")
+ok, rows = finite_series(f"{work}/newton/series.csv")
+tv.check(ok, f"Newton failure: series.csv ({rows} rows) holds only finite values")
+
+# singular system: the only support is a roller on the right wall, which the body
+# does not touch -> the tangent has rigid-body modes
+text = tv.prm_set(base, "output/directory", "out_s")
+text = tv.prm_set(text, "boundary conditions/fixed", "")
+text = tv.prm_set(text, "boundary conditions/roller", "1")
+rc, out, err = tv.run_tool(tool, text, work, "singular", expect_rc=None)
+tv.check(rc == 3, f"singular system: exit {rc} (expected 3)")
+tv.check("linear system is singular" in (out + err) and "boundary conditions" in (out + err),
+         f"singular system: the log names the failed solve: {(out + err)[-400:]}")
+ok, rows = finite_series(f"{work}/out_s/series.csv")
+tv.check(ok, f"singular system: series.csv ({rows} rows) holds only finite values")
+tv.finish()

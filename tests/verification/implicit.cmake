@@ -1,0 +1,43 @@
+# The implicit updated-Lagrangian family (talus-implicit, issue 13). Label "fast"
+# for the CI subset, "verify" for the full versions (make verify).
+set(_v ${CMAKE_CURRENT_SOURCE_DIR}/verification)
+set(_w ${CMAKE_BINARY_DIR}/tests/verification)
+set(_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1;PYTHONPATH=${_v}")
+
+# static cantilever under self-weight (seed 001 §4.5.1): quadratic Newton, tip
+# deflection vs the thesis, observed order over three grids
+add_test(NAME verification.implicit_cantilever
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cantilever.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_cantilever 0.005 0.5 0.25 0.125 0.0625)
+set_tests_properties(verification.implicit_cantilever PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+add_test(NAME verification.implicit_cantilever_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cantilever.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_cantilever_full 0.0005
+                 0.5 0.25 0.125 0.0625 0.03125)
+set_tests_properties(verification.implicit_cantilever_full PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 3600)
+
+# 1 vs 2 ranks: the cantilever (static) and the bar (dynamic)
+add_test(NAME verification.implicit_ranks_cantilever
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_ranks_cantilever
+                 "grid/cells=34, 10")
+set_tests_properties(verification.implicit_ranks_cantilever PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)
+add_test(NAME verification.implicit_ranks_bar
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${_w}/implicit_ranks_bar)
+set_tests_properties(verification.implicit_ranks_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)
+
+# dynamic: first axial mode of an elastic bar at 10 x the explicit critical step:
+# period = the exact period stretched by the trapezoidal rule, energy conserved
+add_test(NAME verification.implicit_bar_vibration
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bar.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${_w}/implicit_bar_vibration)
+set_tests_properties(verification.implicit_bar_vibration PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# bad input, Newton failure, singular system: messages, exit codes, no NaN
+add_test(NAME verification.implicit_bad_input
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bad_input.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_bad_input)
+set_tests_properties(verification.implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
