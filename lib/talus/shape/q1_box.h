@@ -129,6 +129,12 @@ namespace talus::shape
     {
       double lm[n_nodes]            = {};
       double T[dim][F::npairs][dim] = {};
+      /// zero the sums (a new cell)
+      inline void
+      clear()
+      {
+        *this = MassForce();
+      }
       /// one point: mass m, t = -V sigma
       inline void
       add(const Eval &e, const double m, const double (&t)[dim][dim])
@@ -174,6 +180,11 @@ namespace talus::shape
     struct Momentum
     {
       double lp[n_nodes][dim] = {};
+      inline void
+      clear()
+      {
+        *this = Momentum();
+      }
       template <class E>
       inline void
       add(const E &e, const double m, const double *vel)

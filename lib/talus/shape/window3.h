@@ -145,6 +145,17 @@ namespace talus::shape
     static inline void
     interpolate(const Eval &e, const double (&u)[n_nodes][nc], double (&val)[nc], double (&grad)[nc][dim])
     {
+      interpolate_strided<nc, 3, 9>(e, u, val, grad);
+    }
+
+    /// interpolate() on nodal values whose window lines (direction 0) start S1
+    /// apart and planes S2 apart: 3, 9 for a window array; 4, 16 for a 4^dim patch
+    /// read from the window's first slot (the kernels contract the patch in place
+    /// instead of copying the window out first). Same arithmetic for any strides.
+    template <unsigned int nc, unsigned int S1, unsigned int S2>
+    static inline void
+    interpolate_strided(const Eval &e, const double (*u)[nc], double (&val)[nc], double (&grad)[nc][dim])
+    {
       if constexpr (dim == 1)
         {
           for (unsigned int c = 0; c < nc; ++c)
@@ -158,11 +169,14 @@ namespace talus::shape
           // along direction 0 for each of the 3 lines b: value and x-derivative
           double v0[3][nc], d0[3][nc];
           for (unsigned int b = 0; b < 3; ++b)
-            for (unsigned int c = 0; c < nc; ++c)
-              {
-                v0[b][c] = e.N[0][0] * u[3 * b][c] + e.N[0][1] * u[3 * b + 1][c] + e.N[0][2] * u[3 * b + 2][c];
-                d0[b][c] = e.dN[0][0] * u[3 * b][c] + e.dN[0][1] * u[3 * b + 1][c] + e.dN[0][2] * u[3 * b + 2][c];
-              }
+            {
+              const double(*r)[nc] = u + S1 * b;
+              for (unsigned int c = 0; c < nc; ++c)
+                {
+                  v0[b][c] = e.N[0][0] * r[0][c] + e.N[0][1] * r[1][c] + e.N[0][2] * r[2][c];
+                  d0[b][c] = e.dN[0][0] * r[0][c] + e.dN[0][1] * r[1][c] + e.dN[0][2] * r[2][c];
+                }
+            }
           for (unsigned int c = 0; c < nc; ++c)
             {
               val[c]     = e.N[1][0] * v0[0][c] + e.N[1][1] * v0[1][c] + e.N[1][2] * v0[2][c];
@@ -172,14 +186,17 @@ namespace talus::shape
         }
       else
         {
-          // direction 0 over the 9 lines (b, c'), then direction 1 over the 3 planes
+          // direction 0 over the 9 lines l = b + 3 c', then direction 1 over the 3 planes
           double v0[9][nc], d0[9][nc];
           for (unsigned int l = 0; l < 9; ++l)
-            for (unsigned int c = 0; c < nc; ++c)
-              {
-                v0[l][c] = e.N[0][0] * u[3 * l][c] + e.N[0][1] * u[3 * l + 1][c] + e.N[0][2] * u[3 * l + 2][c];
-                d0[l][c] = e.dN[0][0] * u[3 * l][c] + e.dN[0][1] * u[3 * l + 1][c] + e.dN[0][2] * u[3 * l + 2][c];
-              }
+            {
+              const double(*r)[nc] = u + S1 * (l % 3) + S2 * (l / 3);
+              for (unsigned int c = 0; c < nc; ++c)
+                {
+                  v0[l][c] = e.N[0][0] * r[0][c] + e.N[0][1] * r[1][c] + e.N[0][2] * r[2][c];
+                  d0[l][c] = e.dN[0][0] * r[0][c] + e.dN[0][1] * r[1][c] + e.dN[0][2] * r[2][c];
+                }
+            }
           double v1[3][nc], dx1[3][nc], dy1[3][nc];
           for (unsigned int p = 0; p < 3; ++p)
             for (unsigned int c = 0; c < nc; ++c)
@@ -197,6 +214,92 @@ namespace talus::shape
               grad[c][2] = e.dN[2][0] * v1[0][c] + e.dN[2][1] * v1[1][c] + e.dN[2][2] * v1[2][c];
             }
         }
+    }
+
+    /// The value part of interpolate_strided() alone (direction by direction:
+    /// sums of 3 terms, where a node-by-node sum chains 3^dim dependent additions).
+    template <unsigned int nc, unsigned int S1, unsigned int S2>
+    static inline void
+    interpolate_value_strided(const Eval &e, const double (*u)[nc], double (&val)[nc])
+    {
+      auto along0 = [&](const double(*r)[nc], const unsigned int c) {
+        return e.N[0][0] * r[0][c] + e.N[0][1] * r[1][c] + e.N[0][2] * r[2][c];
+      };
+      if constexpr (dim == 1)
+        for (unsigned int c = 0; c < nc; ++c)
+          val[c] = along0(u, c);
+      else if constexpr (dim == 2)
+        for (unsigned int c = 0; c < nc; ++c)
+          val[c] = e.N[1][0] * along0(u, c) + e.N[1][1] * along0(u + S1, c) + e.N[1][2] * along0(u + 2 * S1, c);
+      else
+        for (unsigned int c = 0; c < nc; ++c)
+          {
+            double v1[3];
+            for (unsigned int p = 0; p < 3; ++p)
+              {
+                const double(*r)[nc] = u + S2 * p;
+                v1[p] = e.N[1][0] * along0(r, c) + e.N[1][1] * along0(r + S1, c) + e.N[1][2] * along0(r + 2 * S1, c);
+              }
+            val[c] = e.N[2][0] * v1[0] + e.N[2][1] * v1[1] + e.N[2][2] * v1[2];
+          }
+    }
+
+    /// Calls f(o, N_w, G_w) for the window nodes w in order (a fastest): o is the
+    /// node's patch slot relative to the window's first slot (patch strides 4, 16),
+    /// N_w and G_w (real-space gradient) the same products as values_and_gradients().
+    /// Explicit loops over the digits, so that no slot or digit is computed by
+    /// division at run time (the w-indexed loops were not unrolled by gcc -O2).
+    template <class F>
+    static inline void
+    for_each_window_node(const Eval &e, F &&f)
+    {
+      if constexpr (dim == 1)
+        for (unsigned int a = 0; a < 3; ++a)
+          {
+            const double g[1] = {e.dN[0][a]};
+            f(a, e.N[0][a], g);
+          }
+      else if constexpr (dim == 2)
+        for (unsigned int b = 0; b < 3; ++b)
+          for (unsigned int a = 0; a < 3; ++a)
+            {
+              const double g[2] = {e.dN[0][a] * e.N[1][b], e.N[0][a] * e.dN[1][b]};
+              f(a + 4 * b, e.N[0][a] * e.N[1][b], g);
+            }
+      else
+        for (unsigned int c = 0; c < 3; ++c)
+          for (unsigned int b = 0; b < 3; ++b)
+            {
+              const double nbc = e.N[1][b] * e.N[2][c], dbc = e.dN[1][b] * e.N[2][c],
+                           nbd = e.N[1][b] * e.dN[2][c];
+              for (unsigned int a = 0; a < 3; ++a)
+                {
+                  const double g[3] = {e.dN[0][a] * nbc, e.N[0][a] * dbc, e.N[0][a] * nbd};
+                  f(a + 4 * b + 16 * c, e.N[0][a] * nbc, g);
+                }
+            }
+    }
+
+    /// The same with values only (f(o, N_w); no gradient products).
+    template <class F>
+    static inline void
+    for_each_window_value(const Eval &e, F &&f)
+    {
+      if constexpr (dim == 1)
+        for (unsigned int a = 0; a < 3; ++a)
+          f(a, e.N[0][a]);
+      else if constexpr (dim == 2)
+        for (unsigned int b = 0; b < 3; ++b)
+          for (unsigned int a = 0; a < 3; ++a)
+            f(a + 4 * b, e.N[0][a] * e.N[1][b]);
+      else
+        for (unsigned int c = 0; c < 3; ++c)
+          for (unsigned int b = 0; b < 3; ++b)
+            {
+              const double nbc = e.N[1][b] * e.N[2][c];
+              for (unsigned int a = 0; a < 3; ++a)
+                f(a + 4 * b + 16 * c, e.N[0][a] * nbc);
+            }
     }
   };
 } // namespace talus::shape

@@ -36,7 +36,7 @@ namespace talus::transfer
     begin_cell(const unsigned int c)
     {
       cell = K::cell(grid, c);
-      sums = typename K::MassForce();
+      sums.clear();
     }
     /// one point with properties P at reference location xi
     inline void
@@ -107,7 +107,7 @@ namespace talus::transfer
     {
       cell = K::cell(grid, c);
       K::gather(cell, A, 1.0, a, false);
-      sums = typename K::Momentum();
+      sums.clear();
     }
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
@@ -151,7 +151,7 @@ namespace talus::transfer
     begin_cell(const unsigned int c)
     {
       cell = K::cell(grid, c);
-      sums = typename K::Momentum();
+      sums.clear();
     }
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
