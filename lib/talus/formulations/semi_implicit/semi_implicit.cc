@@ -73,6 +73,17 @@ namespace talus::semi_implicit
       prm.declare_entry("pressure solver tolerance", "1e-10", Double(0, 1e-2),
                         "Relative residual |b - A x| / |b| at which CG + ML AMG stops on the pressure-"
                         "increment Poisson equation.");
+      prm.declare_entry("pressure smoothing", "linear", Selection("linear|mass weighted|none"),
+                        "mass weighted: the water points' pore pressure is replaced by the mass-weighted "
+                        "map and remap through the nodes at every step (Eq. 77); it is biased by O(h grad p) "
+                        "where a node's support is cut by a wall or the free surface. linear: the same map "
+                        "with each point's value carried to the node by its pressure gradient, "
+                        "p_I = sum N m (p + grad p . (x_I - x_p)) / sum N m, exact for linear fields "
+                        "(docs/semi-implicit.md). none: the pressure changes only by the interpolated "
+                        "increments (p += sum N dp).");
+      prm.declare_entry("flip fraction", "1", Double(0, 1),
+                        "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
+                        "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
       prm.declare_entry("kozeny carman", "false", Bool(),
                         "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
                         "(Alg. 8(g)); false: k stays k0.");
@@ -130,6 +141,9 @@ namespace talus::semi_implicit
     p.free_surface_fraction = prm.get_double("free surface volume fraction");
     p.pressure_tolerance    = prm.get_double("pressure solver tolerance");
     p.kozeny_carman         = prm.get_bool("kozeny carman");
+    p.pressure_smoothing    = prm.get("pressure smoothing") != "none";
+    p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
+    p.flip_fraction         = prm.get_double("flip fraction");
     require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
     require(p.unit_weight_gravity > 0, "semi implicit/unit weight gravity", "must be > 0 m/s^2");
     require(p.free_surface_fraction > 0 && p.free_surface_fraction < 1, "semi implicit/free surface volume fraction",
@@ -206,6 +220,7 @@ namespace talus::semi_implicit
     struct Fields
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
+      unsigned int pressure_gradient = 0;
       unsigned int poisson_coefficient = 0, poisson_source = 0;
     };
 
@@ -280,10 +295,12 @@ namespace talus::semi_implicit
     // per grid local DoF: the node's component-0 DoF, component, prescribed zero
     std::vector<unsigned int>  node_of;
     std::vector<unsigned char> component, constrained;
+    std::vector<dealii::Point<dim>> node_x; // position of the node of a local DoF
     // nodal fields (grid vectors; scalars at the component-0 DoF)
     Vector Ms, Ps, Mn, Mk, Fs;          // soil mass, momentum, sum m n, sum m k, force (internal + gravity)
     Vector Ww, Pw0, Ww0, Mwp, Mw;       // sum N rho_w V, sum N rho_w V0 v, sum N rho_w V0, sum N m p, sum N m
     Vector Fp;                          // -sum V p grad N (pore pressure force on the mixture)
+    Vector Mwg;                         // sum N m grad p (linear pressure map)
     Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
     Vector p_node, dp_node, gs, gw, wet, dry;
@@ -321,6 +338,7 @@ namespace talus::semi_implicit
     const unsigned int nl = n_local();
     node_of.assign(nl, 0);
     component.assign(nl, 0);
+    node_x.assign(nl, dealii::Point<dim>());
     for (const auto &cc : grid.cells)
       for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
         for (unsigned int d = 0; d < dim; ++d)
@@ -330,9 +348,11 @@ namespace talus::semi_implicit
               {
                 node_of[i]   = cc.dofs[v * dim];
                 component[i] = d;
+                for (unsigned int e = 0; e < dim; ++e) // vertex v: bit e set = upper side in direction e
+                  node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
               }
           }
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &n_node, &Q_node, &Mw_node, &vs_t,
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
                       &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry})
       grid.reinit_vector(*v);
 
@@ -348,6 +368,7 @@ namespace talus::semi_implicit
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_source              = soil.layout.add_extra("poisson_source", 1);
     fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
+    fw.pressure_gradient           = water.layout.add_extra("pore_pressure_gradient", dim, true);
     fw.porosity                    = water.layout.add_extra("porosity", 1);
     fw.initial_porosity            = water.layout.add_extra("initial_porosity", 1);
     fw.initial_volume              = water.layout.add_extra("initial_volume", 1);
@@ -414,6 +435,8 @@ namespace talus::semi_implicit
               {
                 P[L::mass]     = n0 * prm.water_density * V0; // Eq. 37
                 P[f.pressure]  = 0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  P[f.pressure_gradient + d] = 0;
               }
           }
         set.collect_active_cells();
@@ -430,6 +453,7 @@ namespace talus::semi_implicit
         auto         P = pt.get_properties();
         const double y = pt.get_location()[dim - 1];
         P[fw.pressure] = -prm.water_density * g * std::max(0.0, prm.water_level - y);
+        P[fw.pressure_gradient + dim - 1] = y < prm.water_level ? prm.water_density * g : 0.0;
       }
     for (auto &pt : soil.handler)
       {
@@ -475,7 +499,7 @@ namespace talus::semi_implicit
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
 
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &gs, &gw, &wet, &dry})
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry})
       *v = 0;
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
@@ -525,7 +549,8 @@ namespace talus::semi_implicit
     cell_water_volume.assign(grid.cells.size(), 0.0);
     {
       const double *nn = at(n_node);
-      double *      ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw);
+      double *      ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw), *mwg = at(Mwg);
+      const bool    linear = prm.linear_smoothing;
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int c, It &it, const Stencil &s) {
         double *     P  = it->get_properties().data();
         const double n  = std::clamp(s.value(nn), 1e-6, 1.0);
@@ -535,12 +560,25 @@ namespace talus::semi_implicit
         s.scatter(ww, rw * P[L::volume]);
         s.scatter_vector(pw0, rw * V0, P + L::velocity);
         s.scatter(ww0, rw * V0);
-        s.scatter(mwp, P[L::mass] * P[fw.pressure]);
+        if (linear) // sum N m (p - grad p . x_p); the node adds (sum N m grad p) . x_I
+          {
+            const auto x  = it->get_location();
+            double     px = P[fw.pressure];
+            for (unsigned int d = 0; d < dim; ++d)
+              px -= P[fw.pressure_gradient + d] * x[d];
+            s.scatter(mwp, P[L::mass] * px);
+            s.scatter_vector(mwg, P[L::mass], P + fw.pressure_gradient);
+          }
+        else
+          s.scatter(mwp, P[L::mass] * P[fw.pressure]);
         s.scatter(mw, P[L::mass]);
         cell_water_volume[c] += P[L::volume];
       });
     }
-    exchange({&Ww, &Pw0, &Ww0, &Mwp, &Mw});
+    exchange({&Ww, &Pw0, &Ww0, &Mwp, &Mw, &Mwg});
+    if (prm.linear_smoothing) // the node's share (sum N m grad p) . x_I, component by component
+      for (unsigned int i = 0; i < nl; ++i)
+        Mwp.local_element(node_of[i]) += Mwg.local_element(i) * node_x[i][component[i]];
     double mw_max = 0;
     for (unsigned int i = 0; i < nl; ++i)
       mw_max = std::max(mw_max, Mw.local_element(i));
@@ -569,8 +607,9 @@ namespace talus::semi_implicit
       double *      fp = at(Fp);
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
         double *     P = it->get_properties().data();
-        const double p = s.value(pn);
-        P[fw.pressure] = p;
+        if (prm.pressure_smoothing)
+          P[fw.pressure] = s.value(pn);
+        const double p = P[fw.pressure];
         double t[dim][dim] = {};
         for (unsigned int d = 0; d < dim; ++d)
           t[d][d] = -P[L::volume] * p;
@@ -644,7 +683,7 @@ namespace talus::semi_implicit
           if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
             continue;
           const bool has_water = Mw.local_element(i) > mw_cut;
-          const bool surface   = wet.local_element(i) > 0 && dry.local_element(i) > 0;
+          const bool surface   = dry.local_element(i) > 0;
           if (!has_water || surface)
             {
               // p^{t+1} = 0 on the surface (Delta p = -p^t); no water: Delta p = 0 (A2, A4)
@@ -714,15 +753,13 @@ namespace talus::semi_implicit
         vw_new.local_element(i) = vw;
         vs_new.local_element(i) = vs;
       }
-    for (unsigned int i = 0; i < nl; ++i)
-      if (component[i] == 0)
-        p_node.local_element(i) += dp_node.local_element(i); // (7c)
 
     // (7) FLIP velocities of both sets, pore pressure to the water points;
     // (8a) MUSL: the soil's new momentum to the nodes (Ps reused)
     Ps = 0;
     {
-      const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *pn = at(p_node);
+      const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *dpn = at(dp_node), *pn = at(p_node);
+      const double  flip = prm.flip_fraction;
       double *      ps = at(Ps);
       transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
         double *P = it->get_properties().data();
@@ -730,7 +767,7 @@ namespace talus::semi_implicit
         s.vector_value(vsn, a);
         s.vector_value(vst, b);
         for (unsigned int d = 0; d < dim; ++d)
-          P[L::velocity + d] += a[d] - b[d];
+          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
         s.scatter_vector(ps, P[L::mass], P + L::velocity);
       });
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
@@ -739,8 +776,14 @@ namespace talus::semi_implicit
         s.vector_value(vwn, a);
         s.vector_value(vwt, b);
         for (unsigned int d = 0; d < dim; ++d)
-          P[L::velocity + d] += a[d] - b[d];
-        P[fw.pressure] = s.value(pn);
+          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+        P[fw.pressure] += s.value(dpn); // (7c) as an increment: p_I^t + dp_I interpolated differs by the remap
+        double gp[dim], gdp[dim];
+        s.gradient(pn, gp);
+        s.gradient(dpn, gdp);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fw.pressure_gradient + d] = gp[d] + gdp[d];
+
       });
     }
     exchange({&Ps});

@@ -47,6 +47,9 @@ namespace talus::semi_implicit
     double free_surface_fraction    = 0.5;   ///< a cell is wet when its water volume / cell volume >= this
     double pressure_tolerance       = 1e-10; ///< CG relative residual of the Poisson solve
     bool   kozeny_carman            = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
+    bool   pressure_smoothing       = true;  ///< Eq. 77 map-remap of the pore pressure every step
+    bool   linear_smoothing         = true;  ///< the map carries each point's value by its gradient
+    double flip_fraction            = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
     // 'initial state' subsection: geostatic water pressure and effective stress
     bool   geostatic    = false;
     double water_level  = 0; ///< vertical coordinate of the free water surface
