@@ -12,3 +12,16 @@ add_test(NAME verification.semi_implicit_hydrostatic
                  ${TALUS_TOOLS_DIR}/talus-critical-dt
                  ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic_explicit.prm)
 set_tests_properties(verification.semi_implicit_hydrostatic PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# bad input: exit 2, the entry named, nothing written
+add_test(NAME verification.semi_implicit_bad_input
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_bad_input.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_bad_input)
+set_tests_properties(verification.semi_implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# self-weight consolidation against Terzaghi's series (triangular initial excess
+# pressure) at T_v = 0.05, 0.1, 0.2, 0.5: relative L2 error < 3 %
+add_test(NAME verification.semi_implicit_consolidation
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation 0.03)
+set_tests_properties(verification.semi_implicit_consolidation PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

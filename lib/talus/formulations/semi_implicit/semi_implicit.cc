@@ -185,9 +185,14 @@ namespace talus::semi_implicit
         require(p.bodies[k].shape != BodyDescription<dim>::Shape::file, "body " + std::to_string(k) + "/shape",
                 "file bodies are not available in talus-semi-implicit yet; allowed: box, ball, polygon");
       }
-    require(any_soil && any_water, "body k/phase",
-            "the scene needs soil and water points: at least one body with phase saturated, or a soil and a "
-            "water body");
+    std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
+                (p.phase_of_body[k] == Phase::soil ? "soil" : p.phase_of_body[k] == Phase::water ? "water" : "saturated");
+    require(any_soil && any_water, phases,
+            std::string("the scene has no ") + (any_soil ? "water" : "soil") +
+              " points (the drag and the mixture need both): give a body phase = saturated, or add a " +
+              (any_soil ? "water" : "soil") + " body");
     require(p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
               p.restart == RunParameters<dim>::Restart::no,
             "checkpoint", "checkpoints and restarts are not available in talus-semi-implicit yet; use interval = 0, "
