@@ -25,3 +25,10 @@ add_test(NAME verification.semi_implicit_consolidation
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation 0.03)
 set_tests_properties(verification.semi_implicit_consolidation PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# 1 vs 2 ranks on the consolidation column to 1e-8
+add_test(NAME verification.semi_implicit_np1_np2
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_ranks.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_np1_np2)
+set_tests_properties(verification.semi_implicit_np1_np2 PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)

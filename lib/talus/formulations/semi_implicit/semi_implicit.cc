@@ -414,11 +414,13 @@ namespace talus::semi_implicit
     node_of.assign(nl, 0);
     component.assign(nl, 0);
     node_x.assign(nl, dealii::Point<dim>());
-    for (const auto &cc : grid.cells)
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cell_iterators[c] != grid.tria.end()) // artificial cells carry no DoFs (their cache is zero)
       for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
         for (unsigned int d = 0; d < dim; ++d)
           {
-            const unsigned int i = cc.dofs[v * dim + d];
+            const auto &       cc = grid.cells[c];
+            const unsigned int i  = cc.dofs[v * dim + d];
             if (i < nl)
               {
                 node_of[i]   = cc.dofs[v * dim];
