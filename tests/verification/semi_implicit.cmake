@@ -32,3 +32,15 @@ add_test(NAME verification.semi_implicit_np1_np2
                  ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_np1_np2)
 set_tests_properties(verification.semi_implicit_np1_np2 PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
                      PROCESSORS 2)
+
+# the paper's Terzaghi case (§5.1, Table 1): normalised L2 error < 3 % at
+# T_v = 0.05, 0.1, 0.2 (fast) and 0.05 ... 1.0 (verify)
+add_test(NAME verification.semi_implicit_terzaghi_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_fast)
+set_tests_properties(verification.semi_implicit_terzaghi_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+add_test(NAME verification.semi_implicit_terzaghi
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi
+                 0.05,0.1,0.2,0.5,1.0)
+set_tests_properties(verification.semi_implicit_terzaghi PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)

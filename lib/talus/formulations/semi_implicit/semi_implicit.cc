@@ -114,6 +114,11 @@ namespace talus::semi_implicit
     for (unsigned int k = 0; k < counts.n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
+        prm.declare_entry("surface load", "0", Double(-1e300, 1e300),
+                          "A uniform vertical pressure q [Pa] (>= 0, pushing down) on the upper face of a box "
+                          "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
+                          "soil points carries it, each point the force q V_p / (h / particles per direction), "
+                          "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
         prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
                           "saturated: soil and water points over the region (the material is the soil's); "
                           "soil: soil points only; water: water points only (density 'semi implicit/water "
@@ -247,8 +252,16 @@ namespace talus::semi_implicit
       {
         prm.enter_subsection("body " + std::to_string(k));
         const std::string ph = prm.get("phase");
+        p.surface_load.push_back(prm.get_double("surface load"));
         prm.leave_subsection();
         p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
+        std::ostringstream q;
+        q << p.surface_load.back();
+        require(std::isfinite(p.surface_load.back()) && p.surface_load.back() >= 0, "body " + std::to_string(k) + "/surface load",
+                "is " + q.str() + "; must be a pressure >= 0 Pa");
+        require(p.surface_load.back() == 0 || (p.phase_of_body.back() != Phase::water &&
+                                                p.bodies[k].shape == BodyDescription<dim>::Shape::box),
+                "body " + std::to_string(k) + "/surface load", "needs a box body with soil points (phase saturated or soil)");
         any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
         any_water = any_water || p.phase_of_body.back() != Phase::soil;
         require(p.bodies[k].shape != BodyDescription<dim>::Shape::file, "body " + std::to_string(k) + "/shape",
@@ -295,7 +308,7 @@ namespace talus::semi_implicit
     struct Fields
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
-      unsigned int pressure_gradient = 0;
+      unsigned int pressure_gradient = 0, surface_force = 0;
       unsigned int poisson_coefficient = 0, poisson_source = 0;
     };
 
@@ -442,6 +455,7 @@ namespace talus::semi_implicit
     fs.initial_porosity            = soil.layout.add_extra("initial_porosity", 1);
     fs.initial_volume              = soil.layout.add_extra("initial_volume", 1);
     fs.conductivity                = soil.layout.add_extra("conductivity", 1);
+    fs.surface_force               = soil.layout.add_extra("surface_force", 1);
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_source              = soil.layout.add_extra("poisson_source", 1);
     fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
@@ -507,6 +521,11 @@ namespace talus::semi_implicit
               {
                 P[L::mass]          = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
                 P[f.conductivity]   = prm.soil_of_material[m].conductivity;
+                // the body's top layer of points carries its surface load
+                const double q  = prm.surface_load[b];
+                const double hy = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
+                const double dy = hy / prm.bodies[b].particles_per_direction;
+                P[f.surface_force] = q > 0 && pt.get_location()[dim - 1] > prm.bodies[b].upper[dim - 1] - dy ? q * V0 / dy : 0.0;
               }
             else
               {
@@ -598,6 +617,12 @@ namespace talus::semi_implicit
         double t[dim][dim];
         minus_V_sigma<dim>(P, P[L::volume], t);
         s.scatter_divergence(fsv, t);
+        if (P[fs.surface_force] != 0)
+          {
+            double f[dim] = {};
+            f[dim - 1]    = -P[fs.surface_force];
+            s.scatter_vector(fsv, 1.0, f);
+          }
       });
     }
     exchange({&Ms, &Ps, &Mn, &Mk, &Fs});

@@ -38,6 +38,7 @@ namespace talus::semi_implicit
   {
     std::vector<Phase>    phase_of_body;
     std::vector<SoilData> soil_of_material;
+    std::vector<double>   surface_load; ///< per body: q [Pa] on its upper face
     // time step: fixed, or courant x the soil skeleton's critical step
     double time_step = 0, courant = 0.5;
     // 'semi implicit' subsection
