@@ -11,7 +11,7 @@ the depth, gamma' = (1-n)(rho_s - rho_w) g, zeta = d / H, M = pi (2m+1) / 2:
 Per T in {0.05, 0.1, 0.2, 0.5} one run to t = T H^2 / c_v with ~3e-4 s steps;
 the relative L2 error over the water points sqrt(sum (u - u_an)^2 / sum u_an^2)
 must be below TOL (argument, default 0.03: the 3 % of issue 14).
-Usage: check_semi_consolidation.py TOOL PRM WORKDIR [TOL] [T,T,...]
+Usage: check_semi_consolidation.py TOOL PRM WORKDIR [TOL] [T,T,...] [quadratic bspline|linear]
 """
 import math
 import sys
@@ -21,6 +21,7 @@ import talus_verify as tv
 tool, prm_path, work = sys.argv[1:4]
 tol = float(sys.argv[4]) if len(sys.argv) > 4 else 0.03
 times = [float(x) for x in sys.argv[5].split(",")] if len(sys.argv) > 5 else [0.05, 0.1, 0.2, 0.5]
+kernel = sys.argv[6] if len(sys.argv) > 6 else None
 g, H, n, rs, rw, E, k = 9.81, 1.0, 0.3, 2650.0, 1000.0, 1e7, 1e-3
 gamma = (1 - n) * (rs - rw) * g
 cv = k * E / (rw * g)
@@ -35,6 +36,8 @@ def analytic(zeta, T):
 
 
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+if kernel:
+    base = tv.prm_set(base, "semi implicit/shape function", kernel)
 for T in times:
     t_end = T * H * H / cv
     n_steps = max(1, round(t_end / 3e-4))

@@ -44,3 +44,9 @@ add_test(NAME verification.semi_implicit_terzaghi
                  ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi
                  0.05,0.1,0.2,0.5,1.0)
 set_tests_properties(verification.semi_implicit_terzaghi PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+# the same with linear shape functions
+add_test(NAME verification.semi_implicit_consolidation_linear
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation_linear
+                 0.03 0.05,0.1,0.2,0.5 linear)
+set_tests_properties(verification.semi_implicit_consolidation_linear PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
