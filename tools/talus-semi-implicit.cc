@@ -12,7 +12,7 @@ main(int argc, char **argv)
                  "López-Querol 2025): soil and water as two sets of material points on one grid, an\n"
                  "incremental fractional step with implicit Darcy drag and one pressure-increment Poisson\n"
                  "solve per step (CG + ML AMG), quadratic B-splines (or linear). The time step is limited\n"
-                 "by the soil skeleton only. Writes soil_*.pvtu / water_*.pvtu, series.csv and, with\n"
+                 "by the soil skeleton only. Writes soil.pvd / water.pvd (+ PVTU/VTU), series.csv and, with\n"
                  "'output/final particles csv', soil_final.csv and water_final.csv.";
   tool.declare = &talus::semi_implicit::declare_parameters;
   tool.check   = &talus::semi_implicit::check_parameters;

@@ -393,6 +393,7 @@ namespace talus::semi_implicit
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
     Vector p_node, dp_node, gs, gw, wet, dry;
     std::vector<double> cell_water_volume;
+    std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
 
     // diagnostics
     LinearSolveInfo    last_solve;
@@ -1044,7 +1045,11 @@ namespace talus::semi_implicit
         MaterialPointSet<dim> &set = is_soil ? soil : water;
         dealii::Particles::DataOut<dim> out;
         out.build_patches(set.handler, set.layout.names(), set.layout.interpretations());
-        io::write_vtu_atomic(out, prm.output_directory, set.name(), counter, comm);
+        const std::string name = io::write_vtu_atomic(out, prm.output_directory, set.name(), counter, comm);
+        auto &            records = pvd_records[is_soil ? 0 : 1];
+        records.emplace_back(time, name);
+        if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) // soil.pvd, water.pvd for ParaView
+          io::write_pvd(prm.output_directory + "/" + set.name() + ".pvd", records);
       }
   }
 
