@@ -13,18 +13,23 @@ lowest pore pressure (series.csv) changing by less than 0.1 % of rho_w g H over
 the second half. The explicit 2-phase
 critical step of the same scene (talus-critical-dt, Eq. 4.129 of seed 000) is
 printed beside the step used, with the ratio.
-Usage: check_semi_hydrostatic.py TOOL PRM WORKDIR [CRITICAL_DT_TOOL EXPLICIT_PRM]
+Usage: check_semi_hydrostatic.py TOOL PRM WORKDIR [CRITICAL_DT_TOOL EXPLICIT_PRM] [--end-time=T]
+  --end-time=1.5: 10^4 steps (the 'no drift over 10^4 steps' of issue 14; make verify)
 """
 import re
 import sys
 
 import talus_verify as tv
 
-tool, prm_path, work = sys.argv[1:4]
-crit_tool = sys.argv[4] if len(sys.argv) > 5 else None
-explicit_prm = sys.argv[5] if len(sys.argv) > 5 else None
+end_time = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--end-time=")), None)
+args = [a for a in sys.argv if not a.startswith("--end-time=")]
+tool, prm_path, work = args[1:4]
+crit_tool = args[4] if len(args) > 5 else None
+explicit_prm = args[5] if len(args) > 5 else None
 g, H, n, rs, rw = 9.81, 1.0, 0.3, 2650.0, 1000.0
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+if end_time:
+    base = tv.prm_set(base, "time/end time", end_time)
 dts = {}
 for k in ("1e-3", "1e-7"):
     text = tv.prm_set(base, "material 0/soil/hydraulic conductivity", k)

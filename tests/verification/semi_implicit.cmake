@@ -50,3 +50,16 @@ add_test(NAME verification.semi_implicit_consolidation_linear
                  ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation_linear
                  0.03 0.05,0.1,0.2,0.5 linear)
 set_tests_properties(verification.semi_implicit_consolidation_linear PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# the hydrostatic column over 10^4 steps (no drift; make verify)
+add_test(NAME verification.semi_implicit_hydrostatic_long
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_hydrostatic.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_hydrostatic_long
+                 --end-time=1.5)
+set_tests_properties(verification.semi_implicit_hydrostatic_long PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+
+# the stencil ops of the family's point passes on 2 ranks (conservation across
+# the partition, the Poisson matrix with rows on the other rank)
+add_test(NAME unit.test_stencil_ops_np2
+         COMMAND mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_stencil_ops)
+set_tests_properties(unit.test_stencil_ops_np2 PROPERTIES LABELS "unit" PROCESSORS 2 TIMEOUT 300 ENVIRONMENT "${_env}")
