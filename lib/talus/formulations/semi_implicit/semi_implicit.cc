@@ -151,6 +151,13 @@ namespace talus::semi_implicit
           cell_volume *= h;
           h_min = std::min(h_min, h);
         }
+      // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
+      for (const auto &bc : p.boundary_conditions)
+        require(bc.id < 2 * dim,
+                std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
+                "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
+                  "D box has the ids 0 to " + std::to_string(2 * dim - 1) + ": x-, x+, y-, y+" +
+                  (dim == 3 ? ", z-, z+)" : ")"));
       if (p.bspline)
         for (unsigned int d = 0; d < dim; ++d)
           require(p.grid_cells[d] >= 3, "grid/cells",
