@@ -119,10 +119,13 @@ namespace talus::semi_implicit
                           "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
                           "soil points carries it, each point the force q V_p / (h / particles per direction), "
                           "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
+        // must be set: it makes a .prm this family's (an explicit scene is not
+        // silently read as a saturated two-phase one)
         prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
-                          "saturated: soil and water points over the region (the material is the soil's); "
-                          "soil: soil points only; water: water points only (density 'semi implicit/water "
-                          "density'; the material entry is unused).");
+                          "What the body seeds (must be set): saturated: soil and water points over the region "
+                          "(the material is the soil's); soil: soil points only; water: water points only "
+                          "(density 'semi implicit/water density'; the material entry is unused).",
+                          /*has_to_be_set=*/true);
         prm.leave_subsection();
       }
   }
