@@ -1,0 +1,1160 @@
+// talus — the semi-implicit two-phase double-point step (seed 002 §4.5) over
+// the shared core: two MaterialPointSets, the kernels' point stencils
+// (transfer/stencil_ops.h), a scalar NodalSpace + ActiveSet for the pressure
+// increment, CG + ML AMG (solvers/linear_solver.h), the one TimeLoop.
+//
+// Signs: tension positive for the effective stress and the pore pressure (the
+// paper's §2), so the hydrostatic pore pressure is negative.
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/common/time_loop.h>
+#include <talus/formulations/semi_implicit/semi_implicit.h>
+#include <talus/grid/background_grid.h>
+#include <talus/grid/nodal_space.h>
+#include <talus/io/output.h>
+#include <talus/io/vtu.h>
+#include <talus/loads/k0.h>
+#include <talus/particles/material_point_set.h>
+#include <talus/shape/bspline2_box.h>
+#include <talus/shape/q1_box.h>
+#include <talus/solvers/linear_solver.h>
+#include <talus/transfer/cell_walk.h>
+#include <talus/transfer/matrix_ops.h>
+#include <talus/transfer/point_ops.h>
+#include <talus/transfer/stencil_ops.h>
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/particles/data_out.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+namespace talus::semi_implicit
+{
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Selection;
+
+  // ================================================================ parameters
+  void
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
+  {
+    const SceneCounts counts = peek_scene_counts(prm_file);
+    declare_scene_parameters(prm, counts);
+    declare_run_parameters(prm);
+    prm.enter_subsection("time");
+    {
+      prm.declare_entry("time step", "0", Double(0),
+                        "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
+                        "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
+                        "conductivity (seed 002 §5.3).");
+      prm.declare_entry("courant number", "0.5", Double(0, 1),
+                        "Fraction of the soil skeleton's critical step used when 'time step' is 0.");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("semi implicit");
+    {
+      prm.declare_entry("shape function", "quadratic bspline", Selection("quadratic bspline|linear"),
+                        "Basis of velocity and pressure (equal order, seed 002 §4.2).");
+      prm.declare_entry("water density", "1000", Double(0), "rho_w [kg/m^3], > 0.");
+      prm.declare_entry("unit weight gravity", "9.81", Double(0),
+                        "g of the Darcy drag n^2 rho_w g / k (Eq. 15) [m/s^2], > 0; kept when the body force "
+                        "is zero (it converts the hydraulic conductivity, it is not a load).");
+      prm.declare_entry("free surface volume fraction", "0.5", Double(0, 1),
+                        "A cell is wet when the volume of its water points divided by the cell volume is at "
+                        "least this; a node touched by water points that is a vertex of a wet and of a dry "
+                        "cell is on the free water surface and gets p = 0. In (0, 1).");
+      prm.declare_entry("pressure solver tolerance", "1e-10", Double(0, 1e-2),
+                        "Relative residual |b - A x| / |b| at which CG + ML AMG stops on the pressure-"
+                        "increment Poisson equation.");
+      prm.declare_entry("pressure smoothing", "linear", Selection("linear|mass weighted|none"),
+                        "mass weighted: the water points' pore pressure is replaced by the mass-weighted "
+                        "map and remap through the nodes at every step (Eq. 77); it is biased by O(h grad p) "
+                        "where a node's support is cut by a wall or the free surface. linear: the same map "
+                        "with each point's value carried to the node by its pressure gradient, "
+                        "p_I = sum N m (p + grad p . (x_I - x_p)) / sum N m, exact for linear fields "
+                        "(docs/semi-implicit.md). none: the pressure changes only by the interpolated "
+                        "increments (p += sum N dp).");
+      prm.declare_entry("flip fraction", "1", Double(0, 1),
+                        "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
+                        "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
+      prm.declare_entry("kozeny carman", "false", Bool(),
+                        "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
+                        "(Alg. 8(g)); false: k stays k0.");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("initial state");
+    {
+      prm.declare_entry("geostatic", "false", Bool(),
+                        "Start from the geostatic state of a horizontally layered scene: pore pressure "
+                        "-rho_w g (water level - y) at water points below the water level, effective "
+                        "vertical stress -(1-n)(rho_s - rho_w) g depth (buoyant below the water level, "
+                        "(1-n) rho_s g above) and horizontal K0 times it at soil points (g = |gravity|).");
+      prm.declare_entry("water level", "0", Double(-1e300, 1e300), "Vertical coordinate of the free water surface [m].");
+      prm.declare_entry("soil surface", "0", Double(-1e300, 1e300), "Vertical coordinate of the soil surface [m].");
+      prm.declare_entry("K0", "1", Double(0), "Horizontal / vertical effective stress ratio.");
+    }
+    prm.leave_subsection();
+    for (unsigned int k = 0; k < counts.n_materials; ++k)
+      {
+        prm.enter_subsection("material " + std::to_string(k));
+        prm.enter_subsection("soil");
+        prm.declare_entry("porosity", "0.3", Double(-1e300, 1e300), "Initial porosity n0 of the soil, in (0, 1).");
+        prm.declare_entry("hydraulic conductivity", "1e-3", Double(-1e300, 1e300),
+                          "Hydraulic conductivity k0 [m/s], > 0.");
+        prm.leave_subsection();
+        prm.leave_subsection();
+      }
+    for (unsigned int k = 0; k < counts.n_bodies; ++k)
+      {
+        prm.enter_subsection("body " + std::to_string(k));
+        prm.declare_entry("surface load", "0", Double(-1e300, 1e300),
+                          "A uniform vertical pressure q [Pa] (>= 0, pushing down) on the upper face of a box "
+                          "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
+                          "soil points carries it, each point the force q V_p / (h / particles per direction), "
+                          "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
+        // must be set: it makes a .prm this family's (an explicit scene is not
+        // silently read as a saturated two-phase one)
+        prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
+                          "What the body seeds (must be set): saturated: soil and water points over the region "
+                          "(the material is the soil's); soil: soil points only; water: water points only "
+                          "(density 'semi implicit/water density'; the material entry is unused).",
+                          /*has_to_be_set=*/true);
+        prm.leave_subsection();
+      }
+  }
+
+  namespace
+  {
+    std::string
+    number_text(const double x)
+    {
+      std::ostringstream os;
+      os << std::setprecision(4) << x;
+      return os.str();
+    }
+
+    /// The checks of a scene that need no grid: every body wholly inside the
+    /// grid (or clipped), the memory the grid and points need, the time step.
+    template <int dim>
+    void
+    check_scene(const Parameters<dim> &p)
+    {
+      double n_cells = 1, cell_volume = 1, h_min = std::numeric_limits<double>::max();
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double h = (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
+          n_cells *= p.grid_cells[d];
+          cell_volume *= h;
+          h_min = std::min(h_min, h);
+        }
+      // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
+      for (const auto &bc : p.boundary_conditions)
+        require(bc.id < 2 * dim,
+                std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
+                "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
+                  "D box has the ids 0 to " + std::to_string(2 * dim - 1) + ": x-, x+, y-, y+" +
+                  (dim == 3 ? ", z-, z+)" : ")"));
+      if (p.bspline)
+        for (unsigned int d = 0; d < dim; ++d)
+          require(p.grid_cells[d] >= 3, "grid/cells",
+                  "quadratic B-splines need at least 3 cells in every direction (a point's 3-node window)");
+      double n_points = 0;
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
+        {
+          const auto &       b     = p.bodies[k];
+          const std::string  where = "body " + std::to_string(k) + " ('" + b.name + "')";
+          dealii::Point<dim> lo, hi;
+          b.bounding_box(lo, hi);
+          double overlap = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+            overlap *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
+          require(overlap > 0, where, "contains no material point: it lies entirely outside the grid");
+          if (!b.clip_to_grid)
+            {
+              const std::string out = outside_extent(b, p.grid_lower, p.grid_upper);
+              require(out.empty(), where,
+                      out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                            "the grid, or set 'clip to grid = true' in 'body " + std::to_string(k) + "')");
+            }
+          // both sets for a saturated body
+          n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * overlap / cell_volume *
+                      std::pow(double(b.particles_per_direction), dim);
+        }
+      // rough peak memory: the explicit family's measured figures per cell and
+      // point (docs/reliability.md) doubled for the pressure space, its matrix
+      // and the two-phase nodal vectors
+      int size = 1;
+      MPI_Comm_size(MPI_COMM_WORLD, &size);
+      const double per_cell = dim == 2 ? 1200 : 2400, per_point = dim == 2 ? 650 : 800;
+      const double need     = 180e6 * size + per_cell * n_cells + per_point * n_points;
+      const double avail    = available_memory_bytes();
+      require(avail < 0 || need <= avail * size, "grid/cells",
+              number_text(n_cells) + " cells and about " + number_text(n_points) + " material points need about " +
+                number_text(need / 1e9) + " GB, but only " + number_text(avail / 1e9) +
+                " GB are available; use fewer cells or particles per direction");
+      const double dt_cr = soil_critical_time_step(p, h_min);
+      require(p.time_step <= dt_cr, "time/time step",
+              "is " + number_text(p.time_step) + " s, above the soil skeleton's critical step " + number_text(dt_cr) +
+                " s (h_min / sqrt(E_c / ((1 - n) rho_s))); the semi-implicit step is limited by it");
+    }
+  } // namespace
+
+  template <int dim>
+  Parameters<dim>
+  parse_parameters(dealii::ParameterHandler &prm)
+  {
+    Parameters<dim> p;
+    parse_run_parameters<dim>(prm, p);
+    parse_scene_parameters<dim>(prm, p);
+    prm.enter_subsection("time");
+    p.time_step = prm.get_double("time step");
+    p.courant   = prm.get_double("courant number");
+    require(p.courant > 0, "time/courant number", "must be > 0");
+    prm.leave_subsection();
+    prm.enter_subsection("semi implicit");
+    p.bspline               = prm.get("shape function") == "quadratic bspline";
+    p.water_density         = prm.get_double("water density");
+    p.unit_weight_gravity   = prm.get_double("unit weight gravity");
+    p.free_surface_fraction = prm.get_double("free surface volume fraction");
+    p.pressure_tolerance    = prm.get_double("pressure solver tolerance");
+    p.kozeny_carman         = prm.get_bool("kozeny carman");
+    p.pressure_smoothing    = prm.get("pressure smoothing") != "none";
+    p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
+    p.flip_fraction         = prm.get_double("flip fraction");
+    require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
+    require(p.unit_weight_gravity > 0, "semi implicit/unit weight gravity", "must be > 0 m/s^2");
+    require(p.free_surface_fraction > 0 && p.free_surface_fraction < 1, "semi implicit/free surface volume fraction",
+            "must lie in (0, 1)");
+    require(p.pressure_tolerance > 0, "semi implicit/pressure solver tolerance", "must be > 0");
+    prm.leave_subsection();
+    prm.enter_subsection("initial state");
+    p.geostatic    = prm.get_bool("geostatic");
+    p.water_level  = prm.get_double("water level");
+    p.soil_surface = prm.get_double("soil surface");
+    p.K0           = prm.get_double("K0");
+    prm.leave_subsection();
+    for (unsigned int k = 0; k < p.materials.size(); ++k)
+      {
+        const std::string where = "material " + std::to_string(k) + "/soil/";
+        prm.enter_subsection("material " + std::to_string(k));
+        prm.enter_subsection("soil");
+        SoilData s;
+        s.porosity     = prm.get_double("porosity");
+        s.conductivity = prm.get_double("hydraulic conductivity");
+        prm.leave_subsection();
+        prm.leave_subsection();
+        std::ostringstream n0, k0;
+        n0 << s.porosity;
+        k0 << s.conductivity;
+        require(s.porosity > 0 && s.porosity < 1, where + "porosity", "is " + n0.str() + "; must lie in (0, 1)");
+        require(s.conductivity > 0, where + "hydraulic conductivity", "is " + k0.str() + "; must be > 0 m/s");
+        p.soil_of_material.push_back(s);
+      }
+    bool any_soil = false, any_water = false;
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      {
+        prm.enter_subsection("body " + std::to_string(k));
+        const std::string ph = prm.get("phase");
+        p.surface_load.push_back(prm.get_double("surface load"));
+        prm.leave_subsection();
+        p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
+        std::ostringstream q;
+        q << p.surface_load.back();
+        require(std::isfinite(p.surface_load.back()) && p.surface_load.back() >= 0, "body " + std::to_string(k) + "/surface load",
+                "is " + q.str() + "; must be a pressure >= 0 Pa");
+        require(p.surface_load.back() == 0 || (p.phase_of_body.back() != Phase::water &&
+                                                p.bodies[k].shape == BodyDescription<dim>::Shape::box),
+                "body " + std::to_string(k) + "/surface load", "needs a box body with soil points (phase saturated or soil)");
+        any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
+        any_water = any_water || p.phase_of_body.back() != Phase::soil;
+        require(p.bodies[k].shape != BodyDescription<dim>::Shape::file, "body " + std::to_string(k) + "/shape",
+                "file bodies are not available in talus-semi-implicit yet; allowed: box, ball, polygon");
+      }
+    std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
+                (p.phase_of_body[k] == Phase::soil ? "soil" : p.phase_of_body[k] == Phase::water ? "water" : "saturated");
+    require(any_soil && any_water, phases,
+            std::string("the scene has no ") + (any_soil ? "water" : "soil") +
+              " points (the drag and the mixture need both): give a body phase = saturated, or add a " +
+              (any_soil ? "water" : "soil") + " body");
+    require(p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
+              p.restart == RunParameters<dim>::Restart::no,
+            "checkpoint", "checkpoints and restarts are not available in talus-semi-implicit yet; use interval = 0, "
+                          "wall clock interval = 0, restart = false");
+    require(!p.balance.enabled(), "load balancing/interval",
+            "load balancing is not available in talus-semi-implicit yet; use 0");
+    require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
+    check_scene(p);
+    return p;
+  }
+
+  template <int dim>
+  double
+  soil_critical_time_step(const Parameters<dim> &p, const double h_min)
+  {
+    double dt = std::numeric_limits<double>::max();
+    for (unsigned int b = 0; b < p.bodies.size(); ++b)
+      if (p.phase_of_body[b] != Phase::water)
+        {
+          const unsigned int m   = p.bodies[b].material_id;
+          const double       rho = (1 - p.soil_of_material[m].porosity) * p.materials[m]->density();
+          dt = std::min(dt, h_min / std::sqrt(p.materials[m]->constrained_modulus() / rho));
+        }
+    return dt;
+  }
+
+  // ================================================================ the formulation
+  namespace
+  {
+    /// Property offsets of the extras of both sets.
+    struct Fields
+    {
+      unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
+      unsigned int pressure_gradient = 0, surface_force = 0;
+      unsigned int poisson_coefficient = 0, poisson_source = 0;
+    };
+
+    /// Nodal masses below this fraction of the largest nodal mass count as
+    /// empty (decision A3: no division by the tiny masses at a support's edge).
+    constexpr double relative_mass_cutoff = 1e-10;
+  } // namespace
+
+  template <int dim>
+  class Solver : public Formulation
+  {
+  public:
+    using L = PropertyLayout<dim>;
+
+    Solver(const Parameters<dim> &p, MPI_Comm comm)
+      : prm(p)
+      , comm(comm)
+      , grid(comm)
+      , soil(grid, "soil")
+      , water(grid, "water")
+      , pspace(grid, 1)
+      , active(pspace)
+    {}
+
+    void setup();
+    std::string tool_name() const override { return "talus-semi-implicit"; }
+    void        describe(std::ostream &out) const override;
+    double      begin_stage(const unsigned int, const bool, const bool) override { return prm.end_time; }
+    StepOutcome advance_by(const double h) override
+    {
+      if (prm.bspline)
+        step<shape::BSpline2Box<dim>>(h);
+      else
+        step<shape::Q1Box<dim>>(h);
+      return StepOutcome::done;
+    }
+    void               check_stability() const override;
+    unsigned long long lost_points() const override
+    {
+      return soil.relocation_stats.lost + water.relocation_stats.lost;
+    }
+    std::vector<std::string> series_columns() const override;
+    std::vector<double>      series_values(const bool after_step) override;
+    void                     write_vtu(const unsigned int counter) override;
+    std::string              write_checkpoint() override
+    {
+      throw InputError("checkpoint: not available in talus-semi-implicit yet");
+    }
+    void finish(const std::string &series_csv) override;
+    void summary(const LoopTimings &timings) override;
+
+  private:
+    template <class K>
+    void step(const double h);
+    void seed();
+    void geostatic_state();
+    /// compress(add) then update ghosts, for every vector given
+    void exchange(std::initializer_list<Vector *> vs) const;
+    /// local (owned + ghost) size of a grid vector
+    unsigned int n_local() const { return grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices(); }
+
+    const Parameters<dim> &prm;
+    MPI_Comm               comm;
+    BackgroundGrid<dim>    grid;
+    MaterialPointSet<dim>  soil, water;
+    Fields                 fs, fw; ///< offsets in the soil and the water layout
+    NodalSpace<dim>        pspace; ///< the scalar pressure space
+    ActiveSet<dim>         active;
+    dealii::TrilinosWrappers::SparseMatrix A;
+    Vector                                 rhs, dp_solution;
+
+    // per grid local DoF: the node's component-0 DoF, component, prescribed zero
+    std::vector<unsigned int>  node_of;
+    std::vector<unsigned char> component, constrained;
+    std::vector<dealii::Point<dim>> node_x; // position of the node of a local DoF
+    // nodal fields (grid vectors; scalars at the component-0 DoF)
+    Vector Ms, Ps, Mn, Mk, Fs;          // soil mass, momentum, sum m n, sum m k, force (internal + gravity)
+    Vector Ww, Pw0, Ww0, Mwp, Mw;       // sum N rho_w V, sum N rho_w V0 v, sum N rho_w V0, sum N m p, sum N m
+    Vector Fp;                          // -sum V p grad N (pore pressure force on the mixture)
+    Vector Mwg;                         // sum N m grad p (linear pressure map)
+    Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
+    Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
+    Vector p_node, dp_node, gs, gw, wet, dry;
+    std::vector<double> cell_water_volume;
+    std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
+
+    // diagnostics
+    LinearSolveInfo    last_solve;
+    unsigned long long solver_iterations = 0, n_solves = 0;
+    double             seconds_solve = 0;
+    double             dt_soil_critical = 0;
+  };
+
+  template <int dim>
+  void
+  Solver<dim>::exchange(std::initializer_list<Vector *> vs) const
+  {
+    for (auto *v : vs)
+      v->compress(dealii::VectorOperation::add);
+    for (auto *v : vs)
+      v->update_ghost_values();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::setup()
+  {
+    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
+    grid.setup();
+    if (prm.bspline)
+      grid.setup_bspline_patches();
+    pspace.setup();
+    constrained = grid.constrained_dofs(prm.boundary_conditions);
+
+    // node and component of every local grid DoF (from the cells' vertex DoFs)
+    const unsigned int nl = n_local();
+    node_of.assign(nl, 0);
+    component.assign(nl, 0);
+    node_x.assign(nl, dealii::Point<dim>());
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cell_iterators[c] != grid.tria.end()) // artificial cells carry no DoFs (their cache is zero)
+      for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const auto &       cc = grid.cells[c];
+            const unsigned int i  = cc.dofs[v * dim + d];
+            if (i < nl)
+              {
+                node_of[i]   = cc.dofs[v * dim];
+                component[i] = d;
+                for (unsigned int e = 0; e < dim; ++e) // vertex v: bit e set = upper side in direction e
+                  node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
+              }
+          }
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
+                      &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry})
+      grid.reinit_vector(*v);
+
+    // layouts: soil points carry the solid model's history; both carry porosity
+    unsigned int n_history = 0;
+    for (const auto &m : prm.materials)
+      n_history = std::max(n_history, m->n_history());
+    soil.layout.n_history          = n_history;
+    fs.porosity                    = soil.layout.add_extra("porosity", 1);
+    fs.initial_porosity            = soil.layout.add_extra("initial_porosity", 1);
+    fs.initial_volume              = soil.layout.add_extra("initial_volume", 1);
+    fs.conductivity                = soil.layout.add_extra("conductivity", 1);
+    fs.surface_force               = soil.layout.add_extra("surface_force", 1);
+    fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
+    fs.poisson_source              = soil.layout.add_extra("poisson_source", 1);
+    fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
+    fw.pressure_gradient           = water.layout.add_extra("pore_pressure_gradient", dim, true);
+    fw.porosity                    = water.layout.add_extra("porosity", 1);
+    fw.initial_porosity            = water.layout.add_extra("initial_porosity", 1);
+    fw.initial_volume              = water.layout.add_extra("initial_volume", 1);
+    fw.poisson_coefficient         = water.layout.add_extra("poisson_coefficient", 1);
+    fw.poisson_source              = water.layout.add_extra("poisson_source", 1);
+    soil.initialize();
+    water.initialize();
+    seed();
+    if (prm.geostatic)
+      geostatic_state();
+    for (auto &pt : soil.handler)
+      {
+        auto        P = pt.get_properties();
+        const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+        if (soil.layout.n_history)
+          m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + soil.layout.history, m.n_history()));
+      }
+    dt_soil_critical = soil_critical_time_step(prm, grid.min_cell_size());
+    dt               = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::seed()
+  {
+    // each set is seeded from the bodies of its phase; the body property keeps
+    // the index of the .prm body
+    for (const bool is_soil : {true, false})
+      {
+        MaterialPointSet<dim> &   set = is_soil ? soil : water;
+        std::vector<BodyDescription<dim>> bodies;
+        std::vector<unsigned int>         body_index;
+        for (unsigned int b = 0; b < prm.bodies.size(); ++b)
+          if (prm.phase_of_body[b] == Phase::saturated || (prm.phase_of_body[b] == Phase::soil) == is_soil)
+            {
+              bodies.push_back(prm.bodies[b]);
+              body_index.push_back(b);
+            }
+        std::vector<double> unit_density(prm.materials.size(), 1.0); // masses set below
+        const auto seeded = seed_bodies(grid, bodies, unit_density, set.layout, set.handler);
+        for (unsigned int k = 0; k < bodies.size(); ++k)
+          require(seeded.volume_per_body[k] > 0, "body " + std::to_string(body_index[k]) + " ('" + bodies[k].name + "')",
+                  "contains no " + std::string(is_soil ? "soil" : "water") +
+                    " point: it lies outside the grid or is smaller than one sub-cell");
+        const Fields &f = is_soil ? fs : fw;
+        for (auto &pt : set.handler)
+          {
+            auto               P = pt.get_properties();
+            const unsigned int b = body_index[static_cast<unsigned int>(P[L::body])];
+            P[L::body]           = b;
+            const unsigned int m = prm.bodies[b].material_id;
+            // a water body's points take the porosity 1 (free water)
+            const double n0          = prm.phase_of_body[b] == Phase::water ? 1.0 : prm.soil_of_material[m].porosity;
+            const double V0          = P[L::volume];
+            P[f.porosity]            = n0;
+            P[f.initial_porosity]    = n0;
+            P[f.initial_volume]      = V0;
+            if (is_soil)
+              {
+                P[L::mass]          = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
+                P[f.conductivity]   = prm.soil_of_material[m].conductivity;
+                // the body's top layer of points carries its surface load
+                const double q  = prm.surface_load[b];
+                const double hy = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
+                const double dy = hy / prm.bodies[b].particles_per_direction;
+                P[f.surface_force] = q > 0 && pt.get_location()[dim - 1] > prm.bodies[b].upper[dim - 1] - dy ? q * V0 / dy : 0.0;
+              }
+            else
+              {
+                P[L::mass]     = n0 * prm.water_density * V0; // Eq. 37
+                P[f.pressure]  = 0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  P[f.pressure_gradient + d] = 0;
+              }
+          }
+        set.collect_active_cells();
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::geostatic_state()
+  {
+    const double g = prm.gravity.norm();
+    for (auto &pt : water.handler)
+      {
+        auto         P = pt.get_properties();
+        const double y = pt.get_location()[dim - 1];
+        P[fw.pressure] = -prm.water_density * g * std::max(0.0, prm.water_level - y);
+        P[fw.pressure_gradient + dim - 1] = y < prm.water_level ? prm.water_density * g : 0.0;
+      }
+    for (auto &pt : soil.handler)
+      {
+        auto               P  = pt.get_properties();
+        const double       y  = pt.get_location()[dim - 1];
+        const unsigned int m  = static_cast<unsigned int>(P[L::material]);
+        const double       n  = P[fs.porosity];
+        const double       rs = prm.materials[m]->density();
+        // dry unit weight above the water level, buoyant below
+        const double above = std::max(0.0, prm.soil_surface - std::max(y, prm.water_level));
+        const double below = std::max(0.0, std::min(prm.soil_surface, prm.water_level) - y);
+        const double sv    = -(1 - n) * g * (rs * above + (rs - prm.water_density) * below);
+        dealii::SymmetricTensor<2, 3> s;
+        for (unsigned int d = 0; d < 3; ++d)
+          s[d][d] = prm.K0 * sv;
+        s[dim - 1][dim - 1] = sv;
+        L::set_stress(s, P.data());
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::describe(std::ostream &out) const
+  {
+    const auto ns = soil.handler.n_global_particles(), nw = water.handler.n_global_particles();
+    out << "talus-semi-implicit: " << dim << "D, grid " << grid.tria.n_global_active_cells() << " cells (h_min "
+        << grid.min_cell_size() << " m), " << (prm.bspline ? "quadratic B-splines" : "linear shape functions")
+        << ", " << ns << " soil + " << nw << " water points\n"
+        << "  time step " << dt << " s (soil skeleton critical step " << dt_soil_critical << " s"
+        << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant)) << "), pressure: CG + ML AMG to "
+        << prm.pressure_tolerance << " relative residual" << std::endl;
+  }
+
+  // ---------------------------------------------------------------- the step
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::step(const double h)
+  {
+    using Stencil     = transfer::PointStencil<dim, K>;
+    using It          = transfer::PointIterator<dim>;
+    const auto   g    = prm.gravity;
+    const double rw   = prm.water_density;
+    const unsigned int nl = n_local();
+
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry})
+      *v = 0;
+    auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
+
+    // (1)-(2) P2N of the soil: mass (44), momentum (45), porosity (46),
+    // conductivity (47); effective-stress internal force and soil gravity (54)-(55)
+    {
+      double *ms = at(Ms), *ps = at(Ps), *mn = at(Mn), *mk = at(Mk), *fsv = at(Fs);
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        const double *P = it->get_properties().data();
+        const double  m = P[L::mass];
+        s.scatter(ms, m);
+        s.scatter_vector(ps, m, P + L::velocity);
+        s.scatter(mn, m * P[fs.porosity]);
+        s.scatter(mk, m * P[fs.conductivity]);
+        double gm[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          gm[d] = g[d];
+        s.scatter_vector(fsv, m, gm);
+        double t[dim][dim];
+        minus_V_sigma<dim>(P, P[L::volume], t);
+        s.scatter_divergence(fsv, t);
+        if (P[fs.surface_force] != 0)
+          {
+            double f[dim] = {};
+            f[dim - 1]    = -P[fs.surface_force];
+            s.scatter_vector(fsv, 1.0, f);
+          }
+      });
+    }
+    exchange({&Ms, &Ps, &Mn, &Mk, &Fs});
+    double ms_max = 0;
+    for (unsigned int i = 0; i < nl; ++i)
+      ms_max = std::max(ms_max, Ms.local_element(i));
+    const double ms_cut = relative_mass_cutoff * dealii::Utilities::MPI::max(ms_max, comm);
+    // nodal porosity and conductivity; nodes without soil: n = 1, no drag (A1)
+    for (unsigned int i = 0; i < nl; ++i)
+      if (component[i] == 0)
+        {
+          const double m = Ms.local_element(i);
+          n_node.local_element(i) = m > ms_cut ? Mn.local_element(i) / m : 1.0;
+          Mk.local_element(i)     = m > ms_cut ? Mk.local_element(i) / m : 0.0; // now k_I
+        }
+    for (unsigned int i = 0; i < nl; ++i)
+      {
+        const double m = Ms.local_element(node_of[i]);
+        vs_t.local_element(i) = m > ms_cut ? Ps.local_element(i) / m : 0.0;
+      }
+
+    // (2)(e)-(f) P2N of the water: porosity at the water points from the nodes
+    // (48, Alg. 8(h)) and their volume (36); water mass with the nodal porosity
+    // (50), velocity with the weights rho_w V0 (51); the mass-weighted nodal
+    // pore pressure (77 / A5); the water volume of each cell (free surface)
+    cell_water_volume.assign(grid.cells.size(), 0.0);
+    {
+      const double *nn = at(n_node);
+      double *      ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw), *mwg = at(Mwg);
+      const bool    linear = prm.linear_smoothing;
+      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int c, It &it, const Stencil &s) {
+        double *     P  = it->get_properties().data();
+        const double n  = std::clamp(s.value(nn), 1e-6, 1.0);
+        const double V0 = P[fw.initial_volume];
+        P[fw.porosity]  = n;
+        P[L::volume]    = P[fw.initial_porosity] / n * V0; // Eq. 36
+        s.scatter(ww, rw * P[L::volume]);
+        s.scatter_vector(pw0, rw * V0, P + L::velocity);
+        s.scatter(ww0, rw * V0);
+        if (linear) // sum N m (p - grad p . x_p); the node adds (sum N m grad p) . x_I
+          {
+            const auto x  = it->get_location();
+            double     px = P[fw.pressure];
+            for (unsigned int d = 0; d < dim; ++d)
+              px -= P[fw.pressure_gradient + d] * x[d];
+            s.scatter(mwp, P[L::mass] * px);
+            s.scatter_vector(mwg, P[L::mass], P + fw.pressure_gradient);
+          }
+        else
+          s.scatter(mwp, P[L::mass] * P[fw.pressure]);
+        s.scatter(mw, P[L::mass]);
+        cell_water_volume[c] += P[L::volume];
+      });
+    }
+    exchange({&Ww, &Pw0, &Ww0, &Mwp, &Mw, &Mwg});
+    if (prm.linear_smoothing) // the node's share (sum N m grad p) . x_I, component by component
+      for (unsigned int i = 0; i < nl; ++i)
+        Mwp.local_element(node_of[i]) += Mwg.local_element(i) * node_x[i][component[i]];
+    double mw_max = 0;
+    for (unsigned int i = 0; i < nl; ++i)
+      mw_max = std::max(mw_max, Mw.local_element(i));
+    const double mw_cut = relative_mass_cutoff * dealii::Utilities::MPI::max(mw_max, comm);
+    for (unsigned int i = 0; i < nl; ++i)
+      if (component[i] == 0)
+        {
+          const bool   has_water     = Mw.local_element(i) > mw_cut;
+          p_node.local_element(i)  = has_water ? Mwp.local_element(i) / Mw.local_element(i) : 0.0;
+          Mw_node.local_element(i) = has_water ? n_node.local_element(i) * Ww.local_element(i) : 0.0; // Eq. 50
+          const double k           = Mk.local_element(i);
+          Q_node.local_element(i)  = (has_water && k > 0) ? prm.unit_weight_gravity * n_node.local_element(i) *
+                                                             Mw_node.local_element(i) / k
+                                                         : 0.0; // Eq. 58
+        }
+    for (unsigned int i = 0; i < nl; ++i)
+      {
+        const double w = Ww0.local_element(node_of[i]);
+        vw_t.local_element(i) = Mw.local_element(node_of[i]) > mw_cut && w > 0 ? Pw0.local_element(i) / w : 0.0;
+      }
+
+    // (3a)/(4a) smoothed pore pressure at the water points (77) and its force
+    // -sum V p grad N on the mixture (55); the water's share is n_I times it (57)
+    {
+      const double *pn = at(p_node);
+      double *      fp = at(Fp);
+      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
+        double *     P = it->get_properties().data();
+        if (prm.pressure_smoothing)
+          P[fw.pressure] = s.value(pn);
+        const double p = P[fw.pressure];
+        double t[dim][dim] = {};
+        for (unsigned int d = 0; d < dim; ++d)
+          t[d][d] = -P[L::volume] * p;
+        s.scatter_divergence(fp, t);
+      });
+    }
+    exchange({&Fp});
+
+    // (3) water predictor, drag implicit in v_w* (53, 59); (4) mixture predictor (52)
+    for (unsigned int i = 0; i < nl; ++i)
+      {
+        const unsigned int j   = node_of[i];
+        const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j);
+        const double       Q = Q_node.local_element(j), n = n_node.local_element(j);
+        const double       b = g[component[i]];
+        double             vw = 0, vs = 0;
+        if (Mwi > 0)
+          vw = (h * (Mwi * b + n * Fp.local_element(i) + Q * vs_t.local_element(i)) + Mwi * vw_t.local_element(i)) /
+               (Mwi + Q * h);
+        if (Msi > ms_cut)
+          vs = (h * (Fs.local_element(i) + Mwi * b + Fp.local_element(i)) - Mwi * (vw - vw_t.local_element(i))) / Msi +
+               vs_t.local_element(i);
+        if (constrained[i]) // same conditions on both phases (A10)
+          vw = vs = 0;
+        vw_star.local_element(i) = vw;
+        vs_star.local_element(i) = vs;
+      }
+
+    // (5) pressure-increment Poisson equation (60)-(63): per point the
+    // coefficient dt phi / rho and the source phi div v* (phi = 1 - n for the
+    // soil, n for the water; point porosity, see docs/semi-implicit.md)
+    {
+      const double *vss = at(vs_star), *vws = at(vw_star);
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        double *     P   = it->get_properties().data();
+        const double phi = 1 - P[fs.porosity];
+        const double rs  = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
+        P[fs.poisson_coefficient] = h * phi / rs;
+        P[fs.poisson_source]      = phi * s.divergence(vss);
+      });
+      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
+        double *     P   = it->get_properties().data();
+        const double phi = P[fw.porosity];
+        P[fw.poisson_coefficient] = h * phi / rw;
+        P[fw.poisson_source]      = phi * s.divergence(vws);
+      });
+    }
+    if (soil.cell_set_changed() || water.cell_set_changed() || step_number == 0)
+      active.template reinit<K>({&soil, &water});
+    // free water surface: per node, whether it is a vertex of a wet and of a dry cell
+    {
+      double *wt = at(wet), *dr = at(dry);
+      for (unsigned int c = 0; c < grid.cells.size(); ++c)
+        if (grid.cells[c].locally_owned)
+          {
+            double cell_volume = 1;
+            for (unsigned int d = 0; d < dim; ++d)
+              cell_volume *= grid.cells[c].h[d];
+            const bool is_wet = cell_water_volume[c] >= prm.free_surface_fraction * cell_volume;
+            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+              (is_wet ? wt : dr)[grid.cells[c].dofs[v * dim]] += 1;
+          }
+    }
+    exchange({&wet, &dry});
+    dealii::AffineConstraints<double> dirichlet;
+    dirichlet.reinit(pspace.locally_relevant_dofs());
+    for (unsigned int i = 0; i < nl; ++i)
+      if (component[i] == 0)
+        {
+          const auto gdof = pspace.node_dof(i, 0);
+          if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
+            continue;
+          const bool has_water = Mw.local_element(i) > mw_cut;
+          const bool surface   = dry.local_element(i) > 0;
+          if (!has_water || surface)
+            {
+              // p^{t+1} = 0 on the surface (Delta p = -p^t); no water: Delta p = 0 (A2, A4)
+              dirichlet.add_line(gdof);
+              dirichlet.set_inhomogeneity(gdof, has_water ? -p_node.local_element(i) : 0.0);
+            }
+        }
+    dirichlet.close();
+    const auto constraints = active.constraints_with(dirichlet);
+    active.reinit_matrix(A);
+    pspace.reinit_vector(rhs);
+    pspace.reinit_vector(dp_solution);
+    {
+      transfer::PoissonWithSource soil_terms{fs.poisson_coefficient, fs.poisson_source};
+      transfer::PoissonWithSource water_terms{fw.poisson_coefficient, fw.poisson_source};
+      transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> as(active, constraints, soil_terms, &A, &rhs);
+      transfer::for_each_active_cell(soil, as);
+      transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> aw(active, constraints, water_terms, &A, &rhs);
+      transfer::for_each_active_cell(water, aw);
+      transfer::finish_assembly(active, as.diag_sum + aw.diag_sum, as.diag_count + aw.diag_count, &A, &rhs);
+    }
+    {
+      const auto          t0 = Clock::now();
+      LinearSolverOptions options;
+      options.method             = LinearSolverOptions::Method::cg_amg;
+      options.relative_tolerance = prm.pressure_tolerance;
+      if (rhs.l2_norm() > 0)
+        last_solve = solve_linear(A, dp_solution, rhs, options);
+      else
+        last_solve = {"cg_amg", 0, 0.0};
+      constraints.distribute(dp_solution);
+      dp_solution.update_ghost_values();
+      seconds_solve += seconds_since(t0);
+      solver_iterations += last_solve.iterations;
+      ++n_solves;
+    }
+    for (unsigned int i = 0; i < nl; ++i)
+      if (component[i] == 0)
+        dp_node.local_element(i) = dp_solution(pspace.node_dof(i, 0));
+
+    // (6) correction (64)-(68): sum V N grad(Delta p) over each phase's points
+    {
+      const double *dpn = at(dp_node);
+      double *      gsv = at(gs), *gwv = at(gw);
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        const double *P = it->get_properties().data();
+        double        gp[dim];
+        s.gradient(dpn, gp);
+        s.scatter_vector(gsv, P[L::volume], gp);
+      });
+      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
+        const double *P = it->get_properties().data();
+        double        gp[dim];
+        s.gradient(dpn, gp);
+        s.scatter_vector(gwv, P[L::volume], gp);
+      });
+    }
+    exchange({&gs, &gw});
+    for (unsigned int i = 0; i < nl; ++i)
+      {
+        const unsigned int j   = node_of[i];
+        const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
+        double vw = Mwi > 0 ? vw_star.local_element(i) + h * n * gw.local_element(i) / Mwi : 0.0;
+        double vs = Msi > ms_cut ? vs_star.local_element(i) + h * (1 - n) * gs.local_element(i) / Msi : 0.0;
+        if (constrained[i])
+          vw = vs = 0;
+        vw_new.local_element(i) = vw;
+        vs_new.local_element(i) = vs;
+      }
+
+    // (7) FLIP velocities of both sets, pore pressure to the water points;
+    // (8a) MUSL: the soil's new momentum to the nodes (Ps reused)
+    Ps = 0;
+    {
+      const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *dpn = at(dp_node), *pn = at(p_node);
+      const double  flip = prm.flip_fraction;
+      double *      ps = at(Ps);
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        double *P = it->get_properties().data();
+        double  a[dim], b[dim];
+        s.vector_value(vsn, a);
+        s.vector_value(vst, b);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+        s.scatter_vector(ps, P[L::mass], P + L::velocity);
+      });
+      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
+        double *P = it->get_properties().data();
+        double  a[dim], b[dim];
+        s.vector_value(vwn, a);
+        s.vector_value(vwt, b);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+        P[fw.pressure] += s.value(dpn); // (7c) as an increment: p_I^t + dp_I interpolated differs by the remap
+        double gp[dim], gdp[dim];
+        s.gradient(pn, gp);
+        s.gradient(dpn, gdp);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fw.pressure_gradient + d] = gp[d] + gdp[d];
+
+      });
+    }
+    exchange({&Ps});
+    for (unsigned int i = 0; i < nl; ++i)
+      {
+        const double m          = Ms.local_element(node_of[i]);
+        vs_t.local_element(i)   = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
+      }
+
+    // (7a) positions from the new nodal velocities; (8b-g) soil: ΔF from the
+    // remapped increment at x^t, volume, J, porosity, conductivity, stress
+    struct SoilUpdate
+    {
+      const Solver &        s;
+      const double *        v_grid; // v_s^{t+1}: the point moves with it
+      const double          h;
+      struct PointState
+      {};
+      inline void
+      increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du,
+                 const double *, double (&gu)[dim][dim], double (&dx)[dim])
+      {
+        double unused[dim];
+        K::value_and_gradient(cell, du, e, unused, gu);
+        typename K::Field vg;
+        K::gather(cell, v_grid, h, vg, false);
+        K::interpolate(vg, e, dx);
+      }
+      inline void
+      update(const unsigned int, const typename K::Cell &, double *P, const double (&gu)[dim][dim], PointState &)
+      {
+        // ΔF = I + grad Δu (Alg. 8(b), the usual index order)
+        dealii::Tensor<2, 3> dF;
+        for (unsigned int i = 0; i < 3; ++i)
+          dF[i][i] = 1;
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            dF[i][j] += gu[i][j];
+        const double dJ = dealii::determinant(dF);
+        if (!(dJ > 0))
+          throw InstabilityError("a soil point's volume increment det(ΔF) = " + std::to_string(dJ) + " is not positive");
+        P[L::volume] *= dJ;                                     // (8d)
+        const double J  = P[L::volume] / P[s.fs.initial_volume]; // (8e)
+        const double n0 = P[s.fs.initial_porosity];
+        const double n  = std::clamp(1 - (1 - n0) / J, 1e-6, 1 - 1e-6); // (8f)
+        P[s.fs.porosity] = n;
+        const unsigned int mid = static_cast<unsigned int>(P[L::material]);
+        if (s.prm.kozeny_carman) // (8g), C1 from k0 and n0
+          {
+            const double k0 = s.prm.soil_of_material[mid].conductivity;
+            const double C1 = k0 * (1 - n0) * (1 - n0) / (n0 * n0 * n0);
+            P[s.fs.conductivity] = C1 * n * n * n / ((1 - n) * (1 - n));
+          }
+        // effective stress: the model's update with the strain and spin
+        // increments of ΔF (rate form, as the explicit family)
+        materials::Strain d_eps;
+        materials::Spin   d_omega;
+        for (unsigned int d = 0; d < dim; ++d)
+          for (unsigned int k = 0; k < dim; ++k)
+            {
+              if (k >= d)
+                d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
+              d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
+            }
+        const materials::Material &m     = *s.prm.materials[mid];
+        auto                       sigma = L::get_stress(P);
+        m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.soil.layout.history, m.n_history()));
+        L::set_stress(sigma, P);
+      }
+      inline void
+      moved(const It &, double *, const dealii::Point<dim> &, PointState &)
+      {}
+    };
+    struct WaterMove
+    {
+      struct PointState
+      {};
+      inline void
+      increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du,
+                 const double *, double (&gu)[dim][dim], double (&dx)[dim])
+      {
+        transfer::default_increments<dim, K>(cell, e, du, gu, dx);
+      }
+      inline void
+      update(const unsigned int, const typename K::Cell &, double *, const double (&)[dim][dim], PointState &)
+      {}
+      inline void
+      moved(const It &, double *, const dealii::Point<dim> &, PointState &)
+      {}
+    };
+    {
+      SoilUpdate                                              su{*this, at(vs_new), h};
+      transfer::UpdateAndMove<dim, K, SoilUpdate>             move_soil(grid, soil, at(vs_t), h, su);
+      transfer::for_each_active_cell(soil, move_soil);
+      soil.relocate();
+      WaterMove                                               wm;
+      transfer::UpdateAndMove<dim, K, WaterMove>              move_water(grid, water, at(vw_new), h, wm);
+      transfer::for_each_active_cell(water, move_water);
+      water.relocate();
+    }
+  }
+
+  // ---------------------------------------------------------------- diagnostics and files
+  template <int dim>
+  void
+  Solver<dim>::check_stability() const
+  {
+    bool bad = false;
+    for (const Vector *v : {&vs_new, &vw_new, &p_node})
+      for (unsigned int i = 0; i < v->locally_owned_size(); ++i)
+        bad = bad || !std::isfinite(v->local_element(i));
+    if (dealii::Utilities::MPI::max(bad ? 1 : 0, comm))
+      throw InstabilityError("a nodal velocity or pore pressure became non-finite");
+  }
+
+  template <int dim>
+  std::vector<std::string>
+  Solver<dim>::series_columns() const
+  {
+    return {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
+            "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual"};
+  }
+
+  template <int dim>
+  std::vector<double>
+  Solver<dim>::series_values(const bool)
+  {
+    double ek[2] = {0, 0}, vmax[2] = {0, 0}, pmin = 0;
+    for (const bool is_soil : {true, false})
+      for (const auto &pt : (is_soil ? soil : water).handler)
+        {
+          const auto P  = pt.get_properties();
+          double     v2 = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            v2 += P[L::velocity + d] * P[L::velocity + d];
+          ek[is_soil ? 0 : 1] += 0.5 * P[L::mass] * v2;
+          vmax[is_soil ? 0 : 1] = std::max(vmax[is_soil ? 0 : 1], std::sqrt(v2));
+          if (!is_soil)
+            pmin = std::min(pmin, P[fw.pressure]);
+        }
+    return {dealii::Utilities::MPI::sum(ek[0], comm),
+            dealii::Utilities::MPI::sum(ek[1], comm),
+            dealii::Utilities::MPI::max(vmax[0], comm),
+            dealii::Utilities::MPI::max(vmax[1], comm),
+            dealii::Utilities::MPI::min(pmin, comm),
+            static_cast<double>(last_solve.iterations),
+            last_solve.relative_residual};
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::write_vtu(const unsigned int counter)
+  {
+    for (const bool is_soil : {true, false})
+      {
+        MaterialPointSet<dim> &set = is_soil ? soil : water;
+        dealii::Particles::DataOut<dim> out;
+        out.build_patches(set.handler, set.layout.names(), set.layout.interpretations());
+        const std::string name = io::write_vtu_atomic(out, prm.output_directory, set.name(), counter, comm);
+        auto &            records = pvd_records[is_soil ? 0 : 1];
+        records.emplace_back(time, name);
+        if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) // soil.pvd, water.pvd for ParaView
+          io::write_pvd(prm.output_directory + "/" + set.name() + ".pvd", records);
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::finish(const std::string &)
+  {
+    if (!prm.final_particles_csv)
+      return;
+    // <set>_final.csv: x, (y, z,) then the properties; rank 0 gathers, writes
+    // under a temporary name and renames
+    for (const bool is_soil : {true, false})
+      {
+        const MaterialPointSet<dim> &set = is_soil ? soil : water;
+        std::ostringstream           rows;
+        rows << std::setprecision(12);
+        for (const auto &pt : set.handler)
+          {
+            const auto x = pt.get_location();
+            for (unsigned int d = 0; d < dim; ++d)
+              rows << x[d] << ",";
+            const auto P = pt.get_properties();
+            for (unsigned int k = 0; k < P.size(); ++k)
+              rows << P[k] << (k + 1 < P.size() ? "," : "\n");
+          }
+        const auto all = dealii::Utilities::MPI::gather(comm, rows.str(), 0);
+        if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+          {
+            const std::string path = prm.output_directory + "/" + set.name() + "_final.csv";
+            {
+              std::ofstream f(path + ".tmp");
+              const char *  xyz[] = {"x", "y", "z"};
+              for (unsigned int d = 0; d < dim; ++d)
+                f << "pos_" << xyz[d] << ",";
+              // vector properties get their component as suffix (velocity_x, ...)
+              const auto names = set.layout.names();
+              for (unsigned int k = 0; k < names.size(); ++k)
+                {
+                  f << names[k];
+                  if (k >= L::velocity && k < L::stress)
+                    f << "_" << xyz[(k - L::velocity) % dim];
+                  f << (k + 1 < names.size() ? "," : "\n");
+                }
+              for (const auto &r : all)
+                f << r;
+            }
+            std::filesystem::rename(path + ".tmp", path);
+          }
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::summary(const LoopTimings &timings)
+  {
+    log() << "talus-semi-implicit: done: " << step_number << " steps, dt " << dt << " s, wall " << timings.total
+          << " s (pressure solves " << seconds_solve << " s, mean "
+          << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations), lost points "
+          << lost_points() << ", output in " << prm.output_directory << "/" << std::endl;
+  }
+
+  // ================================================================ tool entry points
+  void
+  check_parameters(dealii::ParameterHandler &prm, const std::string &)
+  {
+    const std::string out = prm.get_integer("dimension") == 2 ? parse_parameters<2>(prm).output_directory
+                                                              : parse_parameters<3>(prm).output_directory;
+    require_output_directory(out, "output/directory");
+  }
+
+  template <int dim>
+  static void
+  run_dim(dealii::ParameterHandler &prm)
+  {
+    auto         p = parse_parameters<dim>(prm);
+    Solver<dim>  s(p, MPI_COMM_WORLD);
+    s.setup();
+    TimeLoop loop(s, loop_settings<dim>(p), MPI_COMM_WORLD);
+    loop.run();
+  }
+
+  int
+  run(dealii::ParameterHandler &prm, const std::string &)
+  {
+    if (prm.get_integer("dimension") == 2)
+      run_dim<2>(prm);
+    else
+      run_dim<3>(prm);
+    return exit_ok;
+  }
+
+  template struct Parameters<2>;
+  template struct Parameters<3>;
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  template double soil_critical_time_step<2>(const Parameters<2> &, double);
+  template double soil_critical_time_step<3>(const Parameters<3> &, double);
+} // namespace talus::semi_implicit

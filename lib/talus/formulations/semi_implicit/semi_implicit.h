@@ -1,0 +1,72 @@
+// talus — the semi-implicit two-phase double-point MPM (seed 002: Xie, Navas &
+// López-Querol 2025, §3-4): soil and water are two MaterialPointSets on one
+// grid; one step is the incremental fractional step of the paper's §4.5 (P2N
+// of both phases, water predictor with implicit Darcy drag, mixture predictor,
+// one pressure-increment Poisson solve, correction, FLIP update of both sets,
+// MUSL remap, ΔF / J / volume / porosity). The time step is limited by the
+// soil skeleton's wave speed only. Decisions the paper leaves open:
+// docs/semi-implicit.md.
+#pragma once
+
+#include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/scene_parameters.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <string>
+#include <vector>
+
+namespace talus::semi_implicit
+{
+  /// What a body seeds (body k/phase).
+  enum class Phase
+  {
+    saturated, ///< soil and water points over the same region
+    soil,      ///< soil points only (dry skeleton)
+    water      ///< water points only (free water)
+  };
+
+  /// The soil's pore data of one material (material k/soil).
+  struct SoilData
+  {
+    double porosity     = 0.3;  ///< n_0 [-]
+    double conductivity = 1e-3; ///< hydraulic conductivity k_0 [m/s]
+  };
+
+  template <int dim>
+  struct Parameters : SceneParameters<dim>, RunParameters<dim>
+  {
+    std::vector<Phase>    phase_of_body;
+    std::vector<SoilData> soil_of_material;
+    std::vector<double>   surface_load; ///< per body: q [Pa] on its upper face
+    // time step: fixed, or courant x the soil skeleton's critical step
+    double time_step = 0, courant = 0.5;
+    // 'semi implicit' subsection
+    bool   bspline                  = true;  ///< quadratic B-spline (else linear Q1)
+    double water_density            = 1000;  ///< rho_w [kg/m^3]
+    double unit_weight_gravity      = 9.81;  ///< g of the drag (Eq. 15), kept when the body force is 0
+    double free_surface_fraction    = 0.5;   ///< a cell is wet when its water volume / cell volume >= this
+    double pressure_tolerance       = 1e-10; ///< CG relative residual of the Poisson solve
+    bool   kozeny_carman            = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
+    bool   pressure_smoothing       = true;  ///< Eq. 77 map-remap of the pore pressure every step
+    bool   linear_smoothing         = true;  ///< the map carries each point's value by its gradient
+    double flip_fraction            = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
+    // 'initial state' subsection: geostatic water pressure and effective stress
+    bool   geostatic    = false;
+    double water_level  = 0; ///< vertical coordinate of the free water surface
+    double soil_surface = 0; ///< vertical coordinate of the soil surface
+    double K0           = 1;
+  };
+
+  void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file);
+  template <int dim>
+  Parameters<dim> parse_parameters(dealii::ParameterHandler &prm);
+  /// --check: parse and validate without grid or points.
+  void check_parameters(dealii::ParameterHandler &prm, const std::string &prm_file);
+  int  run(dealii::ParameterHandler &prm, const std::string &prm_file);
+
+  /// The critical step of the soil skeleton: min over soil materials of
+  /// h / sqrt(E_c / ((1 - n) rho_s)) (the skeleton alone, the fastest wave).
+  template <int dim>
+  double soil_critical_time_step(const Parameters<dim> &p, double h_min);
+} // namespace talus::semi_implicit

@@ -1,0 +1,189 @@
+// talus — point ops on a point's own stencil (K::point_stencil: the nodes one
+// point touches, with values and real-space gradients), for passes whose
+// per-point arithmetic is a short formula over those nodes: the semi-implicit
+// family's P2N and N2P of two point sets (mass, momentum, porosity, pressure,
+// divergence, pressure gradient). The walk is cell_walk.h's; the formula comes
+// in as a callable visit(c, it, stencil).
+//
+// Nodal data live in grid vectors (BackgroundGrid::reinit_vector): a vector
+// field at the node's DoFs of every component, a scalar field at the node's
+// component-0 DoF (the other components unused). Indices are the grid's local
+// (owned + ghost) indices, as the kernels' Cell::dofs hold them.
+#pragma once
+
+#include <talus/grid/background_grid.h>
+#include <talus/transfer/cell_walk.h>
+#include <talus/transfer/matrix_ops.h>
+
+namespace talus::transfer
+{
+  /// The nodes one point touches (N or grad N non-zero), with grid local DoF
+  /// indices per component.
+  template <int dim, class K>
+  struct PointStencil
+  {
+    static constexpr unsigned int max_nodes = K::n_point_nodes;
+    unsigned int                  n         = 0;
+    unsigned int                  dof[max_nodes][dim]; ///< dof[w][0]: the node's scalar slot
+    double                        N[max_nodes];
+    double                        G[max_nodes][dim];
+
+    /// A scalar nodal field at the point.
+    inline double
+    value(const double *f) const
+    {
+      double s = 0;
+      for (unsigned int w = 0; w < n; ++w)
+        s += N[w] * f[dof[w][0]];
+      return s;
+    }
+    /// A vector nodal field at the point.
+    inline void
+    vector_value(const double *f, double (&out)[dim]) const
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        out[d] = 0;
+      for (unsigned int w = 0; w < n; ++w)
+        for (unsigned int d = 0; d < dim; ++d)
+          out[d] += N[w] * f[dof[w][d]];
+    }
+    /// Gradient of a scalar nodal field at the point.
+    inline void
+    gradient(const double *f, double (&out)[dim]) const
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        out[d] = 0;
+      for (unsigned int w = 0; w < n; ++w)
+        {
+          const double fw = f[dof[w][0]];
+          for (unsigned int d = 0; d < dim; ++d)
+            out[d] += G[w][d] * fw;
+        }
+    }
+    /// Divergence of a vector nodal field at the point.
+    inline double
+    divergence(const double *f) const
+    {
+      double s = 0;
+      for (unsigned int w = 0; w < n; ++w)
+        for (unsigned int d = 0; d < dim; ++d)
+          s += G[w][d] * f[dof[w][d]];
+      return s;
+    }
+    /// f[node] += a N (scalar field)
+    inline void
+    scatter(double *f, const double a) const
+    {
+      for (unsigned int w = 0; w < n; ++w)
+        f[dof[w][0]] += a * N[w];
+    }
+    /// f[node][d] += a N v[d] (vector field)
+    inline void
+    scatter_vector(double *f, const double a, const double *v) const
+    {
+      for (unsigned int w = 0; w < n; ++w)
+        for (unsigned int d = 0; d < dim; ++d)
+          f[dof[w][d]] += a * N[w] * v[d];
+    }
+    /// f[node][i] += sum_j t[i][j] dN/dx_j (a stress-like tensor t)
+    inline void
+    scatter_divergence(double *f, const double (&t)[dim][dim]) const
+    {
+      for (unsigned int w = 0; w < n; ++w)
+        for (unsigned int i = 0; i < dim; ++i)
+          {
+            double q = 0;
+            for (unsigned int j = 0; j < dim; ++j)
+              q += t[i][j] * G[w][j];
+            f[dof[w][i]] += q;
+          }
+    }
+  };
+
+  /// Fill the stencil of the point at reference location xi of `cell`.
+  template <int dim, class K>
+  inline void
+  point_stencil(const typename K::Cell &cell, const dealii::Point<dim> &xi, PointStencil<dim, K> &s)
+  {
+    unsigned int slot[K::n_point_nodes];
+    double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+    K::point_stencil(cell, xi, slot, N, G);
+    s.n = 0;
+    for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+      if (touches<dim>(N[w], G[w]))
+        {
+          const unsigned int k = s.n++;
+          s.N[k]               = N[w];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              s.G[k][d]   = G[w][d];
+              s.dof[k][d] = cell.dofs[slot[w] * dim + d];
+            }
+        }
+  }
+
+  /// The op: visit(c, it, stencil) for every point of the walk.
+  template <int dim, class K, class Visit>
+  struct VisitStencils
+  {
+    const BackgroundGrid<dim> &grid;
+    Visit &                    visit;
+    static constexpr bool      prefetch_location = false;
+    typename K::Cell           cell;
+    PointStencil<dim, K>       stencil;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+    }
+    inline bool
+    point(const unsigned int c, PointIterator<dim> &it)
+    {
+      point_stencil<dim, K>(cell, it->get_reference_location(), stencil);
+      visit(c, it, stencil);
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {}
+  };
+
+  /// One walk over `set` calling visit(c, it, stencil) per point.
+  template <int dim, class K, class Visit>
+  inline void
+  for_each_point_stencil(const BackgroundGrid<dim> &grid, MaterialPointSet<dim> &set, Visit &&visit)
+  {
+    VisitStencils<dim, K, std::remove_reference_t<Visit>> op{grid, visit, {}, {}};
+    for_each_active_cell(set, op);
+  }
+
+  /// Integrand of a scalar Poisson matrix and its source (transfer::assemble,
+  /// AssembleSystem with nc = 1): A_ij += P[coefficient] V_p grad N_i . grad N_j,
+  /// b_i += P[source] V_p N_i. One pass for both, so inhomogeneous Dirichlet
+  /// values reach b (deal.II moves -A_ij g_j from the local matrix).
+  struct PoissonWithSource
+  {
+    unsigned int          coefficient = 0, source = 0; ///< property offsets
+    static constexpr bool matrix = true, vector = true;
+    template <int dim, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      static_assert(nc == 1, "PoissonWithSource: a scalar space");
+      const double V = P[PropertyLayout<dim>::volume];
+      const double a = P[coefficient] * V, f = P[source] * V;
+      for (unsigned int i = 0; i < p.n; ++i)
+        {
+          for (unsigned int j = 0; j < p.n; ++j)
+            {
+              double gg = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                gg += p.G[i][d] * p.G[j][d];
+              ls.a(p.local[i], p.local[j]) += a * gg;
+            }
+          ls.b[p.local[i]] += f * p.N[i];
+        }
+    }
+  };
+} // namespace talus::transfer

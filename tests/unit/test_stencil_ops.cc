@@ -1,0 +1,187 @@
+// transfer/stencil_ops.h (the semi-implicit family's point passes), for the Q1
+// and the quadratic B-spline kernel in 2D and 3D, on 1 or 2 ranks:
+//  * P2N through for_each_point_stencil conserves mass and momentum (sum over
+//    the nodes = sum over the points, after compress);
+//  * N2P of a linear nodal field: value, gradient and divergence exact at every
+//    point (linear reproduction, walls included);
+//  * PoissonWithSource over an ActiveSet: the matrix is symmetric and
+//    annihilates the constant on the active nodes; the source vector sums to
+//    sum_p V_p s_p (partition of unity).
+#include <talus/grid/nodal_space.h>
+#include <talus/particles/material_point_set.h>
+#include <talus/shape/bspline2_box.h>
+#include <talus/shape/q1_box.h>
+#include <talus/transfer/stencil_ops.h>
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace talus;
+
+namespace
+{
+  template <int dim, class K>
+  void
+  run_checks(const bool bspline)
+  {
+    using L = PropertyLayout<dim>;
+    BackgroundGrid<dim> grid(MPI_COMM_WORLD);
+    dealii::Point<dim>  lo, hi;
+    std::vector<unsigned int> cells;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lo[d] = 0;
+        hi[d] = 1.0 + 0.25 * d;
+        cells.push_back(4 + d);
+      }
+    grid.make_box(lo, hi, cells);
+    grid.setup();
+    if (bspline)
+      grid.setup_bspline_patches();
+    MaterialPointSet<dim> set(grid, "points");
+    const unsigned int    coefficient = set.layout.add_extra("coefficient", 1);
+    const unsigned int    source      = set.layout.add_extra("source", 1);
+    set.initialize();
+    BodyDescription<dim> body; // touches the lower walls, not the upper ones
+    for (unsigned int d = 0; d < dim; ++d)
+      body.lower[d] = 0, body.upper[d] = 0.7 * hi[d];
+    body.particles_per_direction = 3;
+    seed_bodies(grid, {body}, {1500.0}, set.layout, set.handler);
+    set.collect_active_cells();
+
+    // a linear velocity field v = a + B x on the points, varying coefficients
+    const double a[3] = {0.3, -0.2, 0.1}, B[3][3] = {{0.5, -1.0, 0.2}, {0.7, 0.25, -0.4}, {0.1, 0.3, -0.6}};
+    double       m_sum = 0, p_sum[dim] = {}, vs_sum = 0;
+    for (auto &pt : set.handler)
+      {
+        auto       P = pt.get_properties();
+        const auto x = pt.get_location();
+        for (unsigned int i = 0; i < dim; ++i)
+          {
+            P[L::velocity + i] = a[i];
+            for (unsigned int j = 0; j < dim; ++j)
+              P[L::velocity + i] += B[i][j] * x[j];
+          }
+        P[coefficient] = 1.0 + x[0];
+        P[source]      = std::sin(3 * x[dim - 1]);
+        m_sum += P[L::mass];
+        for (unsigned int i = 0; i < dim; ++i)
+          p_sum[i] += P[L::mass] * P[L::velocity + i];
+        vs_sum += P[L::volume] * P[source];
+      }
+    const MPI_Comm comm = MPI_COMM_WORLD;
+    m_sum               = dealii::Utilities::MPI::sum(m_sum, comm);
+    vs_sum              = dealii::Utilities::MPI::sum(vs_sum, comm);
+    for (unsigned int i = 0; i < dim; ++i)
+      p_sum[i] = dealii::Utilities::MPI::sum(p_sum[i], comm);
+
+    // P2N of mass (scalar at component 0) and momentum
+    Vector M, Pm;
+    grid.reinit_vector(M);
+    grid.reinit_vector(Pm);
+    transfer::for_each_point_stencil<dim, K>(grid, set, [&](unsigned int, auto &it, const auto &s) {
+      const double *P = it->get_properties().data();
+      s.scatter(M.begin(), P[L::mass]);
+      s.scatter_vector(Pm.begin(), P[L::mass], P + L::velocity);
+    });
+    M.compress(dealii::VectorOperation::add);
+    Pm.compress(dealii::VectorOperation::add);
+    // component of every owned grid DoF
+    std::vector<unsigned int> comp(M.locally_owned_size() + grid.partitioner->n_ghost_indices(), 0);
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cell_iterators[c] != grid.tria.end())
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            comp[grid.cells[c].dofs[v * dim + d]] = d;
+    double Mn = 0, Pn[dim] = {};
+    for (unsigned int i = 0; i < M.locally_owned_size(); ++i)
+      {
+        Mn += M.local_element(i);
+        Pn[comp[i]] += Pm.local_element(i);
+      }
+    EXPECT_NEAR(dealii::Utilities::MPI::sum(Mn, comm), m_sum, 1e-12 * m_sum);
+    for (unsigned int i = 0; i < dim; ++i)
+      EXPECT_NEAR(dealii::Utilities::MPI::sum(Pn[i], comm), p_sum[i], 1e-12 * m_sum);
+
+    // a linear nodal field at the points: value, gradient, divergence
+    Vector V, S;
+    grid.reinit_vector(V);
+    grid.reinit_vector(S);
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cell_iterators[c] != grid.tria.end())
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          {
+            double x[dim];
+            for (unsigned int e = 0; e < dim; ++e)
+              x[e] = grid.cells[c].lower[e] + ((v >> e) & 1u) * grid.cells[c].h[e];
+            for (unsigned int i = 0; i < dim; ++i)
+              {
+                double vi = a[i];
+                for (unsigned int j = 0; j < dim; ++j)
+                  vi += B[i][j] * x[j];
+                V.local_element(grid.cells[c].dofs[v * dim + i]) = vi;
+              }
+            S.local_element(grid.cells[c].dofs[v * dim]) = 2.0 - x[0] + 0.5 * x[dim - 1];
+          }
+    double worst = 0;
+    transfer::for_each_point_stencil<dim, K>(grid, set, [&](unsigned int, auto &it, const auto &s) {
+      const double *P = it->get_properties().data();
+      double        v[dim], gs[dim];
+      s.vector_value(V.begin(), v);
+      for (unsigned int i = 0; i < dim; ++i)
+        worst = std::max(worst, std::abs(v[i] - P[L::velocity + i]));
+      double tr = 0;
+      for (unsigned int i = 0; i < dim; ++i)
+        tr += B[i][i];
+      worst = std::max(worst, std::abs(s.divergence(V.begin()) - tr));
+      const auto x = it->get_location();
+      worst        = std::max(worst, std::abs(s.value(S.begin()) - (2.0 - x[0] + 0.5 * x[dim - 1])));
+      s.gradient(S.begin(), gs);
+      worst = std::max(worst, std::abs(gs[0] + 1.0) + std::abs(gs[dim - 1] - 0.5));
+    });
+    EXPECT_LT(dealii::Utilities::MPI::max(worst, comm), 1e-12);
+
+    // the Poisson matrix and source over the active region
+    NodalSpace<dim> space(grid, 1);
+    space.setup();
+    ActiveSet<dim> active(space);
+    active.template reinit<K>({&set});
+    dealii::TrilinosWrappers::SparseMatrix A;
+    Vector                                 b, one, A_one;
+    active.reinit_matrix(A);
+    space.reinit_vector(b);
+    space.reinit_vector(one);
+    space.reinit_vector(A_one);
+    transfer::PoissonWithSource                                    terms{coefficient, source};
+    transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> op(active, active.constraints(), terms, &A, &b);
+    transfer::for_each_active_cell(set, op);
+    transfer::finish_assembly(active, op.diag_sum, op.diag_count, &A, &b);
+    EXPECT_NEAR(b.mean_value() * b.size(), vs_sum, 1e-12 * std::max(1.0, std::abs(vs_sum)));
+    for (const auto i : active.active_owned_dofs())
+      one(i) = 1.0;
+    A.vmult(A_one, one);
+    EXPECT_LT(A_one.linfty_norm(), 1e-12 * A.linfty_norm());
+    // symmetric: (A x, y) = (x, A y) for two fields on the active dofs
+    Vector x, y, Ax, Ay;
+    for (Vector *w : {&x, &y, &Ax, &Ay})
+      space.reinit_vector(*w);
+    for (const auto i : active.active_owned_dofs())
+      {
+        x(i) = std::sin(0.37 * i);
+        y(i) = std::cos(1.3 * i);
+      }
+    A.vmult(Ax, x);
+    A.vmult(Ay, y);
+    EXPECT_NEAR(Ax * y, x * Ay, 1e-12 * A.linfty_norm() * x.l2_norm() * y.l2_norm());
+  }
+} // namespace
+
+TEST(StencilOps, Q1In2D) { run_checks<2, shape::Q1Box<2>>(false); }
+TEST(StencilOps, Q1In3D) { run_checks<3, shape::Q1Box<3>>(false); }
+TEST(StencilOps, BSplineIn2D) { run_checks<2, shape::BSpline2Box<2>>(true); }
+TEST(StencilOps, BSplineIn3D) { run_checks<3, shape::BSpline2Box<3>>(true); }

@@ -1,0 +1,54 @@
+"""Bad input of talus-semi-implicit (issue 14): each case must exit with code 2
+before any output (the output directory is not even created), with one message
+'talus-semi-implicit: error: ...' naming the entry. Both through --check and a
+plain run.
+Usage: check_semi_bad_input.py TOOL PRM WORKDIR   (PRM: the hydrostatic column)
+"""
+import os
+import subprocess
+import sys
+
+import talus_verify as tv
+
+tool, prm_path, work = sys.argv[1:4]
+base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+cases = [
+    ("porosity above 1", [("material 0/soil/porosity", "1.2")], "material 0/soil/porosity"),
+    ("porosity 0", [("material 0/soil/porosity", "0")], "material 0/soil/porosity"),
+    ("zero conductivity", [("material 0/soil/hydraulic conductivity", "0")], "material 0/soil/hydraulic conductivity"),
+    ("negative conductivity", [("material 0/soil/hydraulic conductivity", "-1e-5")],
+     "material 0/soil/hydraulic conductivity"),
+    # a water body alone: no soil, so no skeleton for the drag and the mixture
+    ("water without soil", [("body 0/phase", "water")], "body 0/phase = water"),
+    ("soil without water", [("body 0/phase", "soil")], "body 0/phase = soil"),
+    ("unknown phase", [("body 0/phase", "gas")], "phase"),
+    ("free surface fraction", [("semi implicit/free surface volume fraction", "1")], "free surface volume fraction"),
+    ("checkpoints", [("checkpoint/interval", "0.1")], "checkpoint"),
+    ("negative surface load", [("body 0/surface load", "-5")], "body 0/surface load"),
+    ("surface load on water", [("body 0/surface load", "1e4"), ("number of bodies", "2"), ("body 1/phase", "water"),
+                               ("body 1/surface load", "1e3"), ("body 1/upper corner", "0.075, 1.05"),
+                               ("body 1/lower corner", "0, 1")], "body 1/surface load"),
+]
+for name, edits, needle in cases:
+    text = base
+    for k, v in edits:
+        text = tv.prm_set(text, k, v)
+    wd = os.path.join(work, name.replace(" ", "_"))
+    rc, out, err = tv.run_tool(tool, text, wd, "case", expect_rc=None)
+    lines = [l for l in (out + err).strip().splitlines() if l.strip()]
+    first_error = next((l for l in lines if ": error:" in l), "")
+    tv.check(rc == 2 and needle in (out + err) and first_error.startswith("talus-semi-implicit: error:")
+             and not os.path.exists(os.path.join(wd, "out")),
+             f"{name}: exit {rc}, message names '{needle}', nothing written: {first_error}")
+    p = subprocess.run([os.path.abspath(tool), "--check", os.path.join(wd, "case.prm")], cwd=wd,
+                       capture_output=True, text=True, env=tv.child_env())
+    tv.check(p.returncode == 2 and needle in (p.stdout + p.stderr), f"{name}: --check exits {p.returncode}")
+# the good file passes --check and writes nothing
+wd = os.path.join(work, "good")
+os.makedirs(wd, exist_ok=True)
+with open(os.path.join(wd, "case.prm"), "w") as f:
+    f.write(base)
+p = subprocess.run([os.path.abspath(tool), "--check", "case.prm"], cwd=wd, capture_output=True, text=True,
+                   env=tv.child_env())
+tv.check(p.returncode == 0 and not os.path.exists(os.path.join(wd, "out")), f"good file: --check exits {p.returncode}")
+tv.finish()

@@ -1,0 +1,46 @@
+"""Terzaghi's 1D consolidation, the paper's §5.1 / Table 1 (seed 002, issue 14):
+H = 1 m, 0.025 m grid, 2 x 2 points per cell per phase, dt = 1e-4 s, q = 10 kPa
+applied suddenly, E = 10 MPa, nu = 0, n0 = 0.3, k = 1e-3 m/s, no body force.
+With zeta = d / H the depth, M = pi (2m+1) / 2, T = c_v t / H^2,
+c_v = k E_oed / (rho_w g):
+  excess pore pressure u = -p = sum_m 2 q / M sin(M zeta) exp(-M^2 T)
+One run per T_v (to t = T_v H^2 / c_v, a whole number of 1e-4 s steps); the
+normalised error over the water points sqrt(sum (u - u_an)^2 / sum u_an^2)
+(decision A30 of the reading) must be below 3 % (the issue's tolerance).
+Usage: check_semi_terzaghi.py TOOL PRM WORKDIR [T,T,...]   (default 0.05,0.1,0.2)
+"""
+import math
+import sys
+
+import talus_verify as tv
+
+tool, prm_path, work = sys.argv[1:4]
+times = [float(x) for x in sys.argv[4].split(",")] if len(sys.argv) > 4 else [0.05, 0.1, 0.2]
+q, H, rw, g, E, k, dt = 1e4, 1.0, 1000.0, 9.81, 1e7, 1e-3, 1e-4
+cv = k * E / (rw * g)
+
+
+def analytic(zeta, T):
+    return sum(2 * q / M * math.sin(M * zeta) * math.exp(-M * M * T)
+               for M in (math.pi * (2 * m + 1) / 2 for m in range(400)))
+
+
+base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+for T in times:
+    n_steps = round(T * H * H / cv / dt)
+    text = tv.prm_set(base, "time/end time", repr(n_steps * dt))
+    name = f"T{T}"
+    tv.run_tool(tool, text, f"{work}/{name}", name)
+    w = tv.read_csv(f"{work}/{name}/out/water_final.csv")
+    Tn = cv * n_steps * dt / (H * H)
+    num = den = worst = 0.0
+    for p, y in zip(w["pore_pressure"], w["pos_y"]):
+        u, ua = -p, analytic(min(max((H - y) / H, 0.0), 1.0), Tn)
+        num += (u - ua) ** 2
+        den += ua ** 2
+        worst = max(worst, abs(u - ua) / q)
+    e = math.sqrt(num / den)
+    print(f"T_v = {Tn:.4f}: {n_steps} steps; normalised L2 error of the pore pressure {e:.3e}, "
+          f"max |u - u_an| / q = {worst:.3e}")
+    tv.check(e < 0.03, f"T_v = {T}: normalised L2 error {e:.2e} < 0.03")
+tv.finish()

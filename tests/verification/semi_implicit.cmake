@@ -1,0 +1,65 @@
+# Verification of the semi-implicit two-phase double-point family (issue 14).
+# Label "fast": make test / CI; "verify": the full versions (make verify).
+set(_v ${CMAKE_CURRENT_SOURCE_DIR}/verification)
+set(_w ${CMAKE_BINARY_DIR}/tests/verification)
+set(_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1;PYTHONPATH=${_v}")
+
+# geostatic saturated column at rest for k = 1e-3 and 1e-7 m/s at the same step;
+# the explicit 2-phase critical step of the same scene printed beside it
+add_test(NAME verification.semi_implicit_hydrostatic
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_hydrostatic.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_hydrostatic
+                 ${TALUS_TOOLS_DIR}/talus-critical-dt
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic_explicit.prm)
+set_tests_properties(verification.semi_implicit_hydrostatic PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# bad input: exit 2, the entry named, nothing written
+add_test(NAME verification.semi_implicit_bad_input
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_bad_input.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_bad_input)
+set_tests_properties(verification.semi_implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# self-weight consolidation against Terzaghi's series (triangular initial excess
+# pressure) at T_v = 0.05, 0.1, 0.2, 0.5: relative L2 error < 3 %
+add_test(NAME verification.semi_implicit_consolidation
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation 0.03)
+set_tests_properties(verification.semi_implicit_consolidation PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# 1 vs 2 ranks on the consolidation column to 1e-8
+add_test(NAME verification.semi_implicit_np1_np2
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_ranks.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_np1_np2)
+set_tests_properties(verification.semi_implicit_np1_np2 PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
+
+# the paper's Terzaghi case (§5.1, Table 1): normalised L2 error < 3 % at
+# T_v = 0.05, 0.1, 0.2 (fast) and 0.05 ... 1.0 (verify)
+add_test(NAME verification.semi_implicit_terzaghi_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_fast)
+set_tests_properties(verification.semi_implicit_terzaghi_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+add_test(NAME verification.semi_implicit_terzaghi
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi
+                 0.05,0.1,0.2,0.5,1.0)
+set_tests_properties(verification.semi_implicit_terzaghi PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+# the same with linear shape functions
+add_test(NAME verification.semi_implicit_consolidation_linear
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation_linear
+                 0.03 0.05,0.1,0.2,0.5 linear)
+set_tests_properties(verification.semi_implicit_consolidation_linear PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# the hydrostatic column over 10^4 steps (no drift; make verify)
+add_test(NAME verification.semi_implicit_hydrostatic_long
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_hydrostatic.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_hydrostatic_long
+                 --end-time=1.5)
+set_tests_properties(verification.semi_implicit_hydrostatic_long PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+
+# the stencil ops of the family's point passes on 2 ranks (conservation across
+# the partition, the Poisson matrix with rows on the other rank)
+add_test(NAME unit.test_stencil_ops_np2
+         COMMAND mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_stencil_ops)
+set_tests_properties(unit.test_stencil_ops_np2 PROPERTIES LABELS "unit" PROCESSORS 2 TIMEOUT 300 ENVIRONMENT "${_env}")
