@@ -11,6 +11,7 @@
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
 #include <talus/transfer/point_ops.h>
+#include <talus/materials/strain_increments.h>
 
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
@@ -675,13 +676,7 @@ namespace talus::explicit_mpm
       {
         materials::Strain d_eps;
         materials::Spin   d_omega;
-        for (unsigned int d = 0; d < dim; ++d)
-          for (unsigned int k = 0; k < dim; ++k)
-            {
-              if (k >= d)
-                d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
-              d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
-            }
+        materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
         if (smoothing) // §6.7.1: smoothed volumetric part
           smoothing->apply(c, d_eps);
         const materials::Material &m     = *materials[static_cast<unsigned int>(P[L::material])];

@@ -248,7 +248,6 @@ namespace talus::implicit_mpm
           }
     active.reinit_matrix(tangent);
     project_to_grid();
-    mass.update_ghost_values();
     dirichlet.close();
     constraints = active.constraints_with(dirichlet);
   }
@@ -340,7 +339,6 @@ namespace talus::implicit_mpm
   Solver<dim>::advance_by(const double h)
   {
     newmark.set_time_step(h);
-    h_step = h;
     prepare_step();
     const dealii::Tensor<1, dim> g = load_factor(time + h) * prm.gravity;
     // the external force scale |f_ext| (lumped nodal masses times g)

@@ -128,7 +128,6 @@ namespace talus::implicit_mpm
     std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
-    double                                  h_step = 0;
     std::vector<std::pair<double, std::string>> pvd_records;
     // totals for the summary
     unsigned long long total_iterations = 0, total_linear_iterations = 0;

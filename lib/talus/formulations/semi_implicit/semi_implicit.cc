@@ -22,6 +22,7 @@
 #include <talus/transfer/matrix_ops.h>
 #include <talus/transfer/point_ops.h>
 #include <talus/transfer/stencil_ops.h>
+#include <talus/materials/strain_increments.h>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/affine_constraints.h>
@@ -954,13 +955,7 @@ namespace talus::semi_implicit
         // increments of ΔF (rate form, as the explicit family)
         materials::Strain d_eps;
         materials::Spin   d_omega;
-        for (unsigned int d = 0; d < dim; ++d)
-          for (unsigned int k = 0; k < dim; ++k)
-            {
-              if (k >= d)
-                d_eps[d][k] = 0.5 * (gu[d][k] + gu[k][d]);
-              d_omega[d][k] = 0.5 * (gu[d][k] - gu[k][d]);
-            }
+        materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
         const materials::Material &m     = *s.prm.materials[mid];
         auto                       sigma = L::get_stress(P);
         m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.soil.layout.history, m.n_history()));
