@@ -1,9 +1,12 @@
 // talus-critical-dt: the critical time step of an explicit scene, from the
-// formula (seed 000 §4.6.1) and, with --probe, measured by short runs.
+// formula (seed 000 §4.6.1) and, with --probe, measured by short runs. For an
+// implicit scene (a talus-implicit .prm) it says that the step is not CFL-limited
+// and prints the explicit critical step of the same grid and materials beside it.
 #include <talus/analysis/scheme_stability.h>
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/io/output.h>
 
 #include <deal.II/base/mpi.h>
@@ -11,7 +14,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <regex>
 #include <iomanip>
 #include <sstream>
 
@@ -39,6 +44,98 @@ namespace
     if (used != v.size() || v.empty() || !std::isfinite(x) || x < 0)
       throw InputError("option --crossing-velocity: '" + v + "' is not a finite velocity >= 0 [m/s]");
     return x;
+  }
+
+  /// A talus-implicit .prm: it has the top-level subsection 'implicit'.
+  bool
+  is_implicit_scene(const std::string &prm_file)
+  {
+    if (prm_file.empty())
+      return false;
+    std::ifstream     in(prm_file);
+    std::string       line;
+    const std::regex  opening(R"(^\s*subsection\s+implicit\s*(#.*)?$)");
+    while (std::getline(in, line))
+      if (std::regex_match(line, opening))
+        return true;
+    return false;
+  }
+
+  /// Implicit scene: no CFL limit for an unconditionally stable Newmark pair (or
+  /// a static analysis); the explicit critical step of the same grid and
+  /// materials (Eq. 4.120 per material) and the ratio of the implicit step to it.
+  template <int dim>
+  int
+  run_implicit(dealii::ParameterHandler &prm)
+  {
+    using P      = implicit_mpm::Parameters<dim>;
+    const auto p = implicit_mpm::parse_parameters<dim>(prm);
+    double     L_min = std::numeric_limits<double>::max();
+    if (p.grid_mesh)
+      L_min = p.grid_mesh->min_edge();
+    else
+      for (unsigned int d = 0; d < dim; ++d)
+        L_min = std::min(L_min, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
+    const auto  rows = explicit_mpm::critical_time_steps(p.materials, {}, L_min);
+    std::size_t ctrl = 0;
+    for (std::size_t i = 1; i < rows.size(); ++i)
+      if (rows[i].dt < rows[ctrl].dt)
+        ctrl = i;
+    const double dt_cr   = rows[ctrl].dt;
+    const double h       = p.time_step;
+    const bool   dynamic = p.analysis == P::Analysis::dynamic;
+    // Newmark on a linear undamped system: unconditionally stable for
+    // 2 beta >= gamma >= 1/2; else stable for omega h <= 1 / sqrt(gamma / 2 - beta).
+    // The largest frequency of the lumped Q1 grid is omega_max = 2 c / L_min, so
+    // that bound is h <= Omega_crit / 2 x (L_min / c).
+    const bool   unconditional = !dynamic || 2 * p.beta >= p.gamma;
+    const double omega_crit    = unconditional ? 0.0 : 1.0 / std::sqrt(0.5 * p.gamma - p.beta);
+    const double h_limit       = unconditional ? std::numeric_limits<double>::infinity() : 0.5 * omega_crit * dt_cr;
+
+    log() << std::setprecision(6) << "talus-critical-dt: implicit MPM scene (talus-implicit), analysis = "
+          << (dynamic ? "dynamic, Newmark gamma = " + std::to_string(p.gamma) + ", beta = " + std::to_string(p.beta) :
+                        std::string("static"))
+          << "\n  L_min = " << L_min << " m (smallest cell edge of the grid)\n";
+    for (const auto &r : rows)
+      log() << "  " << r.material << " (" << r.model << "): c = " << r.wave_speed << " m/s, explicit dt_cr = " << r.dt
+            << " s (" << r.formula << ")\n";
+    if (!dynamic)
+      log() << "  static analysis: no inertia, time is a load parameter; the step is not limited by stability "
+               "(load steps are chosen for Newton convergence)\n";
+    else if (unconditional)
+      log() << "  Newmark with 2 beta >= gamma >= 1/2 is unconditionally stable (linear analysis): the time step is "
+               "not CFL-limited; it is chosen for accuracy (trapezoidal rule: period error (omega h)^2 / 12) and "
+               "Newton convergence\n";
+    else
+      log() << "  Newmark with 2 beta < gamma is only conditionally stable: for finite elements with the lumped "
+               "mass, omega h <= "
+            << omega_crit << " with omega_max = 2 c / L_min, i.e. h <= " << h_limit << " s = " << h_limit / dt_cr
+            << " x the explicit dt_cr. WARNING: this is not a safe bound for MPM: the projection of velocity and "
+               "acceleration through the points every step lowers it (measured on the implicit bar, beta = 0.2: "
+               "unstable from about 0.7 x this value; docs/implicit.md). Use 2 beta >= gamma.\n";
+    log() << "  controlling material: " << rows[ctrl].material << "; explicit critical time step " << dt_cr << " s\n"
+          << "  implicit time step in use: " << h << " s = " << h / dt_cr
+          << " x the explicit critical step (explicit steps per implicit step)"
+          << (unconditional ? "" : (h <= h_limit ? "; within the finite-element Newmark bound" :
+                                                   "; ABOVE the finite-element Newmark bound"))
+          << "\n";
+
+    const std::string csv = tool_option_value("--csv", "");
+    if (!csv.empty() && dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      {
+        io::AtomicFile f(csv);
+        f.stream() << std::setprecision(10)
+                   << "material,model,formula,wave_speed,L_min,dt_critical_explicit,controlling,analysis,newmark_gamma,"
+                      "newmark_beta,cfl_limited,dt_newmark_limit,dt_in_use,ratio_to_explicit\n";
+        for (std::size_t i = 0; i < rows.size(); ++i)
+          f.stream() << rows[i].material << "," << rows[i].model << ",\"" << rows[i].formula << "\","
+                     << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << (i == ctrl ? 1 : 0) << ","
+                     << (dynamic ? "dynamic" : "static") << "," << p.gamma << "," << p.beta << ","
+                     << (unconditional ? 0 : 1) << "," << (unconditional ? 0.0 : h_limit) << "," << h << ","
+                     << h / dt_cr << "\n";
+        f.commit();
+      }
+    return exit_ok;
   }
 
   template <int dim>
@@ -257,14 +354,37 @@ main(int argc, char **argv)
                  "the scheme actually implemented (eigenvalues of one step on a uniform 1D grid with the\n"
                  "points per direction of the scene; docs/stability-analysis.md).\n"
                  "With --probe, the real limit is measured by bisection on short forced runs whose\n"
-                 "instability check (energy growth, non-finite state) decides stable / unstable.";
-  tool.declare = &talus::explicit_mpm::declare_parameters;
-  tool.options = {{"--probe", "measure the limit by bisection on f x dt_cr, f in [0.5, 4]"},
+                 "instability check (energy growth, non-finite state) decides stable / unstable.\n"
+                 "An implicit scene (a talus-implicit .prm, recognised by its 'implicit' subsection): the\n"
+                 "tool states whether the step is CFL-limited (static, or Newmark with 2 beta >= gamma:\n"
+                 "no; else the Newmark limit) and prints the explicit critical step of the same grid and\n"
+                 "materials and the ratio of the implicit step to it (the speed-up in steps).";
+  tool.declare = [](dealii::ParameterHandler &prm, const std::string &prm_file) {
+    if (is_implicit_scene(prm_file))
+      talus::implicit_mpm::declare_parameters(prm, prm_file);
+    else
+      talus::explicit_mpm::declare_parameters(prm, prm_file);
+  };
+  tool.options = {{"--probe", "measure the limit by bisection on f x dt_cr, f in [0.5, 4] (explicit scenes)"},
                   {"--probe-steps=", "steps per probe run (default 400)"},
                   {"--csv=", "also write the results to this CSV file"},
                   {"--crossing-velocity=", "points cross cells at VALUE m/s: growth per step (Floquet, 1D)"}};
-  tool.check   = [](dealii::ParameterHandler &prm, const std::string &) {
-    if (prm.get_integer("dimension") == 2)
+  tool.check   = [](dealii::ParameterHandler &prm, const std::string &prm_file) {
+    const bool implicit = is_implicit_scene(prm_file);
+    const bool two      = prm.get_integer("dimension") == 2;
+    if (implicit)
+      {
+        if (two)
+          talus::implicit_mpm::parse_parameters<2>(prm);
+        else
+          talus::implicit_mpm::parse_parameters<3>(prm);
+        for (const char *o : {"--probe", "--probe-steps", "--crossing-velocity"})
+          if (talus::tool_option_given(o))
+            throw talus::InputError(std::string("option ") + o +
+                                    ": the probe runs and the crossing analysis are those of the explicit scheme; "
+                                    "not available for an implicit scene (allowed: --csv=FILE)");
+      }
+    else if (two)
       talus::explicit_mpm::parse_parameters<2>(prm);
     else
       talus::explicit_mpm::parse_parameters<3>(prm);
@@ -273,8 +393,11 @@ main(int argc, char **argv)
     if (talus::tool_option_given("--csv"))
       talus::require_output_file(talus::tool_option_value("--csv", ""), "option --csv");
   };
-  tool.run     = [](dealii::ParameterHandler &prm, const std::string &) {
-    return prm.get_integer("dimension") == 2 ? run<2>(prm) : run<3>(prm);
+  tool.run     = [](dealii::ParameterHandler &prm, const std::string &prm_file) {
+    const bool two = prm.get_integer("dimension") == 2;
+    if (is_implicit_scene(prm_file))
+      return two ? run_implicit<2>(prm) : run_implicit<3>(prm);
+    return two ? run<2>(prm) : run<3>(prm);
   };
   return talus::run_tool(argc, argv, tool);
 }

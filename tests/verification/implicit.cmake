@@ -41,3 +41,10 @@ add_test(NAME verification.implicit_bad_input
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bad_input.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_bad_input)
 set_tests_properties(verification.implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# talus-critical-dt on implicit scenes: not CFL-limited, the explicit step and the
+# ratio beside it; the Newmark limit when 2 beta < gamma (and a run inside it)
+add_test(NAME verification.critical_dt_implicit
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_critical_dt_implicit.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit ${_w}/critical_dt_implicit)
+set_tests_properties(verification.critical_dt_implicit PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

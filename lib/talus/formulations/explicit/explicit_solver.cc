@@ -139,10 +139,18 @@ namespace talus::explicit_mpm
         require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/shape function",
                 "coupled 2-phase materials and body tractions" + why + "1-phase materials without tractions");
+        // prescribed velocities on grid nodes need only the nodal momentum p^t,
+        // projected by the kernel-templated ScatterMomentum
         for (const auto &st : p.loads.stages)
-          require(st.tractions.empty() && st.velocities.empty() && st.friction_ids.empty(), "numerics/shape function",
-                  "tractions, prescribed velocities and boundary friction (loads sections)" + why +
-                    "damping, mass scaling, quasi-static convergence, K0 and stages");
+          {
+            bool on_points = false;
+            for (const auto &v : st.velocities)
+              on_points = on_points || v.target == loads::PrescribedVelocity<dim>::Target::body;
+            require(st.tractions.empty() && !on_points && st.friction_ids.empty(), "numerics/shape function",
+                    "tractions, prescribed velocities of bodies and boundary friction (loads sections)" + why +
+                      "damping, mass scaling, quasi-static convergence, K0, stages and prescribed velocities "
+                      "on grid nodes (apply to = boundary | region)");
+          }
         require(!p.grid_mesh, "grid/source",
                 "a grid file with quadratic B-splines: they need a uniform box grid; allowed: box");
         for (unsigned int d = 0; d < dim; ++d)

@@ -27,7 +27,7 @@ namespace talus::explicit_mpm
                       "the linear extrapolation, so fixed and roller walls hold exactly at the wall; "
                       "docs/shape-functions.md). Quadratic B-splines need a uniform box grid with at least 3 "
                       "cells per direction and integration = mpm, without strain smoothing, contact, 2-phase "
-                      "materials, tractions or prescribed velocities.");
+                      "materials, tractions, friction or prescribed velocities of bodies.");
     prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
                       "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
                       "UL-FEM): 'mpm' at the material points; "
