@@ -7,7 +7,11 @@
 # and of a 2D column collapse in the corner of a wide box: 1 rank, two concurrent
 # 1-rank runs (the memory-bandwidth ceiling of 2 ranks), 2 ranks (and 2 ranks with
 # load balancing for the corner scene): speed-up, efficiency against the ceiling,
-# full sorts, peak memory per point. Build type must be Release (the Makefile's default).
+# full sorts, peak memory per point. Then the implicit family (issue 13): a 2D and a
+# 3D scene (time per step and per Newton iteration, assembly ns per point, linear
+# solve time), and the quasi-static oedometer solved by talus-explicit (local
+# damping) and by talus-implicit (static) to the same accuracy: both wall times.
+# Build type must be Release (the Makefile's default).
 set -euo pipefail
 BUILD=${1:-build}
 LOG=$(mktemp)
@@ -113,3 +117,37 @@ print(f"  linear solve {ts / max(ns, 1):.3f} s per solve ({ns} solves)")
 print(f"  convective phase {1e9 * tc / (steps * n):.0f} ns per point-step")
 PY
 done
+
+# ---- quasi-static: the same oedometer by talus-explicit (local damping until the
+# force ratio < 1e-6) and talus-implicit (static, one load step): wall times (the
+# tools' own figure and the process time) and the error of each against the
+# analytic settlement, so the accuracy is seen to be the same
+for fam in explicit implicit; do
+  PRM=parameter_files/bench/qs_oedometer_$fam.prm
+  echo "bench: $PRM"
+  /usr/bin/time -f "process wall %e s" -o "$TMPD/qs_$fam.time" \
+    "$BUILD/tools/talus-$fam" "$(prm_with "$PRM" "$TMPD/out_qs_$fam")" > "$TMPD/qs_$fam.log"
+  tail -n 2 "$TMPD/qs_$fam.log"
+done
+python3 - "$TMPD" <<'PY'
+import csv, re, sys
+d = sys.argv[1]
+E, nu, rho, g, H = 1e7, 0.3, 2000.0, 9.81, 1.0
+E_oed = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+top = rho * g * H * H / (2 * E_oed)
+res = {}
+for fam in ("explicit", "implicit"):
+    rows = list(csv.DictReader(open(f"{d}/out_qs_{fam}/particles_final.csv")))
+    err = 0.0
+    for r in rows:
+        Y = float(r["pos_y"]) - float(r["u_y"])
+        err = max(err, abs(float(r["u_y"]) + rho * g * (H * Y - Y * Y / 2) / E_oed))
+    wall = float(re.search(r"wall ([\d.e+-]+) s", open(f"{d}/qs_{fam}.log").read()).group(1))
+    proc = float(re.search(r"process wall ([\d.]+) s", open(f"{d}/qs_{fam}.time").read()).group(1))
+    res[fam] = (wall, proc, err / top, len(rows))
+print("\nbench quasi-static oedometer (%d points):" % res["implicit"][3])
+for fam, (wall, proc, err, _) in res.items():
+    print(f"  talus-{fam:9s} wall {wall:8.2f} s (process {proc:6.2f} s), max settlement error {100 * err:.3f} % of the top value")
+print(f"  implicit speed-up: {res['explicit'][0] / res['implicit'][0]:.0f} x (solver wall), "
+      f"{res['explicit'][1] / res['implicit'][1]:.0f} x (process, start-up included)")
+PY
