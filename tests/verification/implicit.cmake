@@ -48,3 +48,24 @@ add_test(NAME verification.critical_dt_implicit
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_critical_dt_implicit.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit ${_w}/critical_dt_implicit)
 set_tests_properties(verification.critical_dt_implicit PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# granular column collapse (seed 001 §6.1) by the thesis's own method: implicit dynamic,
+# Hencky Mohr-Coulomb, Rayleigh alpha 1.5, 3 x 3 points per cell; run-out within 15 % of
+# Table 6.5 (Tables 6.2-6.4 printed beside). Fast: a = 1.2 on the coarse grid (cell d_i/12);
+# verify: a = 3 (cell d_i/12) and both at the .prm's cell d_i/18.
+add_test(NAME verification.implicit_column_collapse_a1.2_coarse
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_column_collapse.py ${TALUS_TOOLS_DIR}/talus-implicit
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_column_collapse_a1.2_coarse
+                 0.6666666667 0)
+set_tests_properties(verification.implicit_column_collapse_a1.2_coarse PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 900)
+foreach(_case "a3;0.6666666667" "a3;1" "a1.2;1")
+  list(GET _case 0 _a)
+  list(GET _case 1 _r)
+  add_test(NAME verification.implicit_column_collapse_${_a}_refine${_r}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_column_collapse.py ${TALUS_TOOLS_DIR}/talus-implicit
+                   ${TALUS_PRM_DIR}/implicit/column_collapse_${_a}.prm
+                   ${_w}/implicit_column_collapse_${_a}_refine${_r} ${_r})
+  set_tests_properties(verification.implicit_column_collapse_${_a}_refine${_r} PROPERTIES LABELS "verify"
+                       ENVIRONMENT "${_env}" TIMEOUT 7200)
+endforeach()
