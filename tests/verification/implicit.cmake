@@ -69,3 +69,10 @@ foreach(_case "a3;0.6666666667" "a3;1" "a1.2;1")
   set_tests_properties(verification.implicit_column_collapse_${_a}_refine${_r} PROPERTIES LABELS "verify"
                        ENVIRONMENT "${_env}" TIMEOUT 7200)
 endforeach()
+
+# checkpoint/restart: bitwise continuation on 1 and on 2 ranks, refused foreign or missing checkpoints
+add_test(NAME verification.implicit_checkpoint_restart
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart)
+set_tests_properties(verification.implicit_checkpoint_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)

@@ -242,6 +242,7 @@ namespace talus
     /// Particles moved (locally) since the last full sort: part of the state a
     /// checkpoint saves, since it decides when the next memory-order sort runs.
     unsigned long long &moves_since_sort() { return moved_since_sort; }
+    unsigned long long  moves_since_sort() const { return moved_since_sort; }
 
   private:
     struct Pending

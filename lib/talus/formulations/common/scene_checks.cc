@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 namespace talus
@@ -245,6 +246,35 @@ namespace talus
               fmt(max_material_points) + " (check 'cells' and 'particles per direction')");
   }
 
+  template <int dim>
+  void
+  check_run_files(const RunParameters<dim> &p)
+  {
+    require_output_directory(p.output_directory, "output/directory");
+    const bool        own = p.checkpoint_directory.empty();
+    const std::string dir = checkpoint_directory_of(p);
+    if (p.checkpoint_interval > 0 || p.checkpoint_wall_interval > 0)
+      require_output_directory(dir, own ? "output/directory" : "checkpoint/directory");
+    if (p.restart == RunParameters<dim>::Restart::yes)
+      {
+        // the newest valid one is chosen (and read) later; here at least one must exist
+        bool            found = false;
+        std::error_code ec;
+        if (std::filesystem::is_directory(dir, ec))
+          for (const auto &e : std::filesystem::directory_iterator(dir, ec))
+            {
+              const std::string n = e.path().filename().string();
+              if (n.rfind("checkpoint-", 0) == 0 && e.path().extension() == ".h5")
+                found = true;
+            }
+        require(found, "checkpoint/restart",
+                "no valid checkpoint: no checkpoint-<step>.h5 in '" + dir +
+                  "' to restart from (allowed: 'if available' to start at t = 0 when there is none, or false)");
+      }
+  }
+
+  template void check_run_files(const RunParameters<2> &);
+  template void check_run_files(const RunParameters<3> &);
   template void check_scene_consistency(const SceneParameters<2> &);
   template void check_scene_consistency(const SceneParameters<3> &);
 } // namespace talus

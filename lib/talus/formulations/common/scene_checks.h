@@ -6,6 +6,8 @@
 
 #include <talus/formulations/common/scene_parameters.h>
 
+#include <string>
+
 namespace talus
 {
   /// Largest box grid (cells in total) and number of material points a scene
@@ -17,6 +19,19 @@ namespace talus
 
   template <int dim>
   void check_scene_consistency(const SceneParameters<dim> &p);
+
+  /// Where checkpoints go: checkpoint/directory, or <output>/checkpoints.
+  template <int dim>
+  std::string checkpoint_directory_of(const RunParameters<dim> &p)
+  {
+    return p.checkpoint_directory.empty() ? p.output_directory + "/checkpoints" : p.checkpoint_directory;
+  }
+
+  /// The files of a run (for --check and before the run): the output
+  /// directory and, with checkpoints, their directory can be created; with
+  /// 'restart = true' a checkpoint exists to restart from.
+  template <int dim>
+  void check_run_files(const RunParameters<dim> &p);
 
   /// Estimated peak memory of one node [bytes] for a scene of n_cells and
   /// n_points run on ranks_on_node ranks (measured figures, docs/reliability.md).

@@ -89,44 +89,14 @@ namespace talus::explicit_mpm
       }
   }
 
-  namespace
-  {
-    template <int dim>
-    void
-    check_files(const Parameters<dim> &p)
-    {
-      require_output_directory(p.output_directory, "output/directory");
-      const bool        own = p.checkpoint_directory.empty();
-      const std::string dir = own ? p.output_directory + "/checkpoints" : p.checkpoint_directory;
-      if (p.checkpoint_interval > 0 || p.checkpoint_wall_interval > 0)
-        require_output_directory(dir, own ? "output/directory" : "checkpoint/directory");
-      if (p.restart == Parameters<dim>::Restart::yes)
-        {
-          // the newest valid one is chosen (and read) later; here at least one must exist
-          bool            found = false;
-          std::error_code ec;
-          if (std::filesystem::is_directory(dir, ec))
-            for (const auto &e : std::filesystem::directory_iterator(dir, ec))
-              {
-                const std::string n = e.path().filename().string();
-                if (n.rfind("checkpoint-", 0) == 0 && e.path().extension() == ".h5")
-                  found = true;
-              }
-          require(found,
-                  "checkpoint/restart",
-                  "no valid checkpoint: no checkpoint-<step>.h5 in '" + dir +
-                    "' to restart from (allowed: 'if available' to start at t = 0 when there is none, or false)");
-        }
-    }
-  } // namespace
 
   void
   check_scene(dealii::ParameterHandler &prm, const std::string &)
   {
     if (prm.get_integer("dimension") == 2)
-      check_files(parse_parameters<2>(prm));
+      check_run_files(parse_parameters<2>(prm));
     else
-      check_files(parse_parameters<3>(prm));
+      check_run_files(parse_parameters<3>(prm));
   }
 
 

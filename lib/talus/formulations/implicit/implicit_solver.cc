@@ -1,9 +1,11 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/implicit/implicit_solver.h>
+#include <talus/io/output.h>
 #include <talus/shape/q1_box.h>
 #include <talus/transfer/updated_lagrangian_ops.h>
 
@@ -133,8 +135,6 @@ namespace talus::implicit_mpm
     const auto not_yet = [](const bool used, const std::string &entry) {
       require(!used, entry, "not available in talus-implicit yet (issue 13); remove the entry");
     };
-    not_yet(p.checkpoint_interval > 0 || p.checkpoint_wall_interval > 0, "checkpoint/interval");
-    not_yet(p.restart != Parameters<dim>::Restart::no, "checkpoint/restart");
     not_yet(!p.results_file.empty(), "output/results file");
     not_yet(!p.probes.empty(), "output/probes");
     not_yet(p.write_grid, "output/write grid");
@@ -152,12 +152,10 @@ namespace talus::implicit_mpm
   void
   check_scene(dealii::ParameterHandler &prm, const std::string &)
   {
-    std::string out;
     if (prm.get_integer("dimension") == 2)
-      out = parse_parameters<2>(prm).output_directory;
+      check_run_files(parse_parameters<2>(prm));
     else
-      out = parse_parameters<3>(prm).output_directory;
-    require_output_directory(out, "output/directory");
+      check_run_files(parse_parameters<3>(prm));
   }
 
   // ================================================================ solver
@@ -191,26 +189,41 @@ namespace talus::implicit_mpm
     acceleration_offset     = points.layout.add_extra("acceleration", dim, true);
     points.initialize();
 
-    std::vector<double> density;
-    for (const auto &m : prm.materials)
-      density.push_back(m->density());
-    auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
-    const auto filed  = insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
-    for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-      require(seeded.volume_per_body[b] + filed.volume_per_body[b] > 0,
-              "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
-              "contains no material point: it lies outside the grid or is smaller than one sub-cell");
-    using L = PropertyLayout<dim>;
-    for (auto &pt : points.handler)
+    bool restored = false;
+    if (prm.restart != Parameters<dim>::Restart::no)
       {
-        auto        P = pt.get_properties();
-        const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
-        m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + L::history, m.n_history()));
-        for (unsigned int d = 0; d < dim; ++d)
-          P[acceleration_offset + d] = 0.0;
+        restored = restore_checkpoint();
+        if (!restored && prm.restart == Parameters<dim>::Restart::yes)
+          throw InputError("checkpoint/restart: no valid checkpoint (checkpoint-<step>.h5) in '" +
+                           checkpoint_directory_of(prm) + "'");
+        if (!restored)
+          log() << "  no checkpoint in " << checkpoint_directory_of(prm) << ": starting at t = 0" << std::endl;
+      }
+    if (!restored)
+      {
+        std::vector<double> density;
+        for (const auto &m : prm.materials)
+          density.push_back(m->density());
+        auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
+        const auto filed =
+          insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
+        for (unsigned int b = 0; b < prm.bodies.size(); ++b)
+          require(seeded.volume_per_body[b] + filed.volume_per_body[b] > 0,
+                  "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
+                  "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+        using L = PropertyLayout<dim>;
+        for (auto &pt : points.handler)
+          {
+            auto        P = pt.get_properties();
+            const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+            m.initialize_history(L::get_stress(P.data()),
+                                 dealii::ArrayView<double>(P.data() + L::history, m.n_history()));
+            for (unsigned int d = 0; d < dim; ++d)
+              P[acceleration_offset + d] = 0.0;
+          }
+        dt = prm.time_step;
       }
     points.collect_active_cells();
-    dt = prm.time_step;
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
       space.reinit_vector(*v);
   }
@@ -602,11 +615,61 @@ namespace talus::implicit_mpm
     write_point_vtu(points, prm.output_directory, "particles", counter, time, pvd_records, comm);
   }
 
+  // ---------------------------------------------------------------- checkpoints
+  // The state between two steps is the points (with their accelerations, Eq.
+  // 2.16), the loop's state and the Newton totals of the summary: the grid is
+  // rebuilt from the points every step. Same rank count: bitwise continuation.
+  namespace
+  {
+    const char *const checkpoint_format  = "talus-implicit-checkpoint";
+    const int         checkpoint_version = 1;
+  } // namespace
+
   template <int dim>
   std::string
   Solver<dim>::write_checkpoint()
   {
-    throw std::logic_error("talus-implicit: checkpoints are refused when the parameters are read");
+    const std::string dir  = checkpoint_directory_of(prm);
+    const std::string name = prepare_checkpoint_file(dir, step_number, comm);
+    io::H5File        f(name, io::H5File::Mode::create, comm);
+    write_checkpoint_header(f, checkpoint_format, checkpoint_version, dim, comm);
+    write_run_state(f, *this);
+    f.write_global("scene/signature", scene_signature(prm, points.layout.n_properties()), 1);
+    f.set_attribute("newton iterations", std::int64_t(total_iterations));
+    f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
+    f.set_attribute("cut-backs", std::int64_t(cut_backs));
+    write_points(f, points);
+    write_pvd_times(f, "output/pvd", pvd_records);
+    f.commit();
+    prune_checkpoint_files(dir, prm.checkpoint_keep, comm);
+    return name;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::rewrite_records()
+  {
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      io::write_pvd(prm.output_directory + "/particles.pvd", pvd_records);
+  }
+
+  template <int dim>
+  bool
+  Solver<dim>::restore_checkpoint()
+  {
+    const auto fp = open_newest_checkpoint<dim>(list_checkpoint_files(checkpoint_directory_of(prm), comm),
+                                                checkpoint_format, checkpoint_version,
+                                                scene_signature(prm, points.layout.n_properties()), comm);
+    if (!fp)
+      return false;
+    read_run_state(*fp, *this, prm.checkpoint_interval);
+    total_iterations        = fp->get_int("newton iterations");
+    total_linear_iterations = fp->get_int("linear iterations");
+    cut_backs               = fp->get_int("cut-backs");
+    read_points(*fp, points, grid, "checkpoint " + fp->path());
+    pvd_records   = read_pvd_records(*fp, "output/pvd", "particles");
+    restored_from = fp->path();
+    return true;
   }
 
   template <int dim>

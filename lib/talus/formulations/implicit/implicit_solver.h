@@ -97,6 +97,7 @@ namespace talus::implicit_mpm
     std::vector<double>      series_values(const bool after_step) override;
     void                     write_vtu(const unsigned int counter) override;
     std::string              write_checkpoint() override;
+    void                     rewrite_records() override;
     void                     finish(const std::string &series_csv) override;
     void                     summary(const LoopTimings &timings) override;
 
@@ -122,6 +123,8 @@ namespace talus::implicit_mpm
     double assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g);
     /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
     void nodal_acceleration(Vector &a) const;
+    /// The newest valid checkpoint into the state (false: none). Collective.
+    bool restore_checkpoint();
 
     unsigned int                            acceleration_offset = 0;
     dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
