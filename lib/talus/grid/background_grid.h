@@ -27,8 +27,7 @@ namespace talus
 
   /// Kinematic boundary condition on every node of a boundary id (seed 000 §5.1):
   /// applied to all nodes of that boundary, active or not, so nodes that become
-  /// active later are constrained too (loads/kinematics.h turns them into DoF
-  /// flags and constraints).
+  /// active later are constrained too.
   struct BoundaryCondition
   {
     enum class Kind
@@ -103,6 +102,11 @@ namespace talus
     /// Distribute DoFs and build the cell cache. Throws InputError if a cell is
     /// not an axis-aligned box (the Q1 kernel and MappingCartesian need boxes).
     void setup();
+
+    /// Per local DoF (owned + ghost) a flag: 1 if its velocity component is
+    /// prescribed zero by one of the conditions.
+    std::vector<unsigned char>
+    constrained_dofs(const std::vector<BoundaryCondition> &bcs) const;
 
     void reinit_vector(Vector &v) const { v.reinit(partitioner); }
 

@@ -224,13 +224,6 @@ namespace talus
     prm.leave_subsection();
   }
 
-  void
-  declare_shared_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
-  {
-    declare_scene_parameters(prm, peek_scene_counts(prm_file));
-    declare_run_parameters(prm);
-  }
-
   template <int dim>
   void
   parse_scene_parameters(dealii::ParameterHandler &prm, SceneParameters<dim> &p)

@@ -94,9 +94,6 @@ namespace talus
   /// Declare time (end time, maximum steps), stability (lost particles), output
   /// (with io/png_snapshots' entries), checkpoint and load balancing.
   void declare_run_parameters(dealii::ParameterHandler &prm);
-  /// What every family's declaration starts with: the counts of `prm_file`
-  /// (may be empty), then the scene and run sections.
-  void declare_shared_parameters(dealii::ParameterHandler &prm, const std::string &prm_file);
 
   template <int dim>
   void parse_scene_parameters(dealii::ParameterHandler &prm, SceneParameters<dim> &p);

@@ -45,7 +45,9 @@ namespace talus::explicit_mpm
   declare_parameters_with_integration(dealii::ParameterHandler &prm, const std::string &prm_file,
                                       const std::string &default_integration)
   {
-    declare_shared_parameters(prm, prm_file);
+    const SceneCounts counts = peek_scene_counts(prm_file);
+    declare_scene_parameters(prm, counts);
+    declare_run_parameters(prm);
     // the explicit family's entries in the shared subsections
     prm.enter_subsection("time");
     {

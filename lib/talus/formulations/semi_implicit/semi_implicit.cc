@@ -48,7 +48,9 @@ namespace talus::semi_implicit
   void
   declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
   {
-    declare_shared_parameters(prm, prm_file);
+    const SceneCounts counts = peek_scene_counts(prm_file);
+    declare_scene_parameters(prm, counts);
+    declare_run_parameters(prm);
     prm.enter_subsection("time");
     {
       prm.declare_entry("time step", "0", Double(0),
