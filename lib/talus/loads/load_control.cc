@@ -2,9 +2,12 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/loads/k0.h>
+#include <talus/loads/kinematics.h>
 #include <talus/loads/load_control.h>
 #include <talus/loads/local_damping.h>
 #include <talus/shape/q1.h>
+#include <talus/transfer/cell_walk.h>
+#include <talus/transfer/point_ops.h>
 
 #include <deal.II/base/geometry_info.h>
 #include <deal.II/base/mpi.h>
@@ -156,7 +159,7 @@ namespace talus::loads
     force_ratio  = energy_ratio = std::numeric_limits<double>::quiet_NaN();
     s.gravity      = current->gravity;
     s.mass_scaling = current->mass_scaling;
-    s.constrained  = s.grid.constrained_dofs(current->boundary_conditions);
+    s.constrained  = wall_dof_flags(s.grid, current->boundary_conditions);
     s.p2g_ready    = false; // gravity may have changed: redo the mass/force P2G
     if (!resume)
       set_time_step(s); // a restart continues with the checkpointed step
@@ -471,34 +474,17 @@ namespace talus::loads
     const unsigned int nt  = current->tractions.size();
     const unsigned int off = force_offset;
     double             work = 0;
-    // frictional walls: the material's displacement away from the wall at each
-    // friction node (min over the points of the adjacent cells)
-    double *const Lf = any_friction ? lift.begin() : nullptr;
     if (any_friction)
-      for (unsigned int i = 0; i < lift.locally_owned_size() + lift.get_partitioner()->n_ghost_indices(); ++i)
-        lift.local_element(i) = std::numeric_limits<double>::max();
+      friction_lift(s);
+    if (!scatter)
+      return;
     auto               pt   = s.points.handler.begin();
     for (const auto [c, n_in_cell] : s.points.active_cells())
       {
         const auto &        cc    = s.grid.cells[c];
-        const unsigned char faces = any_friction ? friction_faces[c] : 0;
         for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
           {
             const double *P = pt->get_properties().data();
-            if (faces)
-              for (unsigned int f = 0; f < 2 * dim; ++f)
-                if (faces & (1u << f))
-                  {
-                    // displacement away from the wall on face f (outward normal +-e_axis)
-                    const unsigned int axis = f / 2;
-                    const double       away = (f % 2 ? -1.0 : 1.0) * P[L::displacement + axis];
-                    for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
-                      {
-                        const unsigned int v = dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i);
-                        double &           l = Lf[cc.dofs[v * dim + axis]];
-                        l                    = std::min(l, away);
-                      }
-                  }
             if (scatter)
               {
                 double f[dim] = {};
@@ -528,8 +514,19 @@ namespace talus::loads
         trac.compress(dealii::VectorOperation::add);
         s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
       }
-    if (any_friction)
-      lift.compress(dealii::VectorOperation::min);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::friction_lift(Solver &s)
+  {
+    // frictional walls: the material's displacement away from the wall at each
+    // friction node (min over the points of the adjacent cells)
+    for (unsigned int i = 0; i < lift.locally_owned_size() + lift.get_partitioner()->n_ghost_indices(); ++i)
+      lift.local_element(i) = std::numeric_limits<double>::max();
+    transfer::MinDisplacementAwayFromWalls<dim> op(s.grid, friction_faces, lift.begin());
+    transfer::for_each_active_cell(s.points, op);
+    lift.compress(dealii::VectorOperation::min);
   }
 
   template <int dim>
@@ -820,50 +817,45 @@ namespace talus::loads
     const bool             cp = s.two_phase && s.two_phase->coupled;
     double *const          PL = cp ? s.two_phase->p_liquid.begin() : nullptr;
     double                 work = 0;
-    auto                   pt   = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[c];
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-          {
-            double *           P = pt->get_properties().data();
-            const unsigned int b = static_cast<unsigned int>(P[L::body]);
-            for (const unsigned int j : particle_conditions)
+    transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
+      const auto &cc = s.grid.cells[c];
+      double *           P = pt->get_properties().data();
+      const unsigned int b = static_cast<unsigned int>(P[L::body]);
+      for (const unsigned int j : particle_conditions)
+        {
+          const auto &pv = current->velocities[j];
+          if (pv.body != b)
+            continue;
+          const double t = (j < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
+          const double f = pv.function.value(t);
+          double       dv[dim], dvL[dim] = {};
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              dv[d] = pv.component[d] ? pv.velocity[d] * f - P[L::velocity + d] : 0.0;
+              P[L::velocity + d] += dv[d];
+              work += P[L::mass] * dv[d] * P[L::velocity + d];
+            }
+          // 2-phase point: its pore liquid moves with the body as well
+          const double mL = cp ? s.two_phase->liquid_mass(P) : 0.0;
+          if (mL > 0)
+            for (unsigned int d = 0; d < dim; ++d)
               {
-                const auto &pv = current->velocities[j];
-                if (pv.body != b)
-                  continue;
-                const double t = (j < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
-                const double f = pv.function.value(t);
-                double       dv[dim], dvL[dim] = {};
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    dv[d] = pv.component[d] ? pv.velocity[d] * f - P[L::velocity + d] : 0.0;
-                    P[L::velocity + d] += dv[d];
-                    work += P[L::mass] * dv[d] * P[L::velocity + d];
-                  }
-                // 2-phase point: its pore liquid moves with the body as well
-                const double mL = cp ? s.two_phase->liquid_mass(P) : 0.0;
-                if (mL > 0)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      double &vl = P[s.two_phase->liquid_velocity + d];
-                      dvL[d]     = pv.component[d] ? pv.velocity[d] * f - vl : 0.0;
-                      vl += dvL[d];
-                      work += mL * dvL[d] * vl;
-                    }
-                double N[nv];
-                shape::Q1<dim>::values(pt->get_reference_location(), N);
-                for (unsigned int v = 0; v < nv; ++v)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      Pn[cc.dofs[v * dim + d]] += P[L::mass] * N[v] * dv[d];
-                      if (mL > 0)
-                        PL[cc.dofs[v * dim + d]] += mL * N[v] * dvL[d];
-                    }
+                double &vl = P[s.two_phase->liquid_velocity + d];
+                dvL[d]     = pv.component[d] ? pv.velocity[d] * f - vl : 0.0;
+                vl += dvL[d];
+                work += mL * dvL[d] * vl;
               }
-          }
-      }
+          double N[nv];
+          shape::Q1<dim>::values(pt->get_reference_location(), N);
+          for (unsigned int v = 0; v < nv; ++v)
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                Pn[cc.dofs[v * dim + d]] += P[L::mass] * N[v] * dv[d];
+                if (mL > 0)
+                  PL[cc.dofs[v * dim + d]] += mL * N[v] * dvL[d];
+              }
+        }
+    });
     s.nodal_p.compress(dealii::VectorOperation::add);
     if (cp)
       s.two_phase->p_liquid.compress(dealii::VectorOperation::add);

@@ -183,6 +183,8 @@ namespace talus::loads
     void assign_tractions(Solver &s);
     void update_factors(const Solver &s);
     void build_node_lists(Solver &s);
+    /// `lift` of the friction nodes from the points next to friction walls.
+    void friction_lift(Solver &s);
     void set_time_step(Solver &s);
     /// the convergence ratios are evaluated in this step
     bool check_step(const Solver &s) const;

@@ -1,8 +1,9 @@
 // talus — isoparametric Q1 on a general (possibly deformed) quad/hex: values,
 // reference derivatives and real-space gradients for given vertex coordinates.
-// Used by the FEM / UL-FEM integration (formulations/explicit/fem.cc), where
-// cells need not be axis-aligned boxes (ul-fem deforms them); the MPM loops use
-// the cheaper box kernel of q1.h.
+// Q1Iso is its kernel policy (the interface of q1_box.h, as far as the FEM /
+// UL-FEM integration of formulations/explicit/fem.cc uses it), where cells need
+// not be axis-aligned boxes (ul-fem deforms them); the MPM loops use the cheaper
+// box kernel Q1Box.
 #pragma once
 
 #include <deal.II/base/point.h>
@@ -91,4 +92,119 @@ namespace talus::shape
     }
   };
 
+  /// The isoparametric Q1 kernel policy: a cell is its (current) vertex
+  /// coordinates and the local DoF indices of its vertices (component d of
+  /// vertex v at dofs[v * dim + d], as the grid's cell cache).
+  template <int dim>
+  struct Q1Iso
+  {
+    using Iso                             = IsoQ1<dim>;
+    static constexpr unsigned int n_nodes = Iso::nv;
+
+    struct Cell
+    {
+      double              X[n_nodes][dim];
+      const unsigned int *dofs = nullptr;
+    };
+
+    /// values, reference derivatives, real-space gradients and det J at a point
+    struct Eval
+    {
+      double N[n_nodes], dN[n_nodes][dim], G[n_nodes][dim];
+      double det = 0;
+    };
+    static inline void
+    evaluate(const Cell &cell, const dealii::Point<dim> &xi, Eval &e)
+    {
+      Iso::shape(xi, e.N, e.dN);
+      e.det = Iso::gradients(cell.X, e.dN, e.G);
+    }
+    /// The gradients at the same reference point for other vertex positions
+    /// (a cell deformed over the step); returns the new det J.
+    static inline double
+    move_vertices(const double (&X)[n_nodes][dim], Eval &e)
+    {
+      e.det = Iso::gradients(X, e.dN, e.G);
+      return e.det;
+    }
+
+    /// scale x the nodal vector V on the cell's vertices
+    struct Field
+    {
+      double u[n_nodes][dim];
+    };
+    static inline void
+    gather(const Cell &cell, const double *V, const double scale, Field &f)
+    {
+      for (unsigned int v = 0; v < n_nodes; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          f.u[v][d] = scale * V[cell.dofs[v * dim + d]];
+    }
+    /// value u(x_p) and gradient g[a][b] = du_a/dx_b of a field at a point
+    static inline void
+    value_and_gradient(const Field &f, const Eval &e, double (&u)[dim], double (&g)[dim][dim])
+    {
+      for (unsigned int a = 0; a < dim; ++a)
+        {
+          u[a] = 0;
+          for (unsigned int b = 0; b < dim; ++b)
+            g[a][b] = 0;
+        }
+      for (unsigned int v = 0; v < n_nodes; ++v)
+        for (unsigned int a = 0; a < dim; ++a)
+          {
+            u[a] += e.N[v] * f.u[v][a];
+            for (unsigned int b = 0; b < dim; ++b)
+              g[a][b] += f.u[v][a] * e.G[v][b];
+          }
+    }
+    /// the position sum_v N_v X_v of a point
+    static inline void
+    position(const Cell &cell, const Eval &e, dealii::Point<dim> &x)
+    {
+      for (unsigned int v = 0; v < n_nodes; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d] += e.N[v] * cell.X[v][d];
+    }
+
+    /// A cell's lumped mass sum_p m_p N_v and internal force sum_p t_p grad N_v
+    /// (t = -V sigma), scattered once per cell with gravity m g added.
+    struct MassForce
+    {
+      double m[n_nodes], f[n_nodes][dim];
+      inline void
+      clear()
+      {
+        for (unsigned int v = 0; v < n_nodes; ++v)
+          {
+            m[v] = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              f[v][d] = 0;
+          }
+      }
+      inline void
+      add(const Eval &e, const double mass, const double (&t)[dim][dim])
+      {
+        for (unsigned int v = 0; v < n_nodes; ++v)
+          {
+            m[v] += mass * e.N[v];
+            for (unsigned int a = 0; a < dim; ++a)
+              for (unsigned int b = 0; b < dim; ++b)
+                f[v][a] += t[a][b] * e.G[v][b];
+          }
+      }
+      template <class Gravity>
+      inline void
+      scatter(const Cell &cell, const Gravity &g, double *M, double *F) const
+      {
+        for (unsigned int v = 0; v < n_nodes; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const unsigned int i = cell.dofs[v * dim + d];
+              M[i] += m[v];
+              F[i] += f[v][d] + m[v] * g[d];
+            }
+      }
+    };
+  };
 } // namespace talus::shape

@@ -109,6 +109,15 @@ namespace talus::transfer
     for_each_active_cell(set, op);
   }
 
+  /// The walk with only a per-point callable point(c, it) (c: the point's cell).
+  template <int dim, class Point>
+  inline void
+  for_each_point(MaterialPointSet<dim> &set, Point &&point)
+  {
+    const auto nothing = [](const unsigned int) {};
+    for_each_active_cell(set, nothing, point, nothing);
+  }
+
   /// Two ops in one pass: `first` runs on every point; `second` only on those
   /// for which first.point returned true (e.g. the points that stayed in their
   /// cell after an update, which the fused P2G of the next step then adds).

@@ -77,38 +77,30 @@ namespace talus::transfer
   template void finish_assembly(const ActiveSet<3> &, double, double, dealii::TrilinosWrappers::SparseMatrix *, Vector *);
 
   // the common assemblies for both kernels
+  template <int dim>
+  using ElasticAndGravity = Sum<LinearElasticStiffness, BodyForce<dim>>;
+#define TALUS_ASSEMBLE(dim, K, nc, Integrand)                                                                   \
+  template void assemble<dim, K, nc, Integrand>(const std::vector<MaterialPointSet<dim> *> &,                  \
+                                                const ActiveSet<dim> &,                                         \
+                                                const dealii::AffineConstraints<double> &,                      \
+                                                const Integrand &,                                              \
+                                                dealii::TrilinosWrappers::SparseMatrix *,                       \
+                                                Vector *,                                                       \
+                                                const Vector *);
 #define TALUS_MATRIX_OPS(dim, K)                                                                                \
   template struct AssembleSystem<dim, K, dim, ConsistentMass>;                                                \
   template struct AssembleSystem<dim, K, 1, ConsistentMass>;                                                  \
   template struct AssembleSystem<dim, K, dim, LinearElasticStiffness>;                                        \
   template struct AssembleSystem<dim, K, dim, BodyForce<dim>>;                                                \
-  template struct AssembleSystem<dim, K, dim, Sum<LinearElasticStiffness, BodyForce<dim>>>;                   \
-  template void assemble<dim, K, dim, ConsistentMass>(const std::vector<MaterialPointSet<dim> *> &,          \
-                                                      const ActiveSet<dim> &,                                 \
-                                                      const dealii::AffineConstraints<double> &,              \
-                                                      const ConsistentMass &,                                 \
-                                                      dealii::TrilinosWrappers::SparseMatrix *,               \
-                                                      Vector *,                                               \
-                                                      const Vector *);                                        \
-  template void assemble<dim, K, 1, ConsistentMass>(const std::vector<MaterialPointSet<dim> *> &,            \
-                                                    const ActiveSet<dim> &,                                   \
-                                                    const dealii::AffineConstraints<double> &,                \
-                                                    const ConsistentMass &,                                   \
-                                                    dealii::TrilinosWrappers::SparseMatrix *,                 \
-                                                    Vector *,                                                 \
-                                                    const Vector *);                                          \
-  template void assemble<dim, K, dim, Sum<LinearElasticStiffness, BodyForce<dim>>>(                          \
-    const std::vector<MaterialPointSet<dim> *> &,                                                             \
-    const ActiveSet<dim> &,                                                                                   \
-    const dealii::AffineConstraints<double> &,                                                                \
-    const Sum<LinearElasticStiffness, BodyForce<dim>> &,                                                      \
-    dealii::TrilinosWrappers::SparseMatrix *,                                                                 \
-    Vector *,                                                                                                 \
-    const Vector *);
+  template struct AssembleSystem<dim, K, dim, ElasticAndGravity<dim>>;                                        \
+  TALUS_ASSEMBLE(dim, K, dim, ConsistentMass)                                                                 \
+  TALUS_ASSEMBLE(dim, K, 1, ConsistentMass)                                                                   \
+  TALUS_ASSEMBLE(dim, K, dim, ElasticAndGravity<dim>)
 
   TALUS_MATRIX_OPS(2, shape::Q1Box<2>)
   TALUS_MATRIX_OPS(3, shape::Q1Box<3>)
   TALUS_MATRIX_OPS(2, shape::BSpline2Box<2>)
   TALUS_MATRIX_OPS(3, shape::BSpline2Box<3>)
 #undef TALUS_MATRIX_OPS
+#undef TALUS_ASSEMBLE
 } // namespace talus::transfer

@@ -175,6 +175,18 @@ namespace talus::transfer
     }
   };
 
+  /// The lumped vector term m_p N_i q_c of a point (P: its properties, p: its
+  /// stencil) for a per-component value q(c) (vector spaces only).
+  template <int dim, class PN, class Value>
+  inline void
+  add_lumped(const double *P, const PN &p, LocalSystem &ls, const Value &q)
+  {
+    const double m = P[PropertyLayout<dim>::mass];
+    for (unsigned int i = 0; i < p.n; ++i)
+      for (unsigned int c = 0; c < dim; ++c)
+        ls.b[p.local[i] * dim + c] += m * p.N[i] * q(c);
+  }
+
   /// Body force m_p g N_i.
   template <int dim>
   struct BodyForce
@@ -186,10 +198,7 @@ namespace talus::transfer
     add(const double *P, const PN &p, LocalSystem &ls) const
     {
       static_assert(nc == dim && d_ == dim, "BodyForce: a vector space (nc = dim)");
-      const double m = P[PropertyLayout<dim>::mass];
-      for (unsigned int i = 0; i < p.n; ++i)
-        for (unsigned int c = 0; c < dim; ++c)
-          ls.b[p.local[i] * dim + c] += m * p.N[i] * g[c];
+      add_lumped<dim>(P, p, ls, [this](const unsigned int c) { return g[c]; });
     }
   };
 
@@ -382,6 +391,21 @@ namespace talus::transfer
     finish_assembly(active, op.diag_sum, op.diag_count, Integrand::matrix ? A : nullptr, b);
   }
 
+  /// The nc components of a space vector u (ghost values up to date) at a
+  /// cell's stencil nodes; 0 at nodes without a DoF (B-spline slots beyond the grid).
+  template <int dim, class K, unsigned int nc>
+  inline void
+  gather_space_vector(const NodalSpace<dim> &space, const typename K::Cell &cell, const Vector &u,
+                      double (&un)[K::n_nodes][nc])
+  {
+    for (unsigned int s = 0; s < K::n_nodes; ++s)
+      for (unsigned int k = 0; k < nc; ++k)
+        {
+          const unsigned int i = cell.dofs[s * dim];
+          un[s][k]             = i == dealii::numbers::invalid_unsigned_int ? 0.0 : u(space.node_dof(i, k));
+        }
+  }
+
   /// G2P of a nodal field u of the space (ghost values up to date): per point
   /// callback(it, val[nc], grad[nc][dim]) with grad[c][k] = d u_c / d x_k.
   template <int dim, class K, unsigned int nc, class Callback>
@@ -406,12 +430,7 @@ namespace talus::transfer
     begin_cell(const unsigned int c)
     {
       cell = K::cell(grid, c);
-      for (unsigned int s = 0; s < K::n_nodes; ++s)
-        for (unsigned int k = 0; k < nc; ++k)
-          {
-            const unsigned int i = cell.dofs[s * dim];
-            un[s][k] = i == dealii::numbers::invalid_unsigned_int ? 0.0 : u(space.node_dof(i, k));
-          }
+      gather_space_vector<dim, K, nc>(space, cell, u, un);
     }
     inline bool
     point(const unsigned int, PointIterator<dim> &it)

@@ -6,21 +6,20 @@
 
 namespace talus::transfer
 {
-  /// Move the point at `it` (in cell c of the box grid) by dx. Returns true if
-  /// it stays in cell c (reference location updated), false if it left (the
-  /// set's relocation will place it; the walk must not touch it again).
+  /// Put the point at `it` (in cell c of the box grid) at its new location x.
+  /// Returns true if it stays in cell c (reference location xi set and
+  /// returned), false if it left (the set's relocation will place it; the walk
+  /// must not touch it again).
   template <int dim>
   inline bool
-  move_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
-             typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it, const double (&dx)[dim])
+  place_moved_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
+                    typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
+                    const dealii::Point<dim> &x, dealii::Point<dim> &xi)
   {
-    auto               x = it->get_location();
-    dealii::Point<dim> xi;
-    const auto &       cc     = grid.cells[c];
-    bool               inside = true;
+    const auto &cc     = grid.cells[c];
+    bool        inside = true;
     for (unsigned int d = 0; d < dim; ++d)
       {
-        x[d] += dx[d];
         xi[d]  = (x[d] - cc.lower[d]) * cc.inv_h[d];
         inside = inside && xi[d] >= 0.0 && xi[d] <= 1.0;
       }
@@ -32,5 +31,18 @@ namespace talus::transfer
       }
     set.leaving(it, c);
     return false;
+  }
+
+  /// Move the point at `it` (in cell c) by dx; place_moved_point.
+  template <int dim>
+  inline bool
+  move_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
+             typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it, const double (&dx)[dim])
+  {
+    auto x = it->get_location();
+    for (unsigned int d = 0; d < dim; ++d)
+      x[d] += dx[d];
+    dealii::Point<dim> xi;
+    return place_moved_point(set, grid, c, it, x, xi);
   }
 } // namespace talus::transfer

@@ -7,30 +7,29 @@
 #include <talus/grid/background_grid.h>
 #include <talus/particles/material_points.h>
 #include <talus/transfer/cell_walk.h>
+#include <talus/transfer/move_point.h>
 
+#include <deal.II/base/geometry_info.h>
 #include <deal.II/base/tensor.h>
+
+#include <algorithm>
+#include <vector>
 
 namespace talus::transfer
 {
-  /// P2G of lumped mass and internal + gravity force (seed 000 Eqs. 4.32, 4.34,
-  /// 4.41) at the points' current reference locations, added to M and F.
-  template <int dim, class K>
-  struct ScatterMassForce
+  /// What the P2G ops share: the current cell's stencil and its per-cell sums
+  /// (the kernel's MassForce or Momentum), cleared at each cell.
+  template <int dim, class K, class Sums>
+  struct CellSums
   {
-    ScatterMassForce(const BackgroundGrid<dim> &grid, const dealii::Tensor<1, dim> &g, double *M, double *F)
+    explicit CellSums(const BackgroundGrid<dim> &grid)
       : grid(grid)
-      , g(g)
-      , M(M)
-      , F(F)
     {}
     const BackgroundGrid<dim> &grid;
-    const dealii::Tensor<1, dim> g;
-    double *const                M;
-    double *const                F;
 
     static constexpr bool prefetch_location = false;
     typename K::Cell      cell;
-    typename K::MassForce sums;
+    Sums                  sums;
 
     inline void
     begin_cell(const unsigned int c)
@@ -38,6 +37,26 @@ namespace talus::transfer
       cell = K::cell(grid, c);
       sums.clear();
     }
+  };
+
+  /// P2G of lumped mass and internal + gravity force (seed 000 Eqs. 4.32, 4.34,
+  /// 4.41) at the points' current reference locations, added to M and F.
+  template <int dim, class K>
+  struct ScatterMassForce : CellSums<dim, K, typename K::MassForce>
+  {
+    using Base = CellSums<dim, K, typename K::MassForce>;
+    using Base::cell;
+    using Base::grid;
+    using Base::sums;
+    ScatterMassForce(const BackgroundGrid<dim> &grid, const dealii::Tensor<1, dim> &g, double *M, double *F)
+      : Base(grid)
+      , g(g)
+      , M(M)
+      , F(F)
+    {}
+    const dealii::Tensor<1, dim> g;
+    double *const                M;
+    double *const                F;
     /// one point with properties P at reference location xi
     inline void
     add(const dealii::Point<dim> &xi, const double *P)
@@ -134,25 +153,16 @@ namespace talus::transfer
   /// P2G of the points' momentum m_p v_p (Eq. 4.47) at their current reference
   /// locations into Pn (the nodal momentum p^t the loads use before a step).
   template <int dim, class K>
-  struct ScatterMomentum
+  struct ScatterMomentum : CellSums<dim, K, typename K::Momentum>
   {
+    using Base = CellSums<dim, K, typename K::Momentum>;
+    using Base::cell;
+    using Base::sums;
     ScatterMomentum(const BackgroundGrid<dim> &grid, double *Pn)
-      : grid(grid)
+      : Base(grid)
       , Pn(Pn)
     {}
-    const BackgroundGrid<dim> &grid;
-    double *const              Pn;
-
-    static constexpr bool prefetch_location = false;
-    typename K::Cell      cell;
-    typename K::Momentum  sums;
-
-    inline void
-    begin_cell(const unsigned int c)
-    {
-      cell = K::cell(grid, c);
-      sums.clear();
-    }
+    double *const Pn;
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
     {
@@ -239,22 +249,7 @@ namespace talus::transfer
           P[L::displacement + d] += dx[d];
         }
       physics.moved(it, P, x, state);
-      // new reference coordinates: same cell if still inside
-      const auto &cc     = grid.cells[c];
-      bool        inside = true;
-      for (unsigned int d = 0; d < dim; ++d)
-        {
-          xi_new[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
-          inside    = inside && xi_new[d] >= 0.0 && xi_new[d] <= 1.0;
-        }
-      it->set_location(x);
-      if (inside)
-        {
-          it->set_reference_location(xi_new);
-          return true;
-        }
-      set.leaving(it, c);
-      return false;
+      return place_moved_point(set, grid, c, it, x, xi_new);
     }
     inline void
     end_cell(const unsigned int)
@@ -273,6 +268,61 @@ namespace talus::transfer
   {
     K::value_and_gradient(cell, du, e, dx, gu);
   }
+
+  /// For rigid walls with friction: at each node of a cell face on such a wall,
+  /// the minimum over the cell's points of their displacement away from that
+  /// wall (the lift that releases the contact). `faces[c]` holds bit f for
+  /// each face f of cell c on a friction wall (outward normal -+e_{f/2} for
+  /// f even/odd); `lift` (local indices of the grid's vector space) must start
+  /// at +max. Q1 vertices only (boundary friction is linear-only).
+  template <int dim>
+  struct MinDisplacementAwayFromWalls
+  {
+    MinDisplacementAwayFromWalls(const BackgroundGrid<dim> &       grid,
+                                 const std::vector<unsigned char> &faces,
+                                 double *                          lift)
+      : grid(grid)
+      , faces(faces)
+      , lift(lift)
+    {}
+    const BackgroundGrid<dim> &       grid;
+    const std::vector<unsigned char> &faces;
+    double *const                     lift;
+
+    static constexpr bool prefetch_location = false;
+    unsigned char         cell_faces        = 0;
+    const unsigned int *  dofs              = nullptr;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell_faces = faces[c];
+      dofs       = grid.cells[c].dofs;
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      if (!cell_faces)
+        return true;
+      const double *P = it->get_properties().data();
+      for (unsigned int f = 0; f < 2 * dim; ++f)
+        if (cell_faces & (1u << f))
+          {
+            const unsigned int axis = f / 2;
+            const double       away = (f % 2 ? -1.0 : 1.0) * P[PropertyLayout<dim>::displacement + axis];
+            for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
+              {
+                const unsigned int v = dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i);
+                double &           l = lift[dofs[v * dim + axis]];
+                l                    = std::min(l, away);
+              }
+          }
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {}
+  };
 
   /// An op that does nothing (a Fused second op when no P2G is fused).
   struct NoOp

@@ -171,11 +171,10 @@ namespace talus::transfer
     add(const double *P, const PN &p, LocalSystem &ls) const
     {
       static_assert(nc == dim && d_ == dim, "NodalProjection: a vector space (nc = dim)");
-      const double m = P[PropertyLayout<dim>::mass];
-      for (unsigned int a = 0; a < p.n; ++a)
-        for (unsigned int c = 0; c < dim; ++c)
-          ls.b[p.local[a] * dim + c] +=
-            m * p.N[a] * (offset == dealii::numbers::invalid_unsigned_int ? 1.0 : P[offset + c]);
+      if (offset == dealii::numbers::invalid_unsigned_int)
+        add_lumped<dim>(P, p, ls, [](const unsigned int) { return 1.0; });
+      else
+        add_lumped<dim>(P, p, ls, [P, this](const unsigned int c) { return P[offset + c]; });
     }
   };
 
@@ -222,14 +221,13 @@ namespace talus::transfer
     begin_cell(const unsigned int c)
     {
       cell = K::cell(grid, c);
-      for (unsigned int s = 0; s < K::n_nodes; ++s)
-        for (unsigned int k = 0; k < dim; ++k)
-          {
-            const unsigned int i = cell.dofs[s * dim];
-            const bool         valid = i != dealii::numbers::invalid_unsigned_int;
-            un[s][k] = valid ? du(space.node_dof(i, k)) : 0.0;
-            an[s][k] = valid && a_new ? (*a_new)(space.node_dof(i, k)) : 0.0;
-          }
+      gather_space_vector<dim, K, dim>(space, cell, du, un);
+      if (a_new)
+        gather_space_vector<dim, K, dim>(space, cell, *a_new, an);
+      else
+        for (auto &node : an)
+          for (double &value : node)
+            value = 0.0;
     }
     inline bool
     point(const unsigned int c, PointIterator<dim> &it)

@@ -3,10 +3,12 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/formulations/common/point_output.h>
+#include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/io/output.h>
 #include <talus/io/vtu.h>
 #include <talus/io/png_snapshots.h>
+#include <talus/loads/kinematics.h>
 #include <talus/loads/load_control.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
@@ -247,7 +249,7 @@ namespace talus::explicit_mpm
     grid.setup();
     if (prm.numerics.bspline())
       grid.setup_bspline_patches(); // the 4^dim node patch of every owned cell
-    constrained = grid.constrained_dofs(prm.boundary_conditions);
+    constrained = loads::wall_dof_flags(grid, prm.boundary_conditions);
     grid.reinit_vector(nodal_mass);
     grid.reinit_vector(nodal_a);
     grid.reinit_vector(nodal_p);
@@ -491,7 +493,7 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::grid_changed()
   {
-    constrained = grid.constrained_dofs(prm.boundary_conditions);
+    constrained = loads::wall_dof_flags(grid, prm.boundary_conditions);
     grid.reinit_vector(nodal_mass);
     grid.reinit_vector(nodal_a);
     grid.reinit_vector(nodal_p);
@@ -1049,13 +1051,6 @@ namespace talus::explicit_mpm
     write_final_points_csv(points, prm.output_directory, comm, fem && !fem->updated_lagrangian());
   }
 
-  template <int dim>
-  void
-  Solver<dim>::run()
-  {
-    TimeLoop(*this, loop_settings(prm), comm).run();
-  }
-
   // ================================================================ Formulation interface
 
   template <int dim>
@@ -1291,29 +1286,8 @@ namespace talus::explicit_mpm
   int
   run(dealii::ParameterHandler &prm, const std::string &)
   {
-    const unsigned int dim = prm.get_integer("dimension");
-    if (dim == 2)
-      {
-        auto       p = parse_parameters<2>(prm);
-        Solver<2>  s(p, MPI_COMM_WORLD);
-        s.setup();
-        s.run();
-      }
-    else
-      {
-        auto       p = parse_parameters<3>(prm);
-        Solver<3>  s(p, MPI_COMM_WORLD);
-        s.setup();
-        s.run();
-      }
-    io::draw_png_snapshots(prm, MPI_COMM_WORLD); // after every output file is complete
-    return exit_ok;
+    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>, /*png_snapshots=*/true);
   }
 
-  template struct Parameters<2>;
-  template struct Parameters<3>;
-  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
-  template class Solver<2>;
-  template class Solver<3>;
+  TALUS_INSTANTIATE_FORMULATION(class);
 } // namespace talus::explicit_mpm

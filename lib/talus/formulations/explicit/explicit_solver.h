@@ -6,6 +6,7 @@
 #include <talus/formulations/common/formulation.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/explicit/fem.h>
+#include <talus/formulations/explicit/forward.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/grid/background_grid.h>
@@ -21,12 +22,6 @@
 #include <memory>
 #include <string>
 #include <vector>
-
-namespace talus::loads
-{
-  template <int dim>
-  class LoadControl;
-}
 
 namespace talus::explicit_mpm
 {
@@ -87,8 +82,6 @@ namespace talus::explicit_mpm
 
     /// Grid, DoFs, boundary conditions, particles, time step. Collective.
     void setup();
-    /// The time loop with output until the end time; throws InstabilityError.
-    void run();
     /// One explicit step of size dt (§4.3.7). Collective.
     void step(const double dt);
     /// n steps of the current time step with the stability check after each

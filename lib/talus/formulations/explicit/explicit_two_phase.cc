@@ -3,6 +3,8 @@
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/loads/load_control.h>
 #include <talus/shape/q1.h>
+#include <talus/transfer/cell_walk.h>
+#include <talus/transfer/move_point.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -349,12 +351,8 @@ namespace talus::explicit_mpm
         porosity        = layout.add_extra("porosity", 1);
         pore_pressure   = layout.add_extra("pore_pressure", 1);
         liquid_velocity = layout.add_extra("liquid_velocity", dim, true);
-        s.grid.reinit_vector(m_liquid);
-        s.grid.reinit_vector(m_liquid_n);
-        s.grid.reinit_vector(drag);
-        s.grid.reinit_vector(f_liquid);
-        s.grid.reinit_vector(p_liquid);
-        s.grid.reinit_vector(a_liquid);
+        for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid, &a_liquid})
+          s.grid.reinit_vector(*v);
       }
   }
 
@@ -461,65 +459,58 @@ namespace talus::explicit_mpm
         s.zero_on_active(*v);
     // traction point forces (loads/traction, at t) scattered in this pass
     double *const T = control ? control->begin_traction_scatter(s) : nullptr;
-    {
-      auto pt = s.points.handler.begin();
-      for (const auto [c, n_in_cell] : s.points.active_cells())
+    transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
+      const auto &cc = s.grid.cells[c];
+      const double *     P   = pt->get_properties().data();
+      const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+      double             N[nv], G[nv][dim];
+      Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
+      const double mS = P[L::mass], V = P[L::volume];
+      auto         sig = L::get_stress(P);
+      const bool   cp  = coupled && pl[mat].drainage == Drainage::coupled;
+      double       mL = 0, mLt = 0, q = 0, p = 0;
+      if (cp)
         {
-          const auto &cc = s.grid.cells[c];
-          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-            {
-              const double *     P   = pt->get_properties().data();
-              const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-              double             N[nv], G[nv][dim];
-              Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
-              const double mS = P[L::mass], V = P[L::volume];
-              auto         sig = L::get_stress(P);
-              const bool   cp  = coupled && pl[mat].drainage == Drainage::coupled;
-              double       mL = 0, mLt = 0, q = 0, p = 0;
-              if (cp)
-                {
-                  const double n = P[porosity];
-                  mLt            = pl[mat].density * V;
-                  mL             = n * mLt;
-                  q              = n * pl[mat].viscosity / pl[mat].intrinsic_permeability * V; // n rho_L g / k V
-                  p              = P[pore_pressure];
-                  for (unsigned int i = 0; i < 3; ++i)
-                    sig[i][i] -= p; // total stress (Eq. 4.117)
-                }
-              double fp[dim] = {};
-              bool   loaded  = false;
-              if (T)
-                {
-                  control->point_force(P, fp);
-                  for (unsigned int d = 0; d < dim; ++d)
-                    loaded = loaded || fp[d] != 0.0;
-                }
-              if (loaded) // Eq. 5.3, added to the mixture force by nodal_forces_two_phase
-                for (unsigned int v = 0; v < nv; ++v)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    T[cc.dofs[v * dim + d]] += N[v] * fp[d];
-              for (unsigned int v = 0; v < nv; ++v)
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    const unsigned int i  = cc.dofs[v * dim + d];
-                    double             fi = 0;
-                    for (unsigned int e = 0; e < dim; ++e)
-                      fi -= V * sig[d][e] * G[v][e];
-                    MS[i] += mS * N[v];
-                    FS[i] += fi + (mS + mL) * N[v] * g[d];
-                    PS[i] += mS * N[v] * P[L::velocity + d];
-                    if (cp)
-                      {
-                        mLt_[i] += mLt * N[v];
-                        mLn_[i] += mL * N[v];
-                        Q_[i] += q * N[v];
-                        FL_[i] += V * p * G[v][d] + mLt * N[v] * g[d];
-                        PL_[i] += mL * N[v] * P[liquid_velocity + d];
-                      }
-                  }
-            }
+          const double n = P[porosity];
+          mLt            = pl[mat].density * V;
+          mL             = n * mLt;
+          q              = n * pl[mat].viscosity / pl[mat].intrinsic_permeability * V; // n rho_L g / k V
+          p              = P[pore_pressure];
+          for (unsigned int i = 0; i < 3; ++i)
+            sig[i][i] -= p; // total stress (Eq. 4.117)
         }
-    }
+      double fp[dim] = {};
+      bool   loaded  = false;
+      if (T)
+        {
+          control->point_force(P, fp);
+          for (unsigned int d = 0; d < dim; ++d)
+            loaded = loaded || fp[d] != 0.0;
+        }
+      if (loaded) // Eq. 5.3, added to the mixture force by nodal_forces_two_phase
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            T[cc.dofs[v * dim + d]] += N[v] * fp[d];
+      for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const unsigned int i  = cc.dofs[v * dim + d];
+            double             fi = 0;
+            for (unsigned int e = 0; e < dim; ++e)
+              fi -= V * sig[d][e] * G[v][e];
+            MS[i] += mS * N[v];
+            FS[i] += fi + (mS + mL) * N[v] * g[d];
+            PS[i] += mS * N[v] * P[L::velocity + d];
+            if (cp)
+              {
+                mLt_[i] += mLt * N[v];
+                mLn_[i] += mL * N[v];
+                Q_[i] += q * N[v];
+                FL_[i] += V * p * G[v][d] + mLt * N[v] * g[d];
+                PL_[i] += mL * N[v] * P[liquid_velocity + d];
+              }
+          }
+    });
     for (Vector *v : {&MSv, &FSv, &PSv})
       v->compress(dealii::VectorOperation::add);
     if (coupled)
@@ -585,42 +576,35 @@ namespace talus::explicit_mpm
     s.zero_on_active(PSv);
     if (coupled)
       s.zero_on_active(p_liquid);
-    {
-      auto pt = s.points.handler.begin();
-      for (const auto [c, n_in_cell] : s.points.active_cells())
+    transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
+      const auto &cc = s.grid.cells[c];
+      double *           P   = pt->get_properties().data();
+      const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+      const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
+      double             N[nv];
+      Q::values(pt->get_reference_location(), N);
+      const double mL = cp ? P[porosity] * pl[mat].density * P[L::volume] : 0.0;
+      for (unsigned int d = 0; d < dim; ++d)
         {
-          const auto &cc = s.grid.cells[c];
-          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
+          double aS = 0, aL = 0;
+          for (unsigned int v = 0; v < nv; ++v)
             {
-              double *           P   = pt->get_properties().data();
-              const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-              const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
-              double             N[nv];
-              Q::values(pt->get_reference_location(), N);
-              const double mL = cp ? P[porosity] * pl[mat].density * P[L::volume] : 0.0;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  double aS = 0, aL = 0;
-                  for (unsigned int v = 0; v < nv; ++v)
-                    {
-                      aS += N[v] * FS[cc.dofs[v * dim + d]];
-                      if (cp)
-                        aL += N[v] * AL_[cc.dofs[v * dim + d]];
-                    }
-                  P[L::velocity + d] += h * aS;
-                  if (cp)
-                    P[liquid_velocity + d] += h * aL;
-                  for (unsigned int v = 0; v < nv; ++v)
-                    {
-                      const unsigned int i = cc.dofs[v * dim + d];
-                      PS[i] += P[L::mass] * N[v] * P[L::velocity + d];
-                      if (cp)
-                        PL_[i] += mL * N[v] * P[liquid_velocity + d];
-                    }
-                }
+              aS += N[v] * FS[cc.dofs[v * dim + d]];
+              if (cp)
+                aL += N[v] * AL_[cc.dofs[v * dim + d]];
+            }
+          P[L::velocity + d] += h * aS;
+          if (cp)
+            P[liquid_velocity + d] += h * aL;
+          for (unsigned int v = 0; v < nv; ++v)
+            {
+              const unsigned int i = cc.dofs[v * dim + d];
+              PS[i] += P[L::mass] * N[v] * P[L::velocity + d];
+              if (cp)
+                PL_[i] += mL * N[v] * P[liquid_velocity + d];
             }
         }
-    }
+    });
     PSv.compress(dealii::VectorOperation::add);
     if (coupled)
       p_liquid.compress(dealii::VectorOperation::add);
@@ -649,123 +633,106 @@ namespace talus::explicit_mpm
     const bool             loaded = control && control->any_traction();
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
-    {
-      auto pt = s.points.handler.begin();
-      for (const auto [c, n_in_cell] : s.points.active_cells())
+    transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
+      const auto &cc          = s.grid.cells[c];
+      double      cell_volume = 1.0;
+      for (unsigned int d = 0; d < dim; ++d)
+        cell_volume *= cc.h[d];
+      double *           P   = pt->get_properties().data();
+      const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+      const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
+      double             N[nv], G[nv][dim];
+      Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
+      double gu[dim][dim] = {}, dx[dim] = {}, div_uL = 0;
+      for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const unsigned int i  = cc.dofs[v * dim + d];
+            const double       du = h * PS[i]; // Eq. 4.112
+            dx[d] += N[v] * du;
+            for (unsigned int e2 = 0; e2 < dim; ++e2)
+              gu[d][e2] += du * G[v][e2];
+            if (cp)
+              div_uL += h * PL_[i] * G[v][d]; // Eq. 4.113 (volumetric part)
+          }
+      materials::Strain d_eps;
+      materials::Spin   d_omega;
+      for (unsigned int d = 0; d < dim; ++d)
+        for (unsigned int k2 = 0; k2 < dim; ++k2)
+          {
+            if (k2 >= d)
+              d_eps[d][k2] = 0.5 * (gu[d][k2] + gu[k2][d]);
+            d_omega[d][k2] = 0.5 * (gu[d][k2] - gu[k2][d]);
+          }
+      const materials::Material &m     = *s.prm.materials[mat];
+      auto                       sigma = L::get_stress(P);
+      m.update_stress(d_eps, d_omega, h, sigma,
+                      dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
+      L::set_stress(sigma, P);
+      const double dvS = trace(d_eps);
+      double       mL = 0, vl2 = 0;
+      if (cp)
         {
-          const auto &cc          = s.grid.cells[c];
-          double      cell_volume = 1.0;
+          // storage equation (Eqs. 4.115-4.116), pore pressure compression positive
+          const double n = P[porosity];
+          P[pore_pressure] -= pl[mat].bulk_modulus / n * ((1 - n) * dvS + n * div_uL);
+          // solid mass conservation (1 - n) V = const (Eq. 3.19)
+          P[porosity] = 1.0 - (1.0 - n) / (1.0 + dvS);
+          mL          = P[porosity] * pl[mat].density * P[L::volume] * (1.0 + dvS);
           for (unsigned int d = 0; d < dim; ++d)
-            cell_volume *= cc.h[d];
-          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-            {
-              double *           P   = pt->get_properties().data();
-              const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-              const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
-              double             N[nv], G[nv][dim];
-              Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
-              double gu[dim][dim] = {}, dx[dim] = {}, div_uL = 0;
-              for (unsigned int v = 0; v < nv; ++v)
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    const unsigned int i  = cc.dofs[v * dim + d];
-                    const double       du = h * PS[i]; // Eq. 4.112
-                    dx[d] += N[v] * du;
-                    for (unsigned int e2 = 0; e2 < dim; ++e2)
-                      gu[d][e2] += du * G[v][e2];
-                    if (cp)
-                      div_uL += h * PL_[i] * G[v][d]; // Eq. 4.113 (volumetric part)
-                  }
-              materials::Strain d_eps;
-              materials::Spin   d_omega;
-              for (unsigned int d = 0; d < dim; ++d)
-                for (unsigned int k2 = 0; k2 < dim; ++k2)
-                  {
-                    if (k2 >= d)
-                      d_eps[d][k2] = 0.5 * (gu[d][k2] + gu[k2][d]);
-                    d_omega[d][k2] = 0.5 * (gu[d][k2] - gu[k2][d]);
-                  }
-              const materials::Material &m     = *s.prm.materials[mat];
-              auto                       sigma = L::get_stress(P);
-              m.update_stress(d_eps, d_omega, h, sigma,
-                              dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
-              L::set_stress(sigma, P);
-              const double dvS = trace(d_eps);
-              double       mL = 0, vl2 = 0;
-              if (cp)
-                {
-                  // storage equation (Eqs. 4.115-4.116), pore pressure compression positive
-                  const double n = P[porosity];
-                  P[pore_pressure] -= pl[mat].bulk_modulus / n * ((1 - n) * dvS + n * div_uL);
-                  // solid mass conservation (1 - n) V = const (Eq. 3.19)
-                  P[porosity] = 1.0 - (1.0 - n) / (1.0 + dvS);
-                  mL          = P[porosity] * pl[mat].density * P[L::volume] * (1.0 + dvS);
-                  for (unsigned int d = 0; d < dim; ++d)
-                    vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
-                  if (s.need_strain_energy)
-                    e.strain += P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
-                                (2 * pl[mat].bulk_modulus);
-                  if (!std::isfinite(P[pore_pressure] + vl2) || !(P[porosity] > 0 && P[porosity] < 1))
-                    bad = true;
-                }
-              P[L::volume] *= (1.0 + dvS); // Eq. 4.118
-              if (P[L::volume] > cell_volume)
-                P[L::volume] = cell_volume;
-
-              if (loaded)
-                {
-                  double f[dim];
-                  control->point_force(P, f);
-                  for (unsigned int d = 0; d < dim; ++d)
-                    work += f[d] * dx[d];
-                }
-              auto x = pt->get_location();
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  x[d] += dx[d]; // Eq. 4.119
-                  P[L::displacement + d] += dx[d];
-                }
-              const double mS = P[L::mass];
-              double       v2 = 0, gx = 0;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  v2 += P[L::velocity + d] * P[L::velocity + d];
-                  gx += g[d] * x[d];
-                  momentum[d] += mS * P[L::velocity + d] + (cp ? mL * P[liquid_velocity + d] : 0.0);
-                }
-              e.kinetic += 0.5 * mS * v2 + 0.5 * mL * vl2;
-              e.gravity_potential -= (mS + mL) * gx;
-              if (s.need_strain_energy)
-                e.strain += P[L::volume] * m.elastic_energy_density(sigma);
-              if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
-                  !(P[L::volume] > 0))
-                bad = true;
-              for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
-                if (pt->get_id() == s.probe_ids[k2])
-                  {
-                    for (unsigned int d = 0; d < dim; ++d)
-                      {
-                        s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
-                        s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
-                      }
-                    for (unsigned int q = 0; q < L::n_stress; ++q)
-                      s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
-                  }
-              bool               inside = true;
-              dealii::Point<dim> nxi;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  nxi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
-                  inside = inside && nxi[d] >= 0.0 && nxi[d] <= 1.0;
-                }
-              pt->set_location(x);
-              if (inside)
-                pt->set_reference_location(nxi);
-              else
-                s.points.leaving(pt, c);
-            }
+            vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
+          if (s.need_strain_energy)
+            e.strain += P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
+                        (2 * pl[mat].bulk_modulus);
+          if (!std::isfinite(P[pore_pressure] + vl2) || !(P[porosity] > 0 && P[porosity] < 1))
+            bad = true;
         }
-    }
+      P[L::volume] *= (1.0 + dvS); // Eq. 4.118
+      if (P[L::volume] > cell_volume)
+        P[L::volume] = cell_volume;
+
+      if (loaded)
+        {
+          double f[dim];
+          control->point_force(P, f);
+          for (unsigned int d = 0; d < dim; ++d)
+            work += f[d] * dx[d];
+        }
+      auto x = pt->get_location();
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          x[d] += dx[d]; // Eq. 4.119
+          P[L::displacement + d] += dx[d];
+        }
+      const double mS = P[L::mass];
+      double       v2 = 0, gx = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          v2 += P[L::velocity + d] * P[L::velocity + d];
+          gx += g[d] * x[d];
+          momentum[d] += mS * P[L::velocity + d] + (cp ? mL * P[liquid_velocity + d] : 0.0);
+        }
+      e.kinetic += 0.5 * mS * v2 + 0.5 * mL * vl2;
+      e.gravity_potential -= (mS + mL) * gx;
+      if (s.need_strain_energy)
+        e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+      if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
+          !(P[L::volume] > 0))
+        bad = true;
+      for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
+        if (pt->get_id() == s.probe_ids[k2])
+          {
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
+                s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
+              }
+            for (unsigned int q = 0; q < L::n_stress; ++q)
+              s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
+          }
+      dealii::Point<dim> xi_new;
+      transfer::place_moved_point(s.points, s.grid, c, pt, x, xi_new);
+    });
     s.local_energies = e;
     s.local_momentum = momentum;
     s.local_bad      = bad;
@@ -792,8 +759,7 @@ namespace talus::explicit_mpm
   FreeSurface<dim>::extend_layout(PropertyLayout<dim> &layout)
   {
     flag = layout.add_extra("free_surface", 1);
-    s.grid.reinit_vector(mass);
-    s.grid.reinit_vector(volume);
+    grid_changed(); // sizes the nodal vectors
   }
 
   template <int dim>
@@ -816,26 +782,25 @@ namespace talus::explicit_mpm
     mass   = 0.0;
     volume = 0.0;
     double *const Mn = mass.begin(), *const Vn = volume.begin();
-    {
-      auto pt = s.points.handler.begin();
-      for (const auto [c, n_in_cell] : s.points.active_cells())
-        {
-          const auto &cc   = s.grid.cells[c];
-          double      vol = 1.0;
-          for (unsigned int d = 0; d < dim; ++d)
-            vol *= cc.h[d];
-          for (unsigned int v = 0; v < nv; ++v)
-            Vn[cc.dofs[v * dim]] += vol / nv;
-          for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-            {
-              double N[nv];
-              Q::values(pt->get_reference_location(), N);
-              const double m = pt->get_properties()[L::mass];
-              for (unsigned int v = 0; v < nv; ++v)
-                Mn[cc.dofs[v * dim]] += m * N[v];
-            }
-        }
-    }
+    transfer::for_each_active_cell(
+      s.points,
+      [&](const unsigned int c) {
+        const auto &cc  = s.grid.cells[c];
+        double      vol = 1.0;
+        for (unsigned int d = 0; d < dim; ++d)
+          vol *= cc.h[d];
+        for (unsigned int v = 0; v < nv; ++v)
+          Vn[cc.dofs[v * dim]] += vol / nv;
+      },
+      [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
+        const auto &cc = s.grid.cells[c];
+        double      N[nv];
+        Q::values(pt->get_reference_location(), N);
+        const double m = pt->get_properties()[L::mass];
+        for (unsigned int v = 0; v < nv; ++v)
+          Mn[cc.dofs[v * dim]] += m * N[v];
+      },
+      [](const unsigned int) {});
     mass.compress(dealii::VectorOperation::add);
     volume.compress(dealii::VectorOperation::add);
     for (unsigned int i = 0; i < mass.locally_owned_size(); ++i)
@@ -844,35 +809,30 @@ namespace talus::explicit_mpm
 
     unsigned long long  n_flagged = 0;
     std::vector<double> lo(dim, std::numeric_limits<double>::max()), hi(dim, -std::numeric_limits<double>::max());
-    auto                pt = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[c];
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-          {
-            double N[nv];
-            Q::values(pt->get_reference_location(), N);
-            double rho = 0;
-            for (unsigned int v = 0; v < nv; ++v)
-              rho += N[v] * Mn[cc.dofs[v * dim]]; // Eq. 6.39
-            double *           P   = pt->get_properties().data();
-            const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-            // reference density: that of the material, or of the solid mass per
-            // volume of a coupled point (its P[mass] is the solid mass)
-            double rho0 = s.prm.materials[mat]->density();
-            if (s.two_phase && s.two_phase->coupled &&
-                s.prm.liquid.pore_liquid[mat].drainage == Drainage::coupled)
-              rho0 *= 1 - s.prm.liquid.pore_liquid[mat].porosity;
-            const bool on = rho <= factor * rho0; // Eq. 6.40
-            P[flag]       = on ? 1.0 : 0.0;
-            n_flagged += on;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                lo[d] = std::min(lo[d], pt->get_location()[d]);
-                hi[d] = std::max(hi[d], pt->get_location()[d]);
-              }
-          }
-      }
+    transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
+      const auto &cc = s.grid.cells[c];
+      double N[nv];
+      Q::values(pt->get_reference_location(), N);
+      double rho = 0;
+      for (unsigned int v = 0; v < nv; ++v)
+        rho += N[v] * Mn[cc.dofs[v * dim]]; // Eq. 6.39
+      double *           P   = pt->get_properties().data();
+      const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+      // reference density: that of the material, or of the solid mass per
+      // volume of a coupled point (its P[mass] is the solid mass)
+      double rho0 = s.prm.materials[mat]->density();
+      if (s.two_phase && s.two_phase->coupled &&
+          s.prm.liquid.pore_liquid[mat].drainage == Drainage::coupled)
+        rho0 *= 1 - s.prm.liquid.pore_liquid[mat].porosity;
+      const bool on = rho <= factor * rho0; // Eq. 6.40
+      P[flag]       = on ? 1.0 : 0.0;
+      n_flagged += on;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          lo[d] = std::min(lo[d], pt->get_location()[d]);
+          hi[d] = std::max(hi[d], pt->get_location()[d]);
+        }
+    });
     count = dealii::Utilities::MPI::sum(n_flagged, s.comm);
     extent.assign(2 * dim, 0.0);
     for (unsigned int d = 0; d < dim; ++d)

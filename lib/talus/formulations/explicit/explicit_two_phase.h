@@ -11,6 +11,7 @@
 // hot loop nothing.
 #pragma once
 
+#include <talus/formulations/explicit/forward.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
 
@@ -21,18 +22,8 @@
 #include <string>
 #include <vector>
 
-namespace talus::loads
-{
-  template <int dim>
-  class LoadControl;
-}
-
 namespace talus::explicit_mpm
 {
-  template <int dim>
-  class Solver;
-  struct Energies;
-
   enum class Drainage
   {
     drained,   ///< 1-phase, no pore pressure (dry, or drained with zero excess pressure)

@@ -11,24 +11,6 @@
 
 namespace talus::explicit_mpm
 {
-  namespace
-  {
-    /// A cell's lumped mass and internal force sums onto its nodes, gravity added.
-    template <int dim, unsigned int nv>
-    inline void
-    scatter_cell(const CellCache<dim> &cc, const double (&lm)[nv], const double (&f)[nv][dim],
-                 const dealii::Tensor<1, dim> &g, double *M, double *F)
-    {
-      for (unsigned int v = 0; v < nv; ++v)
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const unsigned int i = cc.dofs[v * dim + d];
-            M[i] += lm[v];
-            F[i] += f[v][d] + lm[v] * g[d];
-          }
-    }
-  } // namespace
-
   template <int dim>
   FemIntegration<dim>::FemIntegration(Solver<dim> &solver, const bool updated_lagrangian)
     : s(solver)
@@ -98,24 +80,22 @@ namespace talus::explicit_mpm
       {
         if (!grid.cells[c].locally_owned || body_of_cell[c] < 0)
           continue;
-        double X[nv][dim];
-        current_vertices(c, X);
+        typename Kernel::Cell cell;
+        current_vertices(c, cell.X);
         const unsigned int b = body_of_cell[c];
         for (unsigned int q = 0; q < nv; ++q)
           {
             dealii::Point<dim> xi, x;
             for (unsigned int d = 0; d < dim; ++d)
               xi[d] = 0.5 + (((q >> d) & 1u) ? gauss : -gauss);
-            double N[nv], dN[nv][dim], G[nv][dim];
-            shape::IsoQ1<dim>::shape(xi, N, dN);
-            const double det = shape::IsoQ1<dim>::gradients(X, dN, G);
+            typename Kernel::Eval e;
+            Kernel::evaluate(cell, xi, e);
+            const double det = e.det;
             if (!(det > 0))
               throw InputError("grid: cell " + grid.cell_iterators[c]->id().to_string() +
                                " is inverted or degenerate (det J = " + std::to_string(det) +
                                " at a Gauss point); numerics/integration = fem | ul-fem needs valid cells");
-            for (unsigned int v = 0; v < nv; ++v)
-              for (unsigned int d = 0; d < dim; ++d)
-                x[d] += N[v] * X[v][d];
+            Kernel::position(cell, e, x);
             points.push_back({x, xi, c, b, static_cast<unsigned int>(material_of_cell[c]), det * weight});
           }
       }
@@ -176,28 +156,23 @@ namespace talus::explicit_mpm
     const auto    g        = s.gravity;
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
-    double X[nv][dim], lm[nv], f[nv][dim]; // the cell's vertices and sums
-    const auto begin_cell = [&](const unsigned int c) {
-      current_vertices(c, X);
-      std::fill(lm, lm + nv, 0.0);
-      std::fill(&f[0][0], &f[0][0] + nv * dim, 0.0);
+    typename Kernel::Cell               cell;
+    typename Kernel::MassForce sums;
+    const auto                 begin_cell = [&](const unsigned int c) {
+      current_vertices(c, cell.X);
+      cell.dofs = s.grid.cells[c].dofs;
+      sums.clear();
     };
     const auto at_point = [&](const unsigned int, auto &pt) {
-            const double *P = pt->get_properties().data();
-            double        N[nv], dN[nv][dim], G[nv][dim], t[dim][dim];
-            shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
-            shape::IsoQ1<dim>::gradients(X, dN, G);
-            minus_V_sigma<dim>(P, P[L::volume], t);
-            for (unsigned int v = 0; v < nv; ++v)
-              {
-                lm[v] += P[L::mass] * N[v];
-                for (unsigned int a = 0; a < dim; ++a)
-                  for (unsigned int b = 0; b < dim; ++b)
-                    f[v][a] += t[a][b] * G[v][b];
-              }
+      const double *        P = pt->get_properties().data();
+      typename Kernel::Eval e;
+      Kernel::evaluate(cell, pt->get_reference_location(), e);
+      double t[dim][dim];
+      minus_V_sigma<dim>(P, P[L::volume], t);
+      sums.add(e, P[L::mass], t);
     };
     transfer::for_each_active_cell(s.points, begin_cell, at_point,
-                                   [&](const unsigned int c) { scatter_cell(s.grid.cells[c], lm, f, g, M, F); });
+                                   [&](const unsigned int) { sums.scatter(cell, g, M, F); });
   }
 
   template <int dim>
@@ -220,32 +195,26 @@ namespace talus::explicit_mpm
     s.zero_on_active(s.nodal_a);
     // the cell's vertices at the start and end of the step, the nodal
     // displacement increments, and the next step's mass and force sums
-    double     X0[nv][dim], X1[nv][dim], du[nv][dim], lm[nv], f[nv][dim];
-    const auto begin_cell = [&](const unsigned int c) {
-      const auto &cc = s.grid.cells[c];
-      current_vertices(c, X0);
+    typename Kernel::Cell               cell; // at the start of the step
+    double                     X1[nv][dim]; // its vertices at the end
+    typename Kernel::Field     du;
+    typename Kernel::MassForce sums;
+    const auto                 begin_cell = [&](const unsigned int c) {
+      current_vertices(c, cell.X);
+      cell.dofs = s.grid.cells[c].dofs;
+      Kernel::gather(cell, Vn, h, du); // seed 000 Eq. 4.49
       for (unsigned int v = 0; v < nv; ++v)
         for (unsigned int d = 0; d < dim; ++d)
-          {
-            du[v][d] = h * Vn[cc.dofs[v * dim + d]]; // seed 000 Eq. 4.49
-            X1[v][d] = X0[v][d] + (ul ? du[v][d] : 0.0);
-          }
-      std::fill(lm, lm + nv, 0.0);
-      std::fill(&f[0][0], &f[0][0] + nv * dim, 0.0);
+          X1[v][d] = cell.X[v][d] + (ul ? du.u[v][d] : 0.0);
+      sums.clear();
     };
     const auto at_point = [&](const unsigned int, auto &pt) {
-            double *     P = pt->get_properties().data();
-            double       N[nv], dN[nv][dim], G[nv][dim];
-            shape::IsoQ1<dim>::shape(pt->get_reference_location(), N, dN);
-            const double det0 = shape::IsoQ1<dim>::gradients(X0, dN, G);
-            double       gu[dim][dim] = {}, dx[dim] = {};
-            for (unsigned int v = 0; v < nv; ++v)
-              for (unsigned int a = 0; a < dim; ++a)
-                {
-                  dx[a] += N[v] * du[v][a];
-                  for (unsigned int b = 0; b < dim; ++b)
-                    gu[a][b] += du[v][a] * G[v][b];
-                }
+            double *              P = pt->get_properties().data();
+            typename Kernel::Eval at;
+            Kernel::evaluate(cell, pt->get_reference_location(), at);
+            const double det0 = at.det;
+            double       gu[dim][dim], dx[dim];
+            Kernel::value_and_gradient(du, at, dx, gu);
             materials::Strain d_eps;
             materials::Spin   d_omega; // zero for small strain (fem)
             for (unsigned int a = 0; a < dim; ++a)
@@ -269,7 +238,7 @@ namespace talus::explicit_mpm
             if (ul)
               {
                 // the point follows its cell: x_p = sum N_i x_i, V_p = det J w
-                det1 = shape::IsoQ1<dim>::gradients(X1, dN, G);
+                det1 = Kernel::move_vertices(X1, at);
                 P[L::volume] *= det1 / det0;
                 for (unsigned int d = 0; d < dim; ++d)
                   x[d] += dx[d];
@@ -307,16 +276,10 @@ namespace talus::explicit_mpm
             // next step's mass and internal force at the updated state
             double t[dim][dim];
             minus_V_sigma<dim>(P, P[L::volume], t);
-            for (unsigned int v = 0; v < nv; ++v)
-              {
-                lm[v] += mass * N[v];
-                for (unsigned int a = 0; a < dim; ++a)
-                  for (unsigned int b = 0; b < dim; ++b)
-                    f[v][a] += t[a][b] * G[v][b];
-              }
+            sums.add(at, mass, t);
     };
     transfer::for_each_active_cell(s.points, begin_cell, at_point,
-                                   [&](const unsigned int c) { scatter_cell(s.grid.cells[c], lm, f, g, M, F); });
+                                   [&](const unsigned int) { sums.scatter(cell, g, M, F); });
     if (ul)
       {
         // move the nodes of the cells with points (owned and ghost entries:

@@ -21,16 +21,15 @@
 // the same pass (no relocation ever happens).
 #pragma once
 
+#include <talus/formulations/explicit/forward.h>
 #include <talus/grid/background_grid.h>
 #include <talus/particles/material_points.h>
+#include <talus/shape/q1_iso.h>
 
 #include <vector>
 
 namespace talus::explicit_mpm
 {
-  template <int dim>
-  class Solver;
-
   template <int dim>
   class FemIntegration
   {
@@ -62,6 +61,7 @@ namespace talus::explicit_mpm
     Solver<dim> &             s;
     const bool                ul;
     static constexpr unsigned int nv = 1u << dim;
+    using Kernel                     = shape::Q1Iso<dim>; ///< the cells may be deformed (ul-fem)
     /// reference vertex coordinates per active cell index: [c][v][d]
     std::vector<double>       vertices;
     Vector                    nodal_u;

@@ -7,6 +7,7 @@
 // solver's hot loops see one null pointer test per cell or particle.
 #pragma once
 
+#include <talus/formulations/explicit/forward.h>
 #include <talus/grid/background_grid.h>
 #include <talus/materials/material.h>
 
@@ -18,9 +19,6 @@
 
 namespace talus::explicit_mpm
 {
-  template <int dim>
-  class Solver;
-
   /// Options of chapter 6 read from the .prm (subsections `numerics`, `contact`).
   struct NumericsOptions
   {

@@ -3,9 +3,11 @@
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/scene_checks.h>
+#include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/io/output.h>
+#include <talus/loads/kinematics.h>
 #include <talus/shape/q1_box.h>
 #include <talus/transfer/updated_lagrangian_ops.h>
 
@@ -180,7 +182,7 @@ namespace talus::implicit_mpm
     grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
     space.setup();
-    boundary_flags = grid.constrained_dofs(prm.boundary_conditions);
+    boundary_flags = loads::wall_dof_flags(grid, prm.boundary_conditions);
 
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
@@ -242,27 +244,11 @@ namespace talus::implicit_mpm
   Solver<dim>::prepare_step()
   {
     active.template reinit<shape::Q1Box<dim>>({&points});
-    // the walls' fixed and roller DoFs (grid DoFs by vertex) as homogeneous
-    // constraints on the increment, merged with the pins of the inactive DoFs
-    dealii::AffineConstraints<double> dirichlet;
-    dirichlet.reinit(space.locally_relevant_dofs());
-    for (const auto &cell : grid.tria.active_cell_iterators())
-      if (!cell->is_artificial())
-      for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-        for (unsigned int k = 0; k < dim; ++k)
-          {
-            const auto &       cc = grid.cells[cell->active_cell_index()];
-            const unsigned int g  = cc.dofs[v * dim + k];
-            if (g == dealii::numbers::invalid_unsigned_int || !boundary_flags[g])
-              continue;
-            const auto i = space.node_dof(cc.dofs[v * dim], k);
-            if (!dirichlet.is_constrained(i))
-              dirichlet.add_line(i);
-          }
     active.reinit_matrix(tangent);
     project_to_grid();
-    dirichlet.close();
-    constraints = active.constraints_with(dirichlet);
+    // the walls' fixed and roller DoFs as homogeneous constraints on the
+    // increment, merged with the pins of the inactive DoFs
+    constraints = active.constraints_with(loads::wall_constraints(grid, space, boundary_flags));
   }
 
   template <int dim>
@@ -692,37 +678,11 @@ namespace talus::implicit_mpm
           << std::endl;
   }
 
-  template <int dim>
-  void
-  Solver<dim>::run()
-  {
-    TimeLoop(*this, loop_settings(prm), comm).run();
-  }
-
   int
   run(dealii::ParameterHandler &prm, const std::string &)
   {
-    if (prm.get_integer("dimension") == 2)
-      {
-        const auto p = parse_parameters<2>(prm);
-        Solver<2>  s(p, MPI_COMM_WORLD);
-        s.setup();
-        s.run();
-      }
-    else
-      {
-        const auto p = parse_parameters<3>(prm);
-        Solver<3>  s(p, MPI_COMM_WORLD);
-        s.setup();
-        s.run();
-      }
-    return exit_ok;
+    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
-  template struct Parameters<2>;
-  template struct Parameters<3>;
-  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
-  template class Solver<2>;
-  template class Solver<3>;
+  TALUS_INSTANTIATE_FORMULATION(class);
 } // namespace talus::implicit_mpm

@@ -74,8 +74,6 @@ namespace talus::implicit_mpm
 
     /// Grid, spaces, points, constraints. Collective.
     void setup();
-    /// The time loop with output until the end time.
-    void run();
 
     unsigned long long n_points() const { return points.handler.n_global_particles(); }
 

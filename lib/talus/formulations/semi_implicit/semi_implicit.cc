@@ -7,6 +7,7 @@
 // paper's §2), so the hydrostatic pore pressure is negative.
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
@@ -14,6 +15,7 @@
 #include <talus/io/output.h>
 #include <talus/io/vtu.h>
 #include <talus/loads/k0.h>
+#include <talus/loads/kinematics.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
@@ -432,7 +434,7 @@ namespace talus::semi_implicit
     if (prm.bspline)
       grid.setup_bspline_patches();
     pspace.setup();
-    constrained = grid.constrained_dofs(prm.boundary_conditions);
+    constrained = loads::wall_dof_flags(grid, prm.boundary_conditions);
 
     // node and component of every local grid DoF (from the cells' vertex DoFs)
     const unsigned int nl = n_local();
@@ -1125,31 +1127,13 @@ namespace talus::semi_implicit
     require_output_directory(out, "output/directory");
   }
 
-  template <int dim>
-  static void
-  run_dim(dealii::ParameterHandler &prm)
-  {
-    auto         p = parse_parameters<dim>(prm);
-    Solver<dim>  s(p, MPI_COMM_WORLD);
-    s.setup();
-    TimeLoop loop(s, loop_settings<dim>(p), MPI_COMM_WORLD);
-    loop.run();
-  }
-
   int
   run(dealii::ParameterHandler &prm, const std::string &)
   {
-    if (prm.get_integer("dimension") == 2)
-      run_dim<2>(prm);
-    else
-      run_dim<3>(prm);
-    return exit_ok;
+    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
-  template struct Parameters<2>;
-  template struct Parameters<3>;
-  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  TALUS_INSTANTIATE_FORMULATION(class);
   template double soil_critical_time_step<2>(const Parameters<2> &, double);
   template double soil_critical_time_step<3>(const Parameters<3> &, double);
 } // namespace talus::semi_implicit

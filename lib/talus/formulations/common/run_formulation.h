@@ -1,0 +1,61 @@
+// talus — the one `run()` of every formulation family's tool: dispatch on
+// 'dimension', parse the family's parameters, build its Solver, set it up, run
+// the time loop (time_loop.h), then (families whose .prm has 'numerics/
+// integration', so far the explicit one) draw the pictures 'output/png
+// snapshots' asks for. A family's tool entry is one line:
+//
+//   int run(dealii::ParameterHandler &prm, const std::string &)
+//   { return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>); }
+//
+// Solver<dim> must be constructible from (const Parameters<dim> &, MPI_Comm),
+// keep that reference, have setup(), and be a Formulation.
+#pragma once
+
+#include <talus/base/tool.h>
+#include <talus/formulations/common/scene_parameters.h>
+#include <talus/formulations/common/time_loop.h>
+#include <talus/io/png_snapshots.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <mpi.h>
+
+namespace talus
+{
+  /// Build, set up and run one Solver of one dimension over `p` (collective).
+  template <class Solver, class Parameters>
+  void
+  run_solver(const Parameters &p, MPI_Comm comm)
+  {
+    Solver s(p, comm);
+    s.setup();
+    TimeLoop(s, loop_settings(p), comm).run();
+  }
+
+  /// The dimension dispatch of a family's tool; returns the exit code.
+  template <template <int> class Solver, class Parameters2, class Parameters3>
+  int
+  run_formulation(dealii::ParameterHandler &prm,
+                  Parameters2 (*parse_2d)(dealii::ParameterHandler &),
+                  Parameters3 (*parse_3d)(dealii::ParameterHandler &),
+                  const bool png_snapshots = false)
+  {
+    if (prm.get_integer("dimension") == 2)
+      run_solver<Solver<2>>(parse_2d(prm), MPI_COMM_WORLD);
+    else
+      run_solver<Solver<3>>(parse_3d(prm), MPI_COMM_WORLD);
+    if (png_snapshots)
+      io::draw_png_snapshots(prm, MPI_COMM_WORLD); // after every output file is complete
+    return exit_ok;
+  }
+} // namespace talus
+
+/// Explicit instantiation of a family's Solver and Parameters for dim 2 and 3
+/// (in the family's one .cc that defines them; inside its namespace).
+#define TALUS_INSTANTIATE_FORMULATION(SolverKind)                                   \
+  template struct Parameters<2>;                                                  \
+  template struct Parameters<3>;                                                  \
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);          \
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);          \
+  template SolverKind Solver<2>;                                                  \
+  template SolverKind Solver<3>

@@ -1,0 +1,34 @@
+// talus — kinematic conditions of the grid's walls, shared by every family
+// (seed 000 §5.1): the scene's (or a stage's) 'boundary conditions' (fixed: all
+// velocity components zero; roller: the normal one) become a flag per local DoF
+// of the grid's vector space (the explicit nodal solve and the semi-implicit
+// velocity updates skip flagged DoFs), and for the implicit families the same
+// DoFs as homogeneous constraints on a NodalSpace (the increment is zero there).
+// Explicit-only loads (damping, mass scaling, convergence, wall friction,
+// prescribed velocities) stay in loads/load_control.
+#pragma once
+
+#include <talus/grid/background_grid.h>
+#include <talus/grid/nodal_space.h>
+
+#include <deal.II/lac/affine_constraints.h>
+
+#include <vector>
+
+namespace talus::loads
+{
+  /// Per local DoF (owned + ghost) of the grid's vector space a flag: 1 if its
+  /// velocity component is prescribed zero by one of the conditions. Throws
+  /// InputError naming 'boundary conditions' for a boundary id the grid lacks.
+  template <int dim>
+  std::vector<unsigned char>
+  wall_dof_flags(const BackgroundGrid<dim> &grid, const std::vector<BoundaryCondition> &bcs);
+
+  /// The flagged DoFs as homogeneous constraints on `space` (a vector space on
+  /// the grid's triangulation, whose node_dof maps the grid's DoFs), closed.
+  template <int dim>
+  dealii::AffineConstraints<double>
+  wall_constraints(const BackgroundGrid<dim> &       grid,
+                   const NodalSpace<dim> &           space,
+                   const std::vector<unsigned char> &flags);
+} // namespace talus::loads
