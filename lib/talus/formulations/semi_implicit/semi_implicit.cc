@@ -402,7 +402,7 @@ namespace talus::semi_implicit
     Vector Mwg;                         // sum N m grad p (linear pressure map)
     Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
-    Vector p_node, dp_node, gs, gw, wet, dry;
+    Vector p_node, dp_node, gs, gw, wet, dry, near_wet;
     std::vector<double> cell_water_volume;
     std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
 
@@ -455,7 +455,7 @@ namespace talus::semi_implicit
               }
           }
     for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
-                      &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry})
+                      &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
 
     // layouts: soil points carry the solid model's history; both carry porosity
@@ -607,7 +607,7 @@ namespace talus::semi_implicit
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
 
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry})
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
@@ -773,7 +773,9 @@ namespace talus::semi_implicit
     }
     if (soil.cell_set_changed() || water.cell_set_changed() || step_number == 0)
       active.template reinit<K>({&soil, &water});
-    // free water surface: per node, whether it is a vertex of a wet and of a dry cell
+    // free water surface: per node, whether it is a vertex of a wet and of a
+    // dry cell, and whether it is a vertex of a cell next to a wet one
+    // (shares a vertex with it: the layer of nodes just outside the water)
     {
       double *wt = at(wet), *dr = at(dry);
       for (unsigned int c = 0; c < grid.cells.size(); ++c)
@@ -788,6 +790,21 @@ namespace talus::semi_implicit
           }
     }
     exchange({&wet, &dry});
+    {
+      const double *wt = at(wet);
+      double *      nr = at(near_wet);
+      for (unsigned int c = 0; c < grid.cells.size(); ++c)
+        if (grid.cells[c].locally_owned)
+          {
+            bool touches_wet = false;
+            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+              touches_wet = touches_wet || wt[grid.cells[c].dofs[v * dim]] > 0;
+            if (touches_wet)
+              for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+                nr[grid.cells[c].dofs[v * dim]] += 1;
+          }
+    }
+    exchange({&near_wet});
     dealii::AffineConstraints<double> dirichlet;
     dirichlet.reinit(pspace.locally_relevant_dofs());
     for (unsigned int i = 0; i < nl; ++i)
@@ -800,9 +817,16 @@ namespace talus::semi_implicit
           const bool surface   = dry.local_element(i) > 0;
           if (!has_water || surface)
             {
-              // p^{t+1} = 0 on the surface (Delta p = -p^t); no water: Delta p = 0 (A2, A4)
+              // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
+              // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
+              // Delta p = -p^t. The dry nodes next to a wet cell (B-spline: the
+              // node above the surface that the top points still touch) keep the
+              // mapped p^t, the linear extrapolation of the water's pressure
+              // (Delta p = 0); forcing 0 there fed the top cell a spurious
+              // pressure step every step (docs/semi-implicit.md, A6).
+              const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
               dirichlet.add_line(gdof);
-              dirichlet.set_inhomogeneity(gdof, has_water ? -p_node.local_element(i) : 0.0);
+              dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
             }
         }
     dirichlet.close();
