@@ -58,6 +58,20 @@ add_test(NAME verification.semi_implicit_hydrostatic_long
                  --end-time=1.5)
 set_tests_properties(verification.semi_implicit_hydrostatic_long PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
 
+# near-incompressible strip footing (App. A, single phase): the modified F-bar
+# removes the checkerboard, no stabilisation locks; h = 0.5 m (fast), 0.2 m and
+# 1 vs 2 ranks (verify)
+add_test(NAME verification.semi_implicit_strip_footing_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_strip_footing.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_strip_footing.prm ${_w}/semi_implicit_strip_footing_fast)
+set_tests_properties(verification.semi_implicit_strip_footing_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+add_test(NAME verification.semi_implicit_strip_footing
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_strip_footing.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_strip_footing.prm ${_w}/semi_implicit_strip_footing
+                 --h=0.2 --np2)
+set_tests_properties(verification.semi_implicit_strip_footing PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 3600
+                     PROCESSORS 2)
+
 # the stencil ops of the family's point passes on 2 ranks (conservation across
 # the partition, the Poisson matrix with rows on the other rank)
 add_test(NAME unit.test_stencil_ops_np2
