@@ -14,15 +14,22 @@ oscillation the stabilisation removes is there); the locking: settlement (mean
 vertical displacement of the loaded top points) without stabilisation < 0.95 x
 the modified f-bar one. With --np2, the modified f-bar run on 2 ranks (patches
 spanning both) matches 1 rank to 1e-8 relative (points matched by initial position).
-Usage: check_semi_strip_footing.py TOOL PRM WORKDIR [--h=H] [--np2]
+Usage: check_semi_strip_footing.py TOOL PRM WORKDIR [--h=H] [--np2] [--locking=R] [--zigzag-none=Z]
   --h=0.2: the paper's coarse grid (make verify); default the .prm's 0.5 m
+  --locking, --zigzag-none: the bounds of the unstabilised run (default 0.95, 1e-2 for h = 0.5;
+  the locking and the oscillation shrink with h: 0.974 and 1.2e-2 measured at h = 0.2)
 """
 import math
 import sys
 
 import talus_verify as tv
 
-h_arg = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--h=")), None)
+def option(name, default):
+    return next((a.split("=", 1)[1] for a in sys.argv if a.startswith(f"--{name}=")), default)
+
+
+h_arg = option("h", None)
+locking, zigzag_none = float(option("locking", 0.95)), float(option("zigzag-none", 1e-2))
 np2 = "--np2" in sys.argv
 tool, prm_path, work = [a for a in sys.argv if not a.startswith("--")][1:4]
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
@@ -71,8 +78,9 @@ ratio = res["none"][1] / res["modified f-bar"][1]
 print(f"settlement without stabilisation / with modified f-bar = {ratio:.3f} (f-bar: "
       f"{res['f-bar'][1] / res['modified f-bar'][1]:.3f})")
 tv.check(res["modified f-bar"][0] < 2e-3, f"modified f-bar: no checkerboard (zigzag {res['modified f-bar'][0]:.2e} < 2e-3)")
-tv.check(res["none"][0] > 1e-2, f"no stabilisation: the checkerboard is there (zigzag {res['none'][0]:.2e} > 1e-2)")
-tv.check(ratio < 0.95, f"no stabilisation locks: settlement ratio {ratio:.3f} < 0.95")
+tv.check(res["none"][0] > zigzag_none,
+         f"no stabilisation: the checkerboard is there (zigzag {res['none'][0]:.2e} > {zigzag_none:.0e})")
+tv.check(ratio < locking, f"no stabilisation locks: settlement ratio {ratio:.3f} < {locking}")
 if np2:
     text = tv.prm_set(base, "semi implicit/volumetric stabilisation", "modified f-bar")
     tv.run_tool(tool, text, f"{work}/np2", "np2", np=2)

@@ -97,6 +97,13 @@ namespace talus::semi_implicit
                         "of the last step scaled by (Jebar / J^e)^(2/3), Jebar the mass-weighted mean of "
                         "J^e = sqrt(det b_e) over the soil points of a fixed square patch (Eqs. 81-83); needs a "
                         "model that keeps b_e (hencky mohr coulomb, nor sand, neo hookean).");
+      prm.declare_entry("point sets", "double", Selection("double|single"),
+                        "double: soil and water are two sets of material points, each moving with its own "
+                        "velocity (the paper's double-point method). single: the water is carried on the soil "
+                        "points: the water points are seeded on the soil points and move with the soil's "
+                        "velocity, so they stay on them; the water keeps its own velocity, mass, pressure and "
+                        "the same equations and basis (the single-point comparison). single needs every body "
+                        "to be saturated or soil.");
       prm.declare_entry("patch size", "1.5", Double(0),
                         "Side of the modified F-bar patches in cells (1.5 for quadratic B-splines, 1 = the "
                         "cell-wise average); the patches tile the grid from its lower corner and stay fixed.");
@@ -277,6 +284,7 @@ namespace talus::semi_implicit
                              : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
                                                       : VolumetricStabilisation::none;
       p.patch_size = prm.get_double("patch size");
+      p.single_point = prm.get("point sets") == "single";
       require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
     }
     require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
@@ -358,6 +366,11 @@ namespace talus::semi_implicit
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
       phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
                 (p.phase_of_body[k] == Phase::soil ? "soil" : p.phase_of_body[k] == Phase::water ? "water" : "saturated");
+    if (p.single_point)
+      for (unsigned int b = 0; b < p.bodies.size(); ++b)
+        require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
+                "single needs every body to carry soil points (the water rides on them), but body " +
+                  std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
     // a dry scene (soil points only) is a single-phase solid: allowed
     (void)any_water;
     require(any_soil, phases,
@@ -1145,7 +1158,9 @@ namespace talus::semi_implicit
       transfer::for_each_active_cell(soil, move_soil);
       soil.relocate();
       WaterMove                                               wm;
-      transfer::UpdateAndMove<dim, K, WaterMove>              move_water(grid, water, at(vw_new), h, wm);
+      // single point: the water rides on the soil points (the same positions,
+      // moved by the same velocity field and the same arithmetic)
+      transfer::UpdateAndMove<dim, K, WaterMove> move_water(grid, water, at(prm.single_point ? vs_new : vw_new), h, wm);
       transfer::for_each_active_cell(water, move_water);
       water.relocate();
     }

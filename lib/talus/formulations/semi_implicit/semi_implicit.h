@@ -76,6 +76,9 @@ namespace talus::semi_implicit
     double flip_fraction            = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
     VolumetricStabilisation stabilisation = VolumetricStabilisation::none;
     double patch_size = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
+    /// single: the water is carried on the soil points (its points move with the
+    /// soil's velocity, so they stay on them); double: its own points
+    bool single_point = false;
     // 'initial state' subsection: geostatic water pressure and effective stress
     bool   geostatic    = false;
     double water_level  = 0; ///< vertical coordinate of the free water surface
