@@ -1185,14 +1185,15 @@ namespace talus::semi_implicit
       const double *v  = vs_t.begin();
       double *      mj = Mdj.begin();
       transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
-        double *             P = it->get_properties().data();
-        dealii::Tensor<2, 3> dF;
+        double *P = it->get_properties().data();
+        double  gv[dim][dim];
+        s.vector_gradient(v, gv);
+        dealii::Tensor<2, 3> dF; // I + h grad v (plane strain: dF_33 = 1)
         for (unsigned int i = 0; i < 3; ++i)
           dF[i][i] = 1;
-        for (unsigned int w = 0; w < s.n; ++w)
-          for (unsigned int i = 0; i < dim; ++i)
-            for (unsigned int j = 0; j < dim; ++j)
-              dF[i][j] += h * v[s.dof[w][i]] * s.G[w][j];
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            dF[i][j] += h * gv[i][j];
         s.scatter(mj, P[L::mass] * dealii::determinant(dF));
         if (modified)
           {
