@@ -108,7 +108,7 @@ namespace
     for (unsigned int i = 0; i < dim; ++i)
       EXPECT_NEAR(dealii::Utilities::MPI::sum(Pn[i], comm), p_sum[i], 1e-12 * m_sum);
 
-    // a linear nodal field at the points: value, gradient, divergence
+    // a linear nodal field at the points: value, gradient (scalar and vector), divergence
     Vector V, S;
     grid.reinit_vector(V);
     grid.reinit_vector(S);
@@ -139,6 +139,11 @@ namespace
       for (unsigned int i = 0; i < dim; ++i)
         tr += B[i][i];
       worst = std::max(worst, std::abs(s.divergence(V.begin()) - tr));
+      double gv[dim][dim];
+      s.vector_gradient(V.begin(), gv);
+      for (unsigned int i = 0; i < dim; ++i)
+        for (unsigned int j = 0; j < dim; ++j)
+          worst = std::max(worst, std::abs(gv[i][j] - B[i][j]));
       const auto x = it->get_location();
       worst        = std::max(worst, std::abs(s.value(S.begin()) - (2.0 - x[0] + 0.5 * x[dim - 1])));
       s.gradient(S.begin(), gs);

@@ -20,7 +20,16 @@ cases = [
      "material 0/soil/hydraulic conductivity"),
     # a water body alone: no soil, so no skeleton for the drag and the mixture
     ("water without soil", [("body 0/phase", "water")], "body 0/phase = water"),
-    ("soil without water", [("body 0/phase", "soil")], "body 0/phase = soil"),
+    # (soil without water is a single-phase solid and allowed: the strip footing)
+    ("modified f-bar without b_e", [("semi implicit/volumetric stabilisation", "modified f-bar")],
+     "semi implicit/volumetric stabilisation"),
+    ("bad stabilisation", [("semi implicit/volumetric stabilisation", "f bar")], "volumetric stabilisation"),
+    ("patch size", [("semi implicit/patch size", "0.1")], "semi implicit/patch size"),
+    ("single point with a water body", [("semi implicit/point sets", "single"), ("number of bodies", "2"),
+                                        ("body 1/phase", "water"), ("body 1/upper corner", "0.075, 1.05"),
+                                        ("body 1/lower corner", "0, 1")], "semi implicit/point sets"),
+    ("surface load extent", [("body 0/surface load", "1e4"), ("body 0/surface load extent", "3, 1")],
+     "body 0/surface load extent"),
     ("unknown phase", [("body 0/phase", "gas")], "phase"),
     ("free surface fraction", [("semi implicit/free surface volume fraction", "1")], "free surface volume fraction"),
     ("checkpoints", [("checkpoint/interval", "0.1")], "checkpoint"),

@@ -7,15 +7,20 @@ c_v = k E_oed / (rho_w g):
 One run per T_v (to t = T_v H^2 / c_v, a whole number of 1e-4 s steps); the
 normalised error over the water points sqrt(sum (u - u_an)^2 / sum u_an^2)
 (decision A30 of the reading) must be below 3 % (the issue's tolerance).
-Usage: check_semi_terzaghi.py TOOL PRM WORKDIR [T,T,...]   (default 0.05,0.1,0.2)
+With --set="semi implicit/point sets=single" (the single-point variant) the water
+points must also sit on the soil points (positions to 1e-12 m).
+Usage: check_semi_terzaghi.py TOOL PRM WORKDIR [T,T,...] [--set=entry=value ...]
+  (default 0.05,0.1,0.2; --set changes a .prm entry, e.g. --set="semi implicit/point sets=single")
 """
 import math
 import sys
 
 import talus_verify as tv
 
-tool, prm_path, work = sys.argv[1:4]
-times = [float(x) for x in sys.argv[4].split(",")] if len(sys.argv) > 4 else [0.05, 0.1, 0.2]
+sets = [a[len("--set="):].split("=", 1) for a in sys.argv if a.startswith("--set=")]
+args = [a for a in sys.argv if not a.startswith("--set=")]
+tool, prm_path, work = args[1:4]
+times = [float(x) for x in args[4].split(",")] if len(args) > 4 else [0.05, 0.1, 0.2]
 q, H, rw, g, E, k, dt = 1e4, 1.0, 1000.0, 9.81, 1e7, 1e-3, 1e-4
 cv = k * E / (rw * g)
 
@@ -26,6 +31,8 @@ def analytic(zeta, T):
 
 
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+for entry, value in sets:
+    base = tv.prm_set(base, entry.strip(), value.strip())
 for T in times:
     n_steps = round(T * H * H / cv / dt)
     text = tv.prm_set(base, "time/end time", repr(n_steps * dt))
@@ -43,4 +50,10 @@ for T in times:
     print(f"T_v = {Tn:.4f}: {n_steps} steps; normalised L2 error of the pore pressure {e:.3e}, "
           f"max |u - u_an| / q = {worst:.3e}")
     tv.check(e < 0.03, f"T_v = {T}: normalised L2 error {e:.2e} < 0.03")
+    if any(v.strip() == "single" for _, v in sets):  # the water rides on the soil points
+        sp = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
+        ws = sorted(zip(w["pos_x"], w["pos_y"]))
+        ss = sorted(zip(sp["pos_x"], sp["pos_y"]))
+        gap = max(abs(a - c) + abs(b - d) for (a, b), (c, d) in zip(ws, ss)) if len(ws) == len(ss) else float("inf")
+        tv.check(gap < 1e-12, f"T_v = {T}: single point: every water point on a soil point (max gap {gap:.1e} m)")
 tv.finish()

@@ -44,6 +44,18 @@ add_test(NAME verification.semi_implicit_terzaghi
                  ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi
                  0.05,0.1,0.2,0.5,1.0)
 set_tests_properties(verification.semi_implicit_terzaghi PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+# the single-point variant (water carried on the soil points), same tolerance:
+# T_v = 0.1 (fast), 0.05 ... 1.0 (verify)
+add_test(NAME verification.semi_implicit_terzaghi_single_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_single_fast
+                 0.1 "--set=semi implicit/point sets=single")
+set_tests_properties(verification.semi_implicit_terzaghi_single_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+add_test(NAME verification.semi_implicit_terzaghi_single
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_single
+                 0.05,0.1,0.2,0.5,1.0 "--set=semi implicit/point sets=single")
+set_tests_properties(verification.semi_implicit_terzaghi_single PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
 # the same with linear shape functions
 add_test(NAME verification.semi_implicit_consolidation_linear
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
@@ -57,6 +69,20 @@ add_test(NAME verification.semi_implicit_hydrostatic_long
                  ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_hydrostatic_long
                  --end-time=1.5)
 set_tests_properties(verification.semi_implicit_hydrostatic_long PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+
+# near-incompressible strip footing (App. A, single phase): the modified F-bar
+# removes the checkerboard, no stabilisation locks; h = 0.5 m (fast), 0.2 m and
+# 1 vs 2 ranks (verify)
+add_test(NAME verification.semi_implicit_strip_footing_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_strip_footing.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_strip_footing.prm ${_w}/semi_implicit_strip_footing_fast)
+set_tests_properties(verification.semi_implicit_strip_footing_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+add_test(NAME verification.semi_implicit_strip_footing
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_strip_footing.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_strip_footing.prm ${_w}/semi_implicit_strip_footing
+                 --h=0.2 --np2 --locking=0.99 --zigzag-none=5e-3)
+set_tests_properties(verification.semi_implicit_strip_footing PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 3600
+                     PROCESSORS 2)
 
 # the stencil ops of the family's point passes on 2 ranks (conservation across
 # the partition, the Poisson matrix with rows on the other rank)

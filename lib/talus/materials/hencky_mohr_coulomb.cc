@@ -245,4 +245,10 @@ namespace talus::materials
   {
     return history[6];
   }
+
+  double
+  HenckyMohrCoulomb::elastic_jacobian(ArrayView<const double> history) const
+  {
+    return std::sqrt(determinant(fs::load_sym(history, 0))); // b_e in history[0..5]
+  }
 } // namespace talus::materials

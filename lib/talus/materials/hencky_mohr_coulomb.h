@@ -50,6 +50,9 @@ namespace talus::materials
     bool has_finite_strain_form() const override { return true; }
 
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
+    /// J^e = sqrt(det b_e) of the history's elastic left Cauchy-Green tensor
+    /// (the modified F-bar of the semi-implicit family, seed 002 Eq. 82).
+    double elastic_jacobian(ArrayView<const double> history) const;
     void finite_strain_update(const dealii::Tensor<2, 3> &dF,
                               ArrayView<const double>     history_old,
                               ArrayView<double>           history_new,

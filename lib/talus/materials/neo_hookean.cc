@@ -276,4 +276,10 @@ namespace talus::materials
   {
     return std::sqrt(determinant(fs::load_sym(history, 0)));
   }
+
+  double
+  NeoHookean::elastic_jacobian(ArrayView<const double> history) const
+  {
+    return std::sqrt(determinant(fs::load_sym(history, 0))); // b_e in history[0..5]
+  }
 } // namespace talus::materials

@@ -60,6 +60,18 @@ namespace talus::transfer
             out[d] += G[w][d] * fw;
         }
     }
+    /// Gradient of a vector nodal field at the point, out[i][j] = d f_i / d x_j.
+    inline void
+    vector_gradient(const double *f, double (&out)[dim][dim]) const
+    {
+      for (unsigned int i = 0; i < dim; ++i)
+        for (unsigned int j = 0; j < dim; ++j)
+          out[i][j] = 0;
+      for (unsigned int w = 0; w < n; ++w)
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            out[i][j] += f[dof[w][i]] * G[w][j];
+    }
     /// Divergence of a vector nodal field at the point.
     inline double
     divergence(const double *f) const

@@ -9,6 +9,7 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
+#include <talus/formulations/semi_implicit/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
@@ -24,6 +25,9 @@
 #include <talus/transfer/matrix_ops.h>
 #include <talus/transfer/point_ops.h>
 #include <talus/transfer/stencil_ops.h>
+#include <talus/materials/hencky_mohr_coulomb.h>
+#include <talus/materials/neo_hookean.h>
+#include <talus/materials/nor_sand.h>
 #include <talus/materials/strain_increments.h>
 
 #include <deal.II/base/mpi.h>
@@ -31,6 +35,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/particles/data_out.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -87,6 +92,23 @@ namespace talus::semi_implicit
       prm.declare_entry("flip fraction", "1", Double(0, 1),
                         "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
                         "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
+      prm.declare_entry("volumetric stabilisation", "none", Selection("none|f-bar|modified f-bar"),
+                        "Soil volumetric-locking stabilisation (seed 002 §4.4.2). none: the increment dF as "
+                        "computed. f-bar: dF scaled by (dJbar / dJ)^(1/dim), dJbar the mass-weighted node map "
+                        "and remap of the points' dJ (Eqs. 79-80). modified f-bar: in addition the elastic b_e "
+                        "of the last step scaled by (Jebar / J^e)^(2/3), Jebar the mass-weighted mean of "
+                        "J^e = sqrt(det b_e) over the soil points of a fixed square patch (Eqs. 81-83); needs a "
+                        "model that keeps b_e (hencky mohr coulomb, nor sand, neo hookean).");
+      prm.declare_entry("point sets", "double", Selection("double|single"),
+                        "double: soil and water are two sets of material points, each moving with its own "
+                        "velocity (the paper's double-point method). single: the water is carried on the soil "
+                        "points: the water points are seeded on the soil points and move with the soil's "
+                        "velocity, so they stay on them; the water keeps its own velocity, mass, pressure and "
+                        "the same equations and basis (the single-point comparison). single needs every body "
+                        "to be saturated or soil.");
+      prm.declare_entry("patch size", "1.5", Double(0),
+                        "Side of the modified F-bar patches in cells (1.5 for quadratic B-splines, 1 = the "
+                        "cell-wise average); the patches tile the grid from its lower corner and stay fixed.");
       prm.declare_entry("kozeny carman", "false", Bool(),
                         "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
                         "(Alg. 8(g)); false: k stays k0.");
@@ -117,6 +139,12 @@ namespace talus::semi_implicit
     for (unsigned int k = 0; k < counts.n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
+        prm.declare_entry("surface load extent", "", dealii::Patterns::Anything(),
+                          "Empty: the surface load covers the body's whole upper face. 'a, b': only the top "
+                          "points with a <= x <= b carry it (a strip load, e.g. a footing; x the first "
+                          "coordinate).");
+        prm.declare_entry("surface load ramp time", "0", Double(0),
+                          "The surface load grows linearly from 0 to q over this time [s]; 0: sudden at t = 0.");
         prm.declare_entry("surface load", "0", Double(-1e300, 1e300),
                           "A uniform vertical pressure q [Pa] (>= 0, pushing down) on the upper face of a box "
                           "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
@@ -135,6 +163,27 @@ namespace talus::semi_implicit
 
   namespace
   {
+    /// J^e = sqrt(det b_e) of a soil point for the modified F-bar (Eq. 82), or
+    /// 0 when its model keeps no b_e. The models that do keep it in history[0..5].
+    double
+    elastic_jacobian(const materials::Material &m, const double *history)
+    {
+      const dealii::ArrayView<const double> h(history, m.n_history());
+      if (const auto *hmc = dynamic_cast<const materials::HenckyMohrCoulomb *>(&m))
+        return hmc->elastic_jacobian(h);
+      if (const auto *ns = dynamic_cast<const materials::NorSand *>(&m))
+        return ns->elastic_jacobian(h);
+      if (const auto *nh = dynamic_cast<const materials::NeoHookean *>(&m))
+        return nh->elastic_jacobian(h);
+      return 0.0;
+    }
+    bool
+    keeps_elastic_b(const materials::Material &m)
+    {
+      return dynamic_cast<const materials::HenckyMohrCoulomb *>(&m) || dynamic_cast<const materials::NorSand *>(&m) ||
+             dynamic_cast<const materials::NeoHookean *>(&m);
+    }
+
     std::string
     number_text(const double x)
     {
@@ -231,6 +280,15 @@ namespace talus::semi_implicit
     p.pressure_smoothing    = prm.get("pressure smoothing") != "none";
     p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
     p.flip_fraction         = prm.get_double("flip fraction");
+    {
+      const std::string st = prm.get("volumetric stabilisation");
+      p.stabilisation      = st == "f-bar"          ? VolumetricStabilisation::f_bar
+                             : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
+                                                      : VolumetricStabilisation::none;
+      p.patch_size = prm.get_double("patch size");
+      p.single_point = prm.get("point sets") == "single";
+      require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
+    }
     require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
     require(p.unit_weight_gravity > 0, "semi implicit/unit weight gravity", "must be > 0 m/s^2");
     require(p.free_surface_fraction > 0 && p.free_surface_fraction < 1, "semi implicit/free surface volume fraction",
@@ -265,14 +323,40 @@ namespace talus::semi_implicit
       {
         prm.enter_subsection("body " + std::to_string(k));
         const std::string ph = prm.get("phase");
-        p.surface_load.push_back(prm.get_double("surface load"));
+        {
+          SurfaceLoad sl;
+          sl.q                     = prm.get_double("surface load");
+          sl.ramp                  = prm.get_double("surface load ramp time");
+          const std::string extent = prm.get("surface load extent");
+          if (!dealii::Utilities::trim(extent).empty())
+            {
+              const auto v = dealii::Utilities::split_string_list(extent, ',');
+              bool       ok = v.size() == 2;
+              try
+                {
+                  if (ok)
+                    {
+                      sl.from = std::stod(v[0]);
+                      sl.to   = std::stod(v[1]);
+                    }
+                }
+              catch (const std::exception &)
+                {
+                  ok = false;
+                }
+              require(ok && std::isfinite(sl.from) && std::isfinite(sl.to) && sl.from < sl.to,
+                      "body " + std::to_string(k) + "/surface load extent",
+                      "is '" + extent + "'; allowed: empty (the whole upper face) or two numbers 'a, b' with a < b");
+            }
+          p.surface_load.push_back(sl);
+        }
         prm.leave_subsection();
         p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
         std::ostringstream q;
-        q << p.surface_load.back();
-        require(std::isfinite(p.surface_load.back()) && p.surface_load.back() >= 0, "body " + std::to_string(k) + "/surface load",
+        q << p.surface_load.back().q;
+        require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0, "body " + std::to_string(k) + "/surface load",
                 "is " + q.str() + "; must be a pressure >= 0 Pa");
-        require(p.surface_load.back() == 0 || (p.phase_of_body.back() != Phase::water &&
+        require(p.surface_load.back().q == 0 || (p.phase_of_body.back() != Phase::water &&
                                                 p.bodies[k].shape == BodyDescription<dim>::Shape::box),
                 "body " + std::to_string(k) + "/surface load", "needs a box body with soil points (phase saturated or soil)");
         any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
@@ -284,10 +368,26 @@ namespace talus::semi_implicit
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
       phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
                 (p.phase_of_body[k] == Phase::soil ? "soil" : p.phase_of_body[k] == Phase::water ? "water" : "saturated");
-    require(any_soil && any_water, phases,
-            std::string("the scene has no ") + (any_soil ? "water" : "soil") +
-              " points (the drag and the mixture need both): give a body phase = saturated, or add a " +
-              (any_soil ? "water" : "soil") + " body");
+    if (p.single_point)
+      for (unsigned int b = 0; b < p.bodies.size(); ++b)
+        require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
+                "single needs every body to carry soil points (the water rides on them), but body " +
+                  std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
+    // a dry scene (soil points only) is a single-phase solid: allowed
+    (void)any_water;
+    require(any_soil, phases,
+            "the scene has no soil points (free water needs a skeleton for the drag and the mixture): give a "
+            "body phase = saturated or soil");
+    if (p.stabilisation == VolumetricStabilisation::modified_f_bar)
+      for (unsigned int b = 0; b < p.bodies.size(); ++b)
+        if (p.phase_of_body[b] != Phase::water)
+          {
+            const auto &m = *p.materials[p.bodies[b].material_id];
+            require(keeps_elastic_b(m), "semi implicit/volumetric stabilisation",
+                    "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
+                      std::to_string(p.bodies[b].material_id) + " is '" + m.model_name() +
+                      "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
+          }
     require(p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
               p.restart == RunParameters<dim>::Restart::no,
             "checkpoint", "checkpoints and restarts are not available in talus-semi-implicit yet; use interval = 0, "
@@ -323,6 +423,7 @@ namespace talus::semi_implicit
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
       unsigned int pressure_gradient = 0, surface_force = 0;
       unsigned int poisson_coefficient = 0, poisson_source = 0;
+      unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
     };
 
     /// Nodal masses below this fraction of the largest nodal mass count as
@@ -376,6 +477,10 @@ namespace talus::semi_implicit
   private:
     template <class K>
     void step(const double h);
+    /// F-bar: the node-smoothed volume increment dJbar at every soil point
+    /// (80) and, for the modified F-bar, the patch mean Jebar (83)
+    template <class K>
+    void fbar_averages(const double h, const double ms_cut);
     void seed();
     void geostatic_state();
     /// compress(add) then update ghosts, for every vector given
@@ -404,8 +509,12 @@ namespace talus::semi_implicit
     Vector Mwg;                         // sum N m grad p (linear pressure map)
     Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
-    Vector p_node, dp_node, gs, gw, wet, dry;
+    Vector p_node, dp_node, gs, gw, wet, dry, near_wet;
     std::vector<double> cell_water_volume;
+    Vector Mdj; // F-bar: sum N m dJ of the soil points
+    // modified F-bar patches: a fixed square tiling from the grid's lower corner
+    PatchTiling<dim>    patches;
+    std::vector<double> patch_mass, patch_mass_Je;
     std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
 
     // diagnostics
@@ -456,8 +565,9 @@ namespace talus::semi_implicit
                   node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
               }
           }
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
-                      &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry})
+    patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
+    for (Vector *v : {&Mdj, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
+                      &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
 
     // layouts: soil points carry the solid model's history; both carry porosity
@@ -472,6 +582,10 @@ namespace talus::semi_implicit
     fs.surface_force               = soil.layout.add_extra("surface_force", 1);
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_source              = soil.layout.add_extra("poisson_source", 1);
+    if (prm.stabilisation != VolumetricStabilisation::none)
+      fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
+    if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
+      fs.patch_elastic_jacobian = soil.layout.add_extra("patch_elastic_jacobian", 1);
     fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
     fw.pressure_gradient           = water.layout.add_extra("pore_pressure_gradient", dim, true);
     fw.porosity                    = water.layout.add_extra("porosity", 1);
@@ -536,10 +650,12 @@ namespace talus::semi_implicit
                 P[L::mass]          = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
                 P[f.conductivity]   = prm.soil_of_material[m].conductivity;
                 // the body's top layer of points carries its surface load
-                const double q  = prm.surface_load[b];
-                const double hy = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
-                const double dy = hy / prm.bodies[b].particles_per_direction;
-                P[f.surface_force] = q > 0 && pt.get_location()[dim - 1] > prm.bodies[b].upper[dim - 1] - dy ? q * V0 / dy : 0.0;
+                const SurfaceLoad &load = prm.surface_load[b];
+                const double       hy   = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
+                const double       dy   = hy / prm.bodies[b].particles_per_direction;
+                const auto         x    = pt.get_location();
+                const bool on_face = x[dim - 1] > prm.bodies[b].upper[dim - 1] - dy && x[0] >= load.from && x[0] <= load.to;
+                P[f.surface_force] = load.q > 0 && on_face ? load.q * V0 / dy : 0.0;
               }
             else
               {
@@ -609,7 +725,7 @@ namespace talus::semi_implicit
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
 
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry})
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
@@ -634,7 +750,7 @@ namespace talus::semi_implicit
         if (P[fs.surface_force] != 0)
           {
             double f[dim] = {};
-            f[dim - 1]    = -P[fs.surface_force];
+            f[dim - 1]    = -P[fs.surface_force] * prm.surface_load[static_cast<unsigned int>(P[L::body])].factor(time, h);
             s.scatter_vector(fsv, 1.0, f);
           }
       });
@@ -773,9 +889,16 @@ namespace talus::semi_implicit
         P[fw.poisson_source]      = phi * s.divergence(vws);
       });
     }
+    // a dry scene (soil points only) is a single-phase solid: no pressure
+    if (water.handler.n_global_particles() == 0)
+      dp_node = 0;
+    else
+    {
     if (soil.cell_set_changed() || water.cell_set_changed() || step_number == 0)
       active.template reinit<K>({&soil, &water});
-    // free water surface: per node, whether it is a vertex of a wet and of a dry cell
+    // free water surface: per node, whether it is a vertex of a wet and of a
+    // dry cell, and whether it is a vertex of a cell next to a wet one
+    // (shares a vertex with it: the layer of nodes just outside the water)
     {
       double *wt = at(wet), *dr = at(dry);
       for (unsigned int c = 0; c < grid.cells.size(); ++c)
@@ -790,6 +913,21 @@ namespace talus::semi_implicit
           }
     }
     exchange({&wet, &dry});
+    {
+      const double *wt = at(wet);
+      double *      nr = at(near_wet);
+      for (unsigned int c = 0; c < grid.cells.size(); ++c)
+        if (grid.cells[c].locally_owned)
+          {
+            bool touches_wet = false;
+            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+              touches_wet = touches_wet || wt[grid.cells[c].dofs[v * dim]] > 0;
+            if (touches_wet)
+              for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+                nr[grid.cells[c].dofs[v * dim]] += 1;
+          }
+    }
+    exchange({&near_wet});
     dealii::AffineConstraints<double> dirichlet;
     dirichlet.reinit(pspace.locally_relevant_dofs());
     for (unsigned int i = 0; i < nl; ++i)
@@ -802,9 +940,16 @@ namespace talus::semi_implicit
           const bool surface   = dry.local_element(i) > 0;
           if (!has_water || surface)
             {
-              // p^{t+1} = 0 on the surface (Delta p = -p^t); no water: Delta p = 0 (A2, A4)
+              // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
+              // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
+              // Delta p = -p^t. The dry nodes next to a wet cell (B-spline: the
+              // node above the surface that the top points still touch) keep the
+              // mapped p^t, the linear extrapolation of the water's pressure
+              // (Delta p = 0); forcing 0 there fed the top cell a spurious
+              // pressure step every step (docs/semi-implicit.md, A6).
+              const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
               dirichlet.add_line(gdof);
-              dirichlet.set_inhomogeneity(gdof, has_water ? -p_node.local_element(i) : 0.0);
+              dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
             }
         }
     dirichlet.close();
@@ -839,6 +984,7 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
         dp_node.local_element(i) = dp_solution(pspace.node_dof(i, 0));
+    }
 
     // (6) correction (64)-(68): sum V N grad(Delta p) over each phase's points
     {
@@ -909,6 +1055,9 @@ namespace talus::semi_implicit
         vs_t.local_element(i)   = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
       }
 
+    if (prm.stabilisation != VolumetricStabilisation::none)
+      fbar_averages<K>(h, ms_cut);
+
     // (7a) positions from the new nodal velocities; (8b-g) soil: ΔF from the
     // remapped increment at x^t, volume, J, porosity, conductivity, stress
     struct SoilUpdate
@@ -941,12 +1090,28 @@ namespace talus::semi_implicit
         const double dJ = dealii::determinant(dF);
         if (!(dJ > 0))
           throw InstabilityError("a soil point's volume increment det(ΔF) = " + std::to_string(dJ) + " is not positive");
+        const unsigned int mid = static_cast<unsigned int>(P[L::material]);
+        const materials::Material &m = *s.prm.materials[mid];
+        double *const history = P + s.soil.layout.history;
+        // the increment the model sees: ΔF, or ΔF-bar (79), or for the modified
+        // F-bar ΔF-bar scaled so that it pushes b_e-bar (81)-(82) (fbar.h)
+        dealii::Tensor<2, 3> dF_model = dF;
+        if (s.prm.stabilisation != VolumetricStabilisation::none)
+          {
+            const double dJ_bar = P[s.fs.smoothed_volume_increment];
+            if (!(dJ_bar > 0))
+              throw InstabilityError("a soil point's smoothed volume increment (F-bar) " + std::to_string(dJ_bar) +
+                                     " is not positive");
+            const double ratio = s.prm.stabilisation == VolumetricStabilisation::modified_f_bar
+                                   ? P[s.fs.patch_elastic_jacobian] / elastic_jacobian(m, history)
+                                   : 1.0;
+            dF_model = stabilised_increment<dim>(dF, dJ_bar, ratio);
+          }
         P[L::volume] *= dJ;                                     // (8d)
         const double J  = P[L::volume] / P[s.fs.initial_volume]; // (8e)
         const double n0 = P[s.fs.initial_porosity];
         const double n  = std::clamp(1 - (1 - n0) / J, 1e-6, 1 - 1e-6); // (8f)
         P[s.fs.porosity] = n;
-        const unsigned int mid = static_cast<unsigned int>(P[L::material]);
         if (s.prm.kozeny_carman) // (8g), C1 from k0 and n0
           {
             const double k0 = s.prm.soil_of_material[mid].conductivity;
@@ -957,10 +1122,15 @@ namespace talus::semi_implicit
         // increments of ΔF (rate form, as the explicit family)
         materials::Strain d_eps;
         materials::Spin   d_omega;
-        materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
-        const materials::Material &m     = *s.prm.materials[mid];
-        auto                       sigma = L::get_stress(P);
-        m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.soil.layout.history, m.n_history()));
+        double            gu_model[dim][dim];
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            gu_model[i][j] = dF_model[i][j] - (i == j ? 1.0 : 0.0);
+        materials::strain_and_spin_increments<dim>(gu_model, d_eps, d_omega);
+        if (dim == 2) // the out-of-plane stretch of the modified F-bar's isotropic factor
+          d_eps[2][2] = dF_model[2][2] - 1;
+        auto sigma = L::get_stress(P);
+        m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(history, m.n_history()));
         L::set_stress(sigma, P);
       }
       inline void
@@ -990,10 +1160,79 @@ namespace talus::semi_implicit
       transfer::for_each_active_cell(soil, move_soil);
       soil.relocate();
       WaterMove                                               wm;
-      transfer::UpdateAndMove<dim, K, WaterMove>              move_water(grid, water, at(vw_new), h, wm);
+      // single point: the water rides on the soil points (the same positions,
+      // moved by the same velocity field and the same arithmetic)
+      transfer::UpdateAndMove<dim, K, WaterMove> move_water(grid, water, at(prm.single_point ? vs_new : vw_new), h, wm);
       transfer::for_each_active_cell(water, move_water);
       water.relocate();
     }
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::fbar_averages(const double h, const double ms_cut)
+  {
+    using Stencil      = transfer::PointStencil<dim, K>;
+    using It           = transfer::PointIterator<dim>;
+    const bool modified = prm.stabilisation == VolumetricStabilisation::modified_f_bar;
+    if (modified)
+      {
+        patch_mass.assign(patches.size(), 0.0);
+        patch_mass_Je.assign(patches.size(), 0.0);
+      }
+    // dJ of the increment the update will use (h x the remapped velocity, at x^t)
+    Mdj = 0;
+    {
+      const double *v  = vs_t.begin();
+      double *      mj = Mdj.begin();
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        double *P = it->get_properties().data();
+        double  gv[dim][dim];
+        s.vector_gradient(v, gv);
+        dealii::Tensor<2, 3> dF; // I + h grad v (plane strain: dF_33 = 1)
+        for (unsigned int i = 0; i < 3; ++i)
+          dF[i][i] = 1;
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            dF[i][j] += h * gv[i][j];
+        s.scatter(mj, P[L::mass] * dealii::determinant(dF));
+        if (modified)
+          {
+            const auto &       m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+            const unsigned int k = patches.index(it->get_location());
+            patch_mass[k] += P[L::mass];
+            patch_mass_Je[k] += P[L::mass] * elastic_jacobian(m, P + soil.layout.history);
+          }
+      });
+    }
+    exchange({&Mdj});
+    // every rank needs the sums of the patches its points are in; a patch may
+    // span cells of several ranks: one sum over all ranks (2 x the number of
+    // patches per step; a neighbour exchange would scale better, not needed yet)
+    if (modified && dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
+      {
+        dealii::Utilities::MPI::sum(patch_mass, comm, patch_mass);
+        dealii::Utilities::MPI::sum(patch_mass_Je, comm, patch_mass_Je);
+      }
+    for (unsigned int i = 0; i < n_local(); ++i)
+      if (component[i] == 0)
+        {
+          const double m         = Ms.local_element(i);
+          Mdj.local_element(i)   = m > ms_cut ? Mdj.local_element(i) / m : 0.0; // now dJ_I
+        }
+    const double *dj = Mdj.begin();
+    transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+      double *P = it->get_properties().data();
+      // the stencil's nodes all carry soil mass (this point's), so the
+      // partition of unity holds: a uniform dJ is returned exactly
+      P[fs.smoothed_volume_increment] = s.value(dj);
+      if (modified)
+        {
+          const unsigned int k           = patches.index(it->get_location());
+          P[fs.patch_elastic_jacobian] = patch_mass_Je[k] / patch_mass[k];
+        }
+    });
   }
 
   // ---------------------------------------------------------------- diagnostics and files

@@ -13,6 +13,7 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -33,12 +34,34 @@ namespace talus::semi_implicit
     double conductivity = 1e-3; ///< hydraulic conductivity k_0 [m/s]
   };
 
+  /// Volumetric-locking stabilisation of the soil (seed 002 §4.4.2).
+  enum class VolumetricStabilisation
+  {
+    none,          ///< the increment dF as it is
+    f_bar,         ///< dF scaled by (node-smoothed dJ / dJ)^(1/dim) (Eqs. 79-80)
+    modified_f_bar ///< and b_e^t by (patch mean J^e / J^e)^(2/3) (Eqs. 81-83)
+  };
+
+  /// A surface load on the upper face of a box body (decision A13).
+  struct SurfaceLoad
+  {
+    double q = 0;         ///< pressure [Pa], >= 0 pushing down
+    double from = -1e300; ///< strip: first horizontal coordinate from ...
+    double to   = 1e300;  ///< ... to (the whole face by default)
+    double ramp = 0;      ///< linear ramp time [s]; 0: sudden at t = 0
+    /// the fraction of q applied over a step that starts at t
+    double factor(const double t, const double h) const
+    {
+      return ramp > 0 ? std::min(1.0, (t + 0.5 * h) / ramp) : 1.0;
+    }
+  };
+
   template <int dim>
   struct Parameters : SceneParameters<dim>, RunParameters<dim>
   {
     std::vector<Phase>    phase_of_body;
     std::vector<SoilData> soil_of_material;
-    std::vector<double>   surface_load; ///< per body: q [Pa] on its upper face
+    std::vector<SurfaceLoad> surface_load; ///< per body: q [Pa] on its upper face
     // time step: fixed, or courant x the soil skeleton's critical step
     double time_step = 0, courant = 0.5;
     // 'semi implicit' subsection
@@ -51,6 +74,11 @@ namespace talus::semi_implicit
     bool   pressure_smoothing       = true;  ///< Eq. 77 map-remap of the pore pressure every step
     bool   linear_smoothing         = true;  ///< the map carries each point's value by its gradient
     double flip_fraction            = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
+    VolumetricStabilisation stabilisation = VolumetricStabilisation::none;
+    double patch_size = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
+    /// single: the water is carried on the soil points (its points move with the
+    /// soil's velocity, so they stay on them); double: its own points
+    bool single_point = false;
     // 'initial state' subsection: geostatic water pressure and effective stress
     bool   geostatic    = false;
     double water_level  = 0; ///< vertical coordinate of the free water surface

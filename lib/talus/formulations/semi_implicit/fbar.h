@@ -1,0 +1,79 @@
+// talus — the F-bar pieces of the semi-implicit family (seed 002 §4.4.2,
+// Eqs. 79-83) that need no grid: the stabilised increment a soil point's model
+// sees, and the fixed patch tiling of the modified F-bar. The averages (the node
+// map-remap of dJ, the patch means of J^e) are walks in semi_implicit.cc.
+#pragma once
+
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace talus::semi_implicit
+{
+  /// dF-bar = (dJbar / dJ)^(1/dim) dF (Eq. 79; in 2D the in-plane block, the
+  /// paper's dof = 2), times (Jebar / J^e)^(1/3) for the modified F-bar: pushing
+  /// b_e-bar = (Jebar / J^e)^(2/3) b_e (Eq. 82) by dF-bar (Eq. 81) is pushing b_e
+  /// by this isotropically scaled increment, so any model that keeps b_e gets
+  /// the modified F-bar through its ordinary update. elastic_ratio = 1: F-bar.
+  template <int dim>
+  inline dealii::Tensor<2, 3>
+  stabilised_increment(const dealii::Tensor<2, 3> &dF, const double dJ_bar, const double elastic_ratio)
+  {
+    const double         a = std::pow(dJ_bar / dealii::determinant(dF), 1.0 / dim);
+    dealii::Tensor<2, 3> f = dF;
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int j = 0; j < dim; ++j)
+        f[i][j] *= a;
+    if (elastic_ratio != 1.0)
+      f *= std::cbrt(elastic_ratio);
+    return f;
+  }
+
+  /// The modified F-bar patches: a fixed tiling of the grid box by squares
+  /// (cubes) of side `patch_size` cells from its lower corner ("defined only
+  /// once", §3.3). The last patch of a direction is cut by the grid's upper
+  /// face; a position outside the box is counted in the nearest patch.
+  template <int dim>
+  struct PatchTiling
+  {
+    dealii::Point<dim>            lower;
+    dealii::Tensor<1, dim>        side;
+    std::array<unsigned int, dim> count{};
+
+    void
+    reinit(const dealii::Point<dim> &grid_lower, const dealii::Point<dim> &grid_upper,
+           const std::vector<unsigned int> &cells, const double patch_size)
+    {
+      lower = grid_lower;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          side[d]  = patch_size * (grid_upper[d] - grid_lower[d]) / cells[d];
+          count[d] = static_cast<unsigned int>(std::ceil(cells[d] / patch_size - 1e-9));
+        }
+    }
+    unsigned int
+    size() const
+    {
+      unsigned int n = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        n *= count[d];
+      return n;
+    }
+    /// the patch of a position, x fastest
+    unsigned int
+    index(const dealii::Point<dim> &x) const
+    {
+      unsigned int k = 0;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          const double r = std::floor((x[d] - lower[d]) / side[d]);
+          k              = k * count[d] + static_cast<unsigned int>(std::clamp(r, 0.0, double(count[d] - 1)));
+        }
+      return k;
+    }
+  };
+} // namespace talus::semi_implicit
