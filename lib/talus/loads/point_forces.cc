@@ -88,7 +88,9 @@ namespace talus::loads
         const auto n_all = dealii::Utilities::MPI::sum(n_sel, comm);
         require(n_all > 0, t.where, "selects no material point (check the body/face or the region)");
         double scale = 1.0;
-        if (t.target == Traction<dim>::Target::body_face)
+        if (t.total) // the resultant spread by area share: traction = force / loaded area
+          scale = 1.0 / area_sum;
+        else if (t.target == Traction<dim>::Target::body_face)
           {
             const auto &b    = bodies[t.body];
             double      area = 1.0;
@@ -105,8 +107,9 @@ namespace talus::loads
               for (unsigned int d = 0; d < dim; ++d)
                 P[off + j * dim + d] = t.traction[d] * Ap;
             }
-        log() << "  " << t.where << ": " << n_all << " boundary material points, loaded area " << area_sum * scale
-              << (dim == 2 ? " m (per unit thickness)" : " m^2") << ", f(t) = " << t.function.text() << std::endl;
+        log() << "  " << t.where << ": " << n_all << " boundary material points, loaded area "
+              << (t.total ? area_sum : area_sum * scale) << (dim == 2 ? " m (per unit thickness)" : " m^2")
+              << (t.total ? " (total force given)" : "") << ", f(t) = " << t.function.text() << std::endl;
       }
   }
 

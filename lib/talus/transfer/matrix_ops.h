@@ -25,6 +25,7 @@
 
 #include <bitset>
 #include <tuple>
+#include <type_traits>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -99,6 +100,7 @@ namespace talus::transfer
   template <int dim, unsigned int max_nodes>
   struct PointNodes
   {
+    static constexpr unsigned int capacity = max_nodes;
     unsigned int n = 0;
     unsigned int local[max_nodes];
     double       N[max_nodes];
@@ -192,6 +194,18 @@ namespace talus::transfer
           ls.b[p.local[i] * dim + c] += m * p.N[i] * g[c];
     }
   };
+
+  /// Whether an integrand has terms over the points of a whole cell (static
+  /// constexpr bool cell_terms = true): AssembleSystem then calls
+  /// begin_cell_terms() at each cell and end_cell_terms<dim, nc>(local system,
+  /// number of local nodes) before distributing it (e.g. the pressure
+  /// projection onto cell means of the mixed u-p stabilisation).
+  template <class T, class = void>
+  struct has_cell_terms : std::false_type
+  {};
+  template <class T>
+  struct has_cell_terms<T, std::void_t<decltype(T::cell_terms)>> : std::bool_constant<T::cell_terms>
+  {};
 
   /// The sum of integrands.
   template <class... T>
@@ -296,6 +310,8 @@ namespace talus::transfer
       for (unsigned int a = 0; a < n_local; ++a)
         local_of_slot[slot_of_local[a]] = dealii::numbers::invalid_unsigned_int;
       n_local = 0;
+      if constexpr (has_cell_terms<Integrand>::value)
+        integrand.begin_cell_terms();
     }
     /// local node of slot s; a new one gets zero rows and columns
     inline unsigned int
@@ -342,6 +358,11 @@ namespace talus::transfer
     {
       if (n_local == 0)
         return;
+      if constexpr (has_cell_terms<Integrand>::value)
+        {
+          LocalSystem ls{Al.data(), bl.data(), max_rows, field ? ul.data() : nullptr};
+          integrand.template end_cell_terms<dim, nc>(ls, n_local);
+        }
       const unsigned int m = n_local * nc;
       dofs.resize(m);
       for (unsigned int a = 0; a < n_local; ++a)
