@@ -54,7 +54,7 @@ set_tests_properties(verification.implicit_traction PROPERTIES LABELS "fast" ENV
 # stabilised u-p does not; u-p at the finest resolution vs 0.323 / 0.275
 add_test(NAME verification.implicit_cooks_membrane
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cooks.py ${TALUS_TOOLS_DIR}
-                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_cooks_membrane 0.05 2 4 8 16 32)
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_cooks_membrane 0.035 2 4 8 16 32)
 set_tests_properties(verification.implicit_cooks_membrane PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
 add_test(NAME verification.implicit_cooks_membrane_full
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cooks.py ${TALUS_TOOLS_DIR}
