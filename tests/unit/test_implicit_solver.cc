@@ -80,7 +80,9 @@ namespace
   // mixed u-p (seed 001 ch. 5): the block tangent (K_uu with the nodal
   // pressure, K_up, K_pu, K_pp with the PPP stabilisation over cell means)
   // against central differences; the iterate's pressures are of the size of
-  // the stresses (pressure_scale ~ E)
+  // the stresses (pressure_scale ~ E). Limit 1e-8 (measured <= 9e-11): leaving
+  // the cell-mean part of S out of K_pp gives 8e-8 .. 1.6e-6, so 1e-6 would
+  // not see it
   const std::string neo_hookean_split = " set model = neo hookean\n subsection neo hookean\n"
                                         "  set young modulus = 1e6\n  set poisson ratio = 0.3\n"
                                         "  set volumetric energy = split\n end\n";
@@ -90,21 +92,21 @@ namespace
   const std::string mixed = " set formulation = mixed up\n";
   TEST(ImplicitTangent, MixedUpStatic2D)
   {
-    EXPECT_LT(tangent_error<2>(neo_hookean_split, "static", 1e-2, 0, 9.81, mixed, 1e6), 1e-6);
+    EXPECT_LT(tangent_error<2>(neo_hookean_split, "static", 1e-2, 0, 9.81, mixed, 1e6), 1e-8);
   }
   TEST(ImplicitTangent, MixedUpQuasiIncompressible2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean_split_incompressible, "static", 1e-2, 0, 9.81,
                                mixed + " set stabilisation factor = 3\n", 1e6),
-              1e-6);
+              1e-8);
   }
   TEST(ImplicitTangent, MixedUpStatic3D)
   {
-    EXPECT_LT(tangent_error<3>(neo_hookean_split, "static", 1e-2, 0, 9.81, mixed, 1e6), 1e-6);
+    EXPECT_LT(tangent_error<3>(neo_hookean_split, "static", 1e-2, 0, 9.81, mixed, 1e6), 1e-8);
   }
   TEST(ImplicitTangent, MixedUpAfterLoadSteps2D)
   {
-    EXPECT_LT(tangent_error<2>(neo_hookean_split, "static", 1e-3, 2, 200.0, mixed, 1e6), 1e-6);
+    EXPECT_LT(tangent_error<2>(neo_hookean_split, "static", 1e-3, 2, 200.0, mixed, 1e6), 1e-8);
   }
   TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
 } // namespace

@@ -34,7 +34,8 @@ namespace talus::loads
     // spacing normal to the face (regular seeding: the area of its sub-cell
     // face); for a body face the shares are normalised to the face area of the
     // box, so the total force is exactly traction x area (seed 000 Eq. 4.29:
-    // f_p = tau S_e / n_ebMP).
+    // f_p = tau S_e / n_ebMP). With Traction::total the shares are normalised
+    // to the selected points' area instead, so the total is the given force.
     using L                = PropertyLayout<dim>;
     const unsigned int off = force_offset;
     for (auto &pt : points.handler)

@@ -597,7 +597,21 @@ namespace talus::implicit_mpm
     Vector Kv_free(Kv);
     constraints.set_zero(Kv_free);
     du = 0;
-    return fd.l2_norm() / Kv_free.l2_norm();
+    // per block (displacement rows, pressure rows): the pressure rows of u-p
+    // are divided by K and are orders of magnitude smaller than the force rows,
+    // so one norm over both would hide an error in them
+    double sums[4] = {0, 0, 0, 0}; // |error|^2, |Kv|^2 of u rows; of p rows
+    for (unsigned int k = 0; k < fd.locally_owned_size(); ++k)
+      {
+        const unsigned int b = space.component(k) < dim ? 0 : 2;
+        sums[b] += fd.local_element(k) * fd.local_element(k);
+        sums[b + 1] += Kv_free.local_element(k) * Kv_free.local_element(k);
+      }
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 4), comm, dealii::ArrayView<double>(sums, 4));
+    double error = std::sqrt(sums[0] / sums[1]);
+    if (prm.mixed_up)
+      error = std::max(error, std::sqrt(sums[2] / sums[3]));
+    return error;
   }
 
   template <int dim>

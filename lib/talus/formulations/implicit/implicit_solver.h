@@ -91,7 +91,8 @@ namespace talus::implicit_mpm
     /// For tests: the tangent against central differences of the residual at
     /// the iterate du = `scale` x a pseudo-random field (constrained DoFs 0), in
     /// a pseudo-random direction, for a step of size h from the current state:
-    /// |K v - (r(du + eps v) - r(du - eps v)) / (2 eps)| / |K v|. Collective.
+    /// |K v - (r(du + eps v) - r(du - eps v)) / (2 eps)| / |K v|, the larger of
+    /// the displacement rows' and (mixed u-p) the pressure rows'. Collective.
     /// Mixed u-p: the pressure components of the iterate are `pressure_scale` x
     /// the pseudo-random field.
     double tangent_error(const double h, const double scale, const double eps, const double pressure_scale = 1.0);
