@@ -69,6 +69,78 @@ namespace talus::transfer
     return F;
   }
 
+  /// The step's first Piola form times c: Pk_ib = c sum_e tau_ie Finv_be
+  /// (c tau dF^-T; V_{n+1} sigma grad_{x_{n+1}} N = Pk grad_{x_n} N for c = V_n / J_n).
+  template <int dim>
+  inline void
+  scaled_piola(const double c, const materials::Stress &tau, const dealii::Tensor<2, 3> &Finv, double (&Pk)[dim][dim])
+  {
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int b = 0; b < dim; ++b)
+        {
+          double s = 0;
+          for (unsigned int e = 0; e < 3; ++e)
+            s += tau[i][e] * Finv[b][e];
+          Pk[i][b] = c * s;
+        }
+  }
+
+  /// Its derivative A_ijkd = d Pk_ij / d dF_kd = c (dtau_iekd Finv_je - tau_ie
+  /// Finv_jk Finv_de): material + geometric stiffness (Eqs. 4.33-4.34 pulled back).
+  template <int dim>
+  inline void
+  scaled_piola_tangent(const double c, const materials::Stress &tau, const dealii::Tensor<4, 3> &dtau,
+                       const dealii::Tensor<2, 3> &Finv, double (&A)[dim][dim][dim][dim])
+  {
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int j = 0; j < dim; ++j)
+        for (unsigned int k = 0; k < dim; ++k)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              double s = 0;
+              for (unsigned int e = 0; e < 3; ++e)
+                s += dtau[i][e][k][d] * Finv[j][e] - tau[i][e] * Finv[j][k] * Finv[d][e];
+              A[i][j][k][d] = c * s;
+            }
+  }
+
+  /// Residual rows b[a * stride + i] += sum_b Pk_ib G_a,b - fe_i N_a.
+  template <int dim, unsigned int stride, class PN>
+  inline void
+  add_internal_minus_external(const double (&Pk)[dim][dim], const double (&fe)[dim], const PN &p, LocalSystem &ls)
+  {
+    for (unsigned int a = 0; a < p.n; ++a)
+      for (unsigned int i = 0; i < dim; ++i)
+        {
+          double f = -fe[i] * p.N[a];
+          for (unsigned int b = 0; b < dim; ++b)
+            f += Pk[i][b] * p.G[a][b];
+          ls.b[p.local[a] * stride + i] += f;
+        }
+  }
+
+  /// Displacement block K[a * stride + i, b * stride + k] += sum_jd A_ijkd G_a,j G_b,d.
+  template <int dim, unsigned int stride, class PN>
+  inline void
+  add_displacement_stiffness(const double (&A)[dim][dim][dim][dim], const PN &p, LocalSystem &ls)
+  {
+    for (unsigned int a = 0; a < p.n; ++a)
+      for (unsigned int b = 0; b < p.n; ++b)
+        {
+          const auto &Ga = p.G[a];
+          const auto &Gb = p.G[b];
+          for (unsigned int i = 0; i < dim; ++i)
+            for (unsigned int k = 0; k < dim; ++k)
+              {
+                double s = 0;
+                for (unsigned int j = 0; j < dim; ++j)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    s += A[i][j][k][d] * Ga[j] * Gb[d];
+                ls.a(p.local[a] * stride + i, p.local[b] * stride + k) += s;
+              }
+        }
+  }
+
   /// External force of one point on its nodes: (m_p g + scale f_p) N_i, f_p
   /// the traction point force (loads::PointForces; null: none). Dead loads:
   /// neither g nor f_p follows the deformation, so they add no tangent.
@@ -151,56 +223,16 @@ namespace talus::transfer
         }
       const double c = P[L::volume] / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + history_offset, nh));
       const dealii::Tensor<2, 3> Finv = invert(dF);
-      // first Piola stress of the step, times c: Pk_ib = c tau_ie Finv_be
       double Pk[dim][dim];
-      for (unsigned int i = 0; i < dim; ++i)
-        for (unsigned int b = 0; b < dim; ++b)
-          {
-            double s = 0;
-            for (unsigned int e = 0; e < 3; ++e)
-              s += tau[i][e] * Finv[b][e];
-            Pk[i][b] = c * s;
-          }
+      scaled_piola<dim>(c, tau, Finv, Pk);
       double fe[dim];
       external_point_force<dim>(P, gravity, point_forces, load_scale, fe);
-      for (unsigned int a = 0; a < p.n; ++a)
-        for (unsigned int i = 0; i < dim; ++i)
-          {
-            double f = -fe[i] * p.N[a];
-            for (unsigned int b = 0; b < dim; ++b)
-              f += Pk[i][b] * p.G[a][b];
-            ls.b[p.local[a] * dim + i] += f;
-          }
+      add_internal_minus_external<dim, dim>(Pk, fe, p, ls);
       if (!tangent)
         return;
-      // A_ijkd = c d(tau_ie Finv_je)/d dF_kd
-      //        = c (dtau_iekd Finv_je - tau_ie Finv_jk Finv_de)
       double A[dim][dim][dim][dim];
-      for (unsigned int i = 0; i < dim; ++i)
-        for (unsigned int j = 0; j < dim; ++j)
-          for (unsigned int k = 0; k < dim; ++k)
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                double s = 0;
-                for (unsigned int e = 0; e < 3; ++e)
-                  s += dtau[i][e][k][d] * Finv[j][e] - tau[i][e] * Finv[j][k] * Finv[d][e];
-                A[i][j][k][d] = c * s;
-              }
-      for (unsigned int a = 0; a < p.n; ++a)
-        for (unsigned int b = 0; b < p.n; ++b)
-          {
-            const auto &Ga = p.G[a];
-            const auto &Gb = p.G[b];
-            for (unsigned int i = 0; i < dim; ++i)
-              for (unsigned int k = 0; k < dim; ++k)
-                {
-                  double s = 0;
-                  for (unsigned int j = 0; j < dim; ++j)
-                    for (unsigned int d = 0; d < dim; ++d)
-                      s += A[i][j][k][d] * Ga[j] * Gb[d];
-                  ls.a(p.local[a] * dim + i, p.local[b] * dim + k) += s;
-                }
-          }
+      scaled_piola_tangent<dim>(c, tau, dtau, Finv, A);
+      add_displacement_stiffness<dim, dim>(A, p, ls);
     }
   };
 
@@ -281,28 +313,17 @@ namespace talus::transfer
       const double Up = m.pressure(J) / K, Upp = m.dpressure_dJ(J) / K;
       // first Piola form of (sigma_dev + p I) V_{n+1}: Pk_ib
       double Pk[dim][dim];
+      scaled_piola<dim>(c, tau_dev, Finv, Pk);
       for (unsigned int i = 0; i < dim; ++i)
         for (unsigned int b = 0; b < dim; ++b)
-          {
-            double s = 0;
-            for (unsigned int e = 0; e < 3; ++e)
-              s += tau_dev[i][e] * Finv[b][e];
-            Pk[i][b] = c * s + Vn * j * pp * Finv[b][i];
-          }
+          Pk[i][b] += Vn * j * pp * Finv[b][i];
       double fe[dim];
       external_point_force<dim>(P, gravity, point_forces, load_scale, fe);
+      add_internal_minus_external<dim, nc>(Pk, fe, p, ls);
       const double rp = Vn * j * (Up - pp / K) - w * pp;
       for (unsigned int a = 0; a < p.n; ++a)
         {
-          const unsigned int r = p.local[a] * nc;
-          for (unsigned int i = 0; i < dim; ++i)
-            {
-              double f = -fe[i] * p.N[a];
-              for (unsigned int b = 0; b < dim; ++b)
-                f += Pk[i][b] * p.G[a][b];
-              ls.b[r + i] += f;
-            }
-          ls.b[r + dim] += p.N[a] * rp;
+          ls.b[p.local[a] * nc + dim] += p.N[a] * rp;
           cell_vn[p.local[a]] += Vn * p.N[a];
           cell_wn[p.local[a]] += w * p.N[a];
         }
@@ -312,16 +333,13 @@ namespace talus::transfer
         return;
       // d(Pk_ij)/d dF_kd: deviatoric (material + geometric) and pressure parts
       double A[dim][dim][dim][dim];
+      scaled_piola_tangent<dim>(c, tau_dev, dtau, Finv, A);
       for (unsigned int i = 0; i < dim; ++i)
         for (unsigned int jj = 0; jj < dim; ++jj)
           for (unsigned int k = 0; k < dim; ++k)
             for (unsigned int d = 0; d < dim; ++d)
-              {
-                double s = 0;
-                for (unsigned int e = 0; e < 3; ++e)
-                  s += dtau[i][e][k][d] * Finv[jj][e] - tau_dev[i][e] * Finv[jj][k] * Finv[d][e];
-                A[i][jj][k][d] = c * s + Vn * pp * j * (Finv[d][k] * Finv[jj][i] - Finv[jj][k] * Finv[d][i]);
-              }
+              A[i][jj][k][d] += Vn * pp * j * (Finv[d][k] * Finv[jj][i] - Finv[jj][k] * Finv[d][i]);
+      add_displacement_stiffness<dim, nc>(A, p, ls);
       // d R_p / d dF_kd = Vn N_a ((U' + J U'') - p/K) j Finv_dk
       const double vol_coef = Vn * j * ((Up + J * Upp) - pp / K);
       double       gx[PN::capacity][dim]; // grad_{x_{n+1}} N = dF^-T grad_{x_n} N
@@ -336,19 +354,9 @@ namespace talus::transfer
       for (unsigned int a = 0; a < p.n; ++a)
         for (unsigned int b = 0; b < p.n; ++b)
           {
-            const auto &       Ga = p.G[a];
-            const auto &       Gb = p.G[b];
             const unsigned int ra = p.local[a] * nc, rb = p.local[b] * nc;
             for (unsigned int i = 0; i < dim; ++i)
               {
-                for (unsigned int k = 0; k < dim; ++k)
-                  {
-                    double s = 0;
-                    for (unsigned int jj = 0; jj < dim; ++jj)
-                      for (unsigned int d = 0; d < dim; ++d)
-                        s += A[i][jj][k][d] * Ga[jj] * Gb[d];
-                    ls.a(ra + i, rb + k) += s;
-                  }
                 ls.a(ra + i, rb + dim) += Vn * j * gx[a][i] * p.N[b]; // K_up
                 ls.a(ra + dim, rb + i) += vol_coef * p.N[a] * gx[b][i]; // K_pu
               }
