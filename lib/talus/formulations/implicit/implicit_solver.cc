@@ -153,7 +153,8 @@ namespace talus::implicit_mpm
             require(nh && nh->energy() == materials::NeoHookean::Energy::split,
                     "material " + std::to_string(k) + "/model",
                     "'mixed up' needs the volumetric/deviatoric split: model 'neo hookean' with 'volumetric energy = "
-                    "split' (got '" + p.materials[k]->model_name() + "')");
+                    "split' (got '" + p.materials[k]->model_name() +
+                      (nh ? "' with 'volumetric energy = coupled')" : "')"));
           }
       }
     // what the implicit family does not offer yet: refused, not ignored
