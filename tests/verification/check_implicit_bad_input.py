@@ -2,7 +2,9 @@
 the right exit code, no NaN written.
   * input errors (exit 2, one message starting 'talus-implicit: error:' naming
     the entry, nothing written): a model without a finite-strain form, a zero
-    time step, gamma out of range, nu = 0.5, an entry of a feature not built yet;
+    time step, gamma out of range, nu = 0.5, an entry of a feature not built yet,
+    mixed u-p without the split Neo-Hookean energy, in a dynamic run or with an
+    iterative solver, a traction with both 'traction' and 'total force';
   * Newton that cannot converge (max iterations 1 with a tolerance no single
     iteration meets): every step is cut back max_cut_backs times, then the run
     stops with exit 3 and says so; series.csv holds only finite values;
@@ -31,6 +33,16 @@ cases = {
     "damping in a static run": (tv.prm_set(base, "implicit/rayleigh alpha", "1"), ["rayleigh alpha", "dynamic"]),
     "static without supports": (tv.prm_set(base, "boundary conditions/fixed", ""), ["boundary conditions", "static",
                                                                                    "singular"]),
+    "mixed up without the split energy": (tv.prm_set(base, "implicit/formulation", "mixed up"),
+                                          ["material 0/model", "mixed up", "volumetric energy = split"]),
+    "mixed up in a dynamic run": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "implicit/analysis",
+                                             "dynamic"), ["implicit/formulation", "static"]),
+    "mixed up with cg amg": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "linear solver/method",
+                                        "cg amg"), ["linear solver/method", "direct"]),
+    "traction and total force": (tv.prm_set(tv.prm_set(tv.prm_set(base, "loads/number of tractions", "1"),
+                                                       "loads/traction 0/traction", "0, -1"),
+                                            "loads/traction 0/total force", "0, -1"),
+                                 ["loads/traction 0/total force", "not both"]),
 }
 for name, (text, needles) in cases.items():
     rc, out, err = tv.run_tool(tool, text, work, name.replace(" ", "_"), expect_rc=None)

@@ -76,3 +76,29 @@ add_test(NAME verification.implicit_checkpoint_restart
                  ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart)
 set_tests_properties(verification.implicit_checkpoint_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+
+# tractions (loads/point_forces): oedometric block under a top traction, u_y and
+# sigma_yy vs the small-strain answer, on 1 and 2 ranks
+add_test(NAME verification.implicit_traction
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_traction.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/block_top_traction.prm ${_w}/implicit_traction 1e-3)
+set_tests_properties(verification.implicit_traction PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
+
+# Cook's membrane (seed 001 §5.4.1, Table 5.1): u locks at nu = 0.499999, the
+# stabilised u-p does not; u-p at the finest resolution vs 0.323 / 0.275
+add_test(NAME verification.implicit_cooks_membrane
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cooks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_cooks_membrane 0.035 2 4 8 16 32)
+set_tests_properties(verification.implicit_cooks_membrane PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+add_test(NAME verification.implicit_cooks_membrane_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cooks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_cooks_membrane_full 0.02 2 4 8 16 32 64)
+set_tests_properties(verification.implicit_cooks_membrane_full PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
+                     TIMEOUT 3600)
+# 1 vs 2 ranks on Cook's membrane (u-p, nu = 0.499999, n = 16)
+add_test(NAME verification.implicit_ranks_cooks
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_ranks_cooks)
+set_tests_properties(verification.implicit_ranks_cooks PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)

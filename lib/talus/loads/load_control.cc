@@ -29,12 +29,7 @@ namespace talus::loads
   void
   LoadControl<dim>::extend_layout(PropertyLayout<dim> &layout)
   {
-    for (unsigned int j = 0; j < settings.max_tractions; ++j)
-      {
-        const unsigned int o = layout.add_extra("point_force_" + std::to_string(j), dim, true);
-        if (j == 0)
-          force_offset = o;
-      }
+    forces.extend_layout(layout, settings.max_tractions);
   }
 
   template <int dim>
@@ -211,88 +206,7 @@ namespace talus::loads
   void
   LoadControl<dim>::assign_tractions(Solver &s)
   {
-    // Boundary material points of each traction, selected by their initial
-    // position X = x - u: the outermost layer of a box body on the face, or
-    // the points in a region. Each point gets the share A_p of the loaded area
-    // proportional to V_p / spacing normal to the face (regular seeding: the
-    // area of its sub-cell face); for a body face the shares are normalised to
-    // the face area of the box, so the total force is exactly traction x area
-    // (seed 000 Eq. 4.29: f_p = tau S_e / n_ebMP).
-    using L                   = PropertyLayout<dim>;
-    const unsigned int off    = force_offset;
-    const unsigned int nslots = settings.max_tractions;
-    for (auto &pt : s.points.handler)
-      {
-        auto P = pt.get_properties();
-        for (unsigned int i = 0; i < nslots * dim; ++i)
-          P[off + i] = 0.0;
-      }
-    have_tractions = !current->tractions.empty();
-    for (unsigned int j = 0; j < current->tractions.size(); ++j)
-      {
-        const auto &t = current->tractions[j];
-        const auto initial = [&](const auto &pt) {
-          auto X = pt.get_location();
-          for (unsigned int d = 0; d < dim; ++d)
-            X[d] -= pt.get_properties()[L::displacement + d];
-          return X;
-        };
-        const auto spacing = [&](const auto &pt) {
-          const auto &       cc = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
-          const unsigned int b  = static_cast<unsigned int>(pt.get_properties()[L::body]);
-          return cc.h[t.axis] / s.prm.bodies[b].particles_per_direction;
-        };
-        double extreme = -std::numeric_limits<double>::max();
-        if (t.target == Traction<dim>::Target::body_face)
-          {
-            for (const auto &pt : s.points.handler)
-              if (static_cast<unsigned int>(pt.get_properties()[L::body]) == t.body)
-                extreme = std::max(extreme, t.side * initial(pt)[t.axis]);
-            extreme = dealii::Utilities::MPI::max(extreme, s.comm);
-          }
-        const auto selected = [&](const auto &pt) {
-          const auto X = initial(pt);
-          if (t.target == Traction<dim>::Target::body_face)
-            return static_cast<unsigned int>(pt.get_properties()[L::body]) == t.body &&
-                   t.side * X[t.axis] > extreme - 0.5 * spacing(pt);
-          for (unsigned int d = 0; d < dim; ++d)
-            if (X[d] < t.lower[d] || X[d] > t.upper[d])
-              return false;
-          return true;
-        };
-        double       area_sum = 0;
-        unsigned int n_sel    = 0;
-        for (const auto &pt : s.points.handler)
-          if (selected(pt))
-            {
-              area_sum += pt.get_properties()[L::volume] / spacing(pt);
-              ++n_sel;
-            }
-        area_sum          = dealii::Utilities::MPI::sum(area_sum, s.comm);
-        const auto n_all  = dealii::Utilities::MPI::sum(n_sel, s.comm);
-        require(n_all > 0, t.where, "selects no material point (check the body/face or the region)");
-        double scale = 1.0;
-        if (t.target == Traction<dim>::Target::body_face)
-          {
-            const auto &b    = s.prm.bodies[t.body];
-            double      area = 1.0;
-            for (unsigned int d = 0; d < dim; ++d)
-              if (d != t.axis)
-                area *= b.upper[d] - b.lower[d];
-            scale = area / area_sum;
-          }
-        for (auto &pt : s.points.handler)
-          if (selected(pt))
-            {
-              auto         P  = pt.get_properties();
-              const double Ap = scale * P[L::volume] / spacing(pt);
-              for (unsigned int d = 0; d < dim; ++d)
-                P[off + j * dim + d] = t.traction[d] * Ap;
-            }
-        log() << "  " << t.where << ": " << n_all << " boundary material points, loaded area "
-              << area_sum * scale << (dim == 2 ? " m (per unit thickness)" : " m^2") << ", f(t) = "
-              << t.function.text() << std::endl;
-      }
+    forces.assign(current->tractions, s.points, s.grid, s.prm.bodies, s.comm);
   }
 
   template <int dim>
@@ -430,7 +344,7 @@ namespace talus::loads
     need_vt = any_friction || any_prescribed || current->damping > 0 || current->viscous_damping > 0;
     if ((need_vt || current->convergence.enabled) && vt.size() == 0)
       s.grid.reinit_vector(vt);
-    if (have_tractions && trac.size() == 0)
+    if (forces.any() && trac.size() == 0)
       s.grid.reinit_vector(trac);
   }
 
@@ -462,7 +376,7 @@ namespace talus::loads
       s.scatter_point_momentum(vt);
     // with momentum_t (the 2-phase step) the caller has scattered the tractions
     // in its own P2G pass (begin/end_traction_scatter)
-    const bool scatter = have_tractions && !momentum_t;
+    const bool scatter = forces.any() && !momentum_t;
     if (!scatter && !any_friction)
       return;
     double *const T   = scatter ? trac.begin() : nullptr;
@@ -471,8 +385,6 @@ namespace talus::loads
         s.zero_on_active(trac);
         update_factors(s);
       }
-    const unsigned int nt  = current->tractions.size();
-    const unsigned int off = force_offset;
     double             work = 0;
     if (any_friction)
       friction_lift(s);
@@ -487,16 +399,8 @@ namespace talus::loads
             const double *P = pt->get_properties().data();
             if (scatter)
               {
-                double f[dim] = {};
-                bool   any    = false;
-                for (unsigned int j = 0; j < nt; ++j)
-                  for (unsigned int d = 0; d < dim; ++d)
-                    if (P[off + j * dim + d] != 0.0)
-                      {
-                        f[d] += factor[j] * P[off + j * dim + d];
-                        any = true;
-                      }
-                if (any)
+                double f[dim];
+                if (forces.force_if_loaded(P, f))
                   {
                     double N[nv];
                     shape::Q1<dim>::values(pt->get_reference_location(), N);
@@ -533,18 +437,14 @@ namespace talus::loads
   void
   LoadControl<dim>::update_factors(const Solver &s)
   {
-    // time factors of the tractions at t
-    const unsigned int nt = current->tractions.size();
-    factor.resize(nt);
-    for (unsigned int j = 0; j < nt; ++j)
-      factor[j] = current->tractions[j].function.value(j < current->n_global_tractions ? s.time : s.time - stage_t0);
+    forces.update_factors(current->tractions, current->n_global_tractions, s.time, stage_t0);
   }
 
   template <int dim>
   double *
   LoadControl<dim>::begin_traction_scatter(Solver &s)
   {
-    if (!have_tractions)
+    if (!forces.any())
       return nullptr;
     update_factors(s);
     s.zero_on_active(trac);
@@ -555,7 +455,7 @@ namespace talus::loads
   void
   LoadControl<dim>::end_traction_scatter()
   {
-    if (have_tractions)
+    if (forces.any())
       trac.compress(dealii::VectorOperation::add);
   }
 
@@ -565,7 +465,7 @@ namespace talus::loads
   {
     double *const       F = s.nodal_a.begin();
     const double *const M = s.nodal_mass.begin();
-    if (have_tractions)
+    if (forces.any())
       {
         const double *T = trac.begin();
         for (const unsigned int i : s.active_dofs)
@@ -574,7 +474,7 @@ namespace talus::loads
     // quasi-static convergence (seed 000 §6.4), on the unbalanced force before damping
     if (check_step(s))
       {
-        const double *T  = have_tractions ? trac.begin() : nullptr;
+        const double *T  = forces.any() ? trac.begin() : nullptr;
         double        v[4] = {0, 0, 0, 0};
         for (const unsigned int i : s.active_dofs)
           if (!excluded[i] && component[i] >= 0)
@@ -646,7 +546,7 @@ namespace talus::loads
     // equation divided by n (pressure gradient + gravity, no drag)
     double *const       F  = s.nodal_a.begin();
     const double *const MS = s.nodal_mass.begin();
-    if (have_tractions) // a traction on the surface of the mixture is a total stress
+    if (forces.any()) // a traction on the surface of the mixture is a total stress
       {
         const double *T = trac.begin();
         for (const unsigned int i : s.active_dofs)
@@ -663,7 +563,7 @@ namespace talus::loads
     // mass itself), its external part is the liquid's weight Mbar_L g.
     const auto *  tp  = s.two_phase.get();
     const bool    cp  = tp->coupled;
-    const double *T   = have_tractions ? trac.begin() : nullptr;
+    const double *T   = forces.any() ? trac.begin() : nullptr;
     const double *mLt = cp ? tp->m_liquid.begin() : nullptr, *mLn = cp ? tp->m_liquid_n.begin() : nullptr;
     const double *FL = cp ? tp->f_liquid.begin() : nullptr, *PL = cp ? tp->p_liquid.begin() : nullptr;
     double        v[4] = {0, 0, 0, 0};

@@ -37,6 +37,7 @@
 #pragma once
 
 #include <talus/grid/background_grid.h>
+#include <talus/loads/point_forces.h>
 #include <talus/loads/settings.h>
 
 #include <limits>
@@ -64,7 +65,7 @@ namespace talus::loads
     /// the property layout; before the ParticleHandler is initialised.
     void extend_layout(PropertyLayout<dim> &layout);
     /// Offset of the first point-force block (slot j at + j dim).
-    unsigned int point_force_offset() const { return force_offset; }
+    unsigned int point_force_offset() const { return forces.offset(); }
     const Stage<dim> &stage(const unsigned int k) const { return settings.stages[k]; }
     bool has_convergence() const;
 
@@ -92,17 +93,8 @@ namespace talus::loads
     void    end_traction_scatter();
     /// Traction force of a point at the time of the last before_nodal_solve
     /// (0 without tractions).
-    void point_force(const double *P, double (&f)[dim]) const
-    {
-      for (unsigned int d = 0; d < dim; ++d)
-        f[d] = 0;
-      if (!have_tractions)
-        return;
-      for (unsigned int j = 0; j < factor.size(); ++j)
-        for (unsigned int d = 0; d < dim; ++d)
-          f[d] += factor[j] * P[force_offset + j * dim + d];
-    }
-    bool any_traction() const { return have_tractions; }
+    void point_force(const double *P, double (&f)[dim]) const { forces.force(P, f); }
+    bool any_traction() const { return forces.any(); }
     void nodal_forces(Solver &s);
     /// 2-phase form of nodal_forces (see above), before the 2-phase nodal solve.
     void nodal_forces_two_phase(Solver &s);
@@ -131,7 +123,7 @@ namespace talus::loads
 
   private:
     const Settings<dim> &settings;
-    unsigned int         force_offset = 0;
+    PointForces<dim>     forces; ///< the traction slots of the points and their time factors
     const Stage<dim> *   current = nullptr;
     unsigned int         stage_index = 0;
     double               h = 0; ///< size of the running step
@@ -141,8 +133,7 @@ namespace talus::loads
     bool                 converged = false;
     double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
 
-    bool need_vt = false, have_tractions = false;
-    std::vector<double> factor; ///< time factors of the stage's tractions at t
+    bool need_vt = false;
     Vector trac, vt;
     std::vector<int> component; ///< of each local DoF (-1: none)
     std::vector<unsigned char> excluded; ///< DoFs left out of the force ratio

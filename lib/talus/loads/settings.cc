@@ -40,18 +40,20 @@ namespace talus::loads
 
     void
     declare_loads(dealii::ParameterHandler &prm, const std::string &prm_file, const std::string &path,
-                  const unsigned int dim)
+                  const unsigned int dim, const bool with_velocities = true)
     {
       const unsigned int n_tr = dealii::Utilities::string_to_int(
         peek_entry(prm_file, path, "number of tractions", "0", Integer(0, 16)));
-      const unsigned int n_v = dealii::Utilities::string_to_int(
-        peek_entry(prm_file, path, "number of velocity conditions", "0", Integer(0, 16)));
+      const unsigned int n_v = with_velocities ? dealii::Utilities::string_to_int(peek_entry(
+                                                   prm_file, path, "number of velocity conditions", "0", Integer(0, 16)))
+                                               : 0;
       prm.enter_subsection("loads");
       prm.declare_entry("number of tractions", "0", Integer(0, 16),
                         "Number of 'traction k' subsections: surface tractions carried by boundary material "
                         "points (seed 000 §4.3.2, §5.2).");
-      prm.declare_entry("number of velocity conditions", "0", Integer(0, 16),
-                        "Number of 'velocity k' subsections: prescribed velocities on grid nodes or material points.");
+      if (with_velocities)
+        prm.declare_entry("number of velocity conditions", "0", Integer(0, 16),
+                          "Number of 'velocity k' subsections: prescribed velocities on grid nodes or material points.");
       for (unsigned int k = 0; k < n_tr; ++k)
         {
           prm.enter_subsection("traction " + std::to_string(k));
@@ -66,6 +68,10 @@ namespace talus::loads
           prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
           prm.declare_entry("traction", zeros_text(dim), Anything(),
                             "Traction vector [Pa], force per unit initial area of the face (e.g. 0, -1e4 pushes down); direction and size do not follow the deformation (seed 000 §5.2).");
+          prm.declare_entry("total force", "", Anything(),
+                            "Instead of 'traction': the resultant force [N; per unit thickness in 2D] spread over "
+                            "the selected points in proportion to their area shares (traction = total force / loaded "
+                            "area: exact totals where the seeded points do not fill the face exactly); empty = off.");
           prm.declare_entry("time function", "constant", Anything(),
                             "Factor f(t): constant | step T | ramp T1 | ramp T0 T1 | table t0:f0, t1:f1, ... | "
                             "table file NAME.csv (time of the stage for stage loads).");
@@ -93,12 +99,12 @@ namespace talus::loads
     template <int dim>
     void
     parse_loads(dealii::ParameterHandler &prm, const std::string &path, const std::vector<BodyDescription<dim>> &bodies,
-                std::vector<Traction<dim>> &tractions, std::vector<PrescribedVelocity<dim>> &velocities)
+                std::vector<Traction<dim>> &tractions, std::vector<PrescribedVelocity<dim>> *velocities)
     {
       prm.enter_subsection("loads");
       const std::string  base = path.empty() ? "loads" : path + "/loads";
       const unsigned int n_tr = prm.get_integer("number of tractions");
-      const unsigned int n_v  = prm.get_integer("number of velocity conditions");
+      const unsigned int n_v  = velocities ? prm.get_integer("number of velocity conditions") : 0;
       for (unsigned int k = 0; k < n_tr; ++k)
         {
           const std::string where = base + "/traction " + std::to_string(k);
@@ -128,7 +134,15 @@ namespace talus::loads
                 require(t.upper[d] > t.lower[d], where + "/region upper corner",
                         "must exceed 'region lower corner' in every direction");
             }
-          t.traction = parse_point<dim>(prm.get("traction"), where + "/traction");
+          t.traction            = parse_point<dim>(prm.get("traction"), where + "/traction");
+          const std::string tot = prm.get("total force");
+          if (!tot.empty())
+            {
+              require(t.traction.norm() == 0, where + "/total force",
+                      "give either 'traction' or 'total force', not both");
+              t.traction = parse_point<dim>(tot, where + "/total force");
+              t.total    = true;
+            }
           t.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
           prm.leave_subsection();
           tractions.push_back(t);
@@ -180,7 +194,7 @@ namespace talus::loads
           v.velocity = parse_point<dim>(prm.get("velocity"), where + "/velocity");
           v.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
           prm.leave_subsection();
-          velocities.push_back(v);
+          velocities->push_back(v);
         }
       prm.leave_subsection();
     }
@@ -384,7 +398,7 @@ namespace talus::loads
         require(bc.id != id, "boundary conditions/friction",
                 "boundary " + std::to_string(id) + " is also fixed/roller; give each boundary one condition");
     prm.leave_subsection();
-    parse_loads<dim>(prm, "", bodies, top.tractions, top.velocities);
+    parse_loads<dim>(prm, "", bodies, top.tractions, &top.velocities);
     parse_two_phase_aliases<dim>(prm, bodies, top.tractions);
     top.n_global_tractions  = top.tractions.size();
     top.n_global_velocities = top.velocities.size();
@@ -487,7 +501,7 @@ namespace talus::loads
         st.velocities          = top.velocities;
         st.n_global_tractions  = top.tractions.size();
         st.n_global_velocities = top.velocities.size();
-        parse_loads<dim>(prm, where, bodies, st.tractions, st.velocities);
+        parse_loads<dim>(prm, where, bodies, st.tractions, &st.velocities);
         parse_switches<dim>(prm, where, st, &top);
         prm.leave_subsection();
         s.stages.push_back(st);
@@ -497,6 +511,25 @@ namespace talus::loads
     return s;
   }
 
+  void
+  declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim)
+  {
+    declare_loads(prm, prm_file, "loads", dim, false);
+  }
+
+  template <int dim>
+  std::vector<Traction<dim>>
+  parse_traction_parameters(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies)
+  {
+    std::vector<Traction<dim>> t;
+    parse_loads<dim>(prm, "", bodies, t, nullptr);
+    return t;
+  }
+
+  template std::vector<Traction<2>> parse_traction_parameters<2>(dealii::ParameterHandler &,
+                                                                 const std::vector<BodyDescription<2>> &);
+  template std::vector<Traction<3>> parse_traction_parameters<3>(dealii::ParameterHandler &,
+                                                                 const std::vector<BodyDescription<3>> &);
   template struct Settings<2>;
   template struct Settings<3>;
   template Settings<2> parse_parameters<2>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 2> &,

@@ -34,7 +34,8 @@ namespace talus::loads
     unsigned int           axis   = dim - 1; ///< normal axis of the face
     int                    side   = +1;      ///< +1: upper face, -1: lower face
     dealii::Point<dim>     lower, upper;     ///< region
-    dealii::Tensor<1, dim> traction;         ///< [Pa] (force per area)
+    dealii::Tensor<1, dim> traction;         ///< [Pa] (force per area); with `total`: the resultant [N]
+    bool                   total = false;    ///< `traction` is the resultant over the selected points
     TimeFunction           function;
     std::string            where;
   };
@@ -114,6 +115,14 @@ namespace talus::loads
   /// in 'boundary conditions', 'initial stress' in every body, stages).
   void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
                           unsigned int n_bodies);
+
+  /// Only the 'loads' subsection with its 'traction k' entries (families
+  /// without prescribed velocities, stages or damping: talus-implicit).
+  void declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim);
+  /// The tractions of declare_traction_parameters (global loads, absolute time).
+  template <int dim>
+  std::vector<Traction<dim>> parse_traction_parameters(dealii::ParameterHandler &               prm,
+                                                       const std::vector<BodyDescription<dim>> &bodies);
 
   /// Parse after the solver has read its own entries (end time, gravity, the
   /// fixed/roller boundaries and the bodies, which are passed in).

@@ -25,6 +25,7 @@
 
 #include <bitset>
 #include <tuple>
+#include <type_traits>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -99,6 +100,7 @@ namespace talus::transfer
   template <int dim, unsigned int max_nodes>
   struct PointNodes
   {
+    static constexpr unsigned int capacity = max_nodes;
     unsigned int n = 0;
     unsigned int local[max_nodes];
     double       N[max_nodes];
@@ -176,15 +178,17 @@ namespace talus::transfer
   };
 
   /// The lumped vector term m_p N_i q_c of a point (P: its properties, p: its
-  /// stencil) for a per-component value q(c) (vector spaces only).
-  template <int dim, class PN, class Value>
+  /// stencil) for a per-component value q(c), on the first dim of the nc
+  /// components of each node (the displacements of a u or u-p space).
+  template <int dim, unsigned int nc, class PN, class Value>
   inline void
   add_lumped(const double *P, const PN &p, LocalSystem &ls, const Value &q)
   {
+    static_assert(nc >= dim, "add_lumped: the dim displacement components come first");
     const double m = P[PropertyLayout<dim>::mass];
     for (unsigned int i = 0; i < p.n; ++i)
       for (unsigned int c = 0; c < dim; ++c)
-        ls.b[p.local[i] * dim + c] += m * p.N[i] * q(c);
+        ls.b[p.local[i] * nc + c] += m * p.N[i] * q(c);
   }
 
   /// Body force m_p g N_i.
@@ -198,9 +202,21 @@ namespace talus::transfer
     add(const double *P, const PN &p, LocalSystem &ls) const
     {
       static_assert(nc == dim && d_ == dim, "BodyForce: a vector space (nc = dim)");
-      add_lumped<dim>(P, p, ls, [this](const unsigned int c) { return g[c]; });
+      add_lumped<dim, nc>(P, p, ls, [this](const unsigned int c) { return g[c]; });
     }
   };
+
+  /// Whether an integrand has terms over the points of a whole cell (static
+  /// constexpr bool cell_terms = true): AssembleSystem then calls
+  /// begin_cell_terms() at each cell and end_cell_terms<dim, nc>(local system,
+  /// number of local nodes) before distributing it (e.g. the pressure
+  /// projection onto cell means of the mixed u-p stabilisation).
+  template <class T, class = void>
+  struct has_cell_terms : std::false_type
+  {};
+  template <class T>
+  struct has_cell_terms<T, std::void_t<decltype(T::cell_terms)>> : std::bool_constant<T::cell_terms>
+  {};
 
   /// The sum of integrands.
   template <class... T>
@@ -305,6 +321,8 @@ namespace talus::transfer
       for (unsigned int a = 0; a < n_local; ++a)
         local_of_slot[slot_of_local[a]] = dealii::numbers::invalid_unsigned_int;
       n_local = 0;
+      if constexpr (has_cell_terms<Integrand>::value)
+        integrand.begin_cell_terms();
     }
     /// local node of slot s; a new one gets zero rows and columns
     inline unsigned int
@@ -351,6 +369,11 @@ namespace talus::transfer
     {
       if (n_local == 0)
         return;
+      if constexpr (has_cell_terms<Integrand>::value)
+        {
+          LocalSystem ls{Al.data(), bl.data(), max_rows, field ? ul.data() : nullptr};
+          integrand.template end_cell_terms<dim, nc>(ls, n_local);
+        }
       const unsigned int m = n_local * nc;
       dofs.resize(m);
       for (unsigned int a = 0; a < n_local; ++a)

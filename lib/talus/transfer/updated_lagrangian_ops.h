@@ -21,7 +21,9 @@
 
 #include <talus/base/errors.h>
 #include <talus/grid/nodal_space.h>
+#include <talus/loads/point_forces.h>
 #include <talus/materials/material.h>
+#include <talus/materials/neo_hookean.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/transfer/matrix_ops.h>
 #include <talus/transfer/move_point.h>
@@ -50,8 +52,10 @@ namespace talus::transfer
     }
   };
 
-  /// dF (3x3; plane strain: dF_33 = 1) = I + sum_a u_a (x) grad N_a.
-  template <int dim, class PN>
+  /// dF (3x3; plane strain: dF_33 = 1) = I + sum_a u_a (x) grad N_a; the
+  /// displacement of local node a at u_local[a * stride] (stride: the space's
+  /// components, displacement first).
+  template <int dim, class PN, unsigned int stride = dim>
   inline dealii::Tensor<2, 3>
   incremental_deformation_gradient(const double *u_local, const PN &p)
   {
@@ -61,19 +65,132 @@ namespace talus::transfer
     for (unsigned int a = 0; a < p.n; ++a)
       for (unsigned int i = 0; i < dim; ++i)
         for (unsigned int j = 0; j < dim; ++j)
-          F[i][j] += u_local[p.local[a] * dim + i] * p.G[a][j];
+          F[i][j] += u_local[p.local[a] * stride + i] * p.G[a][j];
     return F;
   }
 
-  /// The residual f_int - lambda f_ext of one point and (optionally) its
-  /// tangent d(f_int)/d(Du) at the iterate Du (AssembleSystem's field). Loads:
-  /// body force m_p g N_i (g already scaled by the load factor).
+  /// The step's first Piola form times c: Pk_ib = c sum_e tau_ie Finv_be
+  /// (c tau dF^-T; V_{n+1} sigma grad_{x_{n+1}} N = Pk grad_{x_n} N for c = V_n / J_n).
+  template <int dim>
+  inline void
+  scaled_piola(const double c, const materials::Stress &tau, const dealii::Tensor<2, 3> &Finv, double (&Pk)[dim][dim])
+  {
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int b = 0; b < dim; ++b)
+        {
+          double s = 0;
+          for (unsigned int e = 0; e < 3; ++e)
+            s += tau[i][e] * Finv[b][e];
+          Pk[i][b] = c * s;
+        }
+  }
+
+  /// Its derivative A_ijkd = d Pk_ij / d dF_kd = c (dtau_iekd Finv_je - tau_ie
+  /// Finv_jk Finv_de): material + geometric stiffness (Eqs. 4.33-4.34 pulled back).
+  template <int dim>
+  inline void
+  scaled_piola_tangent(const double c, const materials::Stress &tau, const dealii::Tensor<4, 3> &dtau,
+                       const dealii::Tensor<2, 3> &Finv, double (&A)[dim][dim][dim][dim])
+  {
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int j = 0; j < dim; ++j)
+        for (unsigned int k = 0; k < dim; ++k)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              double s = 0;
+              for (unsigned int e = 0; e < 3; ++e)
+                s += dtau[i][e][k][d] * Finv[j][e] - tau[i][e] * Finv[j][k] * Finv[d][e];
+              A[i][j][k][d] = c * s;
+            }
+  }
+
+  /// Residual rows b[a * stride + i] += sum_b Pk_ib G_a,b - fe_i N_a.
+  template <int dim, unsigned int stride, class PN>
+  inline void
+  add_internal_minus_external(const double (&Pk)[dim][dim], const double (&fe)[dim], const PN &p, LocalSystem &ls)
+  {
+    for (unsigned int a = 0; a < p.n; ++a)
+      for (unsigned int i = 0; i < dim; ++i)
+        {
+          double f = -fe[i] * p.N[a];
+          for (unsigned int b = 0; b < dim; ++b)
+            f += Pk[i][b] * p.G[a][b];
+          ls.b[p.local[a] * stride + i] += f;
+        }
+  }
+
+  /// Displacement block K[a * stride + i, b * stride + k] += sum_jd A_ijkd G_a,j G_b,d.
+  template <int dim, unsigned int stride, class PN>
+  inline void
+  add_displacement_stiffness(const double (&A)[dim][dim][dim][dim], const PN &p, LocalSystem &ls)
+  {
+    for (unsigned int a = 0; a < p.n; ++a)
+      for (unsigned int b = 0; b < p.n; ++b)
+        {
+          const auto &Ga = p.G[a];
+          const auto &Gb = p.G[b];
+          for (unsigned int i = 0; i < dim; ++i)
+            for (unsigned int k = 0; k < dim; ++k)
+              {
+                double s = 0;
+                for (unsigned int j = 0; j < dim; ++j)
+                  for (unsigned int d = 0; d < dim; ++d)
+                    s += A[i][j][k][d] * Ga[j] * Gb[d];
+                ls.a(p.local[a] * stride + i, p.local[b] * stride + k) += s;
+              }
+        }
+  }
+
+  /// External force of one point on its nodes: (m_p g + scale f_p) N_i, f_p
+  /// the traction point force (loads::PointForces; null: none). Dead loads:
+  /// neither g nor f_p follows the deformation, so they add no tangent.
+  template <int dim>
+  inline void
+  external_point_force(const double *P, const dealii::Tensor<1, dim> &g, const loads::PointForces<dim> *forces,
+                       const double scale, double (&f)[dim])
+  {
+    const double m = P[PropertyLayout<dim>::mass];
+    double       fp[dim] = {};
+    if (forces && forces->any())
+      forces->force(P, fp);
+    for (unsigned int d = 0; d < dim; ++d)
+      f[d] = m * g[d] + scale * fp[d];
+  }
+
+  /// Integrand: the nodal external force sum_p N_i (m_p g + scale f_p) (the
+  /// force scale of a step's residual test).
+  template <int dim>
+  struct ExternalForce
+  {
+    dealii::Tensor<1, dim>          gravity;
+    const loads::PointForces<dim> * point_forces = nullptr;
+    double                          load_scale   = 1;
+    static constexpr bool           matrix = false, vector = true;
+    template <int d_, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      static_assert(nc >= dim && d_ == dim, "ExternalForce: the displacement components come first");
+      double f[dim];
+      external_point_force<dim>(P, gravity, point_forces, load_scale, f);
+      for (unsigned int a = 0; a < p.n; ++a)
+        for (unsigned int i = 0; i < dim; ++i)
+          ls.b[p.local[a] * nc + i] += f[i] * p.N[a];
+    }
+  };
+
+  /// The residual f_int - f_ext of one point and (optionally) its tangent
+  /// d(f_int)/d(Du) at the iterate Du (AssembleSystem's field). Loads: body
+  /// force m_p g N_i (g already scaled by the load factor) and the traction
+  /// point forces times load_scale (external_point_force).
   template <int dim>
   struct UpdatedLagrangianForce
   {
     const std::vector<std::shared_ptr<const materials::Material>> *materials = nullptr;
     unsigned int                                                   history_offset = 0;
     dealii::Tensor<1, dim>                                         gravity;
+    const loads::PointForces<dim> *                                point_forces = nullptr;
+    double                                                         load_scale   = 1;
     bool                                                           tangent = true;
     PointFailure *                                                 failure = nullptr;
 
@@ -106,55 +223,183 @@ namespace talus::transfer
         }
       const double c = P[L::volume] / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + history_offset, nh));
       const dealii::Tensor<2, 3> Finv = invert(dF);
-      // first Piola stress of the step, times c: Pk_ib = c tau_ie Finv_be
       double Pk[dim][dim];
-      for (unsigned int i = 0; i < dim; ++i)
-        for (unsigned int b = 0; b < dim; ++b)
-          {
-            double s = 0;
-            for (unsigned int e = 0; e < 3; ++e)
-              s += tau[i][e] * Finv[b][e];
-            Pk[i][b] = c * s;
-          }
-      const double mass = P[L::mass];
-      for (unsigned int a = 0; a < p.n; ++a)
-        for (unsigned int i = 0; i < dim; ++i)
-          {
-            double f = -mass * gravity[i] * p.N[a];
-            for (unsigned int b = 0; b < dim; ++b)
-              f += Pk[i][b] * p.G[a][b];
-            ls.b[p.local[a] * dim + i] += f;
-          }
+      scaled_piola<dim>(c, tau, Finv, Pk);
+      double fe[dim];
+      external_point_force<dim>(P, gravity, point_forces, load_scale, fe);
+      add_internal_minus_external<dim, dim>(Pk, fe, p, ls);
       if (!tangent)
         return;
-      // A_ijkd = c d(tau_ie Finv_je)/d dF_kd
-      //        = c (dtau_iekd Finv_je - tau_ie Finv_jk Finv_de)
       double A[dim][dim][dim][dim];
+      scaled_piola_tangent<dim>(c, tau, dtau, Finv, A);
+      add_displacement_stiffness<dim, dim>(A, p, ls);
+    }
+  };
+
+  /// Mixed u-p (seed 001 ch. 5) on a space of dim + 1 components (the
+  /// displacement increment Du, then the nodal pressure p = mean Cauchy stress,
+  /// tension positive): the residual and the exact tangent of
+  ///   R_u,i = sum_p [c_p tau_dev dF^-T + V_n j p_p cof-form] grad_{x_n} N_i - f_ext
+  ///         = sum_p V_{n+1} (sigma_dev + p_p I) grad_{x_{n+1}} N_i - f_ext   (Eq. 5.6)
+  ///   R_p,i = sum_p V_{n+1} N_i (U'(J) - p_p / K) - S_ij p_j           (Eq. 5.7 / K, 5.16)
+  /// with j = det dF, J = J_n j, p_p = N p (the nodal pressure, not the
+  /// model's), tau_dev = mu dev(J^-2/3 b) and U of the split Neo-Hookean model
+  /// (materials/neo_hookean.h: p = K U'(J)). The pressure row is divided by K
+  /// (Kratos's form: the blocks are of one scale and K_pu = K_up^T at J = 1).
+  /// S is the PPP stabilisation (Eqs. 5.14-5.19), over the points of one grid
+  /// cell, with w_p = alpha V_n / G_p on the volume at the start of the step:
+  ///   S_ij = sum_p w_p (N_i - m_i)(N_j - m_j),  m_i = sum_p V_n N_i / sum_p V_n
+  /// i.e. int (alpha/G)(q - q~)(p - p~) with q~, p~ the cell means over the
+  /// points (the projection onto P0 of Eq. 5.14); S is symmetric positive
+  /// semi-definite and vanishes for a pressure constant in the cell.
+  /// docs/implicit.md writes out the linearisation.
+  template <int dim>
+  struct MixedUpForce
+  {
+    /// per material id: the split Neo-Hookean model (checked when read)
+    const std::vector<const materials::NeoHookean *> *models = nullptr;
+    unsigned int                                      history_offset = 0;
+    dealii::Tensor<1, dim>                            gravity;
+    const loads::PointForces<dim> *                   point_forces = nullptr;
+    double                                            load_scale   = 1;
+    double                                            alpha        = 1; ///< stabilisation factor of Eq. 5.15
+    bool                                              tangent      = true;
+    PointFailure *                                    failure      = nullptr;
+
+    static constexpr bool         matrix = true, vector = true, cell_terms = true;
+    static constexpr unsigned int nc     = dim + 1, max_local = 64;
+    // the cell's sums for the projection onto the cell mean
+    mutable double cell_vn[max_local], cell_wn[max_local], cell_w = 0, cell_v = 0;
+
+    void
+    begin_cell_terms() const
+    {
+      std::fill(std::begin(cell_vn), std::end(cell_vn), 0.0);
+      std::fill(std::begin(cell_wn), std::end(cell_wn), 0.0);
+      cell_w = cell_v = 0;
+    }
+
+    template <int d_, unsigned int nc_, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      static_assert(nc_ == dim + 1 && d_ == dim, "MixedUpForce: a space of dim + 1 components");
+      using L                = PropertyLayout<dim>;
+      const auto &       m   = *(*models)[static_cast<unsigned int>(P[L::material])];
+      const unsigned int nh  = m.n_history();
+      double             history_new[64];
+      const dealii::Tensor<2, 3> dF = incremental_deformation_gradient<dim, PN, nc>(ls.u, p);
+      materials::Stress          tau_dev;
+      dealii::Tensor<4, 3>       dtau;
+      double                     J = 1;
+      try
+        {
+          m.split_update(dF, dealii::ArrayView<const double>(P + history_offset, nh),
+                         dealii::ArrayView<double>(history_new, nh), tau_dev, J, tangent ? &dtau : nullptr);
+        }
+      catch (const std::exception &e)
+        {
+          failure->set(e.what());
+          return;
+        }
+      const double Vn = P[L::volume];
+      const double c  = Vn / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + history_offset, nh));
+      const double j  = determinant(dF);
+      const dealii::Tensor<2, 3> Finv = invert(dF);
+      double                     pp   = 0;
+      for (unsigned int a = 0; a < p.n; ++a)
+        pp += p.N[a] * ls.u[p.local[a] * nc + dim];
+      const double K = m.bulk_modulus(), w = alpha * Vn / m.shear_modulus();
+      const double Up = m.pressure(J) / K, Upp = m.dpressure_dJ(J) / K;
+      // first Piola form of (sigma_dev + p I) V_{n+1}: Pk_ib
+      double Pk[dim][dim];
+      scaled_piola<dim>(c, tau_dev, Finv, Pk);
       for (unsigned int i = 0; i < dim; ++i)
-        for (unsigned int j = 0; j < dim; ++j)
+        for (unsigned int b = 0; b < dim; ++b)
+          Pk[i][b] += Vn * j * pp * Finv[b][i];
+      double fe[dim];
+      external_point_force<dim>(P, gravity, point_forces, load_scale, fe);
+      add_internal_minus_external<dim, nc>(Pk, fe, p, ls);
+      const double rp = Vn * j * (Up - pp / K) - w * pp;
+      for (unsigned int a = 0; a < p.n; ++a)
+        {
+          ls.b[p.local[a] * nc + dim] += p.N[a] * rp;
+          cell_vn[p.local[a]] += Vn * p.N[a];
+          cell_wn[p.local[a]] += w * p.N[a];
+        }
+      cell_w += w;
+      cell_v += Vn;
+      if (!tangent)
+        return;
+      // d(Pk_ij)/d dF_kd: deviatoric (material + geometric) and pressure parts
+      double A[dim][dim][dim][dim];
+      scaled_piola_tangent<dim>(c, tau_dev, dtau, Finv, A);
+      for (unsigned int i = 0; i < dim; ++i)
+        for (unsigned int jj = 0; jj < dim; ++jj)
           for (unsigned int k = 0; k < dim; ++k)
             for (unsigned int d = 0; d < dim; ++d)
-              {
-                double s = 0;
-                for (unsigned int e = 0; e < 3; ++e)
-                  s += dtau[i][e][k][d] * Finv[j][e] - tau[i][e] * Finv[j][k] * Finv[d][e];
-                A[i][j][k][d] = c * s;
-              }
+              A[i][jj][k][d] += Vn * pp * j * (Finv[d][k] * Finv[jj][i] - Finv[jj][k] * Finv[d][i]);
+      add_displacement_stiffness<dim, nc>(A, p, ls);
+      // d R_p / d dF_kd = Vn N_a ((U' + J U'') - p/K) j Finv_dk
+      const double vol_coef = Vn * j * ((Up + J * Upp) - pp / K);
+      double       gx[PN::capacity][dim]; // grad_{x_{n+1}} N = dF^-T grad_{x_n} N
+      for (unsigned int a = 0; a < p.n; ++a)
+        for (unsigned int k = 0; k < dim; ++k)
+          {
+            double s = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              s += Finv[d][k] * p.G[a][d];
+            gx[a][k] = s;
+          }
       for (unsigned int a = 0; a < p.n; ++a)
         for (unsigned int b = 0; b < p.n; ++b)
           {
-            const auto &Ga = p.G[a];
-            const auto &Gb = p.G[b];
+            const unsigned int ra = p.local[a] * nc, rb = p.local[b] * nc;
             for (unsigned int i = 0; i < dim; ++i)
-              for (unsigned int k = 0; k < dim; ++k)
-                {
-                  double s = 0;
-                  for (unsigned int j = 0; j < dim; ++j)
-                    for (unsigned int d = 0; d < dim; ++d)
-                      s += A[i][j][k][d] * Ga[j] * Gb[d];
-                  ls.a(p.local[a] * dim + i, p.local[b] * dim + k) += s;
-                }
+              {
+                ls.a(ra + i, rb + dim) += Vn * j * gx[a][i] * p.N[b]; // K_up
+                ls.a(ra + dim, rb + i) += vol_coef * p.N[a] * gx[b][i]; // K_pu
+              }
+            ls.a(ra + dim, rb + dim) -= (Vn * j / K + w) * p.N[a] * p.N[b]; // K_pp
           }
+    }
+
+    /// The cell-mean part of S: -m_a wn_b - wn_a m_b + m_a m_b W.
+    template <int d_, unsigned int nc_>
+    void
+    end_cell_terms(LocalSystem &ls, const unsigned int n_local) const
+    {
+      if (cell_v <= 0)
+        return;
+      for (unsigned int a = 0; a < n_local; ++a)
+        for (unsigned int b = 0; b < n_local; ++b)
+          {
+            const double ma = cell_vn[a] / cell_v, mb = cell_vn[b] / cell_v;
+            const double S  = -ma * cell_wn[b] - cell_wn[a] * mb + ma * mb * cell_w;
+            ls.b[a * nc + dim] -= S * ls.u[b * nc + dim];
+            if (tangent)
+              ls.a(a * nc + dim, b * nc + dim) -= S;
+          }
+    }
+  };
+
+  /// Lumped projection of the point pressure (Eq. 5.20) onto the pressure
+  /// component (the last) of a mixed space: sum_p m_p N_i p_p (weighted) or
+  /// sum_p m_p N_i; their ratio is the nodal pressure.
+  template <int dim>
+  struct PressureProjection
+  {
+    unsigned int          pressure_offset = 0;
+    bool                  weighted        = true;
+    static constexpr bool matrix = false, vector = true;
+    template <int d_, unsigned int nc, class PN>
+    inline void
+    add(const double *P, const PN &p, LocalSystem &ls) const
+    {
+      static_assert(nc == dim + 1 && d_ == dim, "PressureProjection: a space of dim + 1 components");
+      const double m = P[PropertyLayout<dim>::mass] * (weighted ? P[pressure_offset] : 1.0);
+      for (unsigned int a = 0; a < p.n; ++a)
+        ls.b[p.local[a] * nc + dim] += m * p.N[a];
     }
   };
 
@@ -170,11 +415,11 @@ namespace talus::transfer
     inline void
     add(const double *P, const PN &p, LocalSystem &ls) const
     {
-      static_assert(nc == dim && d_ == dim, "NodalProjection: a vector space (nc = dim)");
+      static_assert(nc >= dim && d_ == dim, "NodalProjection: the displacement components come first");
       if (offset == dealii::numbers::invalid_unsigned_int)
-        add_lumped<dim>(P, p, ls, [](const unsigned int) { return 1.0; });
+        add_lumped<dim, nc>(P, p, ls, [](const unsigned int) { return 1.0; });
       else
-        add_lumped<dim>(P, p, ls, [P, this](const unsigned int c) { return P[offset + c]; });
+        add_lumped<dim, nc>(P, p, ls, [P, this](const unsigned int c) { return P[offset + c]; });
     }
   };
 
@@ -184,14 +429,17 @@ namespace talus::transfer
   /// and v_p += h ((1 - gamma) a_p^n + gamma a_p^{n+1}) (Eq. 2.16: integrated,
   /// not interpolated); x_p and u_p += Du_p; points that left their cell are
   /// handed to the set's relocation. Du and a_new: vectors of `space` with
-  /// ghost values; a_new null in a static analysis (v_p = 0 then).
+  /// ghost values; a_new null in a static analysis (v_p = 0 then). Mixed u-p
+  /// (`pressure_offset` valid; the space's last component is p): the point
+  /// pressure p_p = N p (Eq. 5.21) is stored there and replaces the mean of
+  /// the point's stress (sigma = dev(tau / J) + p_p I).
   template <int dim, class K>
   struct CommitUpdatedLagrangian
   {
     CommitUpdatedLagrangian(MaterialPointSet<dim> &set, const NodalSpace<dim> &space, const Vector &du,
                             const Vector *a_new, const std::vector<std::shared_ptr<const materials::Material>> &mats,
                             const unsigned int acceleration_offset, const double h, const double gamma,
-                            PointFailure &failure)
+                            PointFailure &failure, const unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int)
       : set(set)
       , grid(space.grid)
       , space(space)
@@ -202,6 +450,7 @@ namespace talus::transfer
       , h(h)
       , gamma(gamma)
       , failure(failure)
+      , pressure(pressure_offset)
     {}
     MaterialPointSet<dim> &                                        set;
     const BackgroundGrid<dim> &                                    grid;
@@ -212,22 +461,26 @@ namespace talus::transfer
     const unsigned int                                             acceleration;
     const double                                                   h, gamma;
     PointFailure &                                                 failure;
+    const unsigned int                                             pressure;
 
     static constexpr bool prefetch_location = true;
     typename K::Cell      cell;
-    double                un[K::n_nodes][dim], an[K::n_nodes][dim];
+    double                un[K::n_nodes][dim], an[K::n_nodes][dim], pn[K::n_nodes];
 
     inline void
     begin_cell(const unsigned int c)
     {
       cell = K::cell(grid, c);
-      gather_space_vector<dim, K, dim>(space, cell, du, un);
-      if (a_new)
-        gather_space_vector<dim, K, dim>(space, cell, *a_new, an);
-      else
-        for (auto &node : an)
-          for (double &value : node)
-            value = 0.0;
+      for (unsigned int s = 0; s < K::n_nodes; ++s)
+        for (unsigned int k = 0; k < dim; ++k)
+          {
+            const unsigned int i = cell.dofs[s * dim];
+            const bool         valid = i != dealii::numbers::invalid_unsigned_int;
+            un[s][k] = valid ? du(space.node_dof(i, k)) : 0.0;
+            an[s][k] = valid && a_new ? (*a_new)(space.node_dof(i, k)) : 0.0;
+            if (k == 0)
+              pn[s] = valid && pressure != dealii::numbers::invalid_unsigned_int ? du(space.node_dof(i, dim)) : 0.0;
+          }
     }
     inline bool
     point(const unsigned int c, PointIterator<dim> &it)
@@ -237,7 +490,7 @@ namespace talus::transfer
       unsigned int slot[K::n_point_nodes];
       double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
       K::point_stencil(cell, it->get_reference_location(), slot, N, G);
-      double               dx[dim] = {}, ap[dim] = {};
+      double               dx[dim] = {}, ap[dim] = {}, pp = 0;
       dealii::Tensor<2, 3> dF;
       for (unsigned int i = 0; i < 3; ++i)
         dF[i][i] = 1.0;
@@ -247,6 +500,8 @@ namespace talus::transfer
             const double u = un[slot[w]][i];
             dx[i] += N[w] * u;
             ap[i] += N[w] * an[slot[w]][i];
+            if (i == 0)
+              pp += N[w] * pn[slot[w]];
             for (unsigned int j = 0; j < dim; ++j)
               dF[i][j] += u * G[w][j];
           }
@@ -265,7 +520,13 @@ namespace talus::transfer
           failure.set(e.what());
           return true;
         }
-      L::set_stress(tau / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + L::history, nh)), P);
+      materials::Stress sigma = tau / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + L::history, nh));
+      if (pressure != dealii::numbers::invalid_unsigned_int)
+        {
+          sigma = dealii::deviator(sigma) + pp * dealii::unit_symmetric_tensor<3>();
+          P[pressure] = pp;
+        }
+      L::set_stress(sigma, P);
       P[L::volume] *= determinant(dF);
       for (unsigned int i = 0; i < dim; ++i)
         {

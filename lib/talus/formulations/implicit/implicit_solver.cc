@@ -32,6 +32,7 @@ namespace talus::implicit_mpm
     const SceneCounts counts = peek_scene_counts(prm_file);
     declare_scene_parameters(prm, counts);
     declare_run_parameters(prm);
+    loads::declare_traction_parameters(prm, prm_file, counts.dim);
     prm.enter_subsection("time");
     prm.declare_entry("time step", "0", Double(0),
                       "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
@@ -55,6 +56,14 @@ namespace talus::implicit_mpm
       prm.declare_entry("ramp loads", "true", Bool(),
                         "static: body forces grow linearly from 0 at t = 0 to their full value at the end "
                         "time (load stepping); false: full loads from the first step.");
+      prm.declare_entry("formulation", "irreducible", Selection("irreducible|mixed up"),
+                        "irreducible: the nodal displacement only; mixed up: displacement and the nodal pressure "
+                        "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
+                        "pressure projection (seed 001 ch. 5; static analysis, neo hookean with 'volumetric energy "
+                        "= split', direct linear solver).");
+      prm.declare_entry("stabilisation factor", "1", Double(0),
+                        "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
+                        "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain"),
                         "2D: plane strain (dF_zz = 1). 3D ignores it.");
     }
@@ -104,6 +113,8 @@ namespace talus::implicit_mpm
     p.beta           = prm.get_double("newmark beta");
     p.rayleigh_alpha = prm.get_double("rayleigh alpha");
     p.ramp_loads     = prm.get_bool("ramp loads");
+    p.mixed_up       = prm.get("formulation") == "mixed up";
+    p.stabilisation  = prm.get_double("stabilisation factor");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
@@ -117,6 +128,7 @@ namespace talus::implicit_mpm
     p.newton.line_search        = prm.get_bool("line search");
     prm.leave_subsection();
     p.newton.validate();
+    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies);
     prm.enter_subsection("linear solver");
     p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
                                                     : LinearSolverOptions::Method::cg_amg;
@@ -132,6 +144,22 @@ namespace talus::implicit_mpm
                   "' has no finite-strain form; talus-implicit needs one of: neo hookean, j2 plasticity, "
                   "hencky mohr coulomb, nor sand");
         require(m.n_history() <= 64, "material " + std::to_string(k), "more than 64 history variables");
+      }
+    if (p.mixed_up)
+      {
+        require(p.analysis == Parameters<dim>::Analysis::quasi_static, "implicit/formulation",
+                "'mixed up' is available for 'analysis = static' only (the dynamic u-p form is not verified yet)");
+        require(p.linear.method == LinearSolverOptions::Method::direct, "linear solver/method",
+                "'mixed up' needs 'direct' (the u-p system is indefinite; no block preconditioner yet)");
+        for (unsigned int k = 0; k < p.materials.size(); ++k)
+          {
+            const auto *nh = dynamic_cast<const materials::NeoHookean *>(p.materials[k].get());
+            require(nh && nh->energy() == materials::NeoHookean::Energy::split,
+                    "material " + std::to_string(k) + "/model",
+                    "'mixed up' needs the volumetric/deviatoric split: model 'neo hookean' with 'volumetric energy = "
+                    "split' (got '" + p.materials[k]->model_name() +
+                      (nh ? "' with 'volumetric energy = coupled')" : "')"));
+          }
       }
     // what the implicit family does not offer yet: refused, not ignored
     const auto not_yet = [](const bool used, const std::string &entry) {
@@ -167,7 +195,7 @@ namespace talus::implicit_mpm
     , comm(c)
     , grid(c)
     , points(grid, "points")
-    , space(grid, dim)
+    , space(grid, p.mixed_up ? dim + 1 : dim)
     , active(space)
     , newmark(p.gamma, p.beta)
   {}
@@ -189,6 +217,13 @@ namespace talus::implicit_mpm
       n_history = std::max(n_history, m->n_history());
     points.layout.n_history = n_history;
     acceleration_offset     = points.layout.add_extra("acceleration", dim, true);
+    point_forces.extend_layout(points.layout, prm.tractions.size());
+    if (prm.mixed_up)
+      {
+        pressure_offset = points.layout.add_extra("pressure", 1);
+        for (const auto &m : prm.materials)
+          split_models.push_back(dynamic_cast<const materials::NeoHookean *>(m.get()));
+      }
     points.initialize();
 
     bool restored = false;
@@ -222,10 +257,14 @@ namespace talus::implicit_mpm
                                  dealii::ArrayView<double>(P.data() + L::history, m.n_history()));
             for (unsigned int d = 0; d < dim; ++d)
               P[acceleration_offset + d] = 0.0;
+            if (prm.mixed_up) // the mean of the initial stress
+              P[pressure_offset] = dealii::trace(L::get_stress(P.data())) / 3.0;
           }
         dt = prm.time_step;
       }
     points.collect_active_cells();
+    if (!prm.tractions.empty())
+      point_forces.assign(prm.tractions, points, grid, prm.bodies, comm);
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
       space.reinit_vector(*v);
   }
@@ -259,7 +298,10 @@ namespace talus::implicit_mpm
     std::vector<MaterialPointSet<dim> *> sets = {&points};
     const auto &pins = active.constraints(); // inactive DoFs only: walls keep their mass
     mass = 0;
-    transfer::assemble<dim, shape::Q1Box<dim>, dim>(sets, active, pins, transfer::NodalProjection<dim>{}, nullptr, &mass);
+    with_components([&](auto nc) {
+      transfer::assemble<dim, shape::Q1Box<dim>, decltype(nc)::value>(sets, active, pins,
+                                                                      transfer::NodalProjection<dim>{}, nullptr, &mass);
+    });
     if (!dynamic())
       return;
     v_n = 0;
@@ -286,13 +328,30 @@ namespace talus::implicit_mpm
     force.materials      = &prm.materials;
     force.history_offset = PropertyLayout<dim>::history;
     force.gravity        = g;
+    force.point_forces   = &point_forces;
+    force.load_scale     = load_factor(time + newmark.dt());
     force.tangent        = with_tangent;
     force.failure        = &failure;
     residual             = 0;
     if (with_tangent)
       tangent = 0;
-    transfer::assemble<dim, shape::Q1Box<dim>, dim>({&points}, active, constraints, force,
-                                                    with_tangent ? &tangent : nullptr, &residual, &du);
+    if (prm.mixed_up)
+      {
+        transfer::MixedUpForce<dim> up;
+        up.models         = &split_models;
+        up.history_offset = force.history_offset;
+        up.gravity        = g;
+        up.point_forces   = &point_forces;
+        up.load_scale     = force.load_scale;
+        up.alpha          = prm.stabilisation;
+        up.tangent        = with_tangent;
+        up.failure        = &failure;
+        transfer::assemble<dim, shape::Q1Box<dim>, dim + 1>({&points}, active, constraints, up,
+                                                            with_tangent ? &tangent : nullptr, &residual, &du);
+      }
+    else
+      transfer::assemble<dim, shape::Q1Box<dim>, dim>({&points}, active, constraints, force,
+                                                      with_tangent ? &tangent : nullptr, &residual, &du);
     const bool any_failed = dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0;
     if (any_failed)
       throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
@@ -324,6 +383,27 @@ namespace talus::implicit_mpm
 
   template <int dim>
   void
+  Solver<dim>::predict_pressure()
+  {
+    // Eq. 5.20: p_i = sum_p N_i m_p p_p / sum_p N_i m_p (residual and delta as scratch)
+    const auto &pins = active.constraints();
+    residual         = 0;
+    delta            = 0;
+    transfer::assemble<dim, shape::Q1Box<dim>, dim + 1>({&points}, active, pins,
+                                                        transfer::PressureProjection<dim>{pressure_offset, true},
+                                                        nullptr, &residual);
+    transfer::assemble<dim, shape::Q1Box<dim>, dim + 1>({&points}, active, pins,
+                                                        transfer::PressureProjection<dim>{pressure_offset, false},
+                                                        nullptr, &delta);
+    for (unsigned int k = 0; k < du.locally_owned_size(); ++k)
+      if (space.component(k) == dim && delta.local_element(k) > 0)
+        du.local_element(k) = residual.local_element(k) / delta.local_element(k);
+    du.update_ghost_values();
+    delta = 0;
+  }
+
+  template <int dim>
+  void
   Solver<dim>::nodal_acceleration(Vector &a) const
   {
     for (unsigned int k = 0; k < a.locally_owned_size(); ++k)
@@ -345,12 +425,27 @@ namespace talus::implicit_mpm
     for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
       {
         const unsigned int c = space.component(k);
-        f2 += std::pow(mass.local_element(k) * g[c], 2);
+        if (c < dim)
+          f2 += std::pow(mass.local_element(k) * g[c], 2);
       }
-    const double f_ext = std::sqrt(dealii::Utilities::MPI::sum(f2, comm));
+    double f_ext = std::sqrt(dealii::Utilities::MPI::sum(f2, comm));
+    point_forces.update_factors(prm.tractions, prm.tractions.size(), time + h, 0.0);
+    if (point_forces.any())
+      {
+        // the scale of gravity plus tractions: |sum_p N_i (m_p g + lambda f_p)|
+        transfer::ExternalForce<dim> load{g, &point_forces, load_factor(time + h)};
+        residual = 0;
+        with_components([&](auto nc) {
+          transfer::assemble<dim, shape::Q1Box<dim>, decltype(nc)::value>({&points}, active, active.constraints(),
+                                                                          load, nullptr, &residual);
+        });
+        f_ext = residual.l2_norm();
+      }
 
     du = 0;
     du.update_ghost_values();
+    if (prm.mixed_up)
+      predict_pressure();
     unsigned int  linear_iterations = 0;
     double        worst_linear_residual = 0;
     NewtonProblem problem;
@@ -441,7 +536,7 @@ namespace talus::implicit_mpm
     transfer::PointFailure failure;
     transfer::CommitUpdatedLagrangian<dim, shape::Q1Box<dim>> commit(points, space, du, dynamic() ? &a_new : nullptr,
                                                                      prm.materials, acceleration_offset, h,
-                                                                     newmark.gamma(), failure);
+                                                                     newmark.gamma(), failure, pressure_offset);
     transfer::for_each_active_cell(points, commit);
     if (dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0)
       throw InstabilityError("the constitutive update of the converged step failed: " +
@@ -457,10 +552,11 @@ namespace talus::implicit_mpm
 
   template <int dim>
   double
-  Solver<dim>::tangent_error(const double h, const double scale, const double eps)
+  Solver<dim>::tangent_error(const double h, const double scale, const double eps, const double pressure_scale)
   {
     newmark.set_time_step(h);
     prepare_step();
+    point_forces.update_factors(prm.tractions, prm.tractions.size(), time + h, 0.0);
     const dealii::Tensor<1, dim> g = load_factor(time + h) * prm.gravity;
     const auto &                 owned = space.locally_owned_dofs();
     Vector                       v;
@@ -469,7 +565,8 @@ namespace talus::implicit_mpm
       {
         const auto i = owned.nth_index_in_set(k);
         // deterministic, rank-independent values from the global index
-        du.local_element(k) = scale * std::sin(1.3 * double(i) + 0.7);
+        du.local_element(k) =
+          (space.component(k) == dim ? pressure_scale : 1.0) * scale * std::sin(1.3 * double(i) + 0.7);
         v.local_element(k)  = std::cos(2.1 * double(i) + 0.3);
       }
     constraints.set_zero(du);
@@ -500,7 +597,21 @@ namespace talus::implicit_mpm
     Vector Kv_free(Kv);
     constraints.set_zero(Kv_free);
     du = 0;
-    return fd.l2_norm() / Kv_free.l2_norm();
+    // per block (displacement rows, pressure rows): the pressure rows of u-p
+    // are divided by K and are orders of magnitude smaller than the force rows,
+    // so one norm over both would hide an error in them
+    double sums[4] = {0, 0, 0, 0}; // |error|^2, |Kv|^2 of u rows; of p rows
+    for (unsigned int k = 0; k < fd.locally_owned_size(); ++k)
+      {
+        const unsigned int b = space.component(k) < dim ? 0 : 2;
+        sums[b] += fd.local_element(k) * fd.local_element(k);
+        sums[b + 1] += Kv_free.local_element(k) * Kv_free.local_element(k);
+      }
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 4), comm, dealii::ArrayView<double>(sums, 4));
+    double error = std::sqrt(sums[0] / sums[1]);
+    if (prm.mixed_up)
+      error = std::max(error, std::sqrt(sums[2] / sums[3]));
+    return error;
   }
 
   template <int dim>
@@ -544,6 +655,11 @@ namespace talus::implicit_mpm
                           (prm.rayleigh_alpha > 0 ? ", Rayleigh alpha = " + std::to_string(prm.rayleigh_alpha) : "")
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
         << "), time step " << dt << std::endl;
+    out << "  formulation: "
+        << (prm.mixed_up ? "mixed u-p (Q1-Q1, PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
+                         : std::string("irreducible (displacement)"))
+        << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
+        << std::endl;
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
         << " iterations; linear solver "

@@ -13,6 +13,9 @@
 #include <talus/formulations/implicit/newton.h>
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
+#include <talus/materials/neo_hookean.h>
+#include <talus/loads/point_forces.h>
+#include <talus/loads/settings.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/solvers/linear_solver.h>
 
@@ -21,6 +24,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 
 #include <memory>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -37,11 +41,16 @@ namespace talus::implicit_mpm
       dynamic       ///< Newmark
     };
     Analysis analysis  = Analysis::dynamic;
+    /// mixed u-p (seed 001 ch. 5): nodal pressure as a second field, PPP stabilisation
+    bool   mixed_up      = false;
+    double stabilisation = 1; ///< alpha of Eq. 5.15 (mixed u-p)
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
     /// static: body forces grow linearly from 0 at t = 0 to full at the end time
     bool           ramp_loads = true;
+    /// 'loads/traction k': dead loads carried by boundary points (global, absolute time)
+    std::vector<loads::Traction<dim>> tractions;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -80,8 +89,11 @@ namespace talus::implicit_mpm
     /// For tests: the tangent against central differences of the residual at
     /// the iterate du = `scale` x a pseudo-random field (constrained DoFs 0), in
     /// a pseudo-random direction, for a step of size h from the current state:
-    /// |K v - (r(du + eps v) - r(du - eps v)) / (2 eps)| / |K v|. Collective.
-    double tangent_error(const double h, const double scale, const double eps);
+    /// |K v - (r(du + eps v) - r(du - eps v)) / (2 eps)| / |K v|, the larger of
+    /// the displacement rows' and (mixed u-p) the pressure rows'. Collective.
+    /// Mixed u-p: the pressure components of the iterate are `pressure_scale` x
+    /// the pseudo-random field.
+    double tangent_error(const double h, const double scale, const double eps, const double pressure_scale = 1.0);
     double             kinetic_energy() const;
 
     // ---- the Formulation interface
@@ -106,6 +118,7 @@ namespace talus::implicit_mpm
     NodalSpace<dim>        space;
     ActiveSet<dim>         active;
     Newmark                newmark;
+    loads::PointForces<dim> point_forces;
     StepReport             last;
 
   private:
@@ -119,12 +132,26 @@ namespace talus::implicit_mpm
     void project_to_grid();
     /// Residual (and tangent) at the iterate du (ghosts up to date); returns |r|.
     double assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g);
+    /// Mixed u-p: the nodal pressure predictor of Eq. 5.20 into the pressure
+    /// components of du (ghosts updated).
+    void predict_pressure();
+    /// f(std::integral_constant<unsigned int, nc>) with the space's components.
+    template <class F>
+    void with_components(F &&f) const
+    {
+      if (prm.mixed_up)
+        f(std::integral_constant<unsigned int, dim + 1>());
+      else
+        f(std::integral_constant<unsigned int, dim>());
+    }
     /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
     void nodal_acceleration(Vector &a) const;
     /// The newest valid checkpoint into the state (false: none). Collective.
     bool restore_checkpoint();
 
     unsigned int                            acceleration_offset = 0;
+    unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int; ///< mixed u-p: p_p
+    std::vector<const materials::NeoHookean *> split_models; ///< mixed u-p, per material id
     dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
     std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
     dealii::TrilinosWrappers::SparseMatrix  tangent;

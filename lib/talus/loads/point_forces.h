@@ -1,0 +1,91 @@
+// talus — traction point forces, the solver-independent part of surface loads
+// (seed 000 Eqs. 4.28-4.29, 5.1-5.3; seed 001 §4.4 f_ext): which boundary
+// material points of a body face or a region carry which traction slot and
+// their share of the loaded area, the time factors of the tractions, and the
+// force of one point f_p = sum_j factor_j(t) t_j A_p. A family scatters
+// f_i += sum_p N_i(x_p) f_p in its own pass (explicit: loads::LoadControl,
+// implicit: the residual integrand of talus-implicit).
+#pragma once
+
+#include <talus/grid/background_grid.h>
+#include <talus/loads/settings.h>
+#include <talus/particles/material_point_set.h>
+#include <talus/particles/material_points.h>
+
+#include <mpi.h>
+
+#include <vector>
+
+namespace talus::loads
+{
+  template <int dim>
+  class PointForces
+  {
+  public:
+    /// Add `n_slots` blocks of dim doubles (point_force_j) to the layout;
+    /// before the ParticleHandler is initialised.
+    void extend_layout(PropertyLayout<dim> &layout, const unsigned int n_slots);
+    unsigned int n_slots() const { return slots; }
+    /// Offset of the first block (slot j at + j dim).
+    unsigned int offset() const { return force_offset; }
+
+    /// Select the points of every traction by their initial position X = x - u
+    /// (the outermost layer of a box body on the face, or the points in a
+    /// region), give each its area share A_p (V_p / the sub-cell spacing normal
+    /// to the face; for a body face normalised to the box face, so the total is
+    /// exactly traction x area) and store t_j A_p in slot j; other slots 0.
+    /// Logs one line per traction; a traction selecting no point is an
+    /// InputError. Collective.
+    void assign(const std::vector<Traction<dim>> &      tractions,
+                MaterialPointSet<dim> &                 points,
+                const BackgroundGrid<dim> &             grid,
+                const std::vector<BodyDescription<dim>> &bodies,
+                MPI_Comm                                comm);
+
+    /// Time factors: traction j < n_global at the absolute time t, the others
+    /// at the stage time t - stage_t0.
+    void update_factors(const std::vector<Traction<dim>> &tractions,
+                        const unsigned int                n_global,
+                        const double                      t,
+                        const double                      stage_t0);
+
+    /// Whether the tractions of the last assign() were not empty.
+    bool any() const { return have_tractions; }
+    const std::vector<double> &factors() const { return factor; }
+
+    /// f_p at the time of the last update_factors (0 without tractions).
+    void
+    force(const double *P, double (&f)[dim]) const
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        f[d] = 0;
+      if (!have_tractions)
+        return;
+      for (unsigned int j = 0; j < factor.size(); ++j)
+        for (unsigned int d = 0; d < dim; ++d)
+          f[d] += factor[j] * P[force_offset + j * dim + d];
+    }
+    /// The same sum over the non-zero entries only; returns whether the point
+    /// carries any (the scatter skips unloaded points).
+    bool
+    force_if_loaded(const double *P, double (&f)[dim]) const
+    {
+      bool any_entry = false;
+      for (unsigned int d = 0; d < dim; ++d)
+        f[d] = 0;
+      for (unsigned int j = 0; j < factor.size(); ++j)
+        for (unsigned int d = 0; d < dim; ++d)
+          if (P[force_offset + j * dim + d] != 0.0)
+            {
+              f[d] += factor[j] * P[force_offset + j * dim + d];
+              any_entry = true;
+            }
+      return any_entry;
+    }
+
+  private:
+    unsigned int        slots = 0, force_offset = 0;
+    bool                have_tractions = false;
+    std::vector<double> factor; ///< time factors of the tractions at t
+  };
+} // namespace talus::loads

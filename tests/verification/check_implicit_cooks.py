@@ -1,0 +1,103 @@
+"""Cook's membrane with talus-implicit, irreducible u and stabilised mixed u-p
+(issue 13; seed 001 §5.4.1, Table 5.1). Neo-Hookean (split energy) E = 70,
+nu = 0.33 and 0.499999, plane strain, static, total shear load 1 N on x = 48.
+
+n cells along the clamped width 48 (square cells h = 48/n, the grid reaching
+above the body: ceil(62/h) rows), 2 x 2 points per cell; the load is a region
+'total force' on the rightmost column of points (X > 48 - h/2).
+
+Displacement of A = (48, 60) (decision, docs/implicit.md): no point sits on A;
+u_y(A) is the value at A of the least-squares plane u_y = a + b (X - 48) +
+c (Y - 60) through the 6 points nearest to A by initial position X = x - u.
+
+Checks (each able to fail):
+  * every run ends (exit 0) with Newton converged in <= 8 iterations;
+  * nu = 0.499999: u locks: u_y(A) < 0.1 at n <= 8 (the issue's bound, from the
+    thesis's triangles) and below 0.6 x the reference (0.165) at every n (Q1
+    cells with 2 x 2 points lock less than the thesis's one-point triangles
+    and unlock slowly: 0.121, 0.126, 0.138 at n = 16, 32, 64); u-p does not:
+    u_y(A) > 0.9 x 0.275 at the finest n;
+  * the u-p displacement at the finest n is within TOL of 0.323 (nu = 0.33) and
+    0.275 (nu = 0.499999).
+Usage: check_implicit_cooks.py TOOLS_DIR PRM WORKDIR TOL N1 [N2 ...]
+"""
+import math
+import sys
+
+import talus_verify as tv
+
+tools, prm_path, work, tol = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
+ns = [int(n) for n in sys.argv[5:]]
+base = open(prm_path).read()
+refs = {"0.33": 0.323, "0.499999": 0.275}
+# thesis Table 5.1 (triangles, one point per element): U, UP no stab, UP stab
+thesis = {
+    "0.33": {2: (0.089, 0.1013, 0.1172), 4: (0.1415, 0.1718, 0.1953), 8: (0.2183, 0.2511, 0.2669),
+             16: (0.2771, 0.2952, 0.3025), 32: (0.30386, 0.3119, 0.315), 64: (0.3133, 0.3176, 0.319)},
+    "0.499999": {2: (0.0723, 0.0788, 0.1277), 4: (0.0736, 0.1157, 0.1932), 8: (0.0742, 0.1821, 0.2424),
+                 16: (0.075, 0.2356, 0.2648), 32: (0.0775, 0.2606, 0.2725), 64: (0.0862, 0.2702, 0.275)},
+}
+
+
+def corner_displacement(path):
+    t = tv.read_csv(path)
+    pts = [(t["pos_x"][i] - t["u_x"][i], t["pos_y"][i] - t["u_y"][i], t["u_y"][i]) for i in range(len(t["id"]))]
+    pts.sort(key=lambda p: (p[0] - 48) ** 2 + (p[1] - 60) ** 2)
+    near = pts[:6]
+    # normal equations of the plane fit (3 x 3), solved by Cramer's rule
+    rows = [(1.0, x - 48, y - 60) for x, y, _ in near]
+    A = [[sum(r[i] * r[j] for r in rows) for j in range(3)] for i in range(3)]
+    b = [sum(r[i] * p[2] for r, p in zip(rows, near)) for i in range(3)]
+
+    def det(m):
+        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+    Ab = [[b[i] if j == 0 else A[i][j] for j in range(3)] for i in range(3)]
+    return det(Ab) / det(A), len(pts)
+
+
+results = {}
+for nu in ("0.33", "0.499999"):
+    for form in ("irreducible", "mixed up"):
+        for n in ns:
+            h = 48.0 / n
+            rows = math.ceil(62.0 / h - 1e-9)
+            text = tv.prm_set(base, "grid/cells", f"{n}, {rows}")
+            text = tv.prm_set(text, "grid/upper corner", f"48, {rows * h}")
+            text = tv.prm_set(text, "loads/traction 0/region lower corner", f"{48 - h / 2}, 40")
+            text = tv.prm_set(text, "loads/traction 0/region upper corner", f"48, {rows * h}")
+            text = tv.prm_set(text, "material 0/neo hookean/poisson ratio", nu)
+            text = tv.prm_set(text, "implicit/formulation", form)
+            name = f"nu{nu}_{form.replace(' ', '')}_n{n}"
+            text = tv.prm_set(text, "output/directory", name)
+            tv.run_tool(f"{tools}/talus-implicit", text, work, name)
+            uA, npts = corner_displacement(f"{work}/{name}/particles_final.csv")
+            s = tv.read_csv(f"{work}/{name}/series.csv")
+            its = int(s["newton_iterations"][-1])
+            results[(nu, form, n)] = (uA, npts, its, s["increment_order"][-1])
+            tv.check(its <= 8, f"{name}: Newton converged in {its} <= 8 iterations")
+
+for nu in ("0.33", "0.499999"):
+    print(f"\nnu = {nu} (reference {refs[nu]}): vertical displacement of A")
+    print(f"{'n':>3} {'points':>6} {'u':>8} {'its':>3} {'u-p':>8} {'its':>3} {'u-p err':>8} | thesis: {'U':>7} {'UP':>7} {'UP stab':>7}")
+    for n in ns:
+        u, npts, iu, _ = results[(nu, "irreducible", n)]
+        up, _, iup, _ = results[(nu, "mixed up", n)]
+        th = thesis[nu].get(n, ("", "", ""))
+        print(f"{n:>3} {npts:>6} {u:8.4f} {iu:>3} {up:8.4f} {iup:>3} {(up - refs[nu]) / refs[nu]:+8.2%} | "
+              f"        {th[0]:>7} {th[1]:>7} {th[2]:>7}")
+
+fine = ns[-1]
+for n in ns:
+    u = results[("0.499999", "irreducible", n)][0]
+    bound = 0.1 if n <= 8 else 0.6 * refs["0.499999"]
+    tv.check(u < bound, f"nu = 0.499999, n = {n}: u locks (u_y(A) = {u:.4f} < {bound:.4g})")
+up_q = results[("0.499999", "mixed up", fine)][0]
+tv.check(up_q > 0.9 * refs["0.499999"], f"nu = 0.499999, n = {fine}: u-p does not lock (u_y(A) = {up_q:.4f} > "
+         f"{0.9 * refs['0.499999']:.4f})")
+for nu in ("0.33", "0.499999"):
+    up = results[(nu, "mixed up", fine)][0]
+    err = abs(up - refs[nu]) / refs[nu]
+    tv.check(err < tol, f"nu = {nu}, n = {fine}: u-p u_y(A) = {up:.4f} within {tol:.1%} of {refs[nu]} ({err:.2%})")
+tv.finish()
