@@ -106,6 +106,10 @@ namespace talus::implicit_mpm
     p.time_step = prm.get_double("time step");
     prm.leave_subsection();
     require(p.time_step > 0, "time/time step", "must be > 0 (the implicit step is chosen by the user)");
+    require(p.time_step <= p.end_time * (1 + 1e-12), "time/time step",
+            "must not exceed time/end time (" + std::to_string(p.end_time) +
+              " s): a larger step is a typo, the run would be one step to the end time (allowed: 0 < time step <= "
+              "end time)");
     prm.enter_subsection("implicit");
     p.analysis       = prm.get("analysis") == "static" ? Parameters<dim>::Analysis::quasi_static
                                                        : Parameters<dim>::Analysis::dynamic;
