@@ -5,6 +5,7 @@
 #include <talus/analysis/scheme_stability.h>
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/io/output.h>
@@ -70,12 +71,7 @@ namespace
   {
     using P      = implicit_mpm::Parameters<dim>;
     const auto p = implicit_mpm::parse_parameters<dim>(prm);
-    double     L_min = std::numeric_limits<double>::max();
-    if (p.grid_mesh)
-      L_min = p.grid_mesh->min_edge();
-    else
-      for (unsigned int d = 0; d < dim; ++d)
-        L_min = std::min(L_min, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
+    const double L_min = smallest_cell_edge(p);
     const auto  rows = explicit_mpm::critical_time_steps(p.materials, {}, L_min);
     std::size_t ctrl = 0;
     for (std::size_t i = 1; i < rows.size(); ++i)

@@ -26,6 +26,8 @@ cases = [
     ("damping alias twice", [("two phase/local damping", "0.3"), ("damping/local damping", "0.5")],
      "two phase/local damping"),
     ("mass scaling below 1", [("mass scaling/factor", "0.5")], "mass scaling/factor"),
+    # issue 12: with B-splines the point pore pressures carry a spurious mode
+    ("B-splines", [("numerics/shape function", "quadratic bspline")], "numerics/shape function"),
 ]
 for name, edits, needle in cases:
     text = base

@@ -10,7 +10,10 @@ mu, seed 000 §6.2 specialised to a rigid fixed boundary).
   * while sliding, the block centre rises less than 5e-4 m (it must stay on the
     floor; before the friction nodes tested whether the material had lifted off,
     velocity noise was rectified into a 3.8 mm rise).
-Usage: check_block_friction.py TOOL PRM WORKDIR
+With a 4th argument `bspline` (issue 12): the same with quadratic B-spline
+shape functions (the friction nodes act on the wall nodes' sums, whichever
+kernel made them).
+Usage: check_block_friction.py TOOL PRM WORKDIR [bspline]
 """
 import math
 import sys
@@ -19,6 +22,8 @@ import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1:4]
 base = open(prm_path).read()
+if len(sys.argv) > 4 and sys.argv[4] == "bspline":
+    base = tv.prm_set(base, "numerics/shape function", "quadratic bspline")
 g = 9.81
 for theta, mu in ((30.0, 0.3), (15.0, 0.4)):
     th = math.radians(theta)

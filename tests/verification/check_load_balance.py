@@ -17,7 +17,12 @@ wide grid: partitioned by cells, one rank holds nearly all points. Checks:
   5. points crossing the rank boundary (translating_bar.prm on 2 ranks, no load
      balancing) are sent to their new owner point to point: no collective full
      sort in the whole run (the log's count), points did move to the other
-     rank, and the particle results equal the 1-rank run to 1e-12 relative.
+     rank, and the particle results equal the 1-rank run to 1e-12 relative;
+  6. the 2-phase step with load balancing: the corner column saturated (coupled
+     pore liquid, porosity 0.4, k = 1e-3 m/s, liquid bulk modulus 2.2e7 Pa so that
+     the test stays short), 0.02 s on 2 ranks rebalancing at every check (every 20
+     steps) against 1 rank: particle results, pore pressures and liquid
+     velocities included, agree to 1e-10 relative, with >= 20 rebalances.
 Usage: check_load_balance.py TOOL PRM WORKDIR
 """
 import filecmp
@@ -92,4 +97,21 @@ tv.check(sent >= 8, f"material points moved to the other rank: {sent}")
 tv.check(sorts == 0, f"collective full sorts in the 2-rank run: {sorts} (expected 0)")
 worst = worst_difference(particles("out_bar_np1"), particles("out_bar_np2"))
 tv.check(worst <= 1e-12, f"1 vs 2 ranks with points crossing ranks agree to 1e-12 relative (worst {worst:.2e})")
+
+# 6. the 2-phase step with rebalancing
+wet = tv.prm_set(eager, "time/end time", "0.02")
+for key, value in {"drainage": "coupled", "porosity": "0.4", "liquid density": "1000",
+                   "liquid bulk modulus": "2.2e7", "liquid viscosity": "1e-3",
+                   "hydraulic conductivity": "1e-3", "permeability gravity": "9.81"}.items():
+    wet = tv.prm_set(wet, f"material 0/pore liquid/{key}", value)
+tv.run_tool(tool, tv.prm_set(wet, "output/directory", "out_wet_np1"), work, "wet_np1")
+_, logw, _ = tv.run_tool(tool, tv.prm_set(wet, "output/directory", "out_wet_np2"), work, "wet_np2", np=2)
+n_wet = int(re.search(r"rebalances (\d+)", logw).group(1))
+tv.check(n_wet >= 20, f"2-phase: rebalances during the 2-rank run: {n_wet} >= 20")
+a, b = particles("out_wet_np1"), particles("out_wet_np2")
+tv.check("pore_pressure" in a and max(abs(x) for x in a["pore_pressure"]) > 0,
+         "2-phase: the points carry a pore pressure")
+worst = worst_difference(a, b)
+tv.check(worst <= 1e-10, f"2-phase: 1 rank vs 2 ranks rebalancing every 20 steps agree to 1e-10 relative "
+                         f"(worst {worst:.2e})")
 tv.finish()

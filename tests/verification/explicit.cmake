@@ -38,6 +38,15 @@ set_tests_properties(verification.critical_dt_bar PROPERTIES LABELS "fast" ENVIR
 # loads, damping, convergence, mass scaling, friction, K0, stages (issue 5)
 talus_verification(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
 talus_verification(explicit_block_friction check_block_friction.py verification/block_friction.prm)
+# the same loads with quadratic B-splines (issue 12): traction point forces and wall friction
+function(talus_verification_bspline name script prm)
+  add_test(NAME verification.${name}_bspline
+           COMMAND ${Python3_EXECUTABLE} ${_v}/${script} ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/${prm} ${_w}/${name}_bspline bspline)
+  set_tests_properties(verification.${name}_bspline PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+endfunction()
+talus_verification_bspline(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
+talus_verification_bspline(explicit_block_friction check_block_friction.py verification/block_friction.prm)
 talus_verification(explicit_staged_column check_stages.py verification/staged_column.prm)
 talus_verification(explicit_k0_column check_k0.py verification/k0_column.prm)
 # chapter 6 numerics (issue 5): contact (§6.2)

@@ -2,6 +2,8 @@
 #include <talus/base/errors.h>
 #include <talus/loads/kinematics.h>
 
+#include <algorithm>
+
 namespace talus::loads
 {
   template <int dim>
@@ -37,6 +39,65 @@ namespace talus::loads
     return walls;
   }
 
+  template <int dim>
+  std::vector<PrescribedNodeDof>
+  prescribed_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<PrescribedVelocity<dim>> &conditions)
+  {
+    using Target               = typename PrescribedVelocity<dim>::Target;
+    const unsigned int n_owned = grid.partitioner->locally_owned_size();
+    std::vector<PrescribedNodeDof> out;
+    std::vector<unsigned char>     seen(n_owned, 0);
+    for (unsigned int j = 0; j < conditions.size(); ++j)
+      {
+        const auto &pv = conditions[j];
+        if (pv.target == Target::body)
+          continue;
+        std::fill(seen.begin(), seen.end(), 0);
+        for (unsigned int c = 0; c < grid.cells.size(); ++c)
+          {
+            const auto &cc = grid.cells[c];
+            if (!(cc.h[0] > 0)) // not a locally relevant cell
+              continue;
+            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+              {
+                const unsigned int i0 = cc.dofs[v * dim];
+                if (i0 >= n_owned || seen[i0])
+                  continue;
+                bool hit = false;
+                if (pv.target == Target::region)
+                  {
+                    hit = true;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      {
+                        const double x   = cc.lower[d] + ((v >> d) & 1u) * cc.h[d];
+                        const double tol = 1e-9 * cc.h[d];
+                        hit              = hit && x >= pv.lower[d] - tol && x <= pv.upper[d] + tol;
+                      }
+                  }
+                else
+                  {
+                    const auto &cell = grid.cell_iterators[c];
+                    for (unsigned int f = 0; f < dealii::GeometryInfo<dim>::faces_per_cell && !hit; ++f)
+                      if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == pv.boundary)
+                        for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
+                          hit = hit || dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i) == v;
+                  }
+                if (!hit)
+                  continue;
+                seen[i0] = 1;
+                for (unsigned int d = 0; d < dim; ++d)
+                  if (pv.component[d])
+                    out.push_back({cc.dofs[v * dim + d], j, d});
+              }
+          }
+      }
+    return out;
+  }
+
+  template std::vector<PrescribedNodeDof>
+  prescribed_node_dofs(const BackgroundGrid<2> &, const std::vector<PrescribedVelocity<2>> &);
+  template std::vector<PrescribedNodeDof>
+  prescribed_node_dofs(const BackgroundGrid<3> &, const std::vector<PrescribedVelocity<3>> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<2> &, const std::vector<BoundaryCondition> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<3> &, const std::vector<BoundaryCondition> &);
   template dealii::AffineConstraints<double>

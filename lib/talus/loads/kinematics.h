@@ -4,12 +4,17 @@
 // of the grid's vector space (the explicit nodal solve and the semi-implicit
 // velocity updates skip flagged DoFs), and for the implicit families the same
 // DoFs as homogeneous constraints on a NodalSpace (the increment is zero there).
-// Explicit-only loads (damping, mass scaling, convergence, wall friction,
-// prescribed velocities) stay in loads/load_control.
+// Prescribed velocities on grid nodes (a boundary id or a region of the
+// 'loads/velocity k' conditions) become a list of (DoF, condition, component)
+// here too; their time functions and how a family enforces them (the explicit
+// a = (vbar - v^t)/h, an implicit increment constraint) stay with the family.
+// Explicit-only loads (damping, mass scaling, convergence, wall friction)
+// stay in loads/load_control.
 #pragma once
 
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
+#include <talus/loads/settings.h>
 
 #include <deal.II/lac/affine_constraints.h>
 
@@ -31,4 +36,20 @@ namespace talus::loads
   wall_constraints(const BackgroundGrid<dim> &       grid,
                    const NodalSpace<dim> &           space,
                    const std::vector<unsigned char> &flags);
+
+  /// One velocity component of a grid node prescribed by a condition.
+  struct PrescribedNodeDof
+  {
+    unsigned int dof;       ///< local DoF of the grid's vector space (owned)
+    unsigned int condition; ///< index into the condition list given
+    unsigned int component; ///< velocity component
+  };
+
+  /// The owned node DoFs reached by the grid-node conditions of `conditions`
+  /// (target boundary: the nodes of the faces with that id; region: the nodes
+  /// inside the box, with a tolerance of 1e-9 cell sizes). Body conditions
+  /// (on material points) are skipped. Each node is listed once per condition.
+  template <int dim>
+  std::vector<PrescribedNodeDof>
+  prescribed_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<PrescribedVelocity<dim>> &conditions);
 } // namespace talus::loads

@@ -1,6 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
-#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/with_kernel.h>
 #include <talus/loads/k0.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/load_control.h>
@@ -282,60 +282,14 @@ namespace talus::loads
     if (any_friction && lift.size() == 0)
       s.grid.reinit_vector(lift);
 
-    // prescribed nodal velocities
-    prescribed_dofs.clear();
+    // prescribed nodal velocities (the node selection is shared: loads/kinematics)
+    prescribed_dofs = prescribed_node_dofs(s.grid, current->velocities);
+    for (const auto &p : prescribed_dofs)
+      excluded[p.dof] = 1;
     particle_conditions.clear();
-    std::vector<unsigned char> seen(n_owned, 0);
     for (unsigned int j = 0; j < current->velocities.size(); ++j)
-      {
-        const auto &pv = current->velocities[j];
-        if (pv.target == PrescribedVelocity<dim>::Target::body)
-          {
-            particle_conditions.push_back(j);
-            continue;
-          }
-        std::fill(seen.begin(), seen.end(), 0);
-        for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
-          {
-            const auto &cc = s.grid.cells[c];
-            if (!(cc.h[0] > 0))
-              continue;
-            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-              {
-                const unsigned int i0 = cc.dofs[v * dim];
-                if (i0 >= n_owned || seen[i0])
-                  continue;
-                bool hit = false;
-                if (pv.target == PrescribedVelocity<dim>::Target::region)
-                  {
-                    hit = true;
-                    for (unsigned int d = 0; d < dim; ++d)
-                      {
-                        const double x   = cc.lower[d] + ((v >> d) & 1u) * cc.h[d];
-                        const double tol = 1e-9 * cc.h[d];
-                        hit              = hit && x >= pv.lower[d] - tol && x <= pv.upper[d] + tol;
-                      }
-                  }
-                else
-                  {
-                    const auto &cell = s.grid.cell_iterators[c];
-                    for (unsigned int f = 0; f < dealii::GeometryInfo<dim>::faces_per_cell && !hit; ++f)
-                      if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == pv.boundary)
-                        for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
-                          hit = hit || dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i) == v;
-                  }
-                if (!hit)
-                  continue;
-                seen[i0] = 1;
-                for (unsigned int d = 0; d < dim; ++d)
-                  if (pv.component[d])
-                    {
-                      prescribed_dofs.push_back({cc.dofs[v * dim + d], j, d});
-                      excluded[cc.dofs[v * dim + d]] = 1;
-                    }
-              }
-          }
-      }
+      if (current->velocities[j].target == PrescribedVelocity<dim>::Target::body)
+        particle_conditions.push_back(j);
     // the collectives first, on every rank: inside a short-circuit || they ran
     // only on the ranks without friction/prescribed nodes of their own, which then
     // reduced against the other ranks' next collective (ExcMPI on one rank, a hang
@@ -362,7 +316,6 @@ namespace talus::loads
   LoadControl<dim>::before_nodal_solve(Solver &s, const double step, const Vector *momentum_t)
   {
     using L                   = PropertyLayout<dim>;
-    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
     h                         = step;
     const bool vt_now         = need_vt || check_step(s);
     if (vt_now && momentum_t) // the caller's nodal momentum at t (owned entries)
@@ -385,39 +338,26 @@ namespace talus::loads
         s.zero_on_active(trac);
         update_factors(s);
       }
-    double             work = 0;
     if (any_friction)
       friction_lift(s);
     if (!scatter)
       return;
-    auto               pt   = s.points.handler.begin();
-    for (const auto [c, n_in_cell] : s.points.active_cells())
-      {
-        const auto &        cc    = s.grid.cells[c];
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt)
-          {
-            const double *P = pt->get_properties().data();
-            if (scatter)
-              {
-                double f[dim];
-                if (forces.force_if_loaded(P, f))
-                  {
-                    double N[nv];
-                    shape::Q1<dim>::values(pt->get_reference_location(), N);
-                    for (unsigned int v = 0; v < nv; ++v)
-                      for (unsigned int d = 0; d < dim; ++d)
-                        T[cc.dofs[v * dim + d]] += N[v] * f[d]; // Eq. 5.3
-                    for (unsigned int d = 0; d < dim; ++d)
-                      work += f[d] * P[L::velocity + d] * h;
-                  }
-              }
-          }
-      }
-    if (scatter)
-      {
-        trac.compress(dealii::VectorOperation::add);
-        s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
-      }
+    // Eq. 5.3: f_trac,i = sum_p N_i(x_p) f_p, with the shape functions of the run
+    double work   = 0;
+    auto   source = [&](const double *P, double (&w)[1], double (&f)[1][dim]) {
+      if (!forces.force_if_loaded(P, f[0]))
+        return false;
+      w[0] = 1.0;
+      for (unsigned int d = 0; d < dim; ++d)
+        work += f[0][d] * P[L::velocity + d] * h;
+      return true;
+    };
+    s.with_kernel([&](auto kernel) {
+      transfer::ScatterPointVectors<dim, decltype(kernel), decltype(source)> op(s.grid, source, {{T}});
+      transfer::for_each_active_cell(s.points, op);
+    });
+    trac.compress(dealii::VectorOperation::add);
+    s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
   }
 
   template <int dim>
@@ -711,50 +651,54 @@ namespace talus::loads
   {
     if (particle_conditions.empty())
       return;
-    using L                   = PropertyLayout<dim>;
-    constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
-    double *const          Pn = s.nodal_p.begin();
-    const bool             cp = s.two_phase && s.two_phase->coupled;
-    double *const          PL = cp ? s.two_phase->p_liquid.begin() : nullptr;
-    double                 work = 0;
-    transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
-      const auto &cc = s.grid.cells[c];
-      double *           P = pt->get_properties().data();
-      const unsigned int b = static_cast<unsigned int>(P[L::body]);
+    using L              = PropertyLayout<dim>;
+    const bool        cp = s.two_phase && s.two_phase->coupled;
+    double            work = 0;
+    // the velocity change of the points of a conditioned body, and its momentum
+    // m_p dv_p (solid) and m_L dv_L (pore liquid) added to the nodal momentum
+    auto source = [&](double *P, double (&w)[2], double (&dv)[2][dim]) {
+      const unsigned int b   = static_cast<unsigned int>(P[L::body]);
+      bool               hit = false;
+      w[0] = P[L::mass];
+      w[1] = 0.0;
+      for (unsigned int d = 0; d < dim; ++d)
+        dv[0][d] = dv[1][d] = 0.0;
       for (const unsigned int j : particle_conditions)
         {
           const auto &pv = current->velocities[j];
           if (pv.body != b)
             continue;
+          hit            = true;
           const double t = (j < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
           const double f = pv.function.value(t);
-          double       dv[dim], dvL[dim] = {};
           for (unsigned int d = 0; d < dim; ++d)
             {
-              dv[d] = pv.component[d] ? pv.velocity[d] * f - P[L::velocity + d] : 0.0;
-              P[L::velocity + d] += dv[d];
-              work += P[L::mass] * dv[d] * P[L::velocity + d];
+              const double change = pv.component[d] ? pv.velocity[d] * f - P[L::velocity + d] : 0.0;
+              P[L::velocity + d] += change;
+              dv[0][d] += change;
+              work += P[L::mass] * change * P[L::velocity + d];
             }
           // 2-phase point: its pore liquid moves with the body as well
           const double mL = cp ? s.two_phase->liquid_mass(P) : 0.0;
           if (mL > 0)
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                double &vl = P[s.two_phase->liquid_velocity + d];
-                dvL[d]     = pv.component[d] ? pv.velocity[d] * f - vl : 0.0;
-                vl += dvL[d];
-                work += mL * dvL[d] * vl;
-              }
-          double N[nv];
-          shape::Q1<dim>::values(pt->get_reference_location(), N);
-          for (unsigned int v = 0; v < nv; ++v)
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                Pn[cc.dofs[v * dim + d]] += P[L::mass] * N[v] * dv[d];
-                if (mL > 0)
-                  PL[cc.dofs[v * dim + d]] += mL * N[v] * dvL[d];
-              }
+            {
+              w[1] = mL;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  double &     vl     = P[s.two_phase->liquid_velocity + d];
+                  const double change = pv.component[d] ? pv.velocity[d] * f - vl : 0.0;
+                  vl += change;
+                  dv[1][d] += change;
+                  work += mL * change * vl;
+                }
+            }
         }
+      return hit;
+    };
+    s.with_kernel([&](auto kernel) {
+      transfer::ScatterPointVectors<dim, decltype(kernel), decltype(source), 2> op(
+        s.grid, source, {{s.nodal_p.begin(), cp ? s.two_phase->p_liquid.begin() : nullptr}});
+      transfer::for_each_active_cell(s.points, op);
     });
     s.nodal_p.compress(dealii::VectorOperation::add);
     if (cp)

@@ -37,6 +37,7 @@
 #pragma once
 
 #include <talus/grid/background_grid.h>
+#include <talus/loads/kinematics.h>
 #include <talus/loads/point_forces.h>
 #include <talus/loads/settings.h>
 
@@ -158,11 +159,7 @@ namespace talus::loads
     Vector       lift;
     static constexpr double lift_tolerance = 1e-3;
     bool         any_friction = false;
-    struct PrescribedDof
-    {
-      unsigned int dof, condition, component;
-    };
-    std::vector<PrescribedDof> prescribed_dofs;
+    std::vector<PrescribedNodeDof> prescribed_dofs;
     bool                       any_prescribed = false; ///< on any rank
     std::vector<unsigned int>  particle_conditions; ///< indices of body velocity conditions
 

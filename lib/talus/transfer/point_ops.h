@@ -13,6 +13,7 @@
 #include <deal.II/base/tensor.h>
 
 #include <algorithm>
+#include <array>
 #include <vector>
 
 namespace talus::transfer
@@ -177,6 +178,61 @@ namespace talus::transfer
     end_cell(const unsigned int)
     {
       sums.scatter(cell, Pn);
+    }
+  };
+
+  /// P2G of vectors that the caller computes per point (a traction point
+  /// force, the momentum change of a prescribed point velocity), into n_out
+  /// nodal vectors: `source(P, w, f)` (P the point's properties, which it may
+  /// change) returns whether the point contributes and sets, per output k, a
+  /// weight w[k] and a vector f[k]; Out[k]_i += sum_p N_i(x_p) w[k] f[k].
+  template <int dim, class K, class Source, unsigned int n_out = 1>
+  struct ScatterPointVectors
+  {
+    ScatterPointVectors(const BackgroundGrid<dim> &grid, Source &source, const std::array<double *, n_out> &out)
+      : grid(grid)
+      , source(source)
+      , out(out)
+    {}
+    const BackgroundGrid<dim> &     grid;
+    Source &                        source;
+    const std::array<double *, n_out> out;
+
+    static constexpr bool prefetch_location = false;
+    typename K::Cell      cell;
+    typename K::Momentum  sums[n_out];
+    bool                  any = false; ///< a point of the cell contributed
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      for (auto &s : sums)
+        s.clear();
+      any = false;
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      double *P = it->get_properties().data();
+      double  w[n_out], f[n_out][dim];
+      if (!source(P, w, f))
+        return true;
+      typename K::Values N;
+      K::values(cell, it->get_reference_location(), N);
+      for (unsigned int k = 0; k < n_out; ++k)
+        if (out[k])
+          sums[k].add(N, w[k], f[k]);
+      any = true;
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {
+      if (any)
+        for (unsigned int k = 0; k < n_out; ++k)
+          if (out[k])
+            sums[k].scatter(cell, out[k]);
     }
   };
 

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <talus/base/tool.h>
+#include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/io/png_snapshots.h>
@@ -47,6 +48,21 @@ namespace talus
     if (png_snapshots)
       io::draw_png_snapshots(prm, MPI_COMM_WORLD); // after every output file is complete
     return exit_ok;
+  }
+
+  /// The --check of a family's tool: parsing validates every entry (InputError
+  /// names it), then the run's files (output and checkpoint directories,
+  /// restart) are checked.
+  template <class Parameters2, class Parameters3>
+  void
+  check_formulation(dealii::ParameterHandler &prm,
+                    Parameters2 (*parse_2d)(dealii::ParameterHandler &),
+                    Parameters3 (*parse_3d)(dealii::ParameterHandler &))
+  {
+    if (prm.get_integer("dimension") == 2)
+      check_run_files(parse_2d(prm));
+    else
+      check_run_files(parse_3d(prm));
   }
 } // namespace talus
 

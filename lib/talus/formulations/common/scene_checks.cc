@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 namespace talus
@@ -273,6 +274,20 @@ namespace talus
       }
   }
 
+  template <int dim>
+  double
+  smallest_cell_edge(const SceneParameters<dim> &p)
+  {
+    if (p.grid_mesh)
+      return p.grid_mesh->min_edge();
+    double h = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+      h = std::min(h, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
+    return h;
+  }
+
+  template double smallest_cell_edge(const SceneParameters<2> &);
+  template double smallest_cell_edge(const SceneParameters<3> &);
   template void check_run_files(const RunParameters<2> &);
   template void check_run_files(const RunParameters<3> &);
   template void check_scene_consistency(const SceneParameters<2> &);

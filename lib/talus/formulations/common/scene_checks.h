@@ -20,6 +20,11 @@ namespace talus
   template <int dim>
   void check_scene_consistency(const SceneParameters<dim> &p);
 
+  /// Smallest cell edge of the scene's grid (grid file or box) [m]: the L of
+  /// the critical time step (seed 000 Eq. 4.120), known before any setup.
+  template <int dim>
+  double smallest_cell_edge(const SceneParameters<dim> &p);
+
   /// Where checkpoints go: checkpoint/directory, or <output>/checkpoints.
   template <int dim>
   std::string checkpoint_directory_of(const RunParameters<dim> &p)

@@ -166,95 +166,93 @@ namespace talus::explicit_mpm
                                                 scene_signature(prm, points.layout.n_properties()), comm);
     if (!fp)
       return false;
-    {
-        const io::H5File &f     = *fp;
-        const std::string file  = f.path();
-        const std::string where = "checkpoint " + file;
-        read_run_state(f, *this, prm.checkpoint_interval);
-        external_work            = f.get_double("external work");
-        energy_scale             = f.get_double("energy scale");
-        initial_energies         = {f.get_double("initial kinetic"), f.get_double("initial strain"),
-                            f.get_double("initial potential"), f.get_double("initial external work")};
-        const bool         same      = f.get_int("ranks") == static_cast<std::int64_t>(n_ranks);
-        if (same && f.exists("balance/weights"))
+    const io::H5File &f     = *fp;
+    const std::string file  = f.path();
+    const std::string where = "checkpoint " + file;
+    read_run_state(f, *this, prm.checkpoint_interval);
+    external_work            = f.get_double("external work");
+    energy_scale             = f.get_double("energy scale");
+    initial_energies         = {f.get_double("initial kinetic"), f.get_double("initial strain"),
+                        f.get_double("initial potential"), f.get_double("initial external work")};
+    const bool         same      = f.get_int("ranks") == static_cast<std::int64_t>(n_ranks);
+    if (same && f.exists("balance/weights"))
+      {
+        // the partition of the saved run: the same weights give the same cells per rank
+        const auto rows = f.read_all("balance/weights");
+        repartition_with(rows);
+        grid_changed();
+        restored_partition = true;
+        if (rank == 0)
+          balance_weights = rows;
+      }
+    if (same)
+      {
+        read_points(f, points, grid, where);
+        // the nodal sums of the next step, exactly as the run left them
+        const auto ndofs = f.read_rows_u64("ranks/n_dofs", 0, n_ranks);
+        std::uint64_t dof_begin = 0;
+        for (unsigned int r = 0; r < rank; ++r)
+          dof_begin += ndofs[r];
+        const auto mass  = f.read_rows("nodal/mass", dof_begin, dof_begin + ndofs[rank]);
+        const auto force = f.read_rows("nodal/force", dof_begin, dof_begin + ndofs[rank]);
+        const bool dofs_match =
+          mass.size() == nodal_mass.locally_owned_size() + nodal_mass.get_partitioner()->n_ghost_indices();
+        const bool all_match = dealii::Utilities::MPI::min(dofs_match ? 1 : 0, comm) == 1;
+        if (all_match && f.get_int("p2g ready"))
           {
-            // the partition of the saved run: the same weights give the same cells per rank
-            const auto rows = f.read_all("balance/weights");
-            repartition_with(rows);
-            grid_changed();
-            restored_partition = true;
-            if (rank == 0)
-              balance_weights = rows;
-          }
-        if (same)
-          {
-            read_points(f, points, grid, where);
-            // the nodal sums of the next step, exactly as the run left them
-            const auto ndofs = f.read_rows_u64("ranks/n_dofs", 0, n_ranks);
-            std::uint64_t dof_begin = 0;
-            for (unsigned int r = 0; r < rank; ++r)
-              dof_begin += ndofs[r];
-            const auto mass  = f.read_rows("nodal/mass", dof_begin, dof_begin + ndofs[rank]);
-            const auto force = f.read_rows("nodal/force", dof_begin, dof_begin + ndofs[rank]);
-            const bool dofs_match =
-              mass.size() == nodal_mass.locally_owned_size() + nodal_mass.get_partitioner()->n_ghost_indices();
-            const bool all_match = dealii::Utilities::MPI::min(dofs_match ? 1 : 0, comm) == 1;
-            if (all_match && f.get_int("p2g ready"))
-              {
-                std::copy(mass.begin(), mass.end(), nodal_mass.begin());
-                std::copy(force.begin(), force.end(), nodal_a.begin());
-                p2g_ready = true;
-              }
-            else
-              p2g_ready = false;
+            std::copy(mass.begin(), mass.end(), nodal_mass.begin());
+            std::copy(force.begin(), force.end(), nodal_a.begin());
+            p2g_ready = true;
           }
         else
+          p2g_ready = false;
+      }
+    else
+      {
+        read_points(f, points, grid, where); // redistributed by deal.II
+
+        // the next step's nodal sums, by vertex and component
+        p2g_ready = false;
+        if (f.exists("nodal/by_vertex") && f.get_int("p2g ready"))
           {
-            read_points(f, points, grid, where); // redistributed by deal.II
-
-            // the next step's nodal sums, by vertex and component
-            p2g_ready = false;
-            if (f.exists("nodal/by_vertex") && f.get_int("p2g ready"))
+            const auto  table = f.read_all("nodal/by_vertex");
+            std::map<std::array<double, dim + 1>, std::pair<double, double>> sums;
+            for (std::size_t r = 0; r + dim + 3 <= table.size(); r += dim + 3)
               {
-                const auto  table = f.read_all("nodal/by_vertex");
-                std::map<std::array<double, dim + 1>, std::pair<double, double>> sums;
-                for (std::size_t r = 0; r + dim + 3 <= table.size(); r += dim + 3)
-                  {
-                    std::array<double, dim + 1> key;
-                    std::copy(table.begin() + r, table.begin() + r + dim + 1, key.begin());
-                    sums[key] = {table[r + dim + 1], table[r + dim + 2]};
-                  }
-                const unsigned int n_owned = nodal_mass.locally_owned_size();
-                const auto         keys    = owned_dof_keys(grid, n_owned);
-                nodal_mass                 = 0;
-                nodal_a                    = 0;
-                bool all_found             = true;
-                for (unsigned int i = 0; i < n_owned; ++i)
-                  {
-                    const auto it = sums.find(keys[i]);
-                    if (it == sums.end())
-                      all_found = false;
-                    else
-                      {
-                        nodal_mass.local_element(i) = it->second.first;
-                        nodal_a.local_element(i)    = it->second.second;
-                      }
-                  }
-                // ghosts stay zero: the compress of the next step adds nothing
-                p2g_ready = dealii::Utilities::MPI::min(all_found ? 1 : 0, comm) == 1;
+                std::array<double, dim + 1> key;
+                std::copy(table.begin() + r, table.begin() + r + dim + 1, key.begin());
+                sums[key] = {table[r + dim + 1], table[r + dim + 2]};
               }
+            const unsigned int n_owned = nodal_mass.locally_owned_size();
+            const auto         keys    = owned_dof_keys(grid, n_owned);
+            nodal_mass                 = 0;
+            nodal_a                    = 0;
+            bool all_found             = true;
+            for (unsigned int i = 0; i < n_owned; ++i)
+              {
+                const auto it = sums.find(keys[i]);
+                if (it == sums.end())
+                  all_found = false;
+                else
+                  {
+                    nodal_mass.local_element(i) = it->second.first;
+                    nodal_a.local_element(i)    = it->second.second;
+                  }
+              }
+            // ghosts stay zero: the compress of the next step adds nothing
+            p2g_ready = dealii::Utilities::MPI::min(all_found ? 1 : 0, comm) == 1;
           }
+      }
 
-        pvd_records      = read_pvd_records(f, "output/pvd", "particles");
-        grid_pvd_records = read_pvd_records(f, "output/grid_pvd", "grid");
-        probe_ids.clear();
-        for (const double id : f.read_all("probes/ids"))
-          probe_ids.push_back(static_cast<dealii::types::particle_index>(id));
-        probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
-        probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
-        restored_from = file;
-        return true;
-    }
+    pvd_records      = read_pvd_records(f, "output/pvd", "particles");
+    grid_pvd_records = read_pvd_records(f, "output/grid_pvd", "grid");
+    probe_ids.clear();
+    for (const double id : f.read_all("probes/ids"))
+      probe_ids.push_back(static_cast<dealii::types::particle_index>(id));
+    probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
+    probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
+    restored_from = file;
+    return true;
   }
 
   template std::string Solver<2>::write_checkpoint();

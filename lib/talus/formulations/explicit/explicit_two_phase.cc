@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
+#include <talus/formulations/explicit/with_kernel.h>
 #include <talus/loads/load_control.h>
 #include <talus/shape/q1.h>
 #include <talus/transfer/cell_walk.h>
@@ -351,9 +352,17 @@ namespace talus::explicit_mpm
         porosity        = layout.add_extra("porosity", 1);
         pore_pressure   = layout.add_extra("pore_pressure", 1);
         liquid_velocity = layout.add_extra("liquid_velocity", dim, true);
-        for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid, &a_liquid})
-          s.grid.reinit_vector(*v);
+        grid_changed();
       }
+  }
+
+  template <int dim>
+  void
+  TwoPhase<dim>::grid_changed()
+  {
+    if (coupled)
+      for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid, &a_liquid})
+        s.grid.reinit_vector(*v);
   }
 
   template <int dim>
@@ -436,9 +445,18 @@ namespace talus::explicit_mpm
   void
   TwoPhase<dim>::step(const double h)
   {
+    s.with_kernel([&](auto kernel) { step_with<decltype(kernel)>(h); });
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  TwoPhase<dim>::step_with(const double h)
+  {
     using L                   = PropertyLayout<dim>;
-    using Q                   = shape::Q1<dim>;
-    constexpr unsigned int nv = Q::n_vertices;
+    // each point reads and writes the nodes of its kernel stencil (Q1: the
+    // cell's vertices; B-spline: its 3^dim window), slot[v] in the cell's list
+    constexpr unsigned int nv = K::n_point_nodes;
     const auto &           pl = s.prm.liquid.pore_liquid;
     const auto             g  = s.gravity; // of the running stage
     const auto             t0 = std::chrono::steady_clock::now();
@@ -460,11 +478,12 @@ namespace talus::explicit_mpm
     // traction point forces (loads/traction, at t) scattered in this pass
     double *const T = control ? control->begin_traction_scatter(s) : nullptr;
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
-      const auto &cc = s.grid.cells[c];
+      const auto         kc  = K::cell(s.grid, c);
       const double *     P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
+      unsigned int       slot[nv];
       double             N[nv], G[nv][dim];
-      Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
+      K::point_stencil(kc, pt->get_reference_location(), slot, N, G);
       const double mS = P[L::mass], V = P[L::volume];
       auto         sig = L::get_stress(P);
       const bool   cp  = coupled && pl[mat].drainage == Drainage::coupled;
@@ -490,11 +509,11 @@ namespace talus::explicit_mpm
       if (loaded) // Eq. 5.3, added to the mixture force by nodal_forces_two_phase
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)
-            T[cc.dofs[v * dim + d]] += N[v] * fp[d];
+            T[kc.dofs[slot[v] * dim + d]] += N[v] * fp[d];
       for (unsigned int v = 0; v < nv; ++v)
         for (unsigned int d = 0; d < dim; ++d)
           {
-            const unsigned int i  = cc.dofs[v * dim + d];
+            const unsigned int i  = kc.dofs[slot[v] * dim + d];
             double             fi = 0;
             for (unsigned int e = 0; e < dim; ++e)
               fi -= V * sig[d][e] * G[v][e];
@@ -577,28 +596,29 @@ namespace talus::explicit_mpm
     if (coupled)
       s.zero_on_active(p_liquid);
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
-      const auto &cc = s.grid.cells[c];
+      const auto         kc  = K::cell(s.grid, c);
       double *           P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
-      double             N[nv];
-      Q::values(pt->get_reference_location(), N);
+      unsigned int       slot[nv];
+      double             N[nv], G[nv][dim];
+      K::point_stencil(kc, pt->get_reference_location(), slot, N, G);
       const double mL = cp ? P[porosity] * pl[mat].density * P[L::volume] : 0.0;
       for (unsigned int d = 0; d < dim; ++d)
         {
           double aS = 0, aL = 0;
           for (unsigned int v = 0; v < nv; ++v)
             {
-              aS += N[v] * FS[cc.dofs[v * dim + d]];
+              aS += N[v] * FS[kc.dofs[slot[v] * dim + d]];
               if (cp)
-                aL += N[v] * AL_[cc.dofs[v * dim + d]];
+                aL += N[v] * AL_[kc.dofs[slot[v] * dim + d]];
             }
           P[L::velocity + d] += h * aS;
           if (cp)
             P[liquid_velocity + d] += h * aL;
           for (unsigned int v = 0; v < nv; ++v)
             {
-              const unsigned int i = cc.dofs[v * dim + d];
+              const unsigned int i = kc.dofs[slot[v] * dim + d];
               PS[i] += P[L::mass] * N[v] * P[L::velocity + d];
               if (cp)
                 PL_[i] += mL * N[v] * P[liquid_velocity + d];
@@ -641,13 +661,15 @@ namespace talus::explicit_mpm
       double *           P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
+      const auto         kc  = K::cell(s.grid, c);
+      unsigned int       slot[nv];
       double             N[nv], G[nv][dim];
-      Q::values_and_gradients(pt->get_reference_location(), cc.inv_h, N, G);
+      K::point_stencil(kc, pt->get_reference_location(), slot, N, G);
       double gu[dim][dim] = {}, dx[dim] = {}, div_uL = 0;
       for (unsigned int v = 0; v < nv; ++v)
         for (unsigned int d = 0; d < dim; ++d)
           {
-            const unsigned int i  = cc.dofs[v * dim + d];
+            const unsigned int i  = kc.dofs[slot[v] * dim + d];
             const double       du = h * PS[i]; // Eq. 4.112
             dx[d] += N[v] * du;
             for (unsigned int e2 = 0; e2 < dim; ++e2)

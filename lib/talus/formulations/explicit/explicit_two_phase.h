@@ -107,11 +107,17 @@ namespace talus::explicit_mpm
     explicit TwoPhase(Solver<dim> &s);
     /// porosity, pore pressure, liquid velocity (coupled)
     void extend_layout(PropertyLayout<dim> &layout);
+    /// After a repartition of the grid (load balancing): the liquid's nodal
+    /// vectors on the new partition (the step rebuilds their values each step).
+    void grid_changed();
     /// after seeding: solid masses (1-n) rho_S V, porosity, liquid velocity
     void initialize_particles();
     /// One step of §4.5.7, with the hooks of the loads (Solver::control) at
     /// the places of the 1-phase step (load_control.h). Collective.
     void step(const double dt);
+    /// step() with the shape kernel K of the run (numerics/shape function).
+    template <class K>
+    void step_with(const double dt);
     Energies energies() const;
     /// sum m_S v_S + m_L v_L (collective)
     dealii::Tensor<1, dim> total_momentum() const;

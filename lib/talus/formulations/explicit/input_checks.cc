@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
+#include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/io/particle_file.h>
@@ -20,12 +21,7 @@ namespace talus::explicit_mpm
   double
   critical_time_step_of(const Parameters<dim> &p)
   {
-    double h = std::numeric_limits<double>::max();
-    if (p.grid_mesh)
-      h = p.grid_mesh->min_edge();
-    else
-      for (unsigned int d = 0; d < dim; ++d)
-        h = std::min(h, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
+    const double h = smallest_cell_edge(p);
     double dt = std::numeric_limits<double>::infinity();
     for (const auto &c : critical_time_steps(p.materials, p.liquid.pore_liquid, h))
       dt = std::min(dt, c.dt);
@@ -93,10 +89,7 @@ namespace talus::explicit_mpm
   void
   check_scene(dealii::ParameterHandler &prm, const std::string &)
   {
-    if (prm.get_integer("dimension") == 2)
-      check_run_files(parse_parameters<2>(prm));
-    else
-      check_run_files(parse_parameters<3>(prm));
+    check_formulation(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
 

@@ -186,10 +186,7 @@ namespace talus::implicit_mpm
   void
   check_scene(dealii::ParameterHandler &prm, const std::string &)
   {
-    if (prm.get_integer("dimension") == 2)
-      check_run_files(parse_parameters<2>(prm));
-    else
-      check_run_files(parse_parameters<3>(prm));
+    check_formulation(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
   // ================================================================ solver
