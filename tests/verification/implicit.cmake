@@ -102,3 +102,18 @@ add_test(NAME verification.implicit_ranks_cooks
                  ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_ranks_cooks)
 set_tests_properties(verification.implicit_ranks_cooks PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+
+# axisymmetry (seed 001 App. C): thick-walled cylinder under internal pressure vs the
+# linear Lame solution (u_r, hoop stress), 3 grids (fast) / 4 grids (verify)
+add_test(NAME verification.implicit_axisymmetric_cylinder
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_cylinder
+                 0.01 0.015 0.7 0.125 0.0625 0.03125)
+set_tests_properties(verification.implicit_axisymmetric_cylinder PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 300)
+add_test(NAME verification.implicit_axisymmetric_cylinder_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_cylinder_full
+                 0.005 0.0075 0.7 0.125 0.0625 0.03125 0.015625)
+set_tests_properties(verification.implicit_axisymmetric_cylinder_full PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 600)
