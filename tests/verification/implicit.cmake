@@ -118,10 +118,10 @@ add_test(NAME verification.implicit_axisymmetric_cylinder_full
 set_tests_properties(verification.implicit_axisymmetric_cylinder_full PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 600)
 # the same cylinder at p / E = 0.1 (five load steps) vs the exact finite-strain solution of the
-# coupled Neo-Hookean model (shooting in the checker): the hoop terms at large strain
+# coupled Neo-Hookean model (shooting in the checker): the hoop terms at large strain; 1 vs 2 ranks
 add_test(NAME verification.implicit_axisymmetric_cylinder_finite
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_finite.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm
                  ${_w}/implicit_axisymmetric_cylinder_finite 5 5 0.01 0.015 0.7 0.125 0.0625 0.03125)
 set_tests_properties(verification.implicit_axisymmetric_cylinder_finite PROPERTIES LABELS "fast"
-                     ENVIRONMENT "${_env}" TIMEOUT 300)
+                     ENVIRONMENT "${_env}" TIMEOUT 300 PROCESSORS 2)
