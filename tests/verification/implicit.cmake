@@ -125,3 +125,10 @@ add_test(NAME verification.implicit_axisymmetric_cylinder_finite
                  ${_w}/implicit_axisymmetric_cylinder_finite 5 5 0.01 0.015 0.7 0.125 0.0625 0.03125)
 set_tests_properties(verification.implicit_axisymmetric_cylinder_finite PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 300 PROCESSORS 2)
+# gravity along the axis with the ring measure: a laterally confined solid cylinder (touching the axis)
+add_test(NAME verification.implicit_axisymmetric_self_weight
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_gravity.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_self_weight
+                 0.025 0.7 8 16)
+set_tests_properties(verification.implicit_axisymmetric_self_weight PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 300)
