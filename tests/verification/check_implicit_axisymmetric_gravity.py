@@ -13,6 +13,10 @@ rho g H; of u_z at every point, relative to the top settlement; |u_r| / that.
 Checks on the finest grid: sigma_zz within TOL, hoop and radial within TOL / 2,
 u_z within TOL / 4, |u_r| < 1e-10; the sigma_zz error falls with h (order >= ORDER
 over the last two grids).
+Then the same cylinder, weightless, under a uniform top traction q on the finest
+grid (the ring weight 2 pi r_p of a traction on a face normal to the axis): below
+the top cell sigma_zz = -q, the hoop stress -nu / (1 - nu) q and u_z within 1e-3,
+u_r = 0 to round-off.
 Usage: check_implicit_axisymmetric_gravity.py TOOLS_DIR PRM WORKDIR TOL ORDER N1 N2 [...]
 """
 import math
@@ -67,4 +71,28 @@ if len(rows) >= 2:
     q = math.log(rows[-2][1] / rows[-1][1]) / math.log(rows[-2][0] / rows[-1][0])
     print(f"observed order of the sigma_zz error over the last two grids: {q:.2f}")
     tv.check(q >= min_order, f"sigma_zz error falls with h at order >= {min_order} ({q:.2f})")
+
+# the same confined cylinder, weightless, under a top traction q = 1 kPa (body face
+# y+): each top point carries q A_p 2 pi r_p (the midpoint rule of its annulus strip,
+# exact for the total q pi R^2), so below the top cell sigma_zz = -q, sigma_rr =
+# sigma_tt = -nu / (1 - nu) q, u_z = -q z / E_oed, u_r = 0 (as the plane oedometer of
+# check_implicit_traction.py; O(q/E) = 1e-4 from the finite-strain model)
+q, n = 1000.0, ns[-1]
+h = 1.0 / n
+text = tv.prm_set(tv.prm_set(base, "gravity/acceleration", "0, 0"), "loads/traction 0/traction", f"0, {-q}")
+text = tv.prm_set(tv.prm_set(text, "loads/traction 0/face", "y+"), "grid/cells", f"{n}, {n + n // 4}")
+tv.run_tool(f"{tools}/talus-implicit", text, f"{work}/top", "top")
+t = tv.read_csv(f"{work}/top/out/particles_final.csv")
+m = len(t["id"])
+Z = [t["pos_y"][i] - t["u_y"][i] for i in range(m)]
+below = [i for i in range(m) if Z[i] < H - h]
+e_zz = max(abs(t["stress_yy"][i] + q) for i in below) / q
+e_tt = max(abs(t["stress_zz"][i] + nu / (1 - nu) * q) for i in below) / q
+e_uz = max(abs(t["u_y"][i] + q * Z[i] / E_oed) for i in below) / (q * H / E_oed)
+e_ur = max(abs(t["u_x"][i]) for i in range(m)) / (q * H / E_oed)
+print(f"top traction, n = {n}: below the top cell sigma_zz {e_zz:.2e} of q, hoop {e_tt:.2e}, u_z {e_uz:.2e} of q H / "
+      f"E_oed, |u_r| {e_ur:.2e}")
+tv.check(max(e_zz, e_tt, e_uz) < 1e-3, f"top traction: sigma_zz, hoop stress and u_z within 1e-3 "
+         f"({e_zz:.2e}, {e_tt:.2e}, {e_uz:.2e})")
+tv.check(e_ur < 1e-10, f"top traction: u_r = 0 to round-off ({e_ur:.2e})")
 tv.finish()
