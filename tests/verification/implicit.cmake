@@ -132,3 +132,11 @@ add_test(NAME verification.implicit_axisymmetric_self_weight
                  0.025 0.7 8 16)
 set_tests_properties(verification.implicit_axisymmetric_self_weight PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 300)
+# checkpoint/restart of an axisymmetric run: the column collapse a = 1.2 as a cylindrical column
+# (x = 0 the axis), bitwise on 1 and 2 ranks (2.4 min on the shared machine: verify)
+add_test(NAME verification.implicit_checkpoint_restart_axisymmetric
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart_axisymmetric
+                 implicit/geometry=axisymmetric)
+set_tests_properties(verification.implicit_checkpoint_restart_axisymmetric PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1800 PROCESSORS 2)

@@ -15,6 +15,7 @@
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
 
 #include <cmath>
+#include <limits>
 #include <iomanip>
 #include <sstream>
 
@@ -321,6 +322,15 @@ namespace talus::implicit_mpm
         using L                = PropertyLayout<dim>;
         const double two_pi    = 2 * dealii::numbers::PI;
         double       totals[2] = {0, 0};
+        // a point on or across the axis (only a particle file can put one there:
+        // seeded points sit at sub-cell centres of a grid with x >= 0)
+        double r_min = std::numeric_limits<double>::max();
+        for (const auto &pt : points.handler)
+          r_min = std::min(r_min, pt.get_location()[0]);
+        r_min = dealii::Utilities::MPI::min(r_min, comm);
+        require(r_min > 0, "implicit/geometry",
+                "'axisymmetric': a material point lies at x = " + std::to_string(r_min) +
+                  " <= 0, on or across the axis (x is the radius; points must have x > 0)");
         for (auto &pt : points.handler)
           {
             auto         P = pt.get_properties();
