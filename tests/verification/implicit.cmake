@@ -140,3 +140,11 @@ add_test(NAME verification.implicit_checkpoint_restart_axisymmetric
                  implicit/geometry=axisymmetric)
 set_tests_properties(verification.implicit_checkpoint_restart_axisymmetric PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1800 PROCESSORS 2)
+# dynamic: the breathing mode of the thick cylinder after a step pressure, period vs the exact
+# fundamental radial mode stretched by the trapezoidal rule
+add_test(NAME verification.implicit_axisymmetric_breathing
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_breathing.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_breathing
+                 1e-3 16 32)
+set_tests_properties(verification.implicit_axisymmetric_breathing PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 300)
