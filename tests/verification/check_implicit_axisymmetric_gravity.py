@@ -43,7 +43,10 @@ for n in ns:
     h = 1.0 / n
     name = f"n{n}"
     start = time.time()
-    tv.run_tool(f"{tools}/talus-implicit", tv.prm_set(base, "grid/cells", f"{n}, {n + n // 4}"), f"{work}/{name}", name)
+    _, out, _ = tv.run_tool(f"{tools}/talus-implicit", tv.prm_set(base, "grid/cells", f"{n}, {n + n // 4}"),
+                            f"{work}/{name}", name)
+    tv.check("the x-min wall is the axis, u_r = 0 there (roller)" in out,
+             f"{name}: the axis roller was added (the .prm names only walls 1 and 2)")
     wall = time.time() - start
     t = tv.read_csv(f"{work}/{name}/out/particles_final.csv")
     m = len(t["id"])

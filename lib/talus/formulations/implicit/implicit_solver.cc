@@ -353,6 +353,11 @@ namespace talus::implicit_mpm
                                     dealii::ArrayView<double>(totals, 2));
         log() << "  axisymmetric: points carry their rings (2 pi r x area): volume " << totals[0] << " m^3, mass "
               << totals[1] << " kg" << std::endl;
+        if (prm.grid_lower[0] == 0)
+          for (const auto &bc : prm.boundary_conditions)
+            if (bc.id == 0)
+              log() << "  axisymmetric: the x-min wall is the axis, u_r = 0 there ("
+                    << (bc.kind == BoundaryCondition::Kind::roller ? "roller" : "fixed") << ")" << std::endl;
       }
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
       space.reinit_vector(*v);
