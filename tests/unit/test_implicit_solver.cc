@@ -24,7 +24,8 @@ namespace
   double
   tangent_error(const std::string &model, const std::string &analysis, const double scale,
                 const unsigned int steps_before = 0, const double gravity = 9.81,
-                const std::string &implicit_extra = "", const double pressure_scale = 1.0)
+                const std::string &implicit_extra = "", const double pressure_scale = 1.0,
+                const std::string &boundary = " set fixed = 0\n")
   {
     std::ostringstream prm_text;
     prm_text << "set dimension = " << dim << "\n"
@@ -33,7 +34,7 @@ namespace
              << "subsection grid\n set lower corner = 0, 0" << (dim == 3 ? ", 0" : "")
              << "\n set upper corner = 2, 1" << (dim == 3 ? ", 1" : "") << "\n set cells = 4, 2"
              << (dim == 3 ? ", 2" : "") << "\nend\n"
-             << "subsection boundary conditions\n set fixed = 0\nend\n"
+             << "subsection boundary conditions\n" << boundary << "end\n"
              << "subsection gravity\n set acceleration = 0, " << (dim == 3 ? "0, " : "") << -gravity << "\nend\n"
              << "subsection output\n set directory = test_implicit_out\n set progress = false\nend\n"
              << "set number of materials = 1\nsubsection material 0\n set density = 1000\n"
@@ -107,6 +108,33 @@ namespace
   TEST(ImplicitTangent, MixedUpAfterLoadSteps2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean_split, "static", 1e-3, 2, 200.0, mixed, 1e6), 1e-8);
+  }
+  // axisymmetric (x = radius, seed 001 App. C): the hoop row N_a / r_n of the
+  // internal force and its four tangent blocks, on a body that touches the axis
+  // (x = 0: the radial displacement there is constrained automatically; a
+  // bottom roller holds it axially). Increments of 1e-2 m at points from r =
+  // 0.125 m: hoop stretches of up to 8 %.
+  const std::string axisymmetric = " set geometry = axisymmetric\n";
+  const std::string bottom_roller = " set roller = 2\n";
+  TEST(ImplicitTangent, AxisymmetricNeoHookeanStatic)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, axisymmetric, 1.0, bottom_roller), 1e-8);
+  }
+  TEST(ImplicitTangent, AxisymmetricNeoHookeanDynamic)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, axisymmetric, 1.0, bottom_roller), 1e-8);
+  }
+  TEST(ImplicitTangent, AxisymmetricNeoHookeanAfterLoadSteps)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-3, 2, 200.0, axisymmetric, 1.0, bottom_roller), 1e-8);
+  }
+  TEST(ImplicitTangent, AxisymmetricHenckyMohrCoulombPlastic)
+  {
+    EXPECT_LT(tangent_error<2>(hencky_mc, "static", 1e-2, 0, 9.81, axisymmetric, 1.0, bottom_roller), 1e-8);
+  }
+  TEST(ImplicitTangent, AxisymmetricJ2Plastic)
+  {
+    EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, axisymmetric, 1.0, bottom_roller), 1e-8);
   }
   TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
 } // namespace

@@ -5,6 +5,9 @@ the right exit code, no NaN written.
     time step, gamma out of range, nu = 0.5, an entry of a feature not built yet,
     mixed u-p without the split Neo-Hookean energy, in a dynamic run or with an
     iterative solver, a traction with both 'traction' and 'total force';
+    'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
+    3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
+    'total force' traction, restarted with tractions;
   * Newton that cannot converge (max iterations 1 with a tolerance no single
     iteration meets): every step is cut back max_cut_backs times, then the run
     stops with exit 3 and says so; series.csv holds only finite values;
@@ -44,6 +47,30 @@ cases = {
                                             "loads/traction 0/total force", "0, -1"),
                                  ["loads/traction 0/total force", "not both"]),
 }
+# axisymmetry (thick_cylinder_axisymmetric.prm beside PRM): what it does not cover is refused
+axi = tv.prm_set(open(os.path.join(os.path.dirname(prm_path), "thick_cylinder_axisymmetric.prm")).read(),
+                 "output/directory", "must_not_exist")
+axi_3d = axi
+for entry, value in (("dimension", "3"), ("grid/lower corner", "0, 0, 0"), ("grid/upper corner", "2.5, 0.5, 0.5"),
+                     ("grid/cells", "10, 2, 2"), ("gravity/acceleration", "0, 0, 0"),
+                     ("body 0/lower corner", "1, 0, 0"), ("body 0/upper corner", "2, 0.5, 0.5"),
+                     ("loads/traction 0/traction", "1000, 0, 0")):
+    axi_3d = tv.prm_set(axi_3d, entry, value)
+cases.update({
+    "axisymmetric in 3D": (axi_3d, ["implicit/geometry", "2D"]),
+    "axisymmetric mixed up": (tv.prm_set(tv.prm_set(axi, "implicit/formulation", "mixed up"),
+                                         "material 0/neo hookean/volumetric energy", "split"),
+                              ["implicit/geometry", "irreducible"]),
+    "axisymmetric grid below x = 0": (tv.prm_set(axi, "grid/lower corner", "-0.5, 0"),
+                                      ["implicit/geometry", "lower corner x >= 0"]),
+    "axisymmetric radial gravity": (tv.prm_set(axi, "gravity/acceleration", "1, -9.81"),
+                                    ["gravity/acceleration", "axis"]),
+    "axisymmetric total force": (tv.prm_set(tv.prm_set(axi, "loads/traction 0/traction", "0, 0"),
+                                            "loads/traction 0/total force", "1000, 0"),
+                                 ["loads/traction 0", "total force", "axisymmetric"]),
+    "axisymmetric restart with tractions": (tv.prm_set(axi, "checkpoint/restart", "if available"),
+                                            ["checkpoint/restart", "axisymmetric"]),
+})
 for name, (text, needles) in cases.items():
     rc, out, err = tv.run_tool(tool, text, work, name.replace(" ", "_"), expect_rc=None)
     msg = err.strip()

@@ -13,7 +13,8 @@ step) on a coarse grid, checkpoints every 0.04 s, two kept.
    uninterrupted 2-rank run.
 4. restart = true without a checkpoint, and a checkpoint of another scene: input
    errors (exit 2) naming the cause.
-Usage: check_implicit_restart.py TOOLS_DIR PRM WORKDIR
+Usage: check_implicit_restart.py TOOLS_DIR PRM WORKDIR [ENTRY=VALUE ...]
+(ENTRY=VALUE: further .prm settings, e.g. implicit/geometry=axisymmetric)
 """
 import os
 import re
@@ -31,6 +32,9 @@ for k, v in {"grid/cells": "60, 20", "time/end time": "0.2", "output/vtu interva
              "output/series interval": "0", "output/final particles csv": "true", "output/progress": "false",
              "checkpoint/interval": "0.04", "checkpoint/keep": "2"}.items():
     base = tv.prm_set(base, k, v)
+for setting in sys.argv[4:]:
+    k, v = setting.split("=", 1)
+    base = tv.prm_set(base, k, v)
 
 
 def run(name, np=1, expect_rc=0, **entries):
@@ -47,7 +51,9 @@ def files(name):
 
 for np in (1, 2):
     ref, part = f"ref_np{np}", f"restarted_np{np}"
-    run(ref, np)
+    _, out, _ = run(ref, np)
+    if "implicit/geometry=axisymmetric" in sys.argv[4:]:
+        tv.check("axisymmetric: points carry their rings" in out, f"np={np}: the run is axisymmetric")
     run(part, np, **{"time/end time": "0.13"})
     _, out, _ = run(part, np, **{"checkpoint/restart": "true"})
     tv.check("restarting from" in out, f"np={np}: the second run restarted from a checkpoint")

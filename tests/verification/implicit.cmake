@@ -102,3 +102,49 @@ add_test(NAME verification.implicit_ranks_cooks
                  ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_ranks_cooks)
 set_tests_properties(verification.implicit_ranks_cooks PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+
+# axisymmetry (seed 001 App. C): thick-walled cylinder under internal pressure vs the
+# linear Lame solution (u_r, hoop stress), 3 grids (fast) / 4 grids (verify)
+add_test(NAME verification.implicit_axisymmetric_cylinder
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_cylinder
+                 0.01 0.015 0.7 0.125 0.0625 0.03125)
+set_tests_properties(verification.implicit_axisymmetric_cylinder PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 300)
+add_test(NAME verification.implicit_axisymmetric_cylinder_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_cylinder_full
+                 0.005 0.0075 0.7 0.125 0.0625 0.03125 0.015625)
+set_tests_properties(verification.implicit_axisymmetric_cylinder_full PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 600)
+# the same cylinder at p / E = 0.1 (five load steps) vs the exact finite-strain solution of the
+# coupled Neo-Hookean model (shooting in the checker): the hoop terms at large strain; 1 vs 2 ranks
+add_test(NAME verification.implicit_axisymmetric_cylinder_finite
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_finite.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm
+                 ${_w}/implicit_axisymmetric_cylinder_finite 5 5 0.01 0.015 0.7 0.125 0.0625 0.03125)
+set_tests_properties(verification.implicit_axisymmetric_cylinder_finite PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 300 PROCESSORS 2)
+# gravity along the axis with the ring measure: a laterally confined solid cylinder (touching the axis)
+add_test(NAME verification.implicit_axisymmetric_self_weight
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_gravity.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_self_weight
+                 0.025 0.7 8 16)
+set_tests_properties(verification.implicit_axisymmetric_self_weight PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 300)
+# checkpoint/restart of an axisymmetric run: the column collapse a = 1.2 as a cylindrical column
+# (x = 0 the axis), bitwise on 1 and 2 ranks (2.4 min on the shared machine: verify)
+add_test(NAME verification.implicit_checkpoint_restart_axisymmetric
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart_axisymmetric
+                 implicit/geometry=axisymmetric)
+set_tests_properties(verification.implicit_checkpoint_restart_axisymmetric PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1800 PROCESSORS 2)
+# dynamic: the breathing mode of the thick cylinder after a step pressure, period vs the exact
+# fundamental radial mode stretched by the trapezoidal rule
+add_test(NAME verification.implicit_axisymmetric_breathing
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_breathing.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm ${_w}/implicit_axisymmetric_breathing
+                 1e-3 16 32)
+set_tests_properties(verification.implicit_axisymmetric_breathing PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 300)

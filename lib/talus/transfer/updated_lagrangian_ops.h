@@ -69,6 +69,69 @@ namespace talus::transfer
     return F;
   }
 
+  /// Axisymmetric (x = radius, y = axis; seed 001 App. C): the step's hoop
+  /// stretch dF_zz = r_{n+1} / r_n = 1 + Du_r(x_p) / r_n, Du_r = sum_a N_a Du_a,x
+  /// (r_n > 0: points never sit on the axis).
+  template <class PN, unsigned int stride>
+  inline double
+  hoop_stretch(const double *u_local, const PN &p, const double r)
+  {
+    double ur = 0;
+    for (unsigned int a = 0; a < p.n; ++a)
+      ur += p.N[a] * u_local[p.local[a] * stride];
+    return 1.0 + ur / r;
+  }
+
+  /// Axisymmetric residual and tangent of one point from the full 3x3 first
+  /// Piola form Pk (c tau dF^-T) and its derivative A = d Pk / d dF: the
+  /// virtual dF of node a, component i, is e_i (x) grad_{x_n} N_a plus, for the
+  /// radial component, the hoop entry N_a / r_n at (z, z), so
+  ///   r_a,i  += sum_b Pk_ib G_a,b + [i = x] Pk_zz N_a / r_n - fe_i N_a
+  ///   K_ai,bk = that virtual dF of (a, i) : A : that of (b, k).
+  template <unsigned int stride, class PN>
+  inline void
+  add_axisymmetric_point(const double (&Pk)[3][3], const double (*A)[3][3][3], const double (&fe)[2],
+                         const double r, const PN &p, LocalSystem &ls)
+  {
+    const double ir = 1.0 / r;
+    for (unsigned int a = 0; a < p.n; ++a)
+      for (unsigned int i = 0; i < 2; ++i)
+        {
+          double f = -fe[i] * p.N[a] + Pk[i][0] * p.G[a][0] + Pk[i][1] * p.G[a][1];
+          if (i == 0)
+            f += Pk[2][2] * p.N[a] * ir;
+          ls.b[p.local[a] * stride + i] += f;
+        }
+    if (!A)
+      return;
+    for (unsigned int a = 0; a < p.n; ++a)
+      for (unsigned int b = 0; b < p.n; ++b)
+        {
+          const auto & Ga = p.G[a];
+          const auto & Gb = p.G[b];
+          const double ha = p.N[a] * ir, hb = p.N[b] * ir; // hoop entries of the virtual dF
+          for (unsigned int i = 0; i < 2; ++i)
+            for (unsigned int k = 0; k < 2; ++k)
+              {
+                double s = 0;
+                for (unsigned int j = 0; j < 2; ++j)
+                  for (unsigned int d = 0; d < 2; ++d)
+                    s += A[i][j][k][d] * Ga[j] * Gb[d];
+                if (k == 0)
+                  for (unsigned int j = 0; j < 2; ++j)
+                    s += A[i][j][2][2] * Ga[j] * hb;
+                if (i == 0)
+                  {
+                    for (unsigned int d = 0; d < 2; ++d)
+                      s += A[2][2][k][d] * ha * Gb[d];
+                    if (k == 0)
+                      s += A[2][2][2][2] * ha * hb;
+                  }
+                ls.a(p.local[a] * stride + i, p.local[b] * stride + k) += s;
+              }
+        }
+  }
+
   /// The step's first Piola form times c: Pk_ib = c sum_e tau_ie Finv_be
   /// (c tau dF^-T; V_{n+1} sigma grad_{x_{n+1}} N = Pk grad_{x_n} N for c = V_n / J_n).
   template <int dim>
@@ -193,6 +256,8 @@ namespace talus::transfer
     double                                                         load_scale   = 1;
     bool                                                           tangent = true;
     PointFailure *                                                 failure = nullptr;
+    /// axisymmetric (2D): the property holding the point's radius r_n; invalid: plane strain / 3D
+    unsigned int radius_offset = dealii::numbers::invalid_unsigned_int;
 
     static constexpr bool matrix = true, vector = true;
 
@@ -206,6 +271,9 @@ namespace talus::transfer
       const unsigned int   nh = m.n_history();
       double               history_new[64];
       dealii::Tensor<2, 3> dF = incremental_deformation_gradient<dim>(ls.u, p);
+      const bool           axisymmetric = dim == 2 && radius_offset != dealii::numbers::invalid_unsigned_int;
+      if (axisymmetric)
+        dF[2][2] = hoop_stretch<PN, dim>(ls.u, p, P[radius_offset]);
       materials::Stress    tau;
       dealii::Tensor<4, 3> dtau;
       try
@@ -223,6 +291,19 @@ namespace talus::transfer
         }
       const double c = P[L::volume] / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + history_offset, nh));
       const dealii::Tensor<2, 3> Finv = invert(dF);
+      if constexpr (dim == 2)
+        if (axisymmetric)
+          {
+            double Pk3[3][3];
+            scaled_piola<3>(c, tau, Finv, Pk3);
+            double fe[2];
+            external_point_force<2>(P, gravity, point_forces, load_scale, fe);
+            double A3[3][3][3][3];
+            if (tangent)
+              scaled_piola_tangent<3>(c, tau, dtau, Finv, A3);
+            add_axisymmetric_point<2>(Pk3, tangent ? A3 : nullptr, fe, P[radius_offset], p, ls);
+            return;
+          }
       double Pk[dim][dim];
       scaled_piola<dim>(c, tau, Finv, Pk);
       double fe[dim];
@@ -439,7 +520,8 @@ namespace talus::transfer
     CommitUpdatedLagrangian(MaterialPointSet<dim> &set, const NodalSpace<dim> &space, const Vector &du,
                             const Vector *a_new, const std::vector<std::shared_ptr<const materials::Material>> &mats,
                             const unsigned int acceleration_offset, const double h, const double gamma,
-                            PointFailure &failure, const unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int)
+                            PointFailure &failure, const unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int,
+                            const unsigned int radius_offset = dealii::numbers::invalid_unsigned_int)
       : set(set)
       , grid(space.grid)
       , space(space)
@@ -451,6 +533,7 @@ namespace talus::transfer
       , gamma(gamma)
       , failure(failure)
       , pressure(pressure_offset)
+      , radius(radius_offset)
     {}
     MaterialPointSet<dim> &                                        set;
     const BackgroundGrid<dim> &                                    grid;
@@ -462,6 +545,7 @@ namespace talus::transfer
     const double                                                   h, gamma;
     PointFailure &                                                 failure;
     const unsigned int                                             pressure;
+    const unsigned int radius; ///< axisymmetric: the property with r_n (invalid: plane / 3D)
 
     static constexpr bool prefetch_location = true;
     typename K::Cell      cell;
@@ -505,6 +589,8 @@ namespace talus::transfer
             for (unsigned int j = 0; j < dim; ++j)
               dF[i][j] += u * G[w][j];
           }
+      if (dim == 2 && radius != dealii::numbers::invalid_unsigned_int)
+        dF[2][2] = 1.0 + dx[0] / P[radius]; // the hoop stretch r_{n+1} / r_n
       const auto &       m  = *materials[static_cast<unsigned int>(P[L::material])];
       const unsigned int nh = m.n_history();
       double             old[64];

@@ -15,6 +15,7 @@
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
 
 #include <cmath>
+#include <limits>
 #include <iomanip>
 #include <sstream>
 
@@ -64,8 +65,13 @@ namespace talus::implicit_mpm
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
-      prm.declare_entry("geometry", "plane strain", Selection("plane strain"),
-                        "2D: plane strain (dF_zz = 1). 3D ignores it.");
+      prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
+                        "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
+                        "body of revolution about the y axis (x = radius, grid lower x >= 0; seed 001 App. C): a "
+                        "point's volume and mass are those of its ring (2 pi r x its area), the hoop stretch "
+                        "dF_zz = r_{n+1} / r_n enters the models, stress_zz is the hoop stress; tractions are per "
+                        "unit ring area; the radial displacement of nodes on the axis (x = 0) is fixed "
+                        "automatically. Irreducible formulation only; 3D: leave 'plane strain'.");
     }
     prm.leave_subsection();
     prm.enter_subsection("newton");
@@ -119,6 +125,7 @@ namespace talus::implicit_mpm
     p.ramp_loads     = prm.get_bool("ramp loads");
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
+    p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
@@ -175,11 +182,41 @@ namespace talus::implicit_mpm
     not_yet(p.balance.enabled(), "load balancing/interval");
     not_yet(bool(p.grid_mesh), "grid/source");
     check_scene_consistency(p); // grid, boundary ids, memory, bodies
+    if (p.axisymmetric)
+      {
+        // what the axisymmetric form covers (docs/implicit.md, "Axisymmetry"); the rest is refused
+        const std::string where = "implicit/geometry";
+        require(dim == 2, where, "'axisymmetric' is a 2D geometry (x = radius, y = axis); in 3D use 'plane strain'");
+        require(!p.mixed_up, where, "'axisymmetric' is available with 'formulation = irreducible' only (the mixed u-p "
+                                    "form has no hoop terms yet)");
+        require(p.grid_lower[0] >= 0, where,
+                "'axisymmetric' needs grid/lower corner x >= 0 (x is the radius; got " +
+                  std::to_string(p.grid_lower[0]) + ")");
+        require(p.gravity[0] == 0, "gravity/acceleration",
+                "with 'axisymmetric' the body force must act along the axis (y): its x (radial) component must be 0");
+        for (const auto &t : p.tractions)
+          require(!t.total, t.where,
+                  "'total force' is not available with 'axisymmetric' (give the traction in Pa; it is applied per "
+                  "unit ring area)");
+        require(p.tractions.empty() || p.restart == Parameters<dim>::Restart::no, "checkpoint/restart",
+                "restarting an 'axisymmetric' run with tractions is not available yet (the ring weights of the "
+                "traction point forces are set on the seeded state)");
+      }
     require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_alpha == 0, "implicit/rayleigh alpha",
             "damping needs 'analysis = dynamic'");
     require(p.analysis == Parameters<dim>::Analysis::dynamic || !p.boundary_conditions.empty(),
             "boundary conditions", "a static analysis needs at least one fixed or roller wall (without, the "
             "bodies can move as rigid bodies and the stiffness is singular)");
+    if (p.axisymmetric && p.grid_lower[0] == 0)
+      {
+        // the axis: u_r = 0 on the nodes at r = 0 (a roller on the x-min wall)
+        // unless the wall is already fixed or a roller
+        bool on_axis = false;
+        for (const auto &bc : p.boundary_conditions)
+          on_axis = on_axis || bc.id == 0;
+        if (!on_axis)
+          p.boundary_conditions.push_back({0, BoundaryCondition::Kind::roller});
+      }
     return p;
   }
 
@@ -219,6 +256,8 @@ namespace talus::implicit_mpm
     points.layout.n_history = n_history;
     acceleration_offset     = points.layout.add_extra("acceleration", dim, true);
     point_forces.extend_layout(points.layout, prm.tractions.size());
+    if (prm.axisymmetric)
+      radius_offset = points.layout.add_extra("radius", 1);
     if (prm.mixed_up)
       {
         pressure_offset = points.layout.add_extra("pressure", 1);
@@ -266,6 +305,57 @@ namespace talus::implicit_mpm
     points.collect_active_cells();
     if (!prm.tractions.empty())
       point_forces.assign(prm.tractions, points, grid, prm.bodies, comm);
+    if (prm.axisymmetric && !restored)
+      {
+        // The ring measure (docs/implicit.md, "Axisymmetry"): the seeded V_p is
+        // the point's area in the r-z plane; its volume and mass become those
+        // of the ring it stands for, 2 pi r_p V_p and 2 pi r_p m_p, so that every
+        // integral of the step (internal force, m_p g, the lumped mass, V_{n+1} =
+        // det(dF) V_n with the hoop stretch in dF) is the plane one with the
+        // ring's measure. The traction forces were assigned on the areas (per
+        // unit length of the face in the r-z plane); they get the ring weight of
+        // the loaded surface: 2 pi x the face's radius for a body face normal to
+        // x (r = the body's lower/upper x), 2 pi r_p otherwise.
+        using L                = PropertyLayout<dim>;
+        const double two_pi    = 2 * dealii::numbers::PI;
+        double       totals[2] = {0, 0};
+        // a point on or across the axis (only a particle file can put one there:
+        // seeded points sit at sub-cell centres of a grid with x >= 0)
+        double r_min = std::numeric_limits<double>::max();
+        for (const auto &pt : points.handler)
+          r_min = std::min(r_min, pt.get_location()[0]);
+        r_min = dealii::Utilities::MPI::min(r_min, comm);
+        require(r_min > 0, "implicit/geometry",
+                "'axisymmetric': a material point lies at x = " + std::to_string(r_min) +
+                  " <= 0, on or across the axis (x is the radius; points must have x > 0)");
+        for (auto &pt : points.handler)
+          {
+            auto         P = pt.get_properties();
+            const double r = pt.get_location()[0];
+            for (unsigned int j = 0; j < prm.tractions.size(); ++j)
+              {
+                const auto &t      = prm.tractions[j];
+                double      r_face = r;
+                if (t.target == loads::Traction<dim>::Target::body_face && t.axis == 0)
+                  r_face = t.side < 0 ? prm.bodies[t.body].lower[0] : prm.bodies[t.body].upper[0];
+                for (unsigned int d = 0; d < dim; ++d)
+                  P[point_forces.offset() + j * dim + d] *= two_pi * r_face;
+              }
+            P[L::volume] *= two_pi * r;
+            P[L::mass] *= two_pi * r;
+            totals[0] += P[L::volume];
+            totals[1] += P[L::mass];
+          }
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(totals, 2), comm,
+                                    dealii::ArrayView<double>(totals, 2));
+        log() << "  axisymmetric: points carry their rings (2 pi r x area): volume " << totals[0] << " m^3, mass "
+              << totals[1] << " kg" << std::endl;
+        if (prm.grid_lower[0] == 0)
+          for (const auto &bc : prm.boundary_conditions)
+            if (bc.id == 0)
+              log() << "  axisymmetric: the x-min wall is the axis, u_r = 0 there ("
+                    << (bc.kind == BoundaryCondition::Kind::roller ? "roller" : "fixed") << ")" << std::endl;
+      }
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
       space.reinit_vector(*v);
   }
@@ -283,6 +373,9 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::prepare_step()
   {
+    if (prm.axisymmetric) // r_n of every point, read by the residual and the convective phase
+      for (auto &pt : points.handler)
+        pt.get_properties()[radius_offset] = pt.get_location()[0];
     active.template reinit<shape::Q1Box<dim>>({&points});
     active.reinit_matrix(tangent);
     project_to_grid();
@@ -333,6 +426,7 @@ namespace talus::implicit_mpm
     force.load_scale     = load_factor(time + newmark.dt());
     force.tangent        = with_tangent;
     force.failure        = &failure;
+    force.radius_offset  = radius_offset;
     residual             = 0;
     if (with_tangent)
       tangent = 0;
@@ -537,7 +631,8 @@ namespace talus::implicit_mpm
     transfer::PointFailure failure;
     transfer::CommitUpdatedLagrangian<dim, shape::Q1Box<dim>> commit(points, space, du, dynamic() ? &a_new : nullptr,
                                                                      prm.materials, acceleration_offset, h,
-                                                                     newmark.gamma(), failure, pressure_offset);
+                                                                     newmark.gamma(), failure, pressure_offset,
+                                                                     radius_offset);
     transfer::for_each_active_cell(points, commit);
     if (dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0)
       throw InstabilityError("the constitutive update of the converged step failed: " +
@@ -660,6 +755,7 @@ namespace talus::implicit_mpm
         << (prm.mixed_up ? "mixed u-p (Q1-Q1, PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
                          : std::string("irreducible (displacement)"))
         << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
+        << (dim == 3 ? std::string() : prm.axisymmetric ? ", axisymmetric (x = radius)" : ", plane strain")
         << std::endl;
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations

@@ -44,6 +44,10 @@ namespace talus::implicit_mpm
     /// mixed u-p (seed 001 ch. 5): nodal pressure as a second field, PPP stabilisation
     bool   mixed_up      = false;
     double stabilisation = 1; ///< alpha of Eq. 5.15 (mixed u-p)
+    /// 2D only: axisymmetric about the y axis (x = radius >= 0; seed 001 App. C):
+    /// V_p and m_p of a point are those of its ring (2 pi r x the seeded area),
+    /// dF_zz = r_{n+1} / r_n is the hoop stretch (docs/implicit.md)
+    bool axisymmetric = false;
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
@@ -151,6 +155,8 @@ namespace talus::implicit_mpm
 
     unsigned int                            acceleration_offset = 0;
     unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int; ///< mixed u-p: p_p
+    /// axisymmetric: the point's radius r_n at the start of the step (set by prepare_step)
+    unsigned int radius_offset = dealii::numbers::invalid_unsigned_int;
     std::vector<const materials::NeoHookean *> split_models; ///< mixed u-p, per material id
     dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
     std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
