@@ -46,6 +46,12 @@ cases = {
                                                        "loads/traction 0/traction", "0, -1"),
                                             "loads/traction 0/total force", "0, -1"),
                                  ["loads/traction 0/total force", "not both"]),
+    "velocity of a body": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
+                                      "loads/velocity 0/apply to", "body"),
+                           ["loads/velocity 0/apply to", "boundary | region"]),
+    "velocity on a missing boundary": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
+                                                  "loads/velocity 0/boundary id", "7"),
+                                       ["loads/velocity 0/boundary id", "does not exist"]),
 }
 # axisymmetry (thick_cylinder_axisymmetric.prm beside PRM): what it does not cover is refused
 axi = tv.prm_set(open(os.path.join(os.path.dirname(prm_path), "thick_cylinder_axisymmetric.prm")).read(),

@@ -148,3 +148,10 @@ add_test(NAME verification.implicit_axisymmetric_breathing
                  1e-3 16 32)
 set_tests_properties(verification.implicit_axisymmetric_breathing PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 300)
+# prescribed grid-node displacements (loads/velocity k, AffineConstraints): homogeneous
+# small-strain compression to round-off on 1 and 2 ranks, and a large-strain compression
+add_test(NAME verification.implicit_prescribed_displacement
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_prescribed.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/block_prescribed_displacement.prm ${_w}/implicit_prescribed_displacement)
+set_tests_properties(verification.implicit_prescribed_displacement PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 PROCESSORS 2)

@@ -16,9 +16,10 @@ namespace talus::loads
 
   template <int dim>
   dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<dim> &       grid,
-                   const NodalSpace<dim> &           space,
-                   const std::vector<unsigned char> &flags)
+  wall_constraints(const BackgroundGrid<dim> &           grid,
+                   const NodalSpace<dim> &               space,
+                   const std::vector<unsigned char> &    flags,
+                   const std::vector<PrescribedNodeDof> *prescribed)
   {
     dealii::AffineConstraints<double> walls;
     walls.reinit(space.locally_relevant_dofs());
@@ -35,18 +36,28 @@ namespace talus::loads
               if (!walls.is_constrained(i))
                 walls.add_line(i);
             }
+    if (prescribed)
+      for (const auto &p : *prescribed)
+        {
+          const auto i = space.node_dof(p.node, p.component);
+          if (!walls.is_constrained(i))
+            walls.add_line(i);
+        }
     walls.close();
     return walls;
   }
 
   template <int dim>
   std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<PrescribedVelocity<dim>> &conditions)
+  prescribed_node_dofs(const BackgroundGrid<dim> &                 grid,
+                       const std::vector<PrescribedVelocity<dim>> &conditions,
+                       const bool                                  owned_only)
   {
     using Target               = typename PrescribedVelocity<dim>::Target;
     const unsigned int n_owned = grid.partitioner->locally_owned_size();
+    const unsigned int n_local = owned_only ? n_owned : n_owned + grid.partitioner->n_ghost_indices();
     std::vector<PrescribedNodeDof> out;
-    std::vector<unsigned char>     seen(n_owned, 0);
+    std::vector<unsigned char>     seen(n_local, 0);
     for (unsigned int j = 0; j < conditions.size(); ++j)
       {
         const auto &pv = conditions[j];
@@ -61,7 +72,7 @@ namespace talus::loads
             for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
               {
                 const unsigned int i0 = cc.dofs[v * dim];
-                if (i0 >= n_owned || seen[i0])
+                if (i0 >= n_local || seen[i0])
                   continue;
                 bool hit = false;
                 if (pv.target == Target::region)
@@ -87,7 +98,7 @@ namespace talus::loads
                 seen[i0] = 1;
                 for (unsigned int d = 0; d < dim; ++d)
                   if (pv.component[d])
-                    out.push_back({cc.dofs[v * dim + d], j, d});
+                    out.push_back({cc.dofs[v * dim + d], i0, j, d});
               }
           }
       }
@@ -95,13 +106,19 @@ namespace talus::loads
   }
 
   template std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<2> &, const std::vector<PrescribedVelocity<2>> &);
+  prescribed_node_dofs(const BackgroundGrid<2> &, const std::vector<PrescribedVelocity<2>> &, const bool);
   template std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<3> &, const std::vector<PrescribedVelocity<3>> &);
+  prescribed_node_dofs(const BackgroundGrid<3> &, const std::vector<PrescribedVelocity<3>> &, const bool);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<2> &, const std::vector<BoundaryCondition> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<3> &, const std::vector<BoundaryCondition> &);
   template dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<2> &, const NodalSpace<2> &, const std::vector<unsigned char> &);
+  wall_constraints(const BackgroundGrid<2> &,
+                   const NodalSpace<2> &,
+                   const std::vector<unsigned char> &,
+                   const std::vector<PrescribedNodeDof> *);
   template dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<3> &, const NodalSpace<3> &, const std::vector<unsigned char> &);
+  wall_constraints(const BackgroundGrid<3> &,
+                   const NodalSpace<3> &,
+                   const std::vector<unsigned char> &,
+                   const std::vector<PrescribedNodeDof> *);
 } // namespace talus::loads

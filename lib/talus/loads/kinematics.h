@@ -22,6 +22,15 @@
 
 namespace talus::loads
 {
+  /// One velocity component of a grid node prescribed by a condition.
+  struct PrescribedNodeDof
+  {
+    unsigned int dof;       ///< local DoF of the grid's vector space
+    unsigned int node;      ///< local DoF of the node's x component (NodalSpace::node_dof)
+    unsigned int condition; ///< index into the condition list given
+    unsigned int component; ///< velocity component
+  };
+
   /// Per local DoF (owned + ghost) of the grid's vector space a flag: 1 if its
   /// velocity component is prescribed zero by one of the conditions. Throws
   /// InputError naming 'boundary conditions' for a boundary id the grid lacks.
@@ -31,25 +40,25 @@ namespace talus::loads
 
   /// The flagged DoFs as homogeneous constraints on `space` (a vector space on
   /// the grid's triangulation, whose node_dof maps the grid's DoFs), closed.
+  /// With `prescribed` (from prescribed_node_dofs with owned_only = false)
+  /// their DoFs get homogeneous lines too: the caller sets the prescribed
+  /// increment in its iterate, the constraints keep the corrections off it.
   template <int dim>
   dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<dim> &       grid,
-                   const NodalSpace<dim> &           space,
-                   const std::vector<unsigned char> &flags);
+  wall_constraints(const BackgroundGrid<dim> &                  grid,
+                   const NodalSpace<dim> &                      space,
+                   const std::vector<unsigned char> &           flags,
+                   const std::vector<PrescribedNodeDof> *prescribed = nullptr);
 
-  /// One velocity component of a grid node prescribed by a condition.
-  struct PrescribedNodeDof
-  {
-    unsigned int dof;       ///< local DoF of the grid's vector space (owned)
-    unsigned int condition; ///< index into the condition list given
-    unsigned int component; ///< velocity component
-  };
-
-  /// The owned node DoFs reached by the grid-node conditions of `conditions`
-  /// (target boundary: the nodes of the faces with that id; region: the nodes
-  /// inside the box, with a tolerance of 1e-9 cell sizes). Body conditions
+  /// The node DoFs reached by the grid-node conditions of `conditions` (target
+  /// boundary: the nodes of the faces with that id; region: the nodes inside
+  /// the box, with a tolerance of 1e-9 cell sizes): the owned ones, or with
+  /// `owned_only = false` all locally relevant ones (constraints of a
+  /// distributed assembly must be known on the ghosts too). Body conditions
   /// (on material points) are skipped. Each node is listed once per condition.
   template <int dim>
   std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<PrescribedVelocity<dim>> &conditions);
+  prescribed_node_dofs(const BackgroundGrid<dim> &                 grid,
+                       const std::vector<PrescribedVelocity<dim>> &conditions,
+                       const bool                                  owned_only = true);
 } // namespace talus::loads

@@ -512,24 +512,31 @@ namespace talus::loads
   }
 
   void
-  declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim)
+  declare_traction_parameters(dealii::ParameterHandler &prm,
+                              const std::string &       prm_file,
+                              const unsigned int        dim,
+                              const bool                with_velocities)
   {
-    declare_loads(prm, prm_file, "loads", dim, false);
+    declare_loads(prm, prm_file, "loads", dim, with_velocities);
   }
 
   template <int dim>
   std::vector<Traction<dim>>
-  parse_traction_parameters(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies)
+  parse_traction_parameters(dealii::ParameterHandler &               prm,
+                            const std::vector<BodyDescription<dim>> &bodies,
+                            std::vector<PrescribedVelocity<dim>> *   velocities)
   {
     std::vector<Traction<dim>> t;
-    parse_loads<dim>(prm, "", bodies, t, nullptr);
+    parse_loads<dim>(prm, "", bodies, t, velocities);
     return t;
   }
 
   template std::vector<Traction<2>> parse_traction_parameters<2>(dealii::ParameterHandler &,
-                                                                 const std::vector<BodyDescription<2>> &);
+                                                                 const std::vector<BodyDescription<2>> &,
+                                                                 std::vector<PrescribedVelocity<2>> *);
   template std::vector<Traction<3>> parse_traction_parameters<3>(dealii::ParameterHandler &,
-                                                                 const std::vector<BodyDescription<3>> &);
+                                                                 const std::vector<BodyDescription<3>> &,
+                                                                 std::vector<PrescribedVelocity<3>> *);
   template struct Settings<2>;
   template struct Settings<3>;
   template Settings<2> parse_parameters<2>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 2> &,

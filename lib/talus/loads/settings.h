@@ -116,13 +116,19 @@ namespace talus::loads
   void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
                           unsigned int n_bodies);
 
-  /// Only the 'loads' subsection with its 'traction k' entries (families
-  /// without prescribed velocities, stages or damping: talus-implicit).
-  void declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim);
-  /// The tractions of declare_traction_parameters (global loads, absolute time).
+  /// Only the 'loads' subsection with its 'traction k' entries and, with
+  /// `with_velocities`, its 'velocity k' conditions (families without stages
+  /// or damping: talus-implicit).
+  void declare_traction_parameters(dealii::ParameterHandler &prm,
+                                   const std::string &       prm_file,
+                                   unsigned int              dim,
+                                   bool                      with_velocities = false);
+  /// The tractions of declare_traction_parameters (global loads, absolute
+  /// time) and, if `velocities` is given, the velocity conditions.
   template <int dim>
   std::vector<Traction<dim>> parse_traction_parameters(dealii::ParameterHandler &               prm,
-                                                       const std::vector<BodyDescription<dim>> &bodies);
+                                                       const std::vector<BodyDescription<dim>> &bodies,
+                                                       std::vector<PrescribedVelocity<dim>> *   velocities = nullptr);
 
   /// Parse after the solver has read its own entries (end time, gravity, the
   /// fixed/roller boundaries and the bodies, which are passed in).

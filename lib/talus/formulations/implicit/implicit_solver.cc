@@ -33,7 +33,7 @@ namespace talus::implicit_mpm
     const SceneCounts counts = peek_scene_counts(prm_file);
     declare_scene_parameters(prm, counts);
     declare_run_parameters(prm);
-    loads::declare_traction_parameters(prm, prm_file, counts.dim);
+    loads::declare_traction_parameters(prm, prm_file, counts.dim, true);
     prm.enter_subsection("time");
     prm.declare_entry("time step", "0", Double(0),
                       "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
@@ -139,7 +139,11 @@ namespace talus::implicit_mpm
     p.newton.line_search        = prm.get_bool("line search");
     prm.leave_subsection();
     p.newton.validate();
-    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies);
+    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
+    for (const auto &v : p.velocities)
+      require(v.target != loads::PrescribedVelocity<dim>::Target::body, v.where + "/apply to",
+              "'body' (a velocity of material points) is not available in talus-implicit: the points move with "
+              "the grid's solution; allowed: boundary | region (prescribed grid nodes)");
     prm.enter_subsection("linear solver");
     p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
                                                     : LinearSolverOptions::Method::cg_amg;
@@ -249,6 +253,9 @@ namespace talus::implicit_mpm
     grid.setup();
     space.setup();
     boundary_flags = loads::wall_dof_flags(grid, prm.boundary_conditions);
+    // the grid nodes of 'loads/velocity k' (owned and ghost: constraints of a
+    // distributed assembly must be known where a rank assembles)
+    prescribed_dofs = loads::prescribed_node_dofs(grid, prm.velocities, false);
 
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
@@ -381,7 +388,45 @@ namespace talus::implicit_mpm
     project_to_grid();
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
-    constraints = active.constraints_with(loads::wall_constraints(grid, space, boundary_flags));
+    constraints = active.constraints_with(loads::wall_constraints(grid, space, boundary_flags, &prescribed_dofs));
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::apply_prescribed_increments(const double h)
+  {
+    // Du = v f over the step (trapezoidal rule: exact for constant and
+    // piecewise-linear time functions whose kinks fall on step ends), set at
+    // the owned prescribed DoFs of active nodes; the constraints keep it
+    // through the Newton corrections (homogeneous lines on those DoFs)
+    const auto &        pins  = active.constraints(); // inactive nodes: no mass, pinned to 0
+    const auto &        owned = space.locally_owned_dofs();
+    std::vector<double> n_active(prm.velocities.size(), 0.0);
+    for (const auto &p : prescribed_dofs)
+      {
+        const auto i = space.node_dof(p.node, p.component);
+        if (!owned.is_element(i) || pins.is_constrained(i))
+          continue;
+        const auto & pv = prm.velocities[p.condition];
+        const double f  = 0.5 * (pv.function.value(time) + pv.function.value(time + h));
+        du[i]           = pv.velocity[p.component] * f * h;
+        n_active[p.condition] += 1;
+      }
+    du.compress(dealii::VectorOperation::insert);
+    du.update_ghost_values();
+    // the nodes of a condition are fixed in space: once the material has left
+    // their cells they carry no mass and the condition acts on nothing; say so
+    // (once per condition) instead of letting a displacement control go slack
+    dealii::Utilities::MPI::sum(n_active, comm, n_active);
+    idle_conditions.resize(prm.velocities.size(), 0);
+    for (unsigned int k = 0; k < n_active.size(); ++k)
+      if (n_active[k] == 0 && !idle_conditions[k])
+        {
+          idle_conditions[k] = 1;
+          log() << "  WARNING: " << prm.velocities[k].where << " reaches no grid node next to material at t = "
+                << time << " s (the prescribed nodes are fixed in space and the material has left their cells): "
+                << "the condition has no effect from here on" << std::endl;
+        }
   }
 
   template <int dim>
@@ -538,7 +583,7 @@ namespace talus::implicit_mpm
       }
 
     du = 0;
-    du.update_ghost_values();
+    apply_prescribed_increments(h);
     if (prm.mixed_up)
       predict_pressure();
     unsigned int  linear_iterations = 0;
@@ -755,6 +800,8 @@ namespace talus::implicit_mpm
         << (prm.mixed_up ? "mixed u-p (Q1-Q1, PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
                          : std::string("irreducible (displacement)"))
         << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
+        << (prm.velocities.empty() ? "" :
+                                     ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")
         << (dim == 3 ? std::string() : prm.axisymmetric ? ", axisymmetric (x = radius)" : ", plane strain")
         << std::endl;
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative

@@ -14,6 +14,7 @@
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
 #include <talus/materials/neo_hookean.h>
+#include <talus/loads/kinematics.h>
 #include <talus/loads/point_forces.h>
 #include <talus/loads/settings.h>
 #include <talus/particles/material_point_set.h>
@@ -55,6 +56,9 @@ namespace talus::implicit_mpm
     bool           ramp_loads = true;
     /// 'loads/traction k': dead loads carried by boundary points (global, absolute time)
     std::vector<loads::Traction<dim>> tractions;
+    /// 'loads/velocity k' on grid nodes (boundary | region): the displacement
+    /// increment of each step, integrated over the step, imposed on those DoFs
+    std::vector<loads::PrescribedVelocity<dim>> velocities;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -160,6 +164,10 @@ namespace talus::implicit_mpm
     std::vector<const materials::NeoHookean *> split_models; ///< mixed u-p, per material id
     dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
     std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
+    std::vector<loads::PrescribedNodeDof>   prescribed_dofs; ///< of 'loads/velocity k' (owned + ghost)
+    std::vector<unsigned char>              idle_conditions; ///< per condition: reported as acting on nothing
+    /// du at the prescribed DoFs: the increment of the step [t, t + h].
+    void apply_prescribed_increments(const double h);
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
     std::vector<std::pair<double, std::string>> pvd_records;
