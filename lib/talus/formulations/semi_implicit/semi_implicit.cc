@@ -505,7 +505,7 @@ namespace talus::semi_implicit
     // nodal fields (grid vectors; scalars at the component-0 DoF)
     Vector Ms, Ps, Mn, Mk, Fs;          // soil mass, momentum, sum m n, sum m k, force (internal + gravity)
     Vector Ww, Pw0, Ww0, Mwp, Mw;       // sum N rho_w V, sum N rho_w V0 v, sum N rho_w V0, sum N m p, sum N m
-    Vector Fp;                          // -sum V p grad N (pore pressure force on the mixture)
+    Vector Gpw, Gps;                    // sum V N grad p^t over the water / the soil points (times n_I, 1 - n_I: the pore pressure forces)
     Vector Mwg;                         // sum N m grad p (linear pressure map)
     Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
@@ -566,7 +566,7 @@ namespace talus::semi_implicit
               }
           }
     patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
-    for (Vector *v : {&Mdj, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
+    for (Vector *v : {&Mdj, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
                       &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
 
@@ -725,7 +725,7 @@ namespace talus::semi_implicit
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
 
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
@@ -832,38 +832,59 @@ namespace talus::semi_implicit
         vw_t.local_element(i) = Mw.local_element(node_of[i]) > mw_cut && w > 0 ? Pw0.local_element(i) / w : 0.0;
       }
 
-    // (3a)/(4a) smoothed pore pressure at the water points (77) and its force
-    // -sum V p grad N on the mixture (55); the water's share is n_I times it (57)
+    // (3a)/(4a) smoothed pore pressure at the water points (77); the pore
+    // pressure force in the form of the correction (66)-(67): the water's
+    // n_I sum_w V N grad p^t, the soil's (1 - n_I) sum_s V N grad p^t, from the
+    // nodal p^t (decision 'pressure force form' in docs/semi-implicit.md: the
+    // printed mixture form -sum_w V p grad N split by n_I gives the soil of a
+    // node at a free-water interface the buoyancy of the whole support)
     {
       const double *pn = at(p_node);
-      double *      fp = at(Fp);
+      double *      gpw = at(Gpw), *gps = at(Gps);
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
-        double *     P = it->get_properties().data();
+        double *P = it->get_properties().data();
         if (prm.pressure_smoothing)
           P[fw.pressure] = s.value(pn);
-        const double p = P[fw.pressure];
-        double t[dim][dim] = {};
-        for (unsigned int d = 0; d < dim; ++d)
-          t[d][d] = -P[L::volume] * p;
-        s.scatter_divergence(fp, t);
+        double gp[dim];
+        s.gradient(pn, gp);
+        s.scatter_vector(gpw, P[L::volume], gp);
+      });
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        const double *P = it->get_properties().data();
+        double        gp[dim];
+        s.gradient(pn, gp);
+        s.scatter_vector(gps, P[L::volume], gp);
       });
     }
-    exchange({&Fp});
+    exchange({&Gpw, &Gps});
 
-    // (3) water predictor, drag implicit in v_w* (53, 59); (4) mixture predictor (52)
+    // (3) water predictor (53, 59) and (4) mixture predictor (52), the drag
+    // implicit in both velocities: the 2 x 2 system per node and component
+    //   (M_s + Q h) v_s* - Q h v_w*         = M_s v_s^t + h (F_s + (1 - n) G_s p)
+    //   -Q h v_s*         + (M_w + Q h) v_w* = M_w v_w^t + h (M_w b + n G_w p)
+    // whose sum is the mixture equation (52); the printed sequence takes v_s^t
+    // in the drag of (53), which amplifies v_s - v_w by about M_w / M_s per step
+    // where M_w > M_s (the nodes at a free-water interface; docs/semi-implicit.md)
     for (unsigned int i = 0; i < nl; ++i)
       {
         const unsigned int j   = node_of[i];
         const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j);
         const double       Q = Q_node.local_element(j), n = n_node.local_element(j);
-        const double       b = g[component[i]];
+        const double       b  = g[component[i]];
+        const double       rs = Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i));
+        const double       rwv = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
         double             vw = 0, vs = 0;
-        if (Mwi > 0)
-          vw = (h * (Mwi * b + n * Fp.local_element(i) + Q * vs_t.local_element(i)) + Mwi * vw_t.local_element(i)) /
-               (Mwi + Q * h);
-        if (Msi > ms_cut)
-          vs = (h * (Fs.local_element(i) + Mwi * b + Fp.local_element(i)) - Mwi * (vw - vw_t.local_element(i))) / Msi +
-               vs_t.local_element(i);
+        const bool         has_soil = Msi > ms_cut, has_water = Mwi > 0;
+        if (has_soil && has_water)
+          {
+            const double a = Msi + h * Q, c = Mwi + h * Q, o = h * Q, det = a * c - o * o;
+            vs = (c * rs + o * rwv) / det;
+            vw = (o * rs + a * rwv) / det;
+          }
+        else if (has_soil)
+          vs = rs / Msi;
+        else if (has_water)
+          vw = rwv / Mwi;
         if (constrained[i]) // same conditions on both phases (A10)
           vw = vs = 0;
         vw_star.local_element(i) = vw;
