@@ -96,3 +96,10 @@ add_test(NAME verification.semi_implicit_pond
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_pond.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_pond.prm ${_w}/semi_implicit_pond)
 set_tests_properties(verification.semi_implicit_pond PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# 1D Darcy seepage through a fixed column under a pond, drained base: flux
+# within 2 % of k dh / L (k = 1e-3, 1e-4 B-splines; 1e-3 linear)
+add_test(NAME verification.semi_implicit_seepage
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_seepage.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_seepage.prm ${_w}/semi_implicit_seepage)
+set_tests_properties(verification.semi_implicit_seepage PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
