@@ -10,7 +10,9 @@ k / (n g) ~ 3e-4 s) the flux n (v_w - v_s) (v_s = 0) averaged over the water
 points in 0.3 < y < 0.7 must be within 2 % of q, and the same in the lower and
 the upper half of that band (uniform flux). k = 1e-3 and 1e-4 m/s with
 B-splines, k = 1e-3 with linear shape functions; 0.1 s each (667 steps; the
-pond drops less than 0.5 mm, 0.25 % of its depth).
+pond drops less than 0.5 mm, 0.25 % of its depth). Mass at the soil surface:
+the pond's water (points above y = 1.05) must sink at the Darcy flux q, within
+10 % (the point form phi div v* of the pressure equation let it sink at q / n).
 Usage: check_semi_seepage.py TOOL PRM WORKDIR
 """
 import sys
@@ -34,10 +36,13 @@ for k, shape in (("1e-3", "quadratic bspline"), ("1e-4", "quadratic bspline"), (
 
     q, q_lo, q_hi = flux(0.3, 0.7), flux(0.3, 0.5), flux(0.5, 0.7)
     top = max(w["pos_y"])
+    pond = [v for v, y in zip(w["velocity_y"], w["pos_y"]) if y > 1.05]
+    v_pond = sum(pond) / len(pond)
     print(f"k = {k} m/s, {shape}: flux n v_w over 0.3 < y < 0.7 = {q:.5e} m/s, Darcy k dh / L = {q_darcy:.5e} m/s, "
           f"ratio {q / q_darcy:.4f} (0.3-0.5: {q_lo / q_darcy:.4f}, 0.5-0.7: {q_hi / q_darcy:.4f}); "
-          f"highest water point at y = {top:.4f} m")
+          f"highest water point at y = {top:.4f} m; pond velocity {v_pond:.4e} m/s = {v_pond / q_darcy:.3f} q")
     tv.check(abs(q / q_darcy - 1) < 0.02, f"k = {k}, {shape}: flux within 2 % of k dh / L ({q / q_darcy:.4f})")
     tv.check(abs(q_lo / q_darcy - 1) < 0.02 and abs(q_hi / q_darcy - 1) < 0.02,
              f"k = {k}, {shape}: the same flux in both halves of the band")
+    tv.check(abs(v_pond / q_darcy - 1) < 0.1, f"k = {k}, {shape}: the pond sinks at the Darcy flux ({v_pond / q_darcy:.3f} q)")
 tv.finish()

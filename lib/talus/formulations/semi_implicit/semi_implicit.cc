@@ -449,6 +449,38 @@ namespace talus::semi_implicit
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
     };
 
+    /// The pressure-increment Poisson terms of one point: K += V c grad N grad N,
+    /// f -= V (phi v*) . grad N (the weak form of div(phi v*), integrated by
+    /// parts: it keeps the phi jump of a free-water / soil interface, which the
+    /// point form phi div v* drops; docs/semi-implicit.md)
+    struct PoissonWithFlux
+    {
+      unsigned int          coefficient = 0, flux = 0; ///< property offsets (flux: dim values)
+      static constexpr bool matrix = true, vector = true;
+      template <int dim, unsigned int nc, class PN>
+      inline void
+      add(const double *P, const PN &p, transfer::LocalSystem &ls) const
+      {
+        static_assert(nc == 1, "PoissonWithFlux: a scalar space");
+        const double V = P[PropertyLayout<dim>::volume];
+        const double a = P[coefficient] * V;
+        for (unsigned int i = 0; i < p.n; ++i)
+          {
+            double fg = 0;
+            for (unsigned int j = 0; j < p.n; ++j)
+              {
+                double gg = 0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  gg += p.G[i][d] * p.G[j][d];
+                ls.a(p.local[i], p.local[j]) += a * gg;
+              }
+            for (unsigned int d = 0; d < dim; ++d)
+              fg += P[flux + d] * p.G[i][d];
+            ls.b[p.local[i]] -= V * fg;
+          }
+      }
+    };
+
     /// Nodal masses below this fraction of the largest nodal mass count as
     /// empty (decision A3: no division by the tiny masses at a support's edge).
     constexpr double relative_mass_cutoff = 1e-10;
@@ -622,7 +654,7 @@ namespace talus::semi_implicit
     fs.conductivity                = soil.layout.add_extra("conductivity", 1);
     fs.surface_force               = soil.layout.add_extra("surface_force", 1);
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
-    fs.poisson_source              = soil.layout.add_extra("poisson_source", 1);
+    fs.poisson_source              = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
       fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
     if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
@@ -633,7 +665,7 @@ namespace talus::semi_implicit
     fw.initial_porosity            = water.layout.add_extra("initial_porosity", 1);
     fw.initial_volume              = water.layout.add_extra("initial_volume", 1);
     fw.poisson_coefficient         = water.layout.add_extra("poisson_coefficient", 1);
-    fw.poisson_source              = water.layout.add_extra("poisson_source", 1);
+    fw.poisson_source              = water.layout.add_extra("poisson_flux", dim, true);
     soil.initialize();
     water.initialize();
     seed();
@@ -947,13 +979,19 @@ namespace talus::semi_implicit
         const double phi = 1 - P[fs.porosity];
         const double rs  = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
         P[fs.poisson_coefficient] = prm.rigid_skeleton ? 0.0 : h * phi / rs;
-        P[fs.poisson_source]      = prm.rigid_skeleton ? 0.0 : phi * s.divergence(vss);
+        double v[dim];
+        s.vector_value(vss, v);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fs.poisson_source + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
       });
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
         double *     P   = it->get_properties().data();
         const double phi = P[fw.porosity];
         P[fw.poisson_coefficient] = h * phi / rw;
-        P[fw.poisson_source]      = phi * s.divergence(vws);
+        double v[dim];
+        s.vector_value(vws, v);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fw.poisson_source + d] = phi * v[d];
       });
     }
     // a dry scene (soil points only) is a single-phase solid: no pressure
@@ -1030,11 +1068,11 @@ namespace talus::semi_implicit
     pspace.reinit_vector(rhs);
     pspace.reinit_vector(dp_solution);
     {
-      transfer::PoissonWithSource soil_terms{fs.poisson_coefficient, fs.poisson_source};
-      transfer::PoissonWithSource water_terms{fw.poisson_coefficient, fw.poisson_source};
-      transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> as(active, constraints, soil_terms, &A, &rhs);
+      PoissonWithFlux soil_terms{fs.poisson_coefficient, fs.poisson_source};
+      PoissonWithFlux water_terms{fw.poisson_coefficient, fw.poisson_source};
+      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> as(active, constraints, soil_terms, &A, &rhs);
       transfer::for_each_active_cell(soil, as);
-      transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> aw(active, constraints, water_terms, &A, &rhs);
+      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> aw(active, constraints, water_terms, &A, &rhs);
       transfer::for_each_active_cell(water, aw);
       transfer::finish_assembly(active, as.diag_sum + aw.diag_sum, as.diag_count + aw.diag_count, &A, &rhs);
     }
