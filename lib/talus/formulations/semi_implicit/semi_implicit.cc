@@ -445,7 +445,7 @@ namespace talus::semi_implicit
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
       unsigned int pressure_gradient = 0, surface_force = 0;
-      unsigned int poisson_coefficient = 0, poisson_source = 0;
+      unsigned int poisson_coefficient = 0, poisson_flux = 0; // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
     };
 
@@ -654,7 +654,7 @@ namespace talus::semi_implicit
     fs.conductivity                = soil.layout.add_extra("conductivity", 1);
     fs.surface_force               = soil.layout.add_extra("surface_force", 1);
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
-    fs.poisson_source              = soil.layout.add_extra("poisson_flux", dim, true);
+    fs.poisson_flux              = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
       fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
     if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
@@ -665,7 +665,7 @@ namespace talus::semi_implicit
     fw.initial_porosity            = water.layout.add_extra("initial_porosity", 1);
     fw.initial_volume              = water.layout.add_extra("initial_volume", 1);
     fw.poisson_coefficient         = water.layout.add_extra("poisson_coefficient", 1);
-    fw.poisson_source              = water.layout.add_extra("poisson_flux", dim, true);
+    fw.poisson_flux              = water.layout.add_extra("poisson_flux", dim, true);
     soil.initialize();
     water.initialize();
     seed();
@@ -982,7 +982,7 @@ namespace talus::semi_implicit
         double v[dim];
         s.vector_value(vss, v);
         for (unsigned int d = 0; d < dim; ++d)
-          P[fs.poisson_source + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
+          P[fs.poisson_flux + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
       });
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
         double *     P   = it->get_properties().data();
@@ -991,7 +991,7 @@ namespace talus::semi_implicit
         double v[dim];
         s.vector_value(vws, v);
         for (unsigned int d = 0; d < dim; ++d)
-          P[fw.poisson_source + d] = phi * v[d];
+          P[fw.poisson_flux + d] = phi * v[d];
       });
     }
     // a dry scene (soil points only) is a single-phase solid: no pressure
@@ -1068,8 +1068,8 @@ namespace talus::semi_implicit
     pspace.reinit_vector(rhs);
     pspace.reinit_vector(dp_solution);
     {
-      PoissonWithFlux soil_terms{fs.poisson_coefficient, fs.poisson_source};
-      PoissonWithFlux water_terms{fw.poisson_coefficient, fw.poisson_source};
+      PoissonWithFlux soil_terms{fs.poisson_coefficient, fs.poisson_flux};
+      PoissonWithFlux water_terms{fw.poisson_coefficient, fw.poisson_flux};
       transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> as(active, constraints, soil_terms, &A, &rhs);
       transfer::for_each_active_cell(soil, as);
       transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> aw(active, constraints, water_terms, &A, &rhs);
