@@ -34,6 +34,8 @@ cases = [
     ("free surface fraction", [("semi implicit/free surface volume fraction", "1")], "free surface volume fraction"),
     ("checkpoints", [("checkpoint/interval", "0.1")], "checkpoint"),
     ("negative surface load", [("body 0/surface load", "-5")], "body 0/surface load"),
+    ("drained boundary of 3D in 2D", [("semi implicit/drained boundaries", "2, 4")], "semi implicit/drained boundaries"),
+    ("drained boundary not a number", [("semi implicit/drained boundaries", "base")], "semi implicit/drained boundaries"),
     ("surface load on water", [("body 0/surface load", "1e4"), ("number of bodies", "2"), ("body 1/phase", "water"),
                                ("body 1/surface load", "1e3"), ("body 1/upper corner", "0.075, 1.05"),
                                ("body 1/lower corner", "0, 1")], "body 1/surface load"),

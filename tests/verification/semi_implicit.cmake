@@ -89,3 +89,17 @@ set_tests_properties(verification.semi_implicit_strip_footing PROPERTIES LABELS 
 add_test(NAME unit.test_stencil_ops_np2
          COMMAND mpirun --oversubscribe -np 2 ${CMAKE_BINARY_DIR}/tests/test_stencil_ops)
 set_tests_properties(unit.test_stencil_ops_np2 PROPERTIES LABELS "unit" PROCESSORS 2 TIMEOUT 300 ENVIRONMENT "${_env}")
+
+# a water body (pond, porosity 1) on a saturated column at rest, k = 1e-3 and 1e-7,
+# B-splines (before the pressure-force fix: det(dF) < 0 within 5 steps)
+add_test(NAME verification.semi_implicit_pond
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_pond.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_pond.prm ${_w}/semi_implicit_pond)
+set_tests_properties(verification.semi_implicit_pond PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# 1D Darcy seepage through a fixed column under a pond, drained base: flux
+# within 2 % of k dh / L (k = 1e-3, 1e-4 B-splines; 1e-3 linear)
+add_test(NAME verification.semi_implicit_seepage
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_seepage.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_seepage.prm ${_w}/semi_implicit_seepage)
+set_tests_properties(verification.semi_implicit_seepage PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

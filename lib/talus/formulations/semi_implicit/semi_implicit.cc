@@ -109,6 +109,15 @@ namespace talus::semi_implicit
       prm.declare_entry("patch size", "1.5", Double(0),
                         "Side of the modified F-bar patches in cells (1.5 for quadratic B-splines, 1 = the "
                         "cell-wise average); the patches tile the grid from its lower corner and stay fixed.");
+      prm.declare_entry("rigid skeleton", "false", Bool(),
+                        "true: the soil skeleton does not move (v_s = 0 at every node, no deformation, the "
+                        "soil's terms dropped from the pressure equation): seepage through a fixed soil. The "
+                        "water keeps its equations, drag and boundary conditions.");
+      prm.declare_entry("drained boundaries", "", dealii::Patterns::Anything(),
+                        "Comma-separated boundary ids of the box grid (0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, "
+                        "5 = z+) where the water drains: the pore pressure is 0 on their nodes that carry water "
+                        "and the water's velocity is not held by the wall condition there (the water can leave "
+                        "the grid; the soil keeps its wall condition). Empty: none.");
       prm.declare_entry("kozeny carman", "false", Bool(),
                         "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
                         "(Alg. 8(g)); false: k stays k0.");
@@ -280,6 +289,20 @@ namespace talus::semi_implicit
     p.pressure_smoothing    = prm.get("pressure smoothing") != "none";
     p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
     p.flip_fraction         = prm.get_double("flip fraction");
+    p.rigid_skeleton        = prm.get_bool("rigid skeleton");
+    {
+      const std::string text = prm.get("drained boundaries");
+      for (const auto &item : dealii::Utilities::split_string_list(text, ','))
+        {
+          bool         ok = !item.empty() && item.find_first_not_of("0123456789") == std::string::npos && item.size() < 3;
+          unsigned int id = ok ? static_cast<unsigned int>(std::stoul(item)) : 0;
+          ok              = ok && id < 2 * dim;
+          require(ok, "semi implicit/drained boundaries",
+                  "is '" + text + "'; allowed: empty or comma-separated boundary ids of the " + std::to_string(dim) +
+                    "D box, 0 to " + std::to_string(2 * dim - 1) + " (x-, x+, y-, y+" + (dim == 3 ? ", z-, z+)" : ")"));
+          p.drained_boundaries.push_back(id);
+        }
+    }
     {
       const std::string st = prm.get("volumetric stabilisation");
       p.stabilisation      = st == "f-bar"          ? VolumetricStabilisation::f_bar
@@ -422,8 +445,40 @@ namespace talus::semi_implicit
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
       unsigned int pressure_gradient = 0, surface_force = 0;
-      unsigned int poisson_coefficient = 0, poisson_source = 0;
+      unsigned int poisson_coefficient = 0, poisson_flux = 0; // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
+    };
+
+    /// The pressure-increment Poisson terms of one point: K += V c grad N grad N,
+    /// f -= V (phi v*) . grad N (the weak form of div(phi v*), integrated by
+    /// parts: it keeps the phi jump of a free-water / soil interface, which the
+    /// point form phi div v* drops; docs/semi-implicit.md)
+    struct PoissonWithFlux
+    {
+      unsigned int          coefficient = 0, flux = 0; ///< property offsets (flux: dim values)
+      static constexpr bool matrix = true, vector = true;
+      template <int dim, unsigned int nc, class PN>
+      inline void
+      add(const double *P, const PN &p, transfer::LocalSystem &ls) const
+      {
+        static_assert(nc == 1, "PoissonWithFlux: a scalar space");
+        const double V = P[PropertyLayout<dim>::volume];
+        const double a = P[coefficient] * V;
+        for (unsigned int i = 0; i < p.n; ++i)
+          {
+            double fg = 0;
+            for (unsigned int j = 0; j < p.n; ++j)
+              {
+                double gg = 0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  gg += p.G[i][d] * p.G[j][d];
+                ls.a(p.local[i], p.local[j]) += a * gg;
+              }
+            for (unsigned int d = 0; d < dim; ++d)
+              fg += P[flux + d] * p.G[i][d];
+            ls.b[p.local[i]] -= V * fg;
+          }
+      }
     };
 
     /// Nodal masses below this fraction of the largest nodal mass count as
@@ -501,11 +556,12 @@ namespace talus::semi_implicit
     // per grid local DoF: the node's component-0 DoF, component, prescribed zero
     std::vector<unsigned int>  node_of;
     std::vector<unsigned char> component, constrained;
+    std::vector<unsigned char> water_constrained, drained; // per DoF; per node (component-0 DoF): on a drained face
     std::vector<dealii::Point<dim>> node_x; // position of the node of a local DoF
     // nodal fields (grid vectors; scalars at the component-0 DoF)
-    Vector Ms, Ps, Mn, Mk, Fs;          // soil mass, momentum, sum m n, sum m k, force (internal + gravity)
+    Vector Ms, Ps, Mn, Mk, Fs;          // soil mass, momentum, sum m n, sum N n^2 rho_w g V / k (drag), force (internal + gravity)
     Vector Ww, Pw0, Ww0, Mwp, Mw;       // sum N rho_w V, sum N rho_w V0 v, sum N rho_w V0, sum N m p, sum N m
-    Vector Fp;                          // -sum V p grad N (pore pressure force on the mixture)
+    Vector Gpw, Gps;                    // sum V N grad p^t over the water / the soil points (times n_I, 1 - n_I: the pore pressure forces)
     Vector Mwg;                         // sum N m grad p (linear pressure map)
     Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
@@ -565,8 +621,25 @@ namespace talus::semi_implicit
                   node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
               }
           }
+    // drained faces: their nodes get p = 0; the water's velocity component
+    // normal to such a face is free there (the soil keeps the wall condition)
+    water_constrained = constrained;
+    drained.assign(nl, 0);
+    for (unsigned int i = 0; i < nl; ++i)
+      for (const unsigned int id : prm.drained_boundaries)
+        {
+          const unsigned int d    = id / 2;
+          const double       face = id % 2 ? prm.grid_upper[d] : prm.grid_lower[d];
+          const double       tol  = 1e-9 * (prm.grid_upper[d] - prm.grid_lower[d]);
+          if (std::abs(node_x[i][d] - face) <= tol)
+            {
+              drained[node_of[i]] = 1;
+              if (component[i] == d)
+                water_constrained[i] = 0;
+            }
+        }
     patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
-    for (Vector *v : {&Mdj, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
+    for (Vector *v : {&Mdj, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
                       &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
 
@@ -581,7 +654,7 @@ namespace talus::semi_implicit
     fs.conductivity                = soil.layout.add_extra("conductivity", 1);
     fs.surface_force               = soil.layout.add_extra("surface_force", 1);
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
-    fs.poisson_source              = soil.layout.add_extra("poisson_source", 1);
+    fs.poisson_flux              = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
       fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
     if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
@@ -592,7 +665,7 @@ namespace talus::semi_implicit
     fw.initial_porosity            = water.layout.add_extra("initial_porosity", 1);
     fw.initial_volume              = water.layout.add_extra("initial_volume", 1);
     fw.poisson_coefficient         = water.layout.add_extra("poisson_coefficient", 1);
-    fw.poisson_source              = water.layout.add_extra("poisson_source", 1);
+    fw.poisson_flux              = water.layout.add_extra("poisson_flux", dim, true);
     soil.initialize();
     water.initialize();
     seed();
@@ -725,12 +798,13 @@ namespace talus::semi_implicit
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
 
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Fp, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
+    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
-    // (1)-(2) P2N of the soil: mass (44), momentum (45), porosity (46),
-    // conductivity (47); effective-stress internal force and soil gravity (54)-(55)
+    // (1)-(2) P2N of the soil: mass (44), momentum (45), porosity (46), the
+    // drag coefficient integrated over the soil points (in place of (47) and
+    // (58), see below); effective-stress internal force and soil gravity (54)-(55)
     {
       double *ms = at(Ms), *ps = at(Ps), *mn = at(Mn), *mk = at(Mk), *fsv = at(Fs);
       transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
@@ -739,7 +813,7 @@ namespace talus::semi_implicit
         s.scatter(ms, m);
         s.scatter_vector(ps, m, P + L::velocity);
         s.scatter(mn, m * P[fs.porosity]);
-        s.scatter(mk, m * P[fs.conductivity]);
+        s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / P[fs.conductivity]);
         double gm[dim];
         for (unsigned int d = 0; d < dim; ++d)
           gm[d] = g[d];
@@ -760,13 +834,12 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < nl; ++i)
       ms_max = std::max(ms_max, Ms.local_element(i));
     const double ms_cut = relative_mass_cutoff * dealii::Utilities::MPI::max(ms_max, comm);
-    // nodal porosity and conductivity; nodes without soil: n = 1, no drag (A1)
+    // nodal porosity; nodes without soil: n = 1, no drag (A1)
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
         {
           const double m = Ms.local_element(i);
           n_node.local_element(i) = m > ms_cut ? Mn.local_element(i) / m : 1.0;
-          Mk.local_element(i)     = m > ms_cut ? Mk.local_element(i) / m : 0.0; // now k_I
         }
     for (unsigned int i = 0; i < nl; ++i)
       {
@@ -821,10 +894,11 @@ namespace talus::semi_implicit
           const bool   has_water     = Mw.local_element(i) > mw_cut;
           p_node.local_element(i)  = has_water ? Mwp.local_element(i) / Mw.local_element(i) : 0.0;
           Mw_node.local_element(i) = has_water ? n_node.local_element(i) * Ww.local_element(i) : 0.0; // Eq. 50
-          const double k           = Mk.local_element(i);
-          Q_node.local_element(i)  = (has_water && k > 0) ? prm.unit_weight_gravity * n_node.local_element(i) *
-                                                             Mw_node.local_element(i) / k
-                                                         : 0.0; // Eq. 58
+          // the drag Q_I = sum_s N n^2 rho_w g V / k over the soil points: Eq. 58
+          // (g n_I M_wI / k_I) integrates the drag over the node's whole water
+          // volume, which at a free-water interface includes the free water
+          // (docs/semi-implicit.md: 2.7 % less Darcy flux through a 1 m column)
+          Q_node.local_element(i) = has_water && Ms.local_element(i) > ms_cut ? Mk.local_element(i) : 0.0;
         }
     for (unsigned int i = 0; i < nl; ++i)
       {
@@ -832,40 +906,65 @@ namespace talus::semi_implicit
         vw_t.local_element(i) = Mw.local_element(node_of[i]) > mw_cut && w > 0 ? Pw0.local_element(i) / w : 0.0;
       }
 
-    // (3a)/(4a) smoothed pore pressure at the water points (77) and its force
-    // -sum V p grad N on the mixture (55); the water's share is n_I times it (57)
+    // (3a)/(4a) smoothed pore pressure at the water points (77); the pore
+    // pressure force in the form of the correction (66)-(67): the water's
+    // n_I sum_w V N grad p^t, the soil's (1 - n_I) sum_s V N grad p^t, from the
+    // nodal p^t (decision 'pressure force form' in docs/semi-implicit.md: the
+    // printed mixture form -sum_w V p grad N split by n_I gives the soil of a
+    // node at a free-water interface the buoyancy of the whole support)
     {
       const double *pn = at(p_node);
-      double *      fp = at(Fp);
+      double *      gpw = at(Gpw), *gps = at(Gps);
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
-        double *     P = it->get_properties().data();
+        double *P = it->get_properties().data();
         if (prm.pressure_smoothing)
           P[fw.pressure] = s.value(pn);
-        const double p = P[fw.pressure];
-        double t[dim][dim] = {};
-        for (unsigned int d = 0; d < dim; ++d)
-          t[d][d] = -P[L::volume] * p;
-        s.scatter_divergence(fp, t);
+        double gp[dim];
+        s.gradient(pn, gp);
+        s.scatter_vector(gpw, P[L::volume], gp);
+      });
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+        const double *P = it->get_properties().data();
+        double        gp[dim];
+        s.gradient(pn, gp);
+        s.scatter_vector(gps, P[L::volume], gp);
       });
     }
-    exchange({&Fp});
+    exchange({&Gpw, &Gps});
 
-    // (3) water predictor, drag implicit in v_w* (53, 59); (4) mixture predictor (52)
+    // (3) water predictor (53, 59) and (4) mixture predictor (52), the drag
+    // implicit in both velocities: the 2 x 2 system per node and component
+    //   (M_s + Q h) v_s* - Q h v_w*         = M_s v_s^t + h (F_s + (1 - n) G_s p)
+    //   -Q h v_s*         + (M_w + Q h) v_w* = M_w v_w^t + h (M_w b + n G_w p)
+    // whose sum is the mixture equation (52); the printed sequence takes v_s^t
+    // in the drag of (53), which amplifies v_s - v_w by about M_w / M_s per step
+    // where M_w > M_s (the nodes at a free-water interface; docs/semi-implicit.md)
     for (unsigned int i = 0; i < nl; ++i)
       {
         const unsigned int j   = node_of[i];
         const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j);
         const double       Q = Q_node.local_element(j), n = n_node.local_element(j);
-        const double       b = g[component[i]];
+        const double       b  = g[component[i]];
+        const double       rs = Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i));
+        const double       rwv = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
         double             vw = 0, vs = 0;
-        if (Mwi > 0)
-          vw = (h * (Mwi * b + n * Fp.local_element(i) + Q * vs_t.local_element(i)) + Mwi * vw_t.local_element(i)) /
-               (Mwi + Q * h);
-        if (Msi > ms_cut)
-          vs = (h * (Fs.local_element(i) + Mwi * b + Fp.local_element(i)) - Mwi * (vw - vw_t.local_element(i))) / Msi +
-               vs_t.local_element(i);
-        if (constrained[i]) // same conditions on both phases (A10)
-          vw = vs = 0;
+        const bool         has_soil = Msi > ms_cut, has_water = Mwi > 0;
+        if (prm.rigid_skeleton) // v_s = 0: the water alone, its drag implicit
+          vw = has_water ? rwv / (Mwi + h * Q) : 0.0;
+        else if (has_soil && has_water)
+          {
+            const double a = Msi + h * Q, c = Mwi + h * Q, o = h * Q, det = a * c - o * o;
+            vs = (c * rs + o * rwv) / det;
+            vw = (o * rs + a * rwv) / det;
+          }
+        else if (has_soil)
+          vs = rs / Msi;
+        else if (has_water)
+          vw = rwv / Mwi;
+        if (constrained[i]) // same conditions on both phases (A10), except the water at a drained face
+          vs = 0;
+        if (water_constrained[i])
+          vw = 0;
         vw_star.local_element(i) = vw;
         vs_star.local_element(i) = vs;
       }
@@ -879,14 +978,20 @@ namespace talus::semi_implicit
         double *     P   = it->get_properties().data();
         const double phi = 1 - P[fs.porosity];
         const double rs  = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
-        P[fs.poisson_coefficient] = h * phi / rs;
-        P[fs.poisson_source]      = phi * s.divergence(vss);
+        P[fs.poisson_coefficient] = prm.rigid_skeleton ? 0.0 : h * phi / rs;
+        double v[dim];
+        s.vector_value(vss, v);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fs.poisson_flux + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
       });
       transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
         double *     P   = it->get_properties().data();
         const double phi = P[fw.porosity];
         P[fw.poisson_coefficient] = h * phi / rw;
-        P[fw.poisson_source]      = phi * s.divergence(vws);
+        double v[dim];
+        s.vector_value(vws, v);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fw.poisson_flux + d] = phi * v[d];
       });
     }
     // a dry scene (soil points only) is a single-phase solid: no pressure
@@ -938,7 +1043,12 @@ namespace talus::semi_implicit
             continue;
           const bool has_water = Mw.local_element(i) > mw_cut;
           const bool surface   = dry.local_element(i) > 0;
-          if (!has_water || surface)
+          if (has_water && drained[i]) // a drained face: p^{t+1} = 0
+            {
+              dirichlet.add_line(gdof);
+              dirichlet.set_inhomogeneity(gdof, -p_node.local_element(i));
+            }
+          else if (!has_water || surface)
             {
               // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
               // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
@@ -958,11 +1068,11 @@ namespace talus::semi_implicit
     pspace.reinit_vector(rhs);
     pspace.reinit_vector(dp_solution);
     {
-      transfer::PoissonWithSource soil_terms{fs.poisson_coefficient, fs.poisson_source};
-      transfer::PoissonWithSource water_terms{fw.poisson_coefficient, fw.poisson_source};
-      transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> as(active, constraints, soil_terms, &A, &rhs);
+      PoissonWithFlux soil_terms{fs.poisson_coefficient, fs.poisson_flux};
+      PoissonWithFlux water_terms{fw.poisson_coefficient, fw.poisson_flux};
+      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> as(active, constraints, soil_terms, &A, &rhs);
       transfer::for_each_active_cell(soil, as);
-      transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> aw(active, constraints, water_terms, &A, &rhs);
+      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> aw(active, constraints, water_terms, &A, &rhs);
       transfer::for_each_active_cell(water, aw);
       transfer::finish_assembly(active, as.diag_sum + aw.diag_sum, as.diag_count + aw.diag_count, &A, &rhs);
     }
@@ -1009,9 +1119,11 @@ namespace talus::semi_implicit
         const unsigned int j   = node_of[i];
         const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
         double vw = Mwi > 0 ? vw_star.local_element(i) + h * n * gw.local_element(i) / Mwi : 0.0;
-        double vs = Msi > ms_cut ? vs_star.local_element(i) + h * (1 - n) * gs.local_element(i) / Msi : 0.0;
+        double vs = Msi > ms_cut && !prm.rigid_skeleton ? vs_star.local_element(i) + h * (1 - n) * gs.local_element(i) / Msi : 0.0;
         if (constrained[i])
-          vw = vs = 0;
+          vs = 0;
+        if (water_constrained[i])
+          vw = 0;
         vw_new.local_element(i) = vw;
         vs_new.local_element(i) = vs;
       }

@@ -79,6 +79,12 @@ namespace talus::semi_implicit
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;
+    /// rigid skeleton: v_s = 0 at every node, the soil's terms dropped from the
+    /// pressure equation (seepage through a fixed soil)
+    bool rigid_skeleton = false;
+    /// boundary ids where the water drains: p = 0 on their nodes that carry
+    /// water, the water's velocity not held by the wall condition there
+    std::vector<unsigned int> drained_boundaries;
     // 'initial state' subsection: geostatic water pressure and effective stress
     bool   geostatic    = false;
     double water_level  = 0; ///< vertical coordinate of the free water surface
