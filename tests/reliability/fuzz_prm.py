@@ -553,7 +553,11 @@ def main():
     ap.add_argument("--subset", choices=["fast", "full"], default="full")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=20.0)
-    ap.add_argument("--fast-per-prm", type=int, default=8, help="mutations per .prm in the fast subset")
+    ap.add_argument("--fast-per-prm", type=int, default=8, help="mutations per .prm in the fast subset (at most)")
+    ap.add_argument("--fast-budget", type=int, default=450,
+                    help="fast subset: about this many category mutations over all .prm files together (each "
+                         "file gets budget / files of them, between 4 and --fast-per-prm), so the CI cost stays "
+                         "flat as files are added; 0: --fast-per-prm each")
     ap.add_argument("--no-check-runs", type=int, default=None,
                     help="how many confirmed-broken inputs to run again without --check (default 10 fast, 80 full)")
     args = ap.parse_args()
@@ -605,6 +609,12 @@ def main():
     print(f"unmodified files: {len(pairs)} (file, tool) pairs with --check", flush=True)
     with cf.ThreadPoolExecutor(max_workers=args.jobs) as ex:
         originals = {(path, t): r for path, t, r in ex.map(original, enumerate(pairs))}
+    fast_per_file = args.fast_per_prm
+    if args.fast_budget > 0:
+        fast_per_file = max(4, min(args.fast_per_prm, args.fast_budget // max(1, len(prms))))
+    if args.subset == "fast":
+        print(f"fast subset: {fast_per_file} category mutations per file ({len(prms)} files, budget "
+              f"{args.fast_budget})", flush=True)
     for path in prms:
         prm = parsed[path]
         rel = os.path.relpath(path, args.prm_dir)
@@ -636,7 +646,7 @@ def main():
                 by_cat.setdefault(m.category, []).append(m)
             order = sorted(by_cat)
             rng.shuffle(order)
-            picked = [rng.choice(by_cat[c]) for c in order[:args.fast_per_prm]]
+            picked = [rng.choice(by_cat[c]) for c in order[:fast_per_file]]
             # the fault classes of issue 16 are always in the fast subset, a few of each
             for cls in REQUIRED_CLASSES:
                 have = [m for m in muts if m.category.startswith(cls) and m not in picked]

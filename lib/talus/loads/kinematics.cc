@@ -19,10 +19,24 @@ namespace talus::loads
   wall_constraints(const BackgroundGrid<dim> &           grid,
                    const NodalSpace<dim> &               space,
                    const std::vector<unsigned char> &    flags,
-                   const std::vector<PrescribedNodeDof> *prescribed)
+                   const std::vector<PrescribedNodeDof> *prescribed,
+                   const std::vector<double> *           values)
   {
     dealii::AffineConstraints<double> walls;
     walls.reinit(space.locally_relevant_dofs());
+    // prescribed DoFs first: on a node that is also on a fixed/roller wall the
+    // prescribed value wins (as in talus-explicit)
+    if (prescribed)
+      for (std::size_t k = 0; k < prescribed->size(); ++k)
+        {
+          const auto &p = (*prescribed)[k];
+          const auto  i = space.node_dof(p.node, p.component);
+          if (walls.is_constrained(i))
+            continue;
+          walls.add_line(i);
+          if (values)
+            walls.set_inhomogeneity(i, (*values)[k]);
+        }
     for (const auto &cell : grid.tria.active_cell_iterators())
       if (!cell->is_artificial())
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
@@ -36,13 +50,6 @@ namespace talus::loads
               if (!walls.is_constrained(i))
                 walls.add_line(i);
             }
-    if (prescribed)
-      for (const auto &p : *prescribed)
-        {
-          const auto i = space.node_dof(p.node, p.component);
-          if (!walls.is_constrained(i))
-            walls.add_line(i);
-        }
     walls.close();
     return walls;
   }
@@ -115,10 +122,12 @@ namespace talus::loads
   wall_constraints(const BackgroundGrid<2> &,
                    const NodalSpace<2> &,
                    const std::vector<unsigned char> &,
-                   const std::vector<PrescribedNodeDof> *);
+                   const std::vector<PrescribedNodeDof> *,
+                   const std::vector<double> *);
   template dealii::AffineConstraints<double>
   wall_constraints(const BackgroundGrid<3> &,
                    const NodalSpace<3> &,
                    const std::vector<unsigned char> &,
-                   const std::vector<PrescribedNodeDof> *);
+                   const std::vector<PrescribedNodeDof> *,
+                   const std::vector<double> *);
 } // namespace talus::loads

@@ -41,14 +41,18 @@ namespace talus::loads
   /// The flagged DoFs as homogeneous constraints on `space` (a vector space on
   /// the grid's triangulation, whose node_dof maps the grid's DoFs), closed.
   /// With `prescribed` (from prescribed_node_dofs with owned_only = false)
-  /// their DoFs get homogeneous lines too: the caller sets the prescribed
-  /// increment in its iterate, the constraints keep the corrections off it.
+  /// their DoFs get lines too (a DoF both on a wall and prescribed: the
+  /// prescribed line), homogeneous, or with `values` (one per entry of
+  /// `prescribed`) those inhomogeneities: the first solve of a step lifts the
+  /// prescribed increment into the right-hand side, the corrections after it
+  /// are homogeneous.
   template <int dim>
   dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<dim> &                  grid,
-                   const NodalSpace<dim> &                      space,
-                   const std::vector<unsigned char> &           flags,
-                   const std::vector<PrescribedNodeDof> *prescribed = nullptr);
+  wall_constraints(const BackgroundGrid<dim> &           grid,
+                   const NodalSpace<dim> &               space,
+                   const std::vector<unsigned char> &    flags,
+                   const std::vector<PrescribedNodeDof> *prescribed = nullptr,
+                   const std::vector<double> *           values     = nullptr);
 
   /// The node DoFs reached by the grid-node conditions of `conditions` (target
   /// boundary: the nodes of the faces with that id; region: the nodes inside

@@ -392,13 +392,64 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
-  void
-  Solver<dim>::apply_prescribed_increments(const double h)
+  double
+  Solver<dim>::prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const
   {
-    // Du = v f over the step (trapezoidal rule: exact for constant and
-    // piecewise-linear time functions whose kinks fall on step ends), set at
-    // the owned prescribed DoFs of active nodes; the constraints keep it
-    // through the Newton corrections (homogeneous lines on those DoFs)
+    // v f integrated over [t, t + h] by the trapezoidal rule (exact for constant
+    // and piecewise-linear time functions whose kinks fall on step ends)
+    const auto &pv = prm.velocities[p.condition];
+    return pv.velocity[p.component] * 0.5 * (pv.function.value(time) + pv.function.value(time + h)) * h;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::predict_prescribed(const double h, const dealii::Tensor<1, dim> &g)
+  {
+    // The first iterate of a step with prescribed DoFs: one linear solve at
+    // Du = 0 with the prescribed increments as inhomogeneous constraints (the
+    // lifting: rhs_F = -r_F - K_FP Du_P), so the free nodes follow the
+    // prescribed ones at once instead of a cell next to them being crushed by
+    // a predictor that moves only the prescribed nodes. The assembly moves
+    // -A_ij g_j to the vector it builds, which here is the residual, whose
+    // negative is the right-hand side: hence g = -Du_P.
+    std::vector<double> minus_increment(prescribed_dofs.size());
+    for (std::size_t k = 0; k < prescribed_dofs.size(); ++k)
+      minus_increment[k] = -prescribed_increment(prescribed_dofs[k], h);
+    auto lifted = active.constraints_with(
+      loads::wall_constraints(grid, space, boundary_flags, &prescribed_dofs, &minus_increment));
+    std::swap(constraints, lifted);
+    try
+      {
+        // the out-of-balance force the prescribed increment creates: the scale
+        // Newton's residual test measures against (after this solve the
+        // residual is small, so its own first value is no scale)
+        lifted_residual = assemble(true, g);
+        Vector rhs(residual);
+        rhs *= -1.0;
+        delta                     = 0;
+        LinearSolveInfo info;
+        try
+          {
+            info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes());
+          }
+        catch (const std::exception &e)
+          {
+            throw NewtonFailure(std::string("linear solve failed: ") + e.what());
+          }
+        ++n_solves;
+        if (!(info.relative_residual <= 1e-6))
+          throw NewtonFailure("the linear system of the prescribed-displacement predictor is singular or nearly so");
+      }
+    catch (...)
+      {
+        std::swap(constraints, lifted);
+        throw;
+      }
+    std::swap(constraints, lifted);
+
+    // Du: the solve's free values, the prescribed increments at the prescribed
+    // DoFs of active nodes, 0 at the other constrained DoFs
+    constraints.set_zero(delta);
     const auto &        pins  = active.constraints(); // inactive nodes: no mass, pinned to 0
     const auto &        owned = space.locally_owned_dofs();
     std::vector<double> n_active(prm.velocities.size(), 0.0);
@@ -407,12 +458,11 @@ namespace talus::implicit_mpm
         const auto i = space.node_dof(p.node, p.component);
         if (!owned.is_element(i) || pins.is_constrained(i))
           continue;
-        const auto & pv = prm.velocities[p.condition];
-        const double f  = 0.5 * (pv.function.value(time) + pv.function.value(time + h));
-        du[i]           = pv.velocity[p.component] * f * h;
+        delta[i] = prescribed_increment(p, h);
         n_active[p.condition] += 1;
       }
-    du.compress(dealii::VectorOperation::insert);
+    delta.compress(dealii::VectorOperation::insert);
+    du = delta;
     du.update_ghost_values();
     // the nodes of a condition are fixed in space: once the material has left
     // their cells they carry no mass and the condition acts on nothing; say so
@@ -583,7 +633,21 @@ namespace talus::implicit_mpm
       }
 
     du = 0;
-    apply_prescribed_increments(h);
+    du.update_ghost_values();
+    lifted_residual = 0;
+    if (!prescribed_dofs.empty())
+      {
+        try
+          {
+            predict_prescribed(h, g);
+          }
+        catch (const NewtonFailure &e)
+          {
+            log() << "  step " << step_number + 1 << " (t = " << time + h
+                  << "): the prescribed-displacement predictor failed: " << e.what() << std::endl;
+            return StepOutcome::cut_back;
+          }
+      }
     if (prm.mixed_up)
       predict_pressure();
     unsigned int  linear_iterations = 0;
@@ -628,7 +692,7 @@ namespace talus::implicit_mpm
       du.update_ghost_values();
     };
     problem.step_increment_norm = [&]() { return du.l2_norm(); };
-    problem.residual_reference  = [&]() { return f_ext; };
+    problem.residual_reference  = [&]() { return std::max(f_ext, lifted_residual); };
     const NewtonResult result = NewtonSolver(prm.newton).solve(problem);
 
     last                   = StepReport();

@@ -166,8 +166,12 @@ namespace talus::implicit_mpm
     std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
     std::vector<loads::PrescribedNodeDof>   prescribed_dofs; ///< of 'loads/velocity k' (owned + ghost)
     std::vector<unsigned char>              idle_conditions; ///< per condition: reported as acting on nothing
-    /// du at the prescribed DoFs: the increment of the step [t, t + h].
-    void apply_prescribed_increments(const double h);
+    /// The displacement of a prescribed DoF over the step [t, t + h].
+    double prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const;
+    /// du before Newton: one linear solve with the prescribed increments lifted
+    /// into the right-hand side (throws NewtonFailure if it fails).
+    void predict_prescribed(const double h, const dealii::Tensor<1, dim> &g);
+    double lifted_residual = 0; ///< |r| of the step's lifted system (0 without prescribed DoFs)
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
     std::vector<std::pair<double, std::string>> pvd_records;
