@@ -402,6 +402,39 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
+  LinearSolveInfo
+  Solver<dim>::solve_for_delta()
+  {
+    const auto start = Clock::now();
+    Vector     rhs(residual);
+    rhs *= -1.0;
+    delta = 0;
+    LinearSolveInfo info;
+    try
+      {
+        info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes());
+      }
+    catch (const std::exception &e)
+      {
+        throw NewtonFailure(std::string("linear solve failed: ") + e.what());
+      }
+    seconds_solve += seconds_since(start);
+    ++n_solves;
+    // a singular tangent (a body free to move as a rigid body in a static
+    // analysis, a point set cut loose) gives a direct solve without error but
+    // a solution that does not solve the system
+    if (!(info.relative_residual <= 1e-6))
+      {
+        std::ostringstream os;
+        os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
+           << " after the " << info.method
+           << " solve): are rigid-body motions of every body prevented by boundary conditions?";
+        throw NewtonFailure(os.str());
+      }
+    return info;
+  }
+
+  template <int dim>
   void
   Solver<dim>::predict_prescribed(const double h, const dealii::Tensor<1, dim> &g)
   {
@@ -424,21 +457,7 @@ namespace talus::implicit_mpm
         // Newton's residual test measures against (after this solve the
         // residual is small, so its own first value is no scale)
         lifted_residual = assemble(true, g);
-        Vector rhs(residual);
-        rhs *= -1.0;
-        delta                     = 0;
-        LinearSolveInfo info;
-        try
-          {
-            info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes());
-          }
-        catch (const std::exception &e)
-          {
-            throw NewtonFailure(std::string("linear solve failed: ") + e.what());
-          }
-        ++n_solves;
-        if (!(info.relative_residual <= 1e-6))
-          throw NewtonFailure("the linear system of the prescribed-displacement predictor is singular or nearly so");
+        solve_for_delta();
       }
     catch (...)
       {
@@ -655,36 +674,11 @@ namespace talus::implicit_mpm
     NewtonProblem problem;
     problem.assemble = [&](const bool with_tangent) { return assemble(with_tangent, g); };
     problem.solve    = [&]() {
-      const auto start = Clock::now();
-      Vector      rhs(residual);
-      rhs *= -1.0;
-      delta = 0;
-      LinearSolveInfo info;
-      try
-        {
-          info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes());
-        }
-      catch (const std::exception &e)
-        {
-          throw NewtonFailure(std::string("linear solve failed: ") + e.what());
-        }
-      // a singular tangent (a body free to move as a rigid body in a static
-      // analysis, a point set cut loose) gives a direct solve without error but
-      // a solution that does not solve the system
-      if (!(info.relative_residual <= 1e-6))
-        {
-          std::ostringstream os;
-          os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
-             << " after the " << info.method
-             << " solve): are rigid-body motions of every body prevented by boundary conditions?";
-          throw NewtonFailure(os.str());
-        }
+      const LinearSolveInfo info = solve_for_delta();
       linear_iterations += info.iterations;
       worst_linear_residual = std::max(worst_linear_residual, info.relative_residual);
       constraints.set_zero(delta);
       delta.update_ghost_values();
-      seconds_solve += seconds_since(start);
-      ++n_solves;
       return delta.l2_norm();
     };
     problem.apply = [&](const double alpha) {

@@ -172,6 +172,9 @@ namespace talus::implicit_mpm
     /// into the right-hand side (throws NewtonFailure if it fails).
     void predict_prescribed(const double h, const dealii::Tensor<1, dim> &g);
     double lifted_residual = 0; ///< |r| of the step's lifted system (0 without prescribed DoFs)
+    /// delta from tangent delta = -residual (the step's linear solve, timed and
+    /// counted); a failed or singular solve throws NewtonFailure.
+    LinearSolveInfo solve_for_delta();
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
     std::vector<std::pair<double, std::string>> pvd_records;
