@@ -170,6 +170,39 @@ namespace talus::transfer
     for_each_active_cell(set, op);
   }
 
+  /// f[node][d] += V_p N (grad phi)(x_p) over every point of `set`: the weak
+  /// gradient force of a nodal scalar phi (the pressure terms G p of the
+  /// semi-implicit predictor and correction), V_p in the point's `volume_slot`.
+  /// `also(it, s)` runs first at every point, for per-point work that wants
+  /// the same stencil (it may be a no-op).
+  template <int dim, class K, class Also>
+  inline void
+  scatter_weak_gradient(const BackgroundGrid<dim> &grid,
+                        MaterialPointSet<dim> &    set,
+                        const double *             phi,
+                        const unsigned int         volume_slot,
+                        double *                   f,
+                        Also &&                    also)
+  {
+    for_each_point_stencil<dim, K>(grid, set, [&](unsigned int, PointIterator<dim> &it, const PointStencil<dim, K> &s) {
+      also(it, s);
+      double g[dim];
+      s.gradient(phi, g);
+      s.scatter_vector(f, it->get_properties()[volume_slot], g);
+    });
+  }
+  template <int dim, class K>
+  inline void
+  scatter_weak_gradient(const BackgroundGrid<dim> &grid,
+                        MaterialPointSet<dim> &    set,
+                        const double *             phi,
+                        const unsigned int         volume_slot,
+                        double *                   f)
+  {
+    scatter_weak_gradient<dim, K>(grid, set, phi, volume_slot, f,
+                                  [](PointIterator<dim> &, const PointStencil<dim, K> &) {});
+  }
+
   /// Integrand of a scalar Poisson matrix and its source (transfer::assemble,
   /// AssembleSystem with nc = 1): A_ij += P[coefficient] V_p grad N_i . grad N_j,
   /// b_i += P[source] V_p N_i. One pass for both, so inhomogeneous Dirichlet

@@ -150,6 +150,19 @@ namespace talus
       }
   }
 
+  SceneCounts
+  declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
+                            const std::string &time_step_doc)
+  {
+    const SceneCounts counts = peek_scene_counts(prm_file);
+    declare_scene_parameters(prm, counts);
+    declare_run_parameters(prm);
+    prm.enter_subsection("time");
+    prm.declare_entry("time step", "0", Double(0), time_step_doc);
+    prm.leave_subsection();
+    return counts;
+  }
+
   void
   declare_run_parameters(dealii::ParameterHandler &prm)
   {

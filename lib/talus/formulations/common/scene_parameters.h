@@ -94,6 +94,11 @@ namespace talus
   /// Declare time (end time, maximum steps), stability (lost particles), output
   /// (with io/png_snapshots' entries), checkpoint and load balancing.
   void declare_run_parameters(dealii::ParameterHandler &prm);
+  /// The head of every family's declaration: the counts peeked from `prm_file`,
+  /// the scene and run entries, and 'time/time step' (default 0) with the
+  /// family's own meaning in `time_step_doc`. Returns the counts.
+  SceneCounts declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
+                                        const std::string &time_step_doc);
 
   template <int dim>
   void parse_scene_parameters(dealii::ParameterHandler &prm, SceneParameters<dim> &p);

@@ -44,18 +44,16 @@ namespace talus::explicit_mpm
   declare_parameters_with_integration(dealii::ParameterHandler &prm, const std::string &prm_file,
                                       const std::string &default_integration)
   {
-    const SceneCounts counts = peek_scene_counts(prm_file);
-    declare_scene_parameters(prm, counts);
-    declare_run_parameters(prm);
+    const SceneCounts counts =
+      declare_common_parameters(prm, prm_file,
+                                "Fixed time step [s]; 0 = courant number x critical time step. A value above the "
+                                "critical time step is refused unless 'force time step' is true.");
     // the explicit family's entries in the shared subsections
     prm.enter_subsection("time");
     {
       prm.declare_entry("courant number", "0.5", Double(0, 1),
                         "Time step as a fraction of the critical time step L_min/c (seed 000 Eq. 4.120), "
                         "used when 'time step' is 0. Range (0, 1].");
-      prm.declare_entry("time step", "0", Double(0),
-                        "Fixed time step [s]; 0 = courant number x critical time step. A value above the "
-                        "critical time step is refused unless 'force time step' is true.");
       prm.declare_entry("force time step", "false", Bool(),
                         "Accept a 'time step' above the critical one (stability studies).");
     }

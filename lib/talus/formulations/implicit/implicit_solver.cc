@@ -30,16 +30,12 @@ namespace talus::implicit_mpm
   void
   declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
   {
-    const SceneCounts counts = peek_scene_counts(prm_file);
-    declare_scene_parameters(prm, counts);
-    declare_run_parameters(prm);
+    const SceneCounts counts =
+      declare_common_parameters(prm, prm_file,
+                                "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
+                                "> 0, required. Not limited by the explicit critical step; a step whose Newton "
+                                "iteration fails is halved and retried (at most 6 times in a row).");
     loads::declare_traction_parameters(prm, prm_file, counts.dim, true);
-    prm.enter_subsection("time");
-    prm.declare_entry("time step", "0", Double(0),
-                      "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
-                      "> 0, required. Not limited by the explicit critical step; a step whose Newton "
-                      "iteration fails is halved and retried (at most 6 times in a row).");
-    prm.leave_subsection();
     prm.enter_subsection("implicit");
     {
       prm.declare_entry("analysis", "dynamic", Selection("static|dynamic"),

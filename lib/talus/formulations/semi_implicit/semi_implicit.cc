@@ -53,15 +53,13 @@ namespace talus::semi_implicit
   void
   declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
   {
-    const SceneCounts counts = peek_scene_counts(prm_file);
-    declare_scene_parameters(prm, counts);
-    declare_run_parameters(prm);
+    const SceneCounts counts =
+      declare_common_parameters(prm, prm_file,
+                                "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
+                                "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
+                                "conductivity (seed 002 §5.3).");
     prm.enter_subsection("time");
     {
-      prm.declare_entry("time step", "0", Double(0),
-                        "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
-                        "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
-                        "conductivity (seed 002 §5.3).");
       prm.declare_entry("courant number", "0.5", Double(0, 1),
                         "Fraction of the soil skeleton's critical step used when 'time step' is 0.");
     }
@@ -915,20 +913,11 @@ namespace talus::semi_implicit
     {
       const double *pn = at(p_node);
       double *      gpw = at(Gpw), *gps = at(Gps);
-      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
-        double *P = it->get_properties().data();
+      transfer::scatter_weak_gradient<dim, K>(grid, water, pn, L::volume, gpw, [&](It &it, const Stencil &s) {
         if (prm.pressure_smoothing)
-          P[fw.pressure] = s.value(pn);
-        double gp[dim];
-        s.gradient(pn, gp);
-        s.scatter_vector(gpw, P[L::volume], gp);
+          it->get_properties()[fw.pressure] = s.value(pn);
       });
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
-        const double *P = it->get_properties().data();
-        double        gp[dim];
-        s.gradient(pn, gp);
-        s.scatter_vector(gps, P[L::volume], gp);
-      });
+      transfer::scatter_weak_gradient<dim, K>(grid, soil, pn, L::volume, gps);
     }
     exchange({&Gpw, &Gps});
 
@@ -1100,18 +1089,8 @@ namespace talus::semi_implicit
     {
       const double *dpn = at(dp_node);
       double *      gsv = at(gs), *gwv = at(gw);
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
-        const double *P = it->get_properties().data();
-        double        gp[dim];
-        s.gradient(dpn, gp);
-        s.scatter_vector(gsv, P[L::volume], gp);
-      });
-      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
-        const double *P = it->get_properties().data();
-        double        gp[dim];
-        s.gradient(dpn, gp);
-        s.scatter_vector(gwv, P[L::volume], gp);
-      });
+      transfer::scatter_weak_gradient<dim, K>(grid, soil, dpn, L::volume, gsv);
+      transfer::scatter_weak_gradient<dim, K>(grid, water, dpn, L::volume, gwv);
     }
     exchange({&gs, &gw});
     for (unsigned int i = 0; i < nl; ++i)
