@@ -78,7 +78,8 @@ namespace
       if (rows[i].dt < rows[ctrl].dt)
         ctrl = i;
     const double dt_cr   = rows[ctrl].dt;
-    const double h       = p.time_step;
+    // the smallest step of the run (with stages: of any stage)
+    const double h       = *std::min_element(p.stage_time_steps.begin(), p.stage_time_steps.end());
     const bool   dynamic = p.analysis == P::Analysis::dynamic;
     // Newmark on a linear undamped system: unconditionally stable for
     // 2 beta >= gamma >= 1/2; else stable for omega h <= 1 / sqrt(gamma / 2 - beta).

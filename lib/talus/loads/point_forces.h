@@ -49,6 +49,10 @@ namespace talus::loads
                         const double                      t,
                         const double                      stage_t0);
 
+    /// Time factors given by the caller, one per slot (a family that keeps the
+    /// tractions of every stage in slots of their own and sets the others to 0).
+    void set_factors(std::vector<double> f) { factor = std::move(f); }
+
     /// Whether the tractions of the last assign() were not empty.
     bool any() const { return have_tractions; }
     const std::vector<double> &factors() const { return factor; }

@@ -348,6 +348,16 @@ namespace talus::loads
         prm.leave_subsection();
       }
 
+    declare_stage_parameters(prm, prm_file, dim, true);
+  }
+
+  void
+  declare_stage_parameters(dealii::ParameterHandler &                            prm,
+                           const std::string &                                   prm_file,
+                           const unsigned int                                    dim,
+                           const bool                                            explicit_entries,
+                           const std::function<void(dealii::ParameterHandler &)> &family_entries)
+  {
     const unsigned int n_stages =
       dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of stages", "0", Integer(0, 32)));
     prm.declare_entry("number of stages", "0", Integer(0, 32),
@@ -364,15 +374,81 @@ namespace talus::loads
         prm.leave_subsection();
         prm.enter_subsection("boundary conditions");
         for (const char *e : {"fixed", "roller", "friction"})
-          prm.declare_entry(e, "inherit", Anything(),
-                            std::string("Boundary ids of the stage, 'none', or 'inherit' (top-level ") + e + ").");
-        prm.declare_entry("friction coefficient", "-1", Double(-1), "-1: the top-level value.");
-        prm.declare_entry("adhesion", "-1", Double(-1), "-1: the top-level value.");
+          if (explicit_entries || std::string(e) != "friction")
+            prm.declare_entry(e, "inherit", Anything(),
+                              std::string("Boundary ids of the stage, 'none', or 'inherit' (top-level ") + e + ").");
+        if (explicit_entries)
+          {
+            prm.declare_entry("friction coefficient", "-1", Double(-1), "-1: the top-level value.");
+            prm.declare_entry("adhesion", "-1", Double(-1), "-1: the top-level value.");
+          }
         prm.leave_subsection();
         declare_loads(prm, prm_file, name + "/loads", dim);
-        declare_switches(prm, true);
+        if (explicit_entries)
+          declare_switches(prm, true);
+        if (family_entries)
+          family_entries(prm);
         prm.leave_subsection();
       }
+  }
+
+  template <int dim>
+  std::vector<Stage<dim>>
+  parse_stages(dealii::ParameterHandler &               prm,
+               const Stage<dim> &                       top,
+               const std::vector<BodyDescription<dim>> &bodies,
+               const bool                               explicit_entries)
+  {
+    std::vector<Stage<dim>> stages;
+    const unsigned int      n_stages = prm.get_integer("number of stages");
+    for (unsigned int k = 0; k < n_stages; ++k)
+      {
+        const std::string where = "stage " + std::to_string(k);
+        prm.enter_subsection(where);
+        Stage<dim> st;
+        st.name     = prm.get("name");
+        st.duration = prm.get_double("duration");
+        require(st.duration > 0, where + "/duration", "must be > 0");
+        prm.enter_subsection("gravity");
+        const std::string g = prm.get("acceleration");
+        st.gravity          = g.empty() ? top.gravity : dealii::Tensor<1, dim>(parse_point<dim>(g, where + "/gravity/acceleration"));
+        prm.leave_subsection();
+        prm.enter_subsection("boundary conditions");
+        const auto list = [&](const char *e, const std::vector<dealii::types::boundary_id> &inherited) {
+          const std::string v = prm.get(e);
+          return v == "inherit" ? inherited : ids(v, where + "/boundary conditions/" + e, dim);
+        };
+        std::vector<dealii::types::boundary_id> top_fixed, top_roller;
+        for (const auto &bc : top.boundary_conditions)
+          (bc.kind == BoundaryCondition::Kind::fixed ? top_fixed : top_roller).push_back(bc.id);
+        for (const auto id : list("fixed", top_fixed))
+          st.boundary_conditions.push_back({id, BoundaryCondition::Kind::fixed});
+        for (const auto id : list("roller", top_roller))
+          st.boundary_conditions.push_back({id, BoundaryCondition::Kind::roller});
+        if (explicit_entries)
+          {
+            st.friction_ids         = list("friction", top.friction_ids);
+            const double mu         = prm.get_double("friction coefficient");
+            const double ad         = prm.get_double("adhesion");
+            st.friction_coefficient = mu < 0 ? top.friction_coefficient : mu;
+            st.adhesion             = ad < 0 ? top.adhesion : ad;
+            for (const auto id : st.friction_ids)
+              for (const auto &bc : st.boundary_conditions)
+                require(bc.id != id, where + "/boundary conditions/friction",
+                        "boundary " + std::to_string(id) + " is also fixed/roller in this stage");
+          }
+        prm.leave_subsection();
+        st.tractions           = top.tractions;
+        st.velocities          = top.velocities;
+        st.n_global_tractions  = top.tractions.size();
+        st.n_global_velocities = top.velocities.size();
+        parse_loads<dim>(prm, where, bodies, st.tractions, &st.velocities);
+        if (explicit_entries)
+          parse_switches<dim>(prm, where, st, &top);
+        prm.leave_subsection();
+        stages.push_back(st);
+      }
+    return stages;
   }
 
   template <int dim>
@@ -459,53 +535,10 @@ namespace talus::loads
         s.k0.push_back(z);
       }
 
-    const unsigned int n_stages = prm.get_integer("number of stages");
-    s.staged                    = n_stages > 0;
+    s.stages = parse_stages<dim>(prm, top, bodies, true);
+    s.staged = !s.stages.empty();
     if (!s.staged)
       s.stages.push_back(top);
-    for (unsigned int k = 0; k < n_stages; ++k)
-      {
-        const std::string where = "stage " + std::to_string(k);
-        prm.enter_subsection(where);
-        Stage<dim> st;
-        st.name     = prm.get("name");
-        st.duration = prm.get_double("duration");
-        require(st.duration > 0, where + "/duration", "must be > 0");
-        prm.enter_subsection("gravity");
-        const std::string g = prm.get("acceleration");
-        st.gravity          = g.empty() ? top.gravity : dealii::Tensor<1, dim>(parse_point<dim>(g, where + "/gravity/acceleration"));
-        prm.leave_subsection();
-        prm.enter_subsection("boundary conditions");
-        const auto list = [&](const char *e, const std::vector<dealii::types::boundary_id> &inherited) {
-          const std::string v = prm.get(e);
-          return v == "inherit" ? inherited : ids(v, where + "/boundary conditions/" + e, dim);
-        };
-        std::vector<dealii::types::boundary_id> top_fixed, top_roller;
-        for (const auto &bc : top.boundary_conditions)
-          (bc.kind == BoundaryCondition::Kind::fixed ? top_fixed : top_roller).push_back(bc.id);
-        for (const auto id : list("fixed", top_fixed))
-          st.boundary_conditions.push_back({id, BoundaryCondition::Kind::fixed});
-        for (const auto id : list("roller", top_roller))
-          st.boundary_conditions.push_back({id, BoundaryCondition::Kind::roller});
-        st.friction_ids         = list("friction", top.friction_ids);
-        const double mu         = prm.get_double("friction coefficient");
-        const double ad         = prm.get_double("adhesion");
-        st.friction_coefficient = mu < 0 ? top.friction_coefficient : mu;
-        st.adhesion             = ad < 0 ? top.adhesion : ad;
-        for (const auto id : st.friction_ids)
-          for (const auto &bc : st.boundary_conditions)
-            require(bc.id != id, where + "/boundary conditions/friction",
-                    "boundary " + std::to_string(id) + " is also fixed/roller in this stage");
-        prm.leave_subsection();
-        st.tractions           = top.tractions;
-        st.velocities          = top.velocities;
-        st.n_global_tractions  = top.tractions.size();
-        st.n_global_velocities = top.velocities.size();
-        parse_loads<dim>(prm, where, bodies, st.tractions, &st.velocities);
-        parse_switches<dim>(prm, where, st, &top);
-        prm.leave_subsection();
-        s.stages.push_back(st);
-      }
     for (const auto &st : s.stages)
       s.max_tractions = std::max<unsigned int>(s.max_tractions, st.tractions.size());
     return s;
@@ -537,6 +570,10 @@ namespace talus::loads
   template std::vector<Traction<3>> parse_traction_parameters<3>(dealii::ParameterHandler &,
                                                                  const std::vector<BodyDescription<3>> &,
                                                                  std::vector<PrescribedVelocity<3>> *);
+  template std::vector<Stage<2>> parse_stages<2>(dealii::ParameterHandler &, const Stage<2> &,
+                                                  const std::vector<BodyDescription<2>> &, const bool);
+  template std::vector<Stage<3>> parse_stages<3>(dealii::ParameterHandler &, const Stage<3> &,
+                                                  const std::vector<BodyDescription<3>> &, const bool);
   template struct Settings<2>;
   template struct Settings<3>;
   template Settings<2> parse_parameters<2>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 2> &,

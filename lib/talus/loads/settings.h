@@ -13,6 +13,7 @@
 #include <deal.II/base/point.h>
 #include <deal.II/base/tensor.h>
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -129,6 +130,26 @@ namespace talus::loads
   std::vector<Traction<dim>> parse_traction_parameters(dealii::ParameterHandler &               prm,
                                                        const std::vector<BodyDescription<dim>> &bodies,
                                                        std::vector<PrescribedVelocity<dim>> *   velocities = nullptr);
+
+  /// 'number of stages' and the 'stage k' subsections: name, duration, gravity,
+  /// fixed/roller boundaries and the stage's own loads; `explicit_entries`
+  /// adds the friction boundaries and the explicit family's switches (local and
+  /// viscous damping, mass scaling, quasi-static convergence);
+  /// `family_entries(prm)`, if given, declares a family's own entries inside
+  /// every 'stage k'.
+  void declare_stage_parameters(dealii::ParameterHandler &                            prm,
+                                const std::string &                                   prm_file,
+                                unsigned int                                          dim,
+                                bool                                                  explicit_entries,
+                                const std::function<void(dealii::ParameterHandler &)> &family_entries = {});
+  /// The 'stage k' subsections of declare_stage_parameters (empty when 'number
+  /// of stages' is 0). `top`: the top-level stage, whose entries 'inherit' and
+  /// -1 stand for and whose loads stay on as global loads in every stage.
+  template <int dim>
+  std::vector<Stage<dim>> parse_stages(dealii::ParameterHandler &               prm,
+                                       const Stage<dim> &                       top,
+                                       const std::vector<BodyDescription<dim>> &bodies,
+                                       bool                                     explicit_entries);
 
   /// Parse after the solver has read its own entries (end time, gravity, the
   /// fixed/roller boundaries and the bodies, which are passed in).

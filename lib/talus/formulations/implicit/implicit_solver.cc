@@ -36,6 +36,10 @@ namespace talus::implicit_mpm
                                 "> 0, required. Not limited by the explicit critical step; a step whose Newton "
                                 "iteration fails is halved and retried (at most 6 times in a row).");
     loads::declare_traction_parameters(prm, prm_file, counts.dim, true);
+    loads::declare_stage_parameters(prm, prm_file, counts.dim, false, [](dealii::ParameterHandler &p) {
+      p.declare_entry("time step", "0", Double(0),
+                      "Time step of the stage [s] (static: its load step); 0 = the top-level time/time step.");
+    });
     prm.enter_subsection("implicit");
     {
       prm.declare_entry("analysis", "dynamic", Selection("static|dynamic"),
@@ -107,11 +111,6 @@ namespace talus::implicit_mpm
     prm.enter_subsection("time");
     p.time_step = prm.get_double("time step");
     prm.leave_subsection();
-    require(p.time_step > 0, "time/time step", "must be > 0 (the implicit step is chosen by the user)");
-    require(p.time_step <= p.end_time * (1 + 1e-12), "time/time step",
-            "must not exceed time/end time (" + std::to_string(p.end_time) +
-              " s): a larger step is a typo, the run would be one step to the end time (allowed: 0 < time step <= "
-              "end time)");
     prm.enter_subsection("implicit");
     p.analysis       = prm.get("analysis") == "static" ? Parameters<dim>::Analysis::quasi_static
                                                        : Parameters<dim>::Analysis::dynamic;
@@ -136,10 +135,58 @@ namespace talus::implicit_mpm
     prm.leave_subsection();
     p.newton.validate();
     p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
-    for (const auto &v : p.velocities)
-      require(v.target != loads::PrescribedVelocity<dim>::Target::body, v.where + "/apply to",
-              "'body' (a velocity of material points) is not available in talus-implicit: the points move with "
-              "the grid's solution; allowed: boundary | region (prescribed grid nodes)");
+    p.traction_stage.assign(p.tractions.size(), -1);
+    {
+      // the stages; without 'number of stages' one from the top-level entries
+      loads::Stage<dim> top;
+      top.name                = "main";
+      top.duration            = p.end_time;
+      top.gravity             = p.gravity;
+      top.boundary_conditions = p.boundary_conditions;
+      top.tractions           = p.tractions;
+      top.velocities          = p.velocities;
+      top.n_global_tractions  = p.tractions.size();
+      top.n_global_velocities = p.velocities.size();
+      p.stages                = loads::parse_stages<dim>(prm, top, p.bodies, false);
+      p.staged                = !p.stages.empty();
+      if (!p.staged)
+        p.stages.push_back(top);
+    }
+    if (!p.staged)
+      {
+        require(p.time_step > 0, "time/time step", "must be > 0 (the implicit step is chosen by the user)");
+        require(p.time_step <= p.end_time * (1 + 1e-12), "time/time step",
+                "must not exceed time/end time (" + std::to_string(p.end_time) +
+                  " s): a larger step is a typo, the run would be one step to the end time (allowed: 0 < time step "
+                  "<= end time)");
+      }
+    for (unsigned int k = 0; k < p.stages.size(); ++k)
+      {
+        const auto &      st    = p.stages[k];
+        const std::string where = p.staged ? "stage " + std::to_string(k) : std::string("time");
+        double            h     = p.time_step;
+        if (p.staged)
+          {
+            prm.enter_subsection(where);
+            const double own = prm.get_double("time step");
+            prm.leave_subsection();
+            h = own > 0 ? own : p.time_step;
+            require(h > 0, where + "/time step", "must be > 0: give it here or in time/time step");
+            require(h <= st.duration * (1 + 1e-12), where + "/time step",
+                    "must not exceed the stage's duration (" + std::to_string(st.duration) + " s)");
+          }
+        p.stage_time_steps.push_back(h);
+        // the stage's own tractions get slots after the global ones
+        for (unsigned int j = st.n_global_tractions; j < st.tractions.size(); ++j)
+          {
+            p.tractions.push_back(st.tractions[j]);
+            p.traction_stage.push_back(int(k));
+          }
+        for (const auto &v : st.velocities)
+          require(v.target != loads::PrescribedVelocity<dim>::Target::body, v.where + "/apply to",
+                  "'body' (a velocity of material points) is not available in talus-implicit: the points move with "
+                  "the grid's solution; allowed: boundary | region (prescribed grid nodes)");
+      }
     prm.enter_subsection("linear solver");
     p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
                                                     : LinearSolverOptions::Method::cg_amg;
@@ -192,8 +239,10 @@ namespace talus::implicit_mpm
         require(p.grid_lower[0] >= 0, where,
                 "'axisymmetric' needs grid/lower corner x >= 0 (x is the radius; got " +
                   std::to_string(p.grid_lower[0]) + ")");
-        require(p.gravity[0] == 0, "gravity/acceleration",
-                "with 'axisymmetric' the body force must act along the axis (y): its x (radial) component must be 0");
+        for (unsigned int k = 0; k < p.stages.size(); ++k)
+          require(p.stages[k].gravity[0] == 0,
+                  p.staged ? "stage " + std::to_string(k) + "/gravity/acceleration" : std::string("gravity/acceleration"),
+                  "with 'axisymmetric' the body force must act along the axis (y): its x (radial) component must be 0");
         for (const auto &t : p.tractions)
           require(!t.total, t.where,
                   "'total force' is not available with 'axisymmetric' (give the traction in Pa; it is applied per "
@@ -204,9 +253,11 @@ namespace talus::implicit_mpm
       }
     require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_alpha == 0, "implicit/rayleigh alpha",
             "damping needs 'analysis = dynamic'");
-    require(p.analysis == Parameters<dim>::Analysis::dynamic || !p.boundary_conditions.empty(),
-            "boundary conditions", "a static analysis needs at least one fixed or roller wall (without, the "
-            "bodies can move as rigid bodies and the stiffness is singular)");
+    for (unsigned int k = 0; k < p.stages.size(); ++k)
+      require(p.analysis == Parameters<dim>::Analysis::dynamic || !p.stages[k].boundary_conditions.empty(),
+              p.staged ? "stage " + std::to_string(k) + "/boundary conditions" : std::string("boundary conditions"),
+              "a static analysis needs at least one fixed or roller wall (without, the "
+              "bodies can move as rigid bodies and the stiffness is singular)");
     if (p.axisymmetric && p.grid_lower[0] == 0)
       {
         // the axis: u_r = 0 on the nodes at r = 0 (a roller on the x-min wall)
@@ -248,10 +299,6 @@ namespace talus::implicit_mpm
     grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
     space.setup();
-    boundary_flags = loads::wall_dof_flags(grid, prm.boundary_conditions);
-    // the grid nodes of 'loads/velocity k' (owned and ghost: constraints of a
-    // distributed assembly must be known where a rank assembles)
-    prescribed_dofs = loads::prescribed_node_dofs(grid, prm.velocities, false);
 
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
@@ -303,8 +350,12 @@ namespace talus::implicit_mpm
             if (prm.mixed_up) // the mean of the initial stress
               P[pressure_offset] = dealii::trace(L::get_stress(P.data())) / 3.0;
           }
-        dt = prm.time_step;
+        dt = prm.stage_time_steps[0];
       }
+    require(current_stage < prm.stages.size(), "checkpoint/restart",
+            "the checkpoint is in stage " + std::to_string(current_stage) + " but the .prm has " +
+              std::to_string(prm.stages.size()) + " stage(s)");
+    enter_stage(current_stage);
     points.collect_active_cells();
     if (!prm.tractions.empty())
       point_forces.assign(prm.tractions, points, grid, prm.bodies, comm);
@@ -369,7 +420,50 @@ namespace talus::implicit_mpm
   {
     if (dynamic() || !prm.ramp_loads)
       return 1.0;
-    return std::min(1.0, t / prm.end_time);
+    if (!prm.staged)
+      return std::min(1.0, t / prm.end_time);
+    return std::min(1.0, (t - stage_start_time) / prm.stages[current_stage].duration);
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  Solver<dim>::apply_loads_at(const double t)
+  {
+    const double r = load_factor(t);
+    if (!prm.staged) // the ramp scales gravity and every traction alike
+      {
+        point_forces.update_factors(prm.tractions, prm.tractions.size(), t, 0.0);
+        point_force_scale = r;
+        return r * prm.gravity;
+      }
+    // global tractions (absolute time) ramp in with stage 0 and stay on; a
+    // stage's own (stage time) ramp in over it and are off in other stages
+    const unsigned int  k = current_stage;
+    std::vector<double> f(prm.tractions.size(), 0.0);
+    for (unsigned int j = 0; j < prm.tractions.size(); ++j)
+      if (prm.traction_stage[j] < 0)
+        f[j] = prm.tractions[j].function.value(t) * (k == 0 ? r : 1.0);
+      else if (static_cast<unsigned int>(prm.traction_stage[j]) == k)
+        f[j] = prm.tractions[j].function.value(t - stage_start_time) * r;
+    point_forces.set_factors(std::move(f));
+    point_force_scale = 1;
+    const dealii::Tensor<1, dim> &g = prm.stages[k].gravity;
+    if (r == 1.0)
+      return g;
+    const dealii::Tensor<1, dim> g_before = k > 0 ? prm.stages[k - 1].gravity : dealii::Tensor<1, dim>();
+    return g_before + r * (g - g_before);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::enter_stage(const unsigned int k)
+  {
+    const auto &st = prm.stages[k];
+    boundary_flags = loads::wall_dof_flags(grid, st.boundary_conditions);
+    // the grid nodes of the stage's 'velocity k' (owned and ghost: constraints
+    // of a distributed assembly must be known where a rank assembles)
+    prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
+    idle_conditions.assign(st.velocities.size(), 0);
   }
 
   template <int dim>
@@ -393,8 +487,10 @@ namespace talus::implicit_mpm
   {
     // v f integrated over [t, t + h] by the trapezoidal rule (exact for constant
     // and piecewise-linear time functions whose kinks fall on step ends)
-    const auto &pv = prm.velocities[p.condition];
-    return pv.velocity[p.component] * 0.5 * (pv.function.value(time) + pv.function.value(time + h)) * h;
+    const auto & st = prm.stages[current_stage];
+    const auto & pv = st.velocities[p.condition];
+    const double t0 = p.condition < st.n_global_velocities ? 0.0 : stage_start_time; // stage loads: stage time
+    return pv.velocity[p.component] * 0.5 * (pv.function.value(time - t0) + pv.function.value(time + h - t0)) * h;
   }
 
   template <int dim>
@@ -467,7 +563,8 @@ namespace talus::implicit_mpm
     constraints.set_zero(delta);
     const auto &        pins  = active.constraints(); // inactive nodes: no mass, pinned to 0
     const auto &        owned = space.locally_owned_dofs();
-    std::vector<double> n_active(prm.velocities.size(), 0.0);
+    const auto &        velocities = prm.stages[current_stage].velocities;
+    std::vector<double> n_active(velocities.size(), 0.0);
     for (const auto &p : prescribed_dofs)
       {
         const auto i = space.node_dof(p.node, p.component);
@@ -483,12 +580,11 @@ namespace talus::implicit_mpm
     // their cells they carry no mass and the condition acts on nothing; say so
     // (once per condition) instead of letting a displacement control go slack
     dealii::Utilities::MPI::sum(n_active, comm, n_active);
-    idle_conditions.resize(prm.velocities.size(), 0);
     for (unsigned int k = 0; k < n_active.size(); ++k)
       if (n_active[k] == 0 && !idle_conditions[k])
         {
           idle_conditions[k] = 1;
-          log() << "  WARNING: " << prm.velocities[k].where << " reaches no grid node next to material at t = "
+          log() << "  WARNING: " << velocities[k].where << " reaches no grid node next to material at t = "
                 << time << " s (the prescribed nodes are fixed in space and the material has left their cells): "
                 << "the condition has no effect from here on" << std::endl;
         }
@@ -533,7 +629,7 @@ namespace talus::implicit_mpm
     force.history_offset = PropertyLayout<dim>::history;
     force.gravity        = g;
     force.point_forces   = &point_forces;
-    force.load_scale     = load_factor(time + newmark.dt());
+    force.load_scale     = point_force_scale; // set with g by apply_loads_at
     force.tangent        = with_tangent;
     force.failure        = &failure;
     force.radius_offset  = radius_offset;
@@ -624,7 +720,7 @@ namespace talus::implicit_mpm
   {
     newmark.set_time_step(h);
     prepare_step();
-    const dealii::Tensor<1, dim> g = load_factor(time + h) * prm.gravity;
+    const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
     // the external force scale |f_ext| (lumped nodal masses times g)
     double f2 = 0;
     for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
@@ -634,11 +730,10 @@ namespace talus::implicit_mpm
           f2 += std::pow(mass.local_element(k) * g[c], 2);
       }
     double f_ext = std::sqrt(dealii::Utilities::MPI::sum(f2, comm));
-    point_forces.update_factors(prm.tractions, prm.tractions.size(), time + h, 0.0);
     if (point_forces.any())
       {
         // the scale of gravity plus tractions: |sum_p N_i (m_p g + lambda f_p)|
-        transfer::ExternalForce<dim> load{g, &point_forces, load_factor(time + h)};
+        transfer::ExternalForce<dim> load{g, &point_forces, point_force_scale};
         residual = 0;
         with_components([&](auto nc) {
           transfer::assemble<dim, shape::Q1Box<dim>, decltype(nc)::value>({&points}, active, active.constraints(),
@@ -751,8 +846,7 @@ namespace talus::implicit_mpm
   {
     newmark.set_time_step(h);
     prepare_step();
-    point_forces.update_factors(prm.tractions, prm.tractions.size(), time + h, 0.0);
-    const dealii::Tensor<1, dim> g = load_factor(time + h) * prm.gravity;
+    const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
     const auto &                 owned = space.locally_owned_dofs();
     Vector                       v;
     space.reinit_vector(v);
@@ -866,9 +960,29 @@ namespace talus::implicit_mpm
 
   template <int dim>
   double
-  Solver<dim>::begin_stage(const unsigned int, const bool, const bool)
+  Solver<dim>::begin_stage(const unsigned int k, const bool, const bool resumed)
   {
-    return prm.end_time;
+    current_stage = k;
+    if (!resumed) // a restart continues with the checkpointed stage start and step
+      {
+        stage_start_time = time;
+        dt               = prm.stage_time_steps[k];
+      }
+    enter_stage(k);
+    if (!prm.staged)
+      return prm.end_time;
+    const auto &st = prm.stages[k];
+    std::ostringstream os;
+    os << "  stage " << k << " '" << st.name << "': t = " << stage_start_time << " s, duration " << st.duration
+       << " s, dt = " << dt << " s, gravity " << st.gravity << ", " << st.boundary_conditions.size()
+       << " fixed/roller wall(s)";
+    const unsigned int own = st.tractions.size() - st.n_global_tractions;
+    if (!st.tractions.empty())
+      os << ", " << st.tractions.size() << " traction(s) (" << own << " of this stage)";
+    if (!st.velocities.empty())
+      os << ", " << st.velocities.size() << " velocity condition(s)";
+    log() << os.str() << std::endl;
+    return stage_start_time + st.duration;
   }
 
   template <int dim>

@@ -54,11 +54,22 @@ namespace talus::implicit_mpm
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
     /// static: body forces grow linearly from 0 at t = 0 to full at the end time
     bool           ramp_loads = true;
-    /// 'loads/traction k': dead loads carried by boundary points (global, absolute time)
+    /// Every traction of the run, one point-force slot each: first the
+    /// top-level 'loads/traction k' (global, absolute time), then each stage's
+    /// own ('stage k/loads', stage time). Dead loads carried by boundary points,
+    /// assigned once on the seeded state.
     std::vector<loads::Traction<dim>> tractions;
+    /// per traction slot: the stage that owns it, or -1 for a global load
+    std::vector<int> traction_stage;
     /// 'loads/velocity k' on grid nodes (boundary | region): the displacement
     /// increment of each step, integrated over the step, imposed on those DoFs
+    /// (the top-level ones; a stage's list is in stages[k].velocities)
     std::vector<loads::PrescribedVelocity<dim>> velocities;
+    /// The stages (one built from the top-level entries without 'number of
+    /// stages'): gravity, fixed/roller walls, velocity conditions, duration.
+    std::vector<loads::Stage<dim>> stages;
+    std::vector<double>            stage_time_steps; ///< per stage (> 0)
+    bool                           staged = false;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -107,6 +118,7 @@ namespace talus::implicit_mpm
     // ---- the Formulation interface
     std::string              tool_name() const override { return "talus-implicit"; }
     void                     describe(std::ostream &out) const override;
+    unsigned int             n_stages() const override { return prm.stages.size(); }
     double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
     StepOutcome              advance_by(const double h) override;
     void                     check_stability() const override;
@@ -131,8 +143,16 @@ namespace talus::implicit_mpm
 
   private:
     bool dynamic() const { return prm.analysis == Parameters<dim>::Analysis::dynamic; }
-    /// The load factor at time t (static with ramp: t / end time; else 1).
+    /// The ramp of the current stage at time t (static with 'ramp loads': the
+    /// fraction of the stage's duration elapsed, at most 1; else 1).
     double load_factor(const double t) const;
+    /// The body force at time t, and the traction factors of point_forces set
+    /// for t (a static ramp takes the gravity from the previous stage's to this
+    /// stage's and the stage's own tractions from 0 to full over the stage).
+    dealii::Tensor<1, dim> apply_loads_at(const double t);
+    /// Walls, prescribed nodes and the condition report of stage k.
+    void enter_stage(const unsigned int k);
+    double point_force_scale = 1; ///< multiplies the point forces (unstaged static ramp)
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
     /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
