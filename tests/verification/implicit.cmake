@@ -155,3 +155,22 @@ add_test(NAME verification.implicit_prescribed_displacement
                  ${TALUS_PRM_DIR}/implicit/block_prescribed_displacement.prm ${_w}/implicit_prescribed_displacement)
 set_tests_properties(verification.implicit_prescribed_displacement PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
+# rolling disk (seed 001 §4.5.2), docs/implicit.md "Rolling disk": Neo-Hookean disk on the grid
+# floor, gravity tilted by 30 deg, dt ~ 19 x the explicit critical step. The smooth (roller)
+# floor: a = g sin theta within 3 %, no spin, and the rolling checks must fail on it (fast).
+add_test(NAME verification.implicit_rolling_disk_smooth_floor
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk_smooth_floor
+                 --floor roller --expect slide)
+set_tests_properties(verification.implicit_rolling_disk_smooth_floor PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 300)
+# The thesis's case, no slip on a fixed floor: a = (2/3) g sin theta within 3 %, rotation and
+# spin match the travel. DISABLED: it fails for a known reason that is not the implicit step
+# (the fixed floor nodes hold the disk's lowest cell row in both directions: the disk stays put,
+# in talus-explicit too; measured figures in docs/implicit.md). Enable it with a floor that
+# lets the points lift off (a unilateral contact wall).
+add_test(NAME verification.implicit_rolling_disk
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk)
+set_tests_properties(verification.implicit_rolling_disk PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 DISABLED TRUE)
