@@ -19,6 +19,16 @@ add_test(NAME verification.semi_implicit_bad_input
                  ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_bad_input)
 set_tests_properties(verification.semi_implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 
+# checkpoint/restart: N steps vs N/2 + restart + N/2 byte for byte on 1 and on 2
+# ranks (both point sets, the modified F-bar's b_e, the surface load); foreign,
+# other-scene, other-dimension and missing checkpoints refused with exit 2
+add_test(NAME verification.semi_implicit_checkpoint_restart
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm
+                 ${TALUS_PRM_DIR}/implicit/block_top_traction.prm ${_w}/semi_implicit_checkpoint_restart)
+set_tests_properties(verification.semi_implicit_checkpoint_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 PROCESSORS 2)
+
 # self-weight consolidation against Terzaghi's series (triangular initial excess
 # pressure) at T_v = 0.05, 0.1, 0.2, 0.5: relative L2 error < 3 %
 add_test(NAME verification.semi_implicit_consolidation
