@@ -117,8 +117,11 @@ set_tests_properties(verification.semi_implicit_seepage PROPERTIES LABELS "fast"
 # the paper's §5.2 / Table 2 large-deformation consolidation (E = 1 MPa, q = 200 kPa, 0.05 m
 # grid, dt = 5e-4 s, to T_v = 2: 39240 steps, ~3.5 min a model): the settlement within 1 % of
 # the ultimate one of the constitutive law, Hencky 0.15542 m and the small-strain rate model
-# 0.18127 m; the settlement history in the work directory. No coarse version keeps 1 % (the
-# error is O(h), docs/semi-implicit.md): verify only
+# 0.18127 m; the settlement history in the work directory. FAILS TODAY on the paper's grid
+# (-1.47 % / -1.20 %: the surface load as point forces leaves the top row of points nearly
+# unloaded; 0.55 % with 4 x 4 points per cell, docs/semi-implicit.md). No coarse version fits
+# 60 s (the cost is the 39240 pressure solves) or keeps 1 % (the error grows with the top
+# row's thickness): verify only
 add_test(NAME verification.semi_implicit_large_consolidation
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_large_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_large_consolidation.prm
