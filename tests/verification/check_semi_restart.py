@@ -10,8 +10,8 @@ all come back. 200 steps of 3e-4 s, checkpoints every 0.015 s, two kept.
 1. Reference: the uninterrupted run to t = 0.06 s.
 2. The same scene run to t = 0.036 s (the loop writes no checkpoint at the last
    step, so its newest is the one of step 100 = N/2, t = 0.03 s), then again
-   with end time 0.06 s and restart = true, from step 100: soil_final.csv, water_final.csv and series.csv byte for byte
-   identical to the reference; soil.pvd and water.pvd without duplicate times;
+   with end time 0.06 s and restart = true, from step 100: soil_final.csv,
+   water_final.csv and series.csv byte for byte identical to the reference; soil.pvd and water.pvd without duplicate times;
    at most 2 checkpoints and no .part file left.
 3. The same on 2 ranks (restart on as many ranks), against the uninterrupted
    2-rank run.
