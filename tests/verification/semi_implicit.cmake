@@ -19,6 +19,16 @@ add_test(NAME verification.semi_implicit_bad_input
                  ${TALUS_PRM_DIR}/verification/semi_implicit_hydrostatic.prm ${_w}/semi_implicit_bad_input)
 set_tests_properties(verification.semi_implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 
+# checkpoint/restart: N steps vs N/2 + restart + N/2 byte for byte on 1 and on 2
+# ranks (both point sets, the modified F-bar's b_e, the surface load); foreign,
+# other-scene, other-dimension and missing checkpoints refused with exit 2
+add_test(NAME verification.semi_implicit_checkpoint_restart
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm
+                 ${TALUS_PRM_DIR}/implicit/block_top_traction.prm ${_w}/semi_implicit_checkpoint_restart)
+set_tests_properties(verification.semi_implicit_checkpoint_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 PROCESSORS 2)
+
 # self-weight consolidation against Terzaghi's series (triangular initial excess
 # pressure) at T_v = 0.05, 0.1, 0.2, 0.5: relative L2 error < 3 %
 add_test(NAME verification.semi_implicit_consolidation
@@ -103,3 +113,18 @@ add_test(NAME verification.semi_implicit_seepage
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_seepage.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_seepage.prm ${_w}/semi_implicit_seepage)
 set_tests_properties(verification.semi_implicit_seepage PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# the paper's §5.2 / Table 2 large-deformation consolidation (E = 1 MPa, q = 200 kPa, 0.05 m
+# grid, dt = 5e-4 s, to T_v = 2: 39240 steps, ~3.5 min a model): the settlement within 1 % of
+# the ultimate one of the constitutive law, Hencky 0.15542 m and the small-strain rate model
+# 0.18127 m; the settlement history in the work directory. FAILS TODAY on the paper's grid
+# (-1.47 % / -1.20 %: the surface load as point forces leaves the top row of points nearly
+# unloaded; 0.55 % with 4 x 4 points per cell, docs/semi-implicit.md). No coarse version fits
+# 60 s (the cost is the 39240 pressure solves) or keeps 1 % (the error grows with the top
+# row's thickness): verify only
+add_test(NAME verification.semi_implicit_large_consolidation
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_large_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_large_consolidation.prm
+                 ${_w}/semi_implicit_large_consolidation 0.01 hencky,small-strain)
+set_tests_properties(verification.semi_implicit_large_consolidation PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
+                     TIMEOUT 3600)

@@ -12,10 +12,15 @@
 // saved order: the continuation agrees to round-off.
 //
 // What a family keeps beyond the points (nodal sums, partition weights,
-// energies) it writes and reads itself, in the same file.
+// energies, a second point set under its own group) it writes and reads
+// itself, in the same file: write_checkpoint_file hands it the open file,
+// open_checkpoint_to_restore the file of the restart.
 #pragma once
 
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/io/hdf5.h>
 #include <talus/particles/material_point_set.h>
@@ -76,4 +81,63 @@ namespace talus
   void write_pvd_times(io::H5File &f, const std::string &name, const std::vector<std::pair<double, std::string>> &records);
   std::vector<std::pair<double, std::string>> read_pvd_records(const io::H5File &f, const std::string &name,
                                                                const std::string &prefix);
+
+  /// The checkpoint of the state `s` in the run's checkpoint directory: the
+  /// header, the run state and the scene signature, then `body(file)` writes
+  /// the family's part (points, sums, records); committed, then the directory
+  /// pruned to 'checkpoint/keep'. Returns the file's name. Collective.
+  template <int dim, class Body>
+  std::string
+  write_checkpoint_file(const RunParameters<dim> &p, const RunState &s, const std::string &format, const int version,
+                        const std::vector<double> &signature, MPI_Comm comm, Body &&body)
+  {
+    const std::string dir  = checkpoint_directory_of(p);
+    const std::string name = prepare_checkpoint_file(dir, s.step_number, comm);
+    {
+      io::H5File f(name, io::H5File::Mode::create, comm);
+      write_checkpoint_header(f, format, version, dim, comm);
+      write_run_state(f, s);
+      f.write_global("scene/signature", signature, 1);
+      body(f);
+      f.commit();
+    }
+    prune_checkpoint_files(dir, p.checkpoint_keep, comm);
+    return name;
+  }
+
+  /// The newest valid checkpoint of the run's directory with its run state read
+  /// into `s` (restored_from set); nullptr if there is none. Collective.
+  template <int dim>
+  std::unique_ptr<io::H5File>
+  open_checkpoint_to_restore(const RunParameters<dim> &p, RunState &s, const std::string &format, const int version,
+                             const std::vector<double> &signature, MPI_Comm comm)
+  {
+    auto fp = open_newest_checkpoint<dim>(list_checkpoint_files(checkpoint_directory_of(p), comm), format, version,
+                                          signature, comm);
+    if (fp)
+      {
+        read_run_state(*fp, s, p.checkpoint_interval);
+        s.restored_from = fp->path();
+      }
+    return fp;
+  }
+
+  /// 'checkpoint/restart': unless false, `restore()` (returns false when there
+  /// is no valid checkpoint) brings the state back; `true` without one is an
+  /// InputError naming the entry, `if available` starts at t = 0. Returns
+  /// whether the state was restored. Collective.
+  template <int dim, class Restore>
+  bool
+  restore_if_asked(const RunParameters<dim> &p, Restore &&restore)
+  {
+    if (p.restart == RunParameters<dim>::Restart::no)
+      return false;
+    const bool restored = restore();
+    if (!restored && p.restart == RunParameters<dim>::Restart::yes)
+      throw InputError("checkpoint/restart: no valid checkpoint (checkpoint-<step>.h5) in '" +
+                       checkpoint_directory_of(p) + "'");
+    if (!restored)
+      log() << "  no checkpoint in " << checkpoint_directory_of(p) << ": starting at t = 0" << std::endl;
+    return restored;
+  }
 } // namespace talus

@@ -3,6 +3,7 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/formulations/explicit/with_kernel.h>
+#include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
@@ -279,16 +280,7 @@ namespace talus::explicit_mpm
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
       smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
-    bool restored = false;
-    if (prm.restart != Parameters<dim>::Restart::no)
-      {
-        restored = restore_checkpoint();
-        if (!restored && prm.restart == Parameters<dim>::Restart::yes)
-          throw InputError("checkpoint/restart: no valid checkpoint (checkpoint-<step>.h5) in '" +
-                           checkpoint_directory() + "'");
-        if (!restored)
-          log() << "  no checkpoint in " << checkpoint_directory() << ": starting at t = 0" << std::endl;
-      }
+    const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
       std::vector<double> density;

@@ -316,16 +316,7 @@ namespace talus::implicit_mpm
       }
     points.initialize();
 
-    bool restored = false;
-    if (prm.restart != Parameters<dim>::Restart::no)
-      {
-        restored = restore_checkpoint();
-        if (!restored && prm.restart == Parameters<dim>::Restart::yes)
-          throw InputError("checkpoint/restart: no valid checkpoint (checkpoint-<step>.h5) in '" +
-                           checkpoint_directory_of(prm) + "'");
-        if (!restored)
-          log() << "  no checkpoint in " << checkpoint_directory_of(prm) << ": starting at t = 0" << std::endl;
-      }
+    const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
         std::vector<double> density;
@@ -1043,20 +1034,14 @@ namespace talus::implicit_mpm
   std::string
   Solver<dim>::write_checkpoint()
   {
-    const std::string dir  = checkpoint_directory_of(prm);
-    const std::string name = prepare_checkpoint_file(dir, step_number, comm);
-    io::H5File        f(name, io::H5File::Mode::create, comm);
-    write_checkpoint_header(f, checkpoint_format, checkpoint_version, dim, comm);
-    write_run_state(f, *this);
-    f.write_global("scene/signature", scene_signature(prm, points.layout.n_properties()), 1);
-    f.set_attribute("newton iterations", std::int64_t(total_iterations));
-    f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
-    f.set_attribute("cut-backs", std::int64_t(cut_backs));
-    write_points(f, points);
-    write_pvd_times(f, "output/pvd", pvd_records);
-    f.commit();
-    prune_checkpoint_files(dir, prm.checkpoint_keep, comm);
-    return name;
+    return write_checkpoint_file(prm, *this, checkpoint_format, checkpoint_version,
+                                 scene_signature(prm, points.layout.n_properties()), comm, [&](io::H5File &f) {
+                                   f.set_attribute("newton iterations", std::int64_t(total_iterations));
+                                   f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
+                                   f.set_attribute("cut-backs", std::int64_t(cut_backs));
+                                   write_points(f, points);
+                                   write_pvd_times(f, "output/pvd", pvd_records);
+                                 });
   }
 
   template <int dim>
@@ -1071,18 +1056,15 @@ namespace talus::implicit_mpm
   bool
   Solver<dim>::restore_checkpoint()
   {
-    const auto fp = open_newest_checkpoint<dim>(list_checkpoint_files(checkpoint_directory_of(prm), comm),
-                                                checkpoint_format, checkpoint_version,
-                                                scene_signature(prm, points.layout.n_properties()), comm);
+    const auto fp = open_checkpoint_to_restore(prm, *this, checkpoint_format, checkpoint_version,
+                                               scene_signature(prm, points.layout.n_properties()), comm);
     if (!fp)
       return false;
-    read_run_state(*fp, *this, prm.checkpoint_interval);
     total_iterations        = fp->get_int("newton iterations");
     total_linear_iterations = fp->get_int("linear iterations");
     cut_backs               = fp->get_int("cut-backs");
     read_points(*fp, points, grid, "checkpoint " + fp->path());
-    pvd_records   = read_pvd_records(*fp, "output/pvd", "particles");
-    restored_from = fp->path();
+    pvd_records = read_pvd_records(*fp, "output/pvd", "particles");
     return true;
   }
 

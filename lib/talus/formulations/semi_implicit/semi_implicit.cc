@@ -7,6 +7,7 @@
 // paper's §2), so the hydrostatic pore pressure is negative.
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/semi_implicit/fbar.h>
@@ -409,10 +410,6 @@ namespace talus::semi_implicit
                       std::to_string(p.bodies[b].material_id) + " is '" + m.model_name() +
                       "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
           }
-    require(p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
-              p.restart == RunParameters<dim>::Restart::no,
-            "checkpoint", "checkpoints and restarts are not available in talus-semi-implicit yet; use interval = 0, "
-                          "wall clock interval = 0, restart = false");
     require(!p.balance.enabled(), "load balancing/interval",
             "load balancing is not available in talus-semi-implicit yet; use 0");
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
@@ -520,16 +517,16 @@ namespace talus::semi_implicit
     std::vector<std::string> series_columns() const override;
     std::vector<double>      series_values(const bool after_step) override;
     void                     write_vtu(const unsigned int counter) override;
-    std::string              write_checkpoint() override
-    {
-      throw InputError("checkpoint: not available in talus-semi-implicit yet");
-    }
+    void                     rewrite_records() override;
+    std::string              write_checkpoint() override;
     void finish(const std::string &series_csv) override;
     void summary(const LoopTimings &timings) override;
 
   private:
     template <class K>
     void step(const double h);
+    /// The newest valid checkpoint into the state (false: none). Collective.
+    bool restore_checkpoint();
     /// F-bar: the node-smoothed volume increment dJbar at every soil point
     /// (80) and, for the modified F-bar, the patch mean Jebar (83)
     template <class K>
@@ -666,6 +663,9 @@ namespace talus::semi_implicit
     fw.poisson_flux              = water.layout.add_extra("poisson_flux", dim, true);
     soil.initialize();
     water.initialize();
+    dt_soil_critical = soil_critical_time_step(prm, grid.min_cell_size());
+    if (restore_if_asked(prm, [this] { return restore_checkpoint(); }))
+      return; // the points, the step and the loop's state as saved
     seed();
     if (prm.geostatic)
       geostatic_state();
@@ -676,8 +676,65 @@ namespace talus::semi_implicit
         if (soil.layout.n_history)
           m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + soil.layout.history, m.n_history()));
       }
-    dt_soil_critical = soil_critical_time_step(prm, grid.min_cell_size());
-    dt               = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
+    dt = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
+  }
+
+  // ---------------------------------------------------------------- checkpoints
+  // The state between two steps is the two point sets with everything they
+  // carry (soil: velocity, stress, the model's history with b_e, volume,
+  // porosity, conductivity, its share of the surface load; water: velocity,
+  // pore pressure and its gradient, porosity, volume) and the loop's state:
+  // every nodal field of a step (masses, p^t, n_I, the drag, the F-bar dJ and
+  // patch means, the free-surface flags, the pressure system) is rebuilt from
+  // the points at its start, and the patch tiling is fixed by the .prm. Same
+  // rank count: bitwise continuation (docs/semi-implicit.md).
+  namespace
+  {
+    const char *const checkpoint_format  = "talus-semi-implicit-checkpoint";
+    const int         checkpoint_version = 1;
+  } // namespace
+
+  template <int dim>
+  std::string
+  Solver<dim>::write_checkpoint()
+  {
+    return write_checkpoint_file(prm, *this, checkpoint_format, checkpoint_version,
+                                 scene_signature(prm, soil.layout.n_properties()), comm, [&](io::H5File &f) {
+                                   f.set_attribute("pressure solves", std::int64_t(n_solves));
+                                   f.set_attribute("pressure cg iterations", std::int64_t(solver_iterations));
+                                   write_points(f, soil, "soil");
+                                   write_points(f, water, "water");
+                                   write_pvd_times(f, "output/soil_pvd", pvd_records[0]);
+                                   write_pvd_times(f, "output/water_pvd", pvd_records[1]);
+                                 });
+  }
+
+  template <int dim>
+  bool
+  Solver<dim>::restore_checkpoint()
+  {
+    const auto fp = open_checkpoint_to_restore(prm, *this, checkpoint_format, checkpoint_version,
+                                               scene_signature(prm, soil.layout.n_properties()), comm);
+    if (!fp)
+      return false;
+    n_solves          = fp->get_int("pressure solves");
+    solver_iterations = fp->get_int("pressure cg iterations");
+    const std::string where = "checkpoint " + fp->path();
+    read_points(*fp, soil, grid, where, "soil");
+    read_points(*fp, water, grid, where, "water");
+    pvd_records[0] = read_pvd_records(*fp, "output/soil_pvd", soil.name());
+    pvd_records[1] = read_pvd_records(*fp, "output/water_pvd", water.name());
+    return true;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::rewrite_records()
+  {
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      for (const bool is_soil : {true, false})
+        io::write_pvd(prm.output_directory + "/" + (is_soil ? soil : water).name() + ".pvd",
+                      pvd_records[is_soil ? 0 : 1]);
   }
 
   template <int dim>
@@ -1344,14 +1401,14 @@ namespace talus::semi_implicit
   Solver<dim>::series_columns() const
   {
     return {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
-            "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual"};
+            "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume"};
   }
 
   template <int dim>
   std::vector<double>
   Solver<dim>::series_values(const bool)
   {
-    double ek[2] = {0, 0}, vmax[2] = {0, 0}, pmin = 0;
+    double ek[2] = {0, 0}, vmax[2] = {0, 0}, pmin = 0, soil_volume = 0;
     for (const bool is_soil : {true, false})
       for (const auto &pt : (is_soil ? soil : water).handler)
         {
@@ -1363,6 +1420,8 @@ namespace talus::semi_implicit
           vmax[is_soil ? 0 : 1] = std::max(vmax[is_soil ? 0 : 1], std::sqrt(v2));
           if (!is_soil)
             pmin = std::min(pmin, P[fw.pressure]);
+          else // the mixture volume of the skeleton: a 1D column's height x its width
+            soil_volume += P[L::volume];
         }
     return {dealii::Utilities::MPI::sum(ek[0], comm),
             dealii::Utilities::MPI::sum(ek[1], comm),
@@ -1370,7 +1429,8 @@ namespace talus::semi_implicit
             dealii::Utilities::MPI::max(vmax[1], comm),
             dealii::Utilities::MPI::min(pmin, comm),
             static_cast<double>(last_solve.iterations),
-            last_solve.relative_residual};
+            last_solve.relative_residual,
+            dealii::Utilities::MPI::sum(soil_volume, comm)};
   }
 
   template <int dim>
@@ -1452,9 +1512,7 @@ namespace talus::semi_implicit
   void
   check_parameters(dealii::ParameterHandler &prm, const std::string &)
   {
-    const std::string out = prm.get_integer("dimension") == 2 ? parse_parameters<2>(prm).output_directory
-                                                              : parse_parameters<3>(prm).output_directory;
-    require_output_directory(out, "output/directory");
+    check_formulation(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
   int
