@@ -183,7 +183,7 @@ for rep in 1 2; do
     for sets in single double; do
       "$BUILD/tools/talus-semi-implicit" "$(prm_set "$SLOPE" "$TMPD/out_semi_${sets}_$ppd" \
         "particles per direction=$ppd" "point sets=$sets")" > "$TMPD/semi_${sets}_${ppd}_$rep.log"
-      tail -n 1 "$TMPD/semi_${sets}_${ppd}_$rep.log"
+      tail -n 2 "$TMPD/semi_${sets}_${ppd}_$rep.log"
     done
   done
 done
