@@ -1001,6 +1001,7 @@ namespace talus::semi_implicit
           P[fw.poisson_flux + d] = phi * v[d];
       });
     }
+    add_lap(phase.poisson); // the points' Poisson coefficient and flux (also in a dry scene)
     // a dry scene (soil points only) is a single-phase solid: no pressure
     if (water.handler.n_global_particles() == 0)
       dp_node = 0;
