@@ -805,7 +805,7 @@ namespace talus::semi_implicit
     const auto   g    = prm.gravity;
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
-    auto lap = Clock::now(); // phase timers: lap(x) adds the time since the last lap to x
+    auto lap = Clock::now(); // phase timers: add_lap(x) adds the time since the last lap to x
     auto add_lap = [&lap](double &x) {
       const auto now = Clock::now();
       x += std::chrono::duration<double>(now - lap).count();
