@@ -11,6 +11,12 @@
 # 3D scene (time per step and per Newton iteration, assembly ns per point, linear
 # solve time), and the quasi-static oedometer solved by talus-explicit (local
 # damping) and by talus-implicit (static) to the same accuracy: both wall times.
+# Then the semi-implicit family (issue 14): the paper's Table 4 protocol on a
+# saturated slope (single- vs double-point, 2x2 ... 6x6 points per cell, ns per
+# point-step with a breakdown, the double/single overhead) and the same slope
+# with k = 1e-7 m/s by talus-explicit 2-phase and talus-semi-implicit to the
+# same simulated time (the explicit wall time extrapolated from a fixed number
+# of steps).
 # Build type must be Release (the Makefile's default).
 set -euo pipefail
 BUILD=${1:-build}
@@ -47,12 +53,24 @@ TMPD=$(mktemp -d)
 trap 'rm -f "$LOG"; rm -rf "$TMPD"' EXIT
 wall() { grep -o "wall [0-9.e+-]* s" "$1" | awk '{print $2}'; }
 points() { grep -o "done: [0-9]* steps, [0-9]* particles" "$1" | awk '{print $2, $4}'; }
+prm_set() { # prm_set FILE OUTDIR [ENTRY=VALUE ...]: a copy with another output directory and
+  # the given 'set ENTRY = VALUE' lines changed (each entry must occur in FILE)
+  local copy kv
+  copy="$TMPD/$(basename "$2").prm"
+  sed -e "s#set directory *= .*#set directory = $2#" "$1" > "$copy"
+  for kv in "${@:3}"; do
+    grep -q "set ${kv%%=*} *= " "$copy" || { echo "bench: no entry '${kv%%=*}' in $1" >&2; return 2; }
+    sed -i "s#\\(set ${kv%%=*} *= *\\).*#\\1${kv#*=}#" "$copy"
+  done
+  echo "$copy"
+}
 prm_with() { # prm_with FILE OUTDIR [load balancing interval]: a copy with another output directory
-  sed -e "s#set directory *= .*#set directory = $2#" "$1" > "$TMPD/$(basename "$2").prm"
+  local copy
+  copy=$(prm_set "$1" "$2")
   if [ -n "${3:-}" ]; then
-    sed -i "s#set interval *= *0 .*#set interval = $3#" "$TMPD/$(basename "$2").prm"
+    sed -i "s#set interval *= *0 .*#set interval = $3#" "$copy"
   fi
-  echo "$TMPD/$(basename "$2").prm"
+  echo "$copy"
 }
 parallel_figures() { # parallel_figures NAME PRM [load balancing interval for the balanced run]
   local name=$1 prm=$2 lb=${3:-}
@@ -150,4 +168,99 @@ for fam, (wall, proc, err, _) in res.items():
     print(f"  talus-{fam:9s} wall {wall:8.2f} s (process {proc:6.2f} s), max settlement error {100 * err:.3f} % of the top value")
 print(f"  implicit speed-up: {res['explicit'][0] / res['implicit'][0]:.0f} x (solver wall), "
       f"{res['explicit'][1] / res['implicit'][1]:.0f} x (process, start-up included)")
+PY
+
+# ---- semi-implicit family (issue 14), (a) the Table 4 protocol of seed 002 on
+# the saturated slope (parameter_files/bench/semi_implicit_slope.prm): single-
+# vs double-point at 2x2 ... 6x6 points per cell, B-splines, the same dt and
+# number of steps, no output; single and double alternate so that the
+# machine's load drifts over both alike, and every run is made twice: the
+# faster of the two counts (a shared machine only ever slows a run down)
+SLOPE=parameter_files/bench/semi_implicit_slope.prm
+echo "bench: $SLOPE (single rank; point sets single | double, 2x2 ... 6x6 points per cell, each twice)"
+for rep in 1 2; do
+  for ppd in 2 3 4 5 6; do
+    for sets in single double; do
+      "$BUILD/tools/talus-semi-implicit" "$(prm_set "$SLOPE" "$TMPD/out_semi_${sets}_$ppd" \
+        "particles per direction=$ppd" "point sets=$sets")" > "$TMPD/semi_${sets}_${ppd}_$rep.log"
+      tail -n 2 "$TMPD/semi_${sets}_${ppd}_$rep.log"
+    done
+  done
+done
+# (b) the same slope with k = 1e-7 m/s: talus-semi-implicit (double point,
+# 2x2) to the scene's end time, and talus-explicit 2-phase (coupled) at the
+# step talus-critical-dt reports, for 'maximum steps' steps
+"$BUILD/tools/talus-semi-implicit" "$(prm_set "$SLOPE" "$TMPD/out_semi_k7" \
+  "particles per direction=2" "hydraulic conductivity=1e-7")" > "$TMPD/semi_k7_1.log"
+EXPL=parameter_files/bench/semi_implicit_slope_explicit.prm
+"$BUILD/tools/talus-critical-dt" "$(prm_set "$EXPL" "$TMPD/out_expl_k7_dt")" > "$TMPD/expl_k7_dt.log"
+"$BUILD/tools/talus-explicit" "$(prm_set "$EXPL" "$TMPD/out_expl_k7")" > "$TMPD/expl_k7.log"
+python3 - "$TMPD" <<'PY'
+import re, sys
+d = sys.argv[1]
+NUM = r"([\d.e+-]+)"
+def semi(tag, reps=(1,)):  # the run of least wall time among the repetitions
+    return min((semi_run(f"{d}/semi_{tag}_{r}.log") for r in reps), key=lambda r: r["wall"])
+def semi_run(path):
+    t = open(path).read()
+    m = re.search(rf"done: (\d+) steps, dt {NUM} s, wall {NUM} s \(pressure solves {NUM} s", t)
+    b = re.search(rf"breakdown \[s\]: P2N {NUM}, grid {NUM}, Poisson assembly {NUM}, pressure solve {NUM}, "
+                  rf"N2P {NUM}, update\+stress {NUM}, relocation {NUM}; points soil (\d+) water (\d+); "
+                  rf"shape functions: one stencil walk over both sets {NUM} s", t)
+    r = dict(steps=int(m.group(1)), dt=float(m.group(2)), wall=float(m.group(3)))
+    for k, v in zip(("p2n", "grid", "poisson", "solve", "n2p", "stress", "relocation"), b.groups()[:7]):
+        r[k] = float(v)
+    r["soil"], r["water"], r["walk"] = int(b.group(8)), int(b.group(9)), float(b.group(10))
+    return r
+def ns(r, seconds):  # per point-step, the points of one set (the paper's count)
+    return 1e9 * seconds / (r["steps"] * r["soil"])
+phases = [("shape functions*", None), ("P2N", "p2n"), ("N2P (FLIP + remap)", "n2p"), ("stress (update + F-bar)", "stress"),
+          ("Poisson set-up + assembly", "poisson"), ("pressure solve", "solve"), ("grid (nodal)", "grid"),
+          ("relocation + water move", "relocation")]
+runs = {(s, p): semi(f"{s}_{p}", (1, 2)) for p in range(2, 7) for s in ("single", "double")}
+r0 = runs[("single", 2)]
+print(f"\nbench semi-implicit, Table 4 protocol: saturated slope, quadratic B-splines, dt {r0['dt']:g} s, "
+      f"{r0['steps']} steps, no output (I/O excluded), 1 rank, the faster of 2 runs each; machine shared, figures noisy")
+print("  ppc  points/set   single [s]  double [s]  double/single   ns/point-step single  double")
+ratios = []
+for p in range(2, 7):
+    s, dd = runs[("single", p)], runs[("double", p)]
+    ratios.append(dd["wall"] / s["wall"])
+    print(f"  {p}x{p}  {s['soil']:10d}  {s['wall']:10.2f}  {dd['wall']:10.2f}  {ratios[-1]:13.3f}   "
+          f"{ns(s, s['wall']):20.0f}  {ns(dd, dd['wall']):6.0f}")
+mean = sum(ratios) / len(ratios)
+print(f"  mean double/single {mean:.3f} (goal <= 1.10: {'met' if mean <= 1.10 else 'NOT met'}; "
+      f"{sum(x <= 1.10 for x in ratios)} of {len(ratios)} sizes within it)")
+print("  breakdown, ns per point-step (points of one set), single / double:")
+print("  " + " " * 27 + "".join(f"{p}x{p}".rjust(14) for p in range(2, 7)))
+for name, key in phases:
+    cells = []
+    for p in range(2, 7):
+        v = []
+        for s in ("single", "double"):
+            r = runs[(s, p)]
+            v.append(ns(r, 7 * r["walk"] * r["steps"]) if key is None else ns(r, r[key]))
+        cells.append(f"{v[0]:.0f}/{v[1]:.0f}".rjust(14))
+    print(f"  {name:27s}" + "".join(cells))
+print("  * 7 stencil walks (cell search, values and gradients) of both sets per step, timed once at the end;"
+      " contained in the phases below it, not added")
+
+k7 = semi("k7")
+T = k7["steps"] * k7["dt"]
+e = open(f"{d}/expl_k7.log").read()
+em = re.search(rf"done: (\d+) steps, (\d+) particles, wall {NUM} s", e)
+edt = float(re.search(rf"dt = {NUM} s", e).group(1))
+crit = re.search(r"critical time step .*", open(f"{d}/expl_k7_dt.log").read()).group(0)
+esteps, ewall = int(em.group(1)), float(em.group(3))
+full = T / edt
+ewall_full = ewall * full / esteps
+print(f"\nbench semi-implicit vs explicit: the same saturated slope, k = 1e-7 m/s, to t = {T:g} s, 1 rank")
+print(f"  talus-critical-dt (explicit scene): {crit}")
+print(f"  talus-explicit 2-phase (coupled, linear, 2x2, {em.group(2)} points): dt {edt:.4g} s, ran {esteps} steps "
+      f"({esteps * edt:.3g} s simulated) in {ewall:.2f} s;")
+print(f"    to t = {T:g} s: {full:.4g} steps, wall {ewall_full:.4g} s EXTRAPOLATED linearly from those {esteps} steps")
+print(f"  talus-semi-implicit (double point, B-splines, 2x2, {k7['soil']} + {k7['water']} points): dt {k7['dt']:g} s, "
+      f"{k7['steps']} steps, wall {k7['wall']:.2f} s (pressure solves {k7['solve']:.2f} s)")
+print(f"  semi-implicit speed-up {ewall_full / k7['wall']:.0f} x (expected > 10 x); time steps {edt:.3g} -> {k7['dt']:g} s "
+      f"({k7['dt'] / edt:.0f} x)")
 PY

@@ -573,6 +573,16 @@ namespace talus::semi_implicit
     unsigned long long solver_iterations = 0, n_solves = 0;
     double             seconds_solve = 0;
     double             dt_soil_critical = 0;
+    // wall-clock phases of the step (a few clock reads per step; the solve is
+    // seconds_solve): P2N, nodal updates, Poisson set-up and assembly, N2P
+    // (FLIP + MUSL remap), soil update and stress (with F-bar), water move
+    // and the relocation of both sets
+    struct PhaseTimes
+    {
+      double p2n = 0, grid = 0, poisson = 0, n2p = 0, stress = 0, relocation = 0;
+    } phase;
+    template <class K>
+    double shape_walk_seconds(); // one stencil walk over both sets (summary)
   };
 
   template <int dim>
@@ -852,6 +862,12 @@ namespace talus::semi_implicit
     const auto   g    = prm.gravity;
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
+    auto lap = Clock::now(); // phase timers: add_lap(x) adds the time since the last lap to x
+    auto add_lap = [&lap](double &x) {
+      const auto now = Clock::now();
+      x += std::chrono::duration<double>(now - lap).count();
+      lap = now;
+    };
 
     for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
@@ -977,6 +993,7 @@ namespace talus::semi_implicit
       transfer::scatter_weak_gradient<dim, K>(grid, soil, pn, L::volume, gps);
     }
     exchange({&Gpw, &Gps});
+    add_lap(phase.p2n);
 
     // (3) water predictor (53, 59) and (4) mixture predictor (52), the drag
     // implicit in both velocities: the 2 x 2 system per node and component
@@ -1014,6 +1031,7 @@ namespace talus::semi_implicit
         vw_star.local_element(i) = vw;
         vs_star.local_element(i) = vs;
       }
+    add_lap(phase.grid);
 
     // (5) pressure-increment Poisson equation (60)-(63): per point the
     // coefficient dt phi / rho and the source phi div v* (phi = 1 - n for the
@@ -1040,6 +1058,7 @@ namespace talus::semi_implicit
           P[fw.poisson_flux + d] = phi * v[d];
       });
     }
+    add_lap(phase.poisson); // the points' Poisson coefficient and flux (also in a dry scene)
     // a dry scene (soil points only) is a single-phase solid: no pressure
     if (water.handler.n_global_particles() == 0)
       dp_node = 0;
@@ -1122,6 +1141,7 @@ namespace talus::semi_implicit
       transfer::for_each_active_cell(water, aw);
       transfer::finish_assembly(active, as.diag_sum + aw.diag_sum, as.diag_count + aw.diag_count, &A, &rhs);
     }
+    add_lap(phase.poisson);
     {
       const auto          t0 = Clock::now();
       LinearSolverOptions options;
@@ -1136,6 +1156,7 @@ namespace talus::semi_implicit
       seconds_solve += seconds_since(t0);
       solver_iterations += last_solve.iterations;
       ++n_solves;
+      lap = Clock::now();
     }
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
@@ -1150,6 +1171,7 @@ namespace talus::semi_implicit
       transfer::scatter_weak_gradient<dim, K>(grid, water, dpn, L::volume, gwv);
     }
     exchange({&gs, &gw});
+    add_lap(phase.p2n);
     for (unsigned int i = 0; i < nl; ++i)
       {
         const unsigned int j   = node_of[i];
@@ -1163,6 +1185,7 @@ namespace talus::semi_implicit
         vw_new.local_element(i) = vw;
         vs_new.local_element(i) = vs;
       }
+    add_lap(phase.grid);
 
     // (7) FLIP velocities of both sets, pore pressure to the water points;
     // (8a) MUSL: the soil's new momentum to the nodes (Ps reused)
@@ -1202,6 +1225,7 @@ namespace talus::semi_implicit
         const double m          = Ms.local_element(node_of[i]);
         vs_t.local_element(i)   = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
       }
+    add_lap(phase.n2p);
 
     if (prm.stabilisation != VolumetricStabilisation::none)
       fbar_averages<K>(h, ms_cut);
@@ -1306,6 +1330,7 @@ namespace talus::semi_implicit
       SoilUpdate                                              su{*this, at(vs_new), h};
       transfer::UpdateAndMove<dim, K, SoilUpdate>             move_soil(grid, soil, at(vs_t), h, su);
       transfer::for_each_active_cell(soil, move_soil);
+      add_lap(phase.stress);
       soil.relocate();
       WaterMove                                               wm;
       // single point: the water rides on the soil points (the same positions,
@@ -1313,7 +1338,34 @@ namespace talus::semi_implicit
       transfer::UpdateAndMove<dim, K, WaterMove> move_water(grid, water, at(prm.single_point ? vs_new : vw_new), h, wm);
       transfer::for_each_active_cell(water, move_water);
       water.relocate();
+      add_lap(phase.relocation);
     }
+  }
+
+  template <int dim>
+  template <class K>
+  double
+  Solver<dim>::shape_walk_seconds()
+  {
+    // the cost of finding every point's cell and evaluating its stencil (values
+    // and gradients), with one interpolation per point so that it is not
+    // optimised away: each point pass of the step pays this once. The least
+    // of 5 walks (one walk is short: a shared machine's hiccup would dominate)
+    double        sum = 0, t = std::numeric_limits<double>::max();
+    const double *nn  = n_node.begin();
+    for (unsigned int repeat = 0; repeat < 5; ++repeat)
+      {
+        const auto t0 = Clock::now();
+        for (MaterialPointSet<dim> *set : {&soil, &water})
+          transfer::for_each_point_stencil<dim, K>(
+            grid, *set, [&](unsigned int, transfer::PointIterator<dim> &, const transfer::PointStencil<dim, K> &s) {
+              sum += s.value(nn);
+            });
+        t = std::min(t, seconds_since(t0));
+      }
+    volatile double keep = sum;
+    (void)keep;
+    return t;
   }
 
   template <int dim>
@@ -1506,6 +1558,14 @@ namespace talus::semi_implicit
           << " s (pressure solves " << seconds_solve << " s, mean "
           << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations), lost points "
           << lost_points() << ", output in " << prm.output_directory << "/" << std::endl;
+    // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
+    // set per step, 8-9 of the soil with F-bar)
+    const double walk = prm.bspline ? shape_walk_seconds<shape::BSpline2Box<dim>>() : shape_walk_seconds<shape::Q1Box<dim>>();
+    log() << std::setprecision(4) << "  breakdown [s]: P2N " << phase.p2n << ", grid " << phase.grid << ", Poisson assembly "
+          << phase.poisson << ", pressure solve " << seconds_solve << ", N2P " << phase.n2p << ", update+stress "
+          << phase.stress << ", relocation " << phase.relocation << "; points soil "
+          << soil.handler.n_global_particles() << " water " << water.handler.n_global_particles()
+          << "; shape functions: one stencil walk over both sets " << walk << " s" << std::endl;
   }
 
   // ================================================================ tool entry points
