@@ -85,6 +85,15 @@ add_test(NAME verification.implicit_traction
 set_tests_properties(verification.implicit_traction PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
                      PROCESSORS 2)
 
+# stages (issue 13): a self-weight stage, then a stage traction with the weight kept,
+# each ramped over its own load steps; settlement after each stage vs the
+# oedometric small-strain solutions within 1 %, on 2 ranks
+add_test(NAME verification.implicit_staged
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_staged.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/block_staged.prm ${_w}/implicit_staged 1e-2)
+set_tests_properties(verification.implicit_staged PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
+
 # Cook's membrane (seed 001 §5.4.1, Table 5.1): u locks at nu = 0.499999, the
 # stabilised u-p does not; u-p at the finest resolution vs 0.323 / 0.275
 add_test(NAME verification.implicit_cooks_membrane
