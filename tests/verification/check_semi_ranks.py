@@ -36,6 +36,10 @@ for s in ("soil", "water"):
         for p, f in floor.items():
             if c.startswith(p + "_"):
                 scale = max(scale, f)
+        # the other components of a vector property (pore_pressure_gradient_x, ...):
+        # on the scale of the vertical one
+        if c[-2:] in ("_x", "_z") and c[:-2] + "_y" in a and not c.startswith("pos_"):
+            scale = max(scale, max(abs(v) for v in a[c[:-2] + "_y"]))
         d[c] = max(abs(x - y) for x, y in zip(a[c], b[c])) / (scale or 1.0)
     worst = max(d, key=d.get)
     print(f"{s}: largest relative difference {d[worst]:.2e} in '{worst}'")

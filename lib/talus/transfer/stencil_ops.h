@@ -15,6 +15,8 @@
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/matrix_ops.h>
 
+#include <algorithm>
+
 namespace talus::transfer
 {
   /// The nodes one point touches (N or grad N non-zero), with grid local DoF
@@ -132,6 +134,32 @@ namespace talus::transfer
               s.dof[k][d] = cell.dofs[slot[w] * dim + d];
             }
         }
+  }
+
+  /// The stencil at x + offset, a position near a point of cell c (e.g. the
+  /// point's share of a loaded face: a traction acts on the surface, not at
+  /// the point), in c or the vertex neighbour of c that contains it; a
+  /// position beyond the grid (no such cell) is clamped into c.
+  template <int dim, class K>
+  inline void
+  offset_stencil(const BackgroundGrid<dim> &grid,
+                 const unsigned int         c,
+                 const dealii::Point<dim> & x,
+                 const double *             offset,
+                 PointStencil<dim, K> &     s)
+  {
+    dealii::Point<dim> y = x, xi;
+    for (unsigned int d = 0; d < dim; ++d)
+      y[d] += offset[d];
+    unsigned int n = grid.find_cell_near(c, y, xi);
+    if (n == dealii::numbers::invalid_unsigned_int)
+      {
+        n  = c;
+        xi = grid.reference_point(c, y);
+        for (unsigned int d = 0; d < dim; ++d)
+          xi[d] = std::clamp(xi[d], 0.0, 1.0);
+      }
+    point_stencil<dim, K>(K::cell(grid, n), xi, s);
   }
 
   /// The op: visit(c, it, stencil) for every point of the walk.

@@ -132,6 +132,18 @@ namespace talus::semi_implicit
       prm.declare_entry("water level", "0", Double(-1e300, 1e300), "Vertical coordinate of the free water surface [m].");
       prm.declare_entry("soil surface", "0", Double(-1e300, 1e300), "Vertical coordinate of the soil surface [m].");
       prm.declare_entry("K0", "1", Double(0), "Horizontal / vertical effective stress ratio.");
+      prm.declare_entry("initialisation time", "0", Double(-1e300, 1e300),
+                        "Seed 002 App. B.4 (0: none). For t below this time [s] gravity grows linearly from 0 "
+                        "to full, the soil models are elastic (nor sand without plasticity; linear elastic and "
+                        "neo hookean as they are; other models are refused), the water points move with the "
+                        "soil velocity (no seepage of the points) and every soil point has the 'initialisation "
+                        "conductivity'. At its end each nor sand point takes its current pressure and elastic "
+                        "volumetric strain as the reference, its image pressure from the OCR (Eq. 113) and "
+                        "v0 <- J v0 (Eq. 114); then plasticity is on. The time continues: the end time includes "
+                        "this stage.");
+      prm.declare_entry("initialisation conductivity", "1", Double(-1e300, 1e300),
+                        "Hydraulic conductivity [m/s] of every soil point during the App. B.4 initialisation "
+                        "(the paper: 1 m/s), > 0.");
     }
     prm.leave_subsection();
     for (unsigned int k = 0; k < counts.n_materials; ++k)
@@ -158,6 +170,12 @@ namespace talus::semi_implicit
                           "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
                           "soil points carries it, each point the force q V_p / (h / particles per direction), "
                           "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
+        prm.declare_entry("surface load acts at", "body surface", dealii::Patterns::Selection("body surface|top points"),
+                          "Where a loaded point's force enters the grid. body surface: at the point's share of the "
+                          "upper face, the point position plus half its sub-cell height, a vector carried by the "
+                          "point's dF (the weak form's integral over the face: the top points carry the full q). "
+                          "top points: at the point itself (the top layer then carries only part of q and is "
+                          "too stiff; kept for comparison; docs/semi-implicit.md).");
         // must be set: it makes a .prm this family's (an explicit scene is not
         // silently read as a saturated two-phase one)
         prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
@@ -322,6 +340,25 @@ namespace talus::semi_implicit
     p.water_level  = prm.get_double("water level");
     p.soil_surface = prm.get_double("soil surface");
     p.K0           = prm.get_double("K0");
+    p.initialisation_time         = prm.get_double("initialisation time");
+    p.initialisation_conductivity = prm.get_double("initialisation conductivity");
+    require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 &&
+              p.initialisation_time < p.end_time,
+            "initial state/initialisation time",
+            "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to below the end time " +
+              number_text(p.end_time) + " s");
+    require(std::isfinite(p.initialisation_conductivity) && p.initialisation_conductivity > 0,
+            "initial state/initialisation conductivity",
+            "is " + number_text(p.initialisation_conductivity) + "; must be > 0 m/s");
+    if (p.initialisation_time > 0)
+      for (unsigned int m = 0; m < p.materials.size(); ++m)
+        {
+          const std::string model = p.materials[m]->model_name();
+          require(model == "nor sand" || model == "linear elastic" || model == "neo hookean",
+                  "material " + std::to_string(m) + "/model",
+                  "is " + model + ", which has no elastic-only mode for 'initial state/initialisation time'; "
+                  "allowed with an initialisation: nor sand, linear elastic, neo hookean");
+        }
     prm.leave_subsection();
     for (unsigned int k = 0; k < p.materials.size(); ++k)
       {
@@ -349,6 +386,7 @@ namespace talus::semi_implicit
           SurfaceLoad sl;
           sl.q                     = prm.get_double("surface load");
           sl.ramp                  = prm.get_double("surface load ramp time");
+          sl.at_surface            = prm.get("surface load acts at") == "body surface";
           const std::string extent = prm.get("surface load extent");
           if (!dealii::Utilities::trim(extent).empty())
             {
@@ -440,6 +478,7 @@ namespace talus::semi_implicit
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
       unsigned int pressure_gradient = 0, surface_force = 0;
+      unsigned int surface_offset = 0; // dim values: from the point to its share of the loaded face
       unsigned int poisson_coefficient = 0, poisson_flux = 0; // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
     };
@@ -567,6 +606,13 @@ namespace talus::semi_implicit
     PatchTiling<dim>    patches;
     std::vector<double> patch_mass, patch_mass_Je;
     std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
+    // App. B.4 initialisation: the models of the elastic stage (nor sand
+    // without plasticity, the others as they are), per material
+    std::vector<std::shared_ptr<const materials::Material>> initialisation_models;
+    bool initialising(const double t) const { return t < prm.initialisation_time - 1e-9 * dt; } // as the loop's end test
+    /// End of the App. B.4 stage: every nor sand point's references from its
+    /// current state (Eqs. 111-114). Logs one line.
+    void end_initialisation();
 
     // diagnostics
     LinearSolveInfo    last_solve;
@@ -658,6 +704,7 @@ namespace talus::semi_implicit
     fs.initial_volume              = soil.layout.add_extra("initial_volume", 1);
     fs.conductivity                = soil.layout.add_extra("conductivity", 1);
     fs.surface_force               = soil.layout.add_extra("surface_force", 1);
+    fs.surface_offset              = soil.layout.add_extra("surface_offset", dim, true);
     fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_flux              = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
@@ -673,6 +720,14 @@ namespace talus::semi_implicit
     fw.poisson_flux              = water.layout.add_extra("poisson_flux", dim, true);
     soil.initialize();
     water.initialize();
+    initialisation_models = prm.materials;
+    for (auto &m : initialisation_models)
+      if (const auto *ns = dynamic_cast<const materials::NorSand *>(m.get()))
+        {
+          auto elastic = std::make_shared<materials::NorSand>(ns->parameters());
+          elastic->set_plasticity(false);
+          m = elastic;
+        }
     dt_soil_critical = soil_critical_time_step(prm, grid.min_cell_size());
     if (restore_if_asked(prm, [this] { return restore_checkpoint(); }))
       return; // the points, the step and the loop's state as saved
@@ -794,6 +849,10 @@ namespace talus::semi_implicit
                 const auto         x    = pt.get_location();
                 const bool on_face = x[dim - 1] > prm.bodies[b].upper[dim - 1] - dy && x[0] >= load.from && x[0] <= load.to;
                 P[f.surface_force] = load.q > 0 && on_face ? load.q * V0 / dy : 0.0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  P[f.surface_offset + d] = 0;
+                if (P[f.surface_force] != 0 && load.at_surface)
+                  P[f.surface_offset + dim - 1] = 0.5 * dy;
               }
             else
               {
@@ -859,7 +918,10 @@ namespace talus::semi_implicit
   {
     using Stencil     = transfer::PointStencil<dim, K>;
     using It          = transfer::PointIterator<dim>;
-    const auto   g    = prm.gravity;
+    // App. B.4 stage: gravity ramped over it (the factor at mid-step), elastic
+    // models, the water on the soil, the initialisation conductivity
+    const bool   initial_stage = initialising(time);
+    const auto   g = (initial_stage ? std::min(1.0, (time + 0.5 * h) / prm.initialisation_time) : 1.0) * prm.gravity;
     const double rw   = prm.water_density;
     const unsigned int nl = n_local();
     auto lap = Clock::now(); // phase timers: add_lap(x) adds the time since the last lap to x
@@ -878,13 +940,15 @@ namespace talus::semi_implicit
     // (58), see below); effective-stress internal force and soil gravity (54)-(55)
     {
       double *ms = at(Ms), *ps = at(Ps), *mn = at(Mn), *mk = at(Mk), *fsv = at(Fs);
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+      Stencil surface; // a loaded point's stencil at its share of the face
+      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int c, It &it, const Stencil &s) {
         const double *P = it->get_properties().data();
         const double  m = P[L::mass];
         s.scatter(ms, m);
         s.scatter_vector(ps, m, P + L::velocity);
         s.scatter(mn, m * P[fs.porosity]);
-        s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / P[fs.conductivity]);
+        const double k = initial_stage ? prm.initialisation_conductivity : P[fs.conductivity];
+        s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / k);
         double gm[dim];
         for (unsigned int d = 0; d < dim; ++d)
           gm[d] = g[d];
@@ -896,7 +960,8 @@ namespace talus::semi_implicit
           {
             double f[dim] = {};
             f[dim - 1]    = -P[fs.surface_force] * prm.surface_load[static_cast<unsigned int>(P[L::body])].factor(time, h);
-            s.scatter_vector(fsv, 1.0, f);
+            transfer::offset_stencil<dim, K>(grid, c, it->get_location(), P + fs.surface_offset, surface);
+            surface.scatter_vector(fsv, 1.0, f);
           }
       });
     }
@@ -1235,6 +1300,7 @@ namespace talus::semi_implicit
     struct SoilUpdate
     {
       const Solver &        s;
+      const std::vector<std::shared_ptr<const materials::Material>> &models; // per material, this step's
       const double *        v_grid; // v_s^{t+1}: the point moves with it
       const double          h;
       struct PointState
@@ -1263,7 +1329,7 @@ namespace talus::semi_implicit
         if (!(dJ > 0))
           throw InstabilityError("a soil point's volume increment det(ΔF) = " + std::to_string(dJ) + " is not positive");
         const unsigned int mid = static_cast<unsigned int>(P[L::material]);
-        const materials::Material &m = *s.prm.materials[mid];
+        const materials::Material &m = *models[mid];
         double *const history = P + s.soil.layout.history;
         // the increment the model sees: ΔF, or ΔF-bar (79), or for the modified
         // F-bar ΔF-bar scaled so that it pushes b_e-bar (81)-(82) (fbar.h)
@@ -1280,6 +1346,19 @@ namespace talus::semi_implicit
             dF_model = stabilised_increment<dim>(dF, dJ_bar, ratio);
           }
         P[L::volume] *= dJ;                                     // (8d)
+        if (P[s.fs.surface_force] != 0) // the loaded face moves with the material: d <- dF d
+          {
+            double d[dim];
+            for (unsigned int i = 0; i < dim; ++i)
+              d[i] = P[s.fs.surface_offset + i];
+            for (unsigned int i = 0; i < dim; ++i)
+              {
+                double di = 0;
+                for (unsigned int j = 0; j < dim; ++j)
+                  di += dF[i][j] * d[j];
+                P[s.fs.surface_offset + i] = di;
+              }
+          }
         const double J  = P[L::volume] / P[s.fs.initial_volume]; // (8e)
         const double n0 = P[s.fs.initial_porosity];
         const double n  = std::clamp(1 - (1 - n0) / J, 1e-6, 1 - 1e-6); // (8f)
@@ -1327,7 +1406,7 @@ namespace talus::semi_implicit
       {}
     };
     {
-      SoilUpdate                                              su{*this, at(vs_new), h};
+      SoilUpdate su{*this, initial_stage ? initialisation_models : prm.materials, at(vs_new), h};
       transfer::UpdateAndMove<dim, K, SoilUpdate>             move_soil(grid, soil, at(vs_t), h, su);
       transfer::for_each_active_cell(soil, move_soil);
       add_lap(phase.stress);
@@ -1335,11 +1414,36 @@ namespace talus::semi_implicit
       WaterMove                                               wm;
       // single point: the water rides on the soil points (the same positions,
       // moved by the same velocity field and the same arithmetic)
-      transfer::UpdateAndMove<dim, K, WaterMove> move_water(grid, water, at(prm.single_point ? vs_new : vw_new), h, wm);
+      transfer::UpdateAndMove<dim, K, WaterMove> move_water(grid, water,
+                                                            at(prm.single_point || initial_stage ? vs_new : vw_new), h, wm);
       transfer::for_each_active_cell(water, move_water);
       water.relocate();
       add_lap(phase.relocation);
     }
+    if (initial_stage && !initialising(time + h))
+      end_initialisation();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::end_initialisation()
+  {
+    unsigned long long n = 0;
+    for (auto &pt : soil.handler)
+      {
+        auto P = pt.get_properties();
+        if (const auto *ns = dynamic_cast<const materials::NorSand *>(prm.materials[static_cast<unsigned int>(P[L::material])].get()))
+          {
+            ns->reinitialize_reference(dealii::ArrayView<double>(P.data() + soil.layout.history, ns->n_history()));
+            ++n;
+          }
+      }
+    n = dealii::Utilities::MPI::sum(n, comm);
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      std::cout << "initialisation (seed 002 App. B.4) ends at t = " << prm.initialisation_time << " s: " << n
+                << " nor sand points take their current pressure and elastic volumetric strain as the reference, "
+                   "the image pressure from the OCR (Eq. 113); plasticity on, conductivity k0, water points free"
+                << std::endl;
   }
 
   template <int dim>
@@ -1533,13 +1637,21 @@ namespace talus::semi_implicit
               const char *  xyz[] = {"x", "y", "z"};
               for (unsigned int d = 0; d < dim; ++d)
                 f << "pos_" << xyz[d] << ",";
-              // vector properties get their component as suffix (velocity_x, ...)
-              const auto names = set.layout.names();
+              // vector properties get their component as suffix (velocity_x,
+              // pore_pressure_gradient_y, ...)
+              const auto   names = set.layout.names();
+              std::vector<int> component(names.size(), -1);
+              for (unsigned int k = L::velocity; k < L::stress; ++k)
+                component[k] = (k - L::velocity) % dim;
+              for (const auto &e : set.layout.extras)
+                if (e.vector)
+                  for (unsigned int i = 0; i < e.size; ++i)
+                    component[e.offset + i] = i % dim;
               for (unsigned int k = 0; k < names.size(); ++k)
                 {
                   f << names[k];
-                  if (k >= L::velocity && k < L::stress)
-                    f << "_" << xyz[(k - L::velocity) % dim];
+                  if (component[k] >= 0)
+                    f << "_" << xyz[component[k]];
                   f << (k + 1 < names.size() ? "," : "\n");
                 }
               for (const auto &r : all)

@@ -49,6 +49,9 @@ namespace talus::semi_implicit
     double from = -1e300; ///< strip: first horizontal coordinate from ...
     double to   = 1e300;  ///< ... to (the whole face by default)
     double ramp = 0;      ///< linear ramp time [s]; 0: sudden at t = 0
+    /// where each loaded point's force acts: at the body's surface (the point
+    /// position + its half sub-cell spacing, carried by dF), or at the point
+    bool at_surface = true;
     /// the fraction of q applied over a step that starts at t
     double factor(const double t, const double h) const
     {
@@ -90,6 +93,11 @@ namespace talus::semi_implicit
     double water_level  = 0; ///< vertical coordinate of the free water surface
     double soil_surface = 0; ///< vertical coordinate of the soil surface
     double K0           = 1;
+    /// seed 002 App. B.4: for t < initialisation time gravity ramps from 0, the
+    /// soil models are elastic, the water rides on the soil and every soil point
+    /// has the conductivity below; at its end the Nor-Sand references are reset
+    double initialisation_time         = 0;
+    double initialisation_conductivity = 1;
   };
 
   void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file);
