@@ -137,3 +137,13 @@ add_test(NAME verification.semi_implicit_large_consolidation_fast
                  "--set=material 0/soil/hydraulic conductivity=1e-2" "--set=time/end time=1.962")
 set_tests_properties(verification.semi_implicit_large_consolidation_fast PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 900)
+
+# seed 002 App. B.4: the elastic initialisation stage of a Nor-Sand scene on a level saturated
+# column (hydrostatic state, Eqs. 111-113 at every point, plasticity after it; a run without
+# the stage must fail the Eq. 111 check), about 45 s
+add_test(NAME verification.semi_implicit_norsand_initialisation
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_norsand_initialisation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_norsand_initialisation.prm
+                 ${_w}/semi_implicit_norsand_initialisation)
+set_tests_properties(verification.semi_implicit_norsand_initialisation PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 900)

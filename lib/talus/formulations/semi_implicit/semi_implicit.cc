@@ -140,7 +140,7 @@ namespace talus::semi_implicit
                         "conductivity'. At its end each nor sand point takes its current pressure and elastic "
                         "volumetric strain as the reference, its image pressure from the OCR (Eq. 113) and "
                         "v0 <- J v0 (Eq. 114); then plasticity is on. The time continues: the end time includes "
-                        "this stage.");
+                        "this stage (an end time equal to it ends the run on the initialised state).");
       prm.declare_entry("initialisation conductivity", "1", Double(-1e300, 1e300),
                         "Hydraulic conductivity [m/s] of every soil point during the App. B.4 initialisation "
                         "(the paper: 1 m/s), > 0.");
@@ -343,9 +343,9 @@ namespace talus::semi_implicit
     p.initialisation_time         = prm.get_double("initialisation time");
     p.initialisation_conductivity = prm.get_double("initialisation conductivity");
     require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 &&
-              p.initialisation_time < p.end_time,
+              p.initialisation_time <= p.end_time,
             "initial state/initialisation time",
-            "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to below the end time " +
+            "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to the end time " +
               number_text(p.end_time) + " s");
     require(std::isfinite(p.initialisation_conductivity) && p.initialisation_conductivity > 0,
             "initial state/initialisation conductivity",
