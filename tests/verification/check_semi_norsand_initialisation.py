@@ -16,7 +16,11 @@ Run A ends at the end of the stage (0.2 s), on the initialised state:
     end of the stage printed once.
 Run B continues 0.03 s with plasticity: some point yields (history 9 > 1e-6),
 the stage ended once (one log line), the water points have left the soil
-points (gap > 1e-9 m).
+points (gap > 1e-9 m). The specific volume is node-smoothed (Eqs. 96-97,
+v = v0 Jbar): the mass-weighted sum of v / v0 equals that of the points' own
+J = V / V0 to 1e-10 (the map-remap conserves it), while single points differ
+from v0 J by more than 1e-6 (the smoothing acts). Run C, the same with
+'nor sand specific volume = point': v = v0 J at every point to 1e-9.
 Mutant: the same run A without the stage (initialisation time = 0) must fail
 the Eq. 111 check (the reference stays p0 = 2 kPa).
 Usage: check_semi_norsand_initialisation.py TOOL PRM WORKDIR
@@ -95,6 +99,26 @@ print(f"0.03 s after the stage: largest plastic deviatoric strain {Ed:.2e}, gap 
 tv.check(Ed > 1e-6, f"plasticity is on after the stage (largest plastic strain {Ed:.2e})")
 tv.check(out.count(END_LINE) == 1, f"the stage ends once in a longer run ({out.count(END_LINE)})")
 tv.check(gap(soil, water) > 1e-9, f"the water points move on their own after the stage (gap {gap(soil, water):.1e} m)")
+v0 = 1.55
+
+
+def specific_volume_vs_J(soil):
+    m = soil["mass"]
+    ratio = [soil["history_7"][i] / v0 for i in range(len(m))]
+    J = [soil["volume"][i] / soil["initial_volume"][i] for i in range(len(m))]
+    sums = abs(sum(a * b for a, b in zip(m, ratio)) - sum(a * b for a, b in zip(m, J))) / sum(m)
+    return sums, max(abs(a - b) for a, b in zip(ratio, J))
+
+
+sums, local = specific_volume_vs_J(soil)
+print(f"node-smoothed specific volume: mass-weighted sums of v / v0 and J differ by {sums:.1e}, points by up to {local:.1e}")
+tv.check(sums < 1e-10, f"Eq. 97 map-remap conserves the mass-weighted J ({sums:.1e})")
+tv.check(local > 1e-6, f"v / v0 is the smoothed J, not the point's J ({local:.1e})")
+_, soil, _ = run("point_v", tv.prm_set(tv.prm_set(base, "time/end time", "0.23"),
+                                        "semi implicit/nor sand specific volume", "point"))
+_, local = specific_volume_vs_J(soil)
+print(f"'point' specific volume: v / v0 vs J {local:.1e}")
+tv.check(local < 1e-9, f"with 'point' v = v0 J at every point ({local:.1e})")
 
 # mutant: no stage, the reference stays p0
 _, soil, _ = run("no_stage", tv.prm_set(base, "initial state/initialisation time", "0"))

@@ -61,6 +61,8 @@ namespace talus::materials
     double constrained_modulus() const override;
 
     unsigned int             n_history() const override { return 13; }
+    /// history slot of the specific volume v (= v0 J unless a caller sets it)
+    static constexpr unsigned int specific_volume_slot = 7;
     std::vector<std::string> history_names() const override;
     /// sigma = 0: isotropic state at p0 (reference), eps_v,ref; p_i from Eq. 113
     /// with the OCR. sigma != 0: reference pressure p_ref = tr(sigma)/3, deviatoric

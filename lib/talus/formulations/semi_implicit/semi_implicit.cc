@@ -105,6 +105,10 @@ namespace talus::semi_implicit
                         "velocity, so they stay on them; the water keeps its own velocity, mass, pressure and "
                         "the same equations and basis (the single-point comparison). single needs every body "
                         "to be saturated or soil.");
+      prm.declare_entry("nor sand specific volume", "node-smoothed", Selection("node-smoothed|point"),
+                        "The specific volume v of nor sand soil points. node-smoothed: v = v0 Jbar, Jbar the "
+                        "mass-weighted node map and remap of the points' total J (seed 002 Eqs. 96-97). point: "
+                        "v = v0 J of the point itself (Borja & Andrade, Eq. 95).");
       prm.declare_entry("patch size", "1.5", Double(0),
                         "Side of the modified F-bar patches in cells (1.5 for quadratic B-splines, 1 = the "
                         "cell-wise average); the patches tile the grid from its lower corner and stay fixed.");
@@ -327,6 +331,7 @@ namespace talus::semi_implicit
                                                       : VolumetricStabilisation::none;
       p.patch_size = prm.get_double("patch size");
       p.single_point = prm.get("point sets") == "single";
+      p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
       require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
     }
     require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
@@ -481,6 +486,7 @@ namespace talus::semi_implicit
       unsigned int surface_offset = 0; // dim values: from the point to its share of the loaded face
       unsigned int poisson_coefficient = 0, poisson_flux = 0; // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
+      unsigned int smoothed_jacobian = 0; // Nor-Sand (96)-(97): Jbar^{t+1}
     };
 
     /// The pressure-increment Poisson terms of one point: K += V c grad N grad N,
@@ -566,10 +572,13 @@ namespace talus::semi_implicit
     void step(const double h);
     /// The newest valid checkpoint into the state (false: none). Collective.
     bool restore_checkpoint();
-    /// F-bar: the node-smoothed volume increment dJbar at every soil point
-    /// (80) and, for the modified F-bar, the patch mean Jebar (83)
+    /// The node-smoothed volume measures of the soil points, one map and
+    /// remap: F-bar's increment dJbar (80) and, for the modified F-bar, the
+    /// patch mean Jebar (83); Nor-Sand's total Jbar^{t+1} (97)
     template <class K>
-    void fbar_averages(const double h, const double ms_cut);
+    void volume_averages(const double h, const double ms_cut);
+    /// whether the soil points need Jbar (a nor sand material, smoothing on)
+    bool smooth_jacobian = false;
     void seed();
     void geostatic_state();
     /// compress(add) then update ghosts, for every vector given
@@ -602,6 +611,7 @@ namespace talus::semi_implicit
     Vector p_node, dp_node, gs, gw, wet, dry, near_wet;
     std::vector<double> cell_water_volume;
     Vector Mdj; // F-bar: sum N m dJ of the soil points
+    Vector Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
     // modified F-bar patches: a fixed square tiling from the grid's lower corner
     PatchTiling<dim>    patches;
     std::vector<double> patch_mass, patch_mass_Je;
@@ -690,7 +700,7 @@ namespace talus::semi_implicit
             }
         }
     patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
-    for (Vector *v : {&Mdj, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
+    for (Vector *v : {&Mdj, &Mjt, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
                       &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
 
@@ -711,6 +721,10 @@ namespace talus::semi_implicit
       fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
     if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
       fs.patch_elastic_jacobian = soil.layout.add_extra("patch_elastic_jacobian", 1);
+    for (const auto &m : prm.materials)
+      smooth_jacobian = smooth_jacobian || (prm.smoothed_specific_volume && m->model_name() == "nor sand");
+    if (smooth_jacobian)
+      fs.smoothed_jacobian = soil.layout.add_extra("smoothed_jacobian", 1);
     fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
     fw.pressure_gradient           = water.layout.add_extra("pore_pressure_gradient", dim, true);
     fw.porosity                    = water.layout.add_extra("porosity", 1);
@@ -1292,8 +1306,8 @@ namespace talus::semi_implicit
       }
     add_lap(phase.n2p);
 
-    if (prm.stabilisation != VolumetricStabilisation::none)
-      fbar_averages<K>(h, ms_cut);
+    if (prm.stabilisation != VolumetricStabilisation::none || smooth_jacobian)
+      volume_averages<K>(h, ms_cut);
 
     // (7a) positions from the new nodal velocities; (8b-g) soil: ΔF from the
     // remapped increment at x^t, volume, J, porosity, conductivity, stress
@@ -1380,6 +1394,12 @@ namespace talus::semi_implicit
         materials::strain_and_spin_increments<dim>(gu_model, d_eps, d_omega);
         if (dim == 2) // the out-of-plane stretch of the modified F-bar's isotropic factor
           d_eps[2][2] = dF_model[2][2] - 1;
+        // Nor-Sand (96): v^{t+1} = v0 Jbar^{t+1}; the model multiplies its v by
+        // det of the increment it is given, so it gets v0 Jbar / det(dF_model)
+        if (s.smooth_jacobian)
+          if (const auto *ns = dynamic_cast<const materials::NorSand *>(&m))
+            history[materials::NorSand::specific_volume_slot] =
+              ns->parameters().v0 * P[s.fs.smoothed_jacobian] / dealii::determinant(dF_model);
         auto sigma = L::get_stress(P);
         m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(history, m.n_history()));
         L::set_stress(sigma, P);
@@ -1475,8 +1495,9 @@ namespace talus::semi_implicit
   template <int dim>
   template <class K>
   void
-  Solver<dim>::fbar_averages(const double h, const double ms_cut)
+  Solver<dim>::volume_averages(const double h, const double ms_cut)
   {
+    const bool fbar = prm.stabilisation != VolumetricStabilisation::none;
     using Stencil      = transfer::PointStencil<dim, K>;
     using It           = transfer::PointIterator<dim>;
     const bool modified = prm.stabilisation == VolumetricStabilisation::modified_f_bar;
@@ -1487,9 +1508,10 @@ namespace talus::semi_implicit
       }
     // dJ of the increment the update will use (h x the remapped velocity, at x^t)
     Mdj = 0;
+    Mjt = 0;
     {
       const double *v  = vs_t.begin();
-      double *      mj = Mdj.begin();
+      double *      mj = Mdj.begin(), *mt = Mjt.begin();
       transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
         double *P = it->get_properties().data();
         double  gv[dim][dim];
@@ -1500,7 +1522,11 @@ namespace talus::semi_implicit
         for (unsigned int i = 0; i < dim; ++i)
           for (unsigned int j = 0; j < dim; ++j)
             dF[i][j] += h * gv[i][j];
-        s.scatter(mj, P[L::mass] * dealii::determinant(dF));
+        const double dJ = dealii::determinant(dF);
+        if (fbar)
+          s.scatter(mj, P[L::mass] * dJ);
+        if (smooth_jacobian) // J^{t+1} = (V / V0) dJ
+          s.scatter(mt, P[L::mass] * P[L::volume] / P[fs.initial_volume] * dJ);
         if (modified)
           {
             const auto &       m = *prm.materials[static_cast<unsigned int>(P[L::material])];
@@ -1510,7 +1536,7 @@ namespace talus::semi_implicit
           }
       });
     }
-    exchange({&Mdj});
+    exchange({&Mdj, &Mjt});
     // every rank needs the sums of the patches its points are in; a patch may
     // span cells of several ranks: one sum over all ranks (2 x the number of
     // patches per step; a neighbour exchange would scale better, not needed yet)
@@ -1524,13 +1550,17 @@ namespace talus::semi_implicit
         {
           const double m         = Ms.local_element(i);
           Mdj.local_element(i)   = m > ms_cut ? Mdj.local_element(i) / m : 0.0; // now dJ_I
+          Mjt.local_element(i)   = m > ms_cut ? Mjt.local_element(i) / m : 0.0; // now J_I
         }
-    const double *dj = Mdj.begin();
+    const double *dj = Mdj.begin(), *jt = Mjt.begin();
     transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
       double *P = it->get_properties().data();
       // the stencil's nodes all carry soil mass (this point's), so the
       // partition of unity holds: a uniform dJ is returned exactly
-      P[fs.smoothed_volume_increment] = s.value(dj);
+      if (fbar)
+        P[fs.smoothed_volume_increment] = s.value(dj);
+      if (smooth_jacobian)
+        P[fs.smoothed_jacobian] = s.value(jt);
       if (modified)
         {
           const unsigned int k           = patches.index(it->get_location());

@@ -82,6 +82,9 @@ namespace talus::semi_implicit
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;
+    /// Nor-Sand specific volume v = v0 Jbar with Jbar the node-smoothed total J
+    /// of the soil points (seed 002 Eqs. 96-97), else v = v0 J (Eq. 95)
+    bool smoothed_specific_volume = true;
     /// rigid skeleton: v_s = 0 at every node, the soil's terms dropped from the
     /// pressure equation (seepage through a fixed soil)
     bool rigid_skeleton = false;
