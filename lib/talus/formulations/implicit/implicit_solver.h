@@ -70,6 +70,15 @@ namespace talus::implicit_mpm
     std::vector<loads::Stage<dim>> stages;
     std::vector<double>            stage_time_steps; ///< per stage (> 0)
     bool                           staged = false;
+    /// 'boundary conditions/contact': unilateral contact walls (grid faces) whose
+    /// nodes are held while the wall pushes on them and released when it would
+    /// pull (active set inside the step; docs/implicit.md "Contact floor")
+    std::vector<dealii::types::boundary_id> contact_ids;
+    /// 'boundary conditions/contact friction': true = no slip (the tangential
+    /// components of a node in contact are held too), false = frictionless
+    bool contact_no_slip = true;
+    /// 'boundary conditions/contact passes': active-set passes per step at most
+    unsigned int contact_passes = 10;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -91,6 +100,9 @@ namespace talus::implicit_mpm
     double       residual_first = 0, residual_last = 0, observed_order = 0;
     double       increment_order = 0; ///< observed order of the increments |du_k|
     std::string  history; ///< residual norms of the iterations, for the log
+    /// contact walls: Newton solves (passes) of the step, nodes released and
+    /// put (back) in contact over its passes, nodes in contact at its end
+    unsigned int contact_passes = 0, contact_released = 0, contact_added = 0, contact_nodes = 0;
   };
 
   template <int dim>
@@ -155,6 +167,24 @@ namespace talus::implicit_mpm
     double point_force_scale = 1; ///< multiplies the point forces (unstaged static ramp)
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
+    /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,
+    /// and the contact nodes now in contact) merged with the inactive pins.
+    dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values = nullptr,
+                                                       const bool with_contact = true) const;
+    /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
+    /// normal DoF of each node, decided by the owner, ghosts updated.
+    std::vector<loads::ContactNode> contact_nodes;
+    Vector                          contact_state;
+    /// Per contact node: times it changed state in the current step (a node that
+    /// changed twice is held in contact for the rest of the step: no cycling).
+    std::vector<unsigned char> contact_changes;
+    /// After a converged Newton solve: the wall reactions (residual at the
+    /// contact DoFs, internal + inertia - external, assembled without the
+    /// contact constraints) release the nodes pulled by the wall and the free
+    /// nodes that penetrate it are put in contact. Returns the global number
+    /// of nodes released and added. Collective.
+    std::pair<unsigned int, unsigned int> update_contact(const dealii::Tensor<1, dim> &g, const double force_scale);
+    unsigned long long total_contact_released = 0, total_contact_added = 0, total_contact_passes = 0;
     /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
     /// (Eqs. 2.6-2.9) onto the active DoFs.
     void project_to_grid();
