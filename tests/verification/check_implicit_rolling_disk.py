@@ -56,7 +56,7 @@ if args.floor:
 # a fixed floor (the floor does not enter the explicit critical step)
 crit_text = text
 if re.search(r"^\s*set\s+contact\s*=\s*\S", text, re.M):
-    crit_text = re.sub(r"^\s*set\s+contact(\s+friction|\s+passes)?\s*=.*$", "", text, flags=re.M)
+    crit_text = re.sub(r"^\s*set\s+contact\b.*$", "", text, flags=re.M)
     crit_text = tv.prm_set(crit_text, "boundary conditions/fixed", "2")
 
 

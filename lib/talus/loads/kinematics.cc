@@ -93,7 +93,7 @@ namespace talus::loads
                 if (seen[node] || wall_flags[normal])
                   continue;
                 seen[node] = 1;
-                nodes.push_back({node, axis, f % 2 ? 1 : -1});
+                nodes.push_back({node, axis, f % 2 ? 1 : -1, cell->face(f)->vertex(v)[axis]});
               }
           }
       }

@@ -64,6 +64,7 @@ namespace talus::loads
     unsigned int node;
     unsigned int axis;
     int          sign;
+    double       wall; ///< the wall's coordinate along `axis`
   };
 
   /// The nodes (owned and ghost) of the box grid's faces with one of the boundary

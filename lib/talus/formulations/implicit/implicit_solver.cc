@@ -49,6 +49,11 @@ namespace talus::implicit_mpm
       prm.declare_entry("contact friction", "no slip", Anything(),
                         "Tangential behaviour of the 'contact' walls: 'no slip' (a node in contact sticks) or "
                         "'frictionless' (only the normal component is held).");
+      prm.declare_entry("contact gap", "0.1", Double(0),
+                        "A contact node can be held only while the material next to it is at the wall: the gap, "
+                        "the smallest (distance to the wall - half the point size V_p^(1/dim)/2) over the points of "
+                        "the node's cells at the start of the step, at most this fraction of the cell size normal "
+                        "to the wall; a held node whose gap grew beyond it is released.");
       prm.declare_entry("contact passes", "10", Integer(1, 1000),
                         "Active-set passes (Newton solves) per step at most; a node that changed its state twice "
                         "in a step stays in contact for the rest of that step.");
@@ -172,6 +177,7 @@ namespace talus::implicit_mpm
       p.contact_no_slip = f == "no slip";
     }
     p.contact_passes = prm.get_integer("contact passes");
+    p.contact_gap    = prm.get_double("contact gap");
     prm.leave_subsection();
     p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
     p.traction_stage.assign(p.tractions.size(), -1);
@@ -444,7 +450,7 @@ namespace talus::implicit_mpm
               log() << "  axisymmetric: the x-min wall is the axis, u_r = 0 there ("
                     << (bc.kind == BoundaryCondition::Kind::roller ? "roller" : "fixed") << ")" << std::endl;
       }
-    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state})
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state, &contact_gap})
       space.reinit_vector(*v);
     // every contact node starts in contact (released in the first step where
     // the wall would pull on it); a restart starts so too
@@ -499,6 +505,9 @@ namespace talus::implicit_mpm
     const auto &st = prm.stages[k];
     boundary_flags = loads::wall_dof_flags(grid, st.boundary_conditions);
     contact_nodes  = loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
+    node_contact.assign(boundary_flags.size(), -1);
+    for (std::size_t k = 0; k < contact_nodes.size(); ++k)
+      node_contact[contact_nodes[k].node] = int(k);
     // the grid nodes of the stage's 'velocity k' (owned and ghost: constraints
     // of a distributed assembly must be known where a rank assembles)
     prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
@@ -518,7 +527,55 @@ namespace talus::implicit_mpm
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
     contact_changes.assign(contact_nodes.size(), 0);
+    if (!prm.contact_ids.empty())
+      measure_contact_gaps();
     constraints = step_constraints();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::measure_contact_gaps()
+  {
+    using L                = PropertyLayout<dim>;
+    const double far       = std::numeric_limits<double>::max();
+    contact_gap            = far;
+    contact_gap.update_ghost_values();
+    for (const auto &pt : points.handler)
+      {
+        const auto & cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+        const auto & x  = pt.get_location();
+        const auto   P  = pt.get_properties();
+        double       V  = P[L::volume];
+        if (prm.axisymmetric)
+          V /= 2 * M_PI * std::max(x[0], 1e-300);
+        const double half = 0.5 * std::pow(V, 1.0 / dim);
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          {
+            const int k = node_contact[cc.dofs[v * dim]];
+            if (k < 0)
+              continue;
+            const auto & c   = contact_nodes[k];
+            const auto   in  = space.node_dof(c.node, c.axis);
+            const double gap = c.sign * (c.wall - x[c.axis]) - half;
+            contact_gap(in)  = std::min(contact_gap(in), gap);
+          }
+      }
+    contact_gap.compress(dealii::VectorOperation::min);
+    contact_gap.update_ghost_values();
+    // the material has left the wall at a node in contact: released
+    const auto & owned = space.locally_owned_dofs();
+    unsigned int left  = 0;
+    for (const auto &c : contact_nodes)
+      {
+        const auto in = space.node_dof(c.node, c.axis);
+        if (owned.is_element(in) && contact_state(in) != 0.0 && contact_gap(in) > contact_gap_tolerance(c))
+          {
+            contact_state(in) = 0.0;
+            ++left;
+          }
+      }
+    contact_state.update_ghost_values();
+    gap_releases += dealii::Utilities::MPI::sum(left, comm);
   }
 
   template <int dim>
@@ -587,7 +644,7 @@ namespace talus::implicit_mpm
                 ++released;
               }
           }
-        else if (du(in) * c.sign > tol_in)
+        else if (du(in) * c.sign > tol_in && contact_gap(in) <= contact_gap_tolerance(c))
           {
             contact_state(in) = 1.0;
             ++contact_changes[k];
@@ -1281,8 +1338,8 @@ namespace talus::implicit_mpm
           << "), linear iterations " << total_linear_iterations << std::endl;
     if (!prm.contact_ids.empty())
       log() << "  contact walls: " << total_contact_passes << " Newton solves (active-set passes), "
-            << total_contact_released << " node releases, " << total_contact_added << " nodes put in contact"
-            << std::endl;
+            << total_contact_released << " node releases, " << total_contact_added << " nodes put in contact, "
+            << gap_releases << " nodes released because the material left the wall" << std::endl;
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;

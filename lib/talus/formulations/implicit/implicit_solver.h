@@ -79,6 +79,9 @@ namespace talus::implicit_mpm
     bool contact_no_slip = true;
     /// 'boundary conditions/contact passes': active-set passes per step at most
     unsigned int contact_passes = 10;
+    /// 'boundary conditions/contact gap': a node is held only while the material
+    /// next to it is within this fraction of a cell of the wall
+    double contact_gap = 0.1;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -178,6 +181,20 @@ namespace talus::implicit_mpm
     /// Per contact node: times it changed state in the current step (a node that
     /// changed twice is held in contact for the rest of the step: no cycling).
     std::vector<unsigned char> contact_changes;
+    /// Per contact node (at its normal DoF, ghosts updated): the gap between the
+    /// wall and the material next to it at the start of the step, the smallest
+    /// over the points of the node's cells of (distance of the point to the
+    /// wall) - (half its size, V_p^(1/dim) / 2). A node can be in contact only
+    /// while its gap is at most half a point size (the material is at the wall).
+    Vector              contact_gap;
+    std::vector<int>    node_contact; ///< by grid local node: index into contact_nodes or -1
+    void                measure_contact_gaps();
+    /// 'contact gap' x the cell size normal to the wall
+    double contact_gap_tolerance(const loads::ContactNode &c) const
+    {
+      return prm.contact_gap * (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+    }
+    unsigned long long gap_releases = 0; ///< nodes released because the material left the wall (all steps)
     /// After a converged Newton solve: the wall reactions (residual at the
     /// contact DoFs, internal + inertia - external, assembled without the
     /// contact constraints) release the nodes pulled by the wall and the free
