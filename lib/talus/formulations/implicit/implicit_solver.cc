@@ -540,6 +540,7 @@ namespace talus::implicit_mpm
     const double far       = std::numeric_limits<double>::max();
     contact_gap            = far;
     contact_gap.update_ghost_values();
+    contact_gap.set_ghost_state(false); // ghost entries written below and sent to the owners (compress)
     for (const auto &pt : points.handler)
       {
         const auto & cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
