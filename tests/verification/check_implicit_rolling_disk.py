@@ -35,7 +35,8 @@ ap = argparse.ArgumentParser()
 ap.add_argument("tools")
 ap.add_argument("prm")
 ap.add_argument("work")
-ap.add_argument("--floor", choices=["fixed", "roller"], default=None, help="override boundary 2 of the .prm")
+ap.add_argument("--floor", choices=["fixed", "roller", "contact"], default=None,
+                help="override boundary 2 of the .prm (contact: talus-implicit's unilateral no-slip wall)")
 ap.add_argument("--expect", choices=["roll", "slide"], default="roll")
 ap.add_argument("--set", action="append", default=[], help="entry=value, e.g. time/end time=0.1")
 args = ap.parse_args()
@@ -44,12 +45,19 @@ text = tv.prm_set(open(args.prm).read(), "output/directory", "out")
 text = tv.prm_set(text, "output/series interval", "0")
 text = tv.prm_set(text, "output/final particles csv", "true")
 text = tv.prm_set(text, "output/vtu interval", "0")
-if args.floor:
-    text = tv.prm_set(text, f"boundary conditions/{args.floor}", "2")
-    text = tv.prm_set(text, "boundary conditions/" + ("roller" if args.floor == "fixed" else "fixed"), "")
 for s in args.set:
     key, value = s.split("=", 1)
     text = tv.prm_set(text, key.strip(), value.strip())
+if args.floor:
+    for kind in ("fixed", "roller", "contact"):
+        if kind == args.floor or f"set {kind}" in text:
+            text = tv.prm_set(text, f"boundary conditions/{kind}", "2" if kind == args.floor else "")
+# talus-critical-dt reads the shared scene entries only: give it the scene with
+# a fixed floor (the floor does not enter the explicit critical step)
+crit_text = text
+if re.search(r"^\s*set\s+contact\s*=\s*\S", text, re.M):
+    crit_text = re.sub(r"^\s*set\s+contact\b.*$", "", text, flags=re.M)
+    crit_text = tv.prm_set(crit_text, "boundary conditions/fixed", "2")
 
 
 def entry(path):
@@ -75,7 +83,7 @@ print(f"theta = {math.degrees(math.asin(sin_theta)):.4f} deg, |g| = {g:.4f} m/s^
 os.makedirs(args.work, exist_ok=True)
 prm_file = os.path.join(args.work, "disk.prm")
 with open(prm_file, "w") as f:
-    f.write(text)
+    f.write(crit_text)
 csv = os.path.join(args.work, "critical_dt.csv")
 p = subprocess.run([os.path.abspath(f"{args.tools}/talus-critical-dt"), "--csv=" + csv, prm_file],
                    capture_output=True, text=True, cwd=args.work, env=tv.child_env())
@@ -97,6 +105,9 @@ tv.check(abs(t[-1] - end) < 1e-9 * max(1.0, end), f"the run reached its end time
 steps = [i for i in range(len(t)) if s["step"][i] > 0]
 its = [s["newton_iterations"][i] for i in steps]
 print(f"{len(steps)} steps; Newton iterations per step: mean {sum(its) / len(its):.2f}, max {max(its):.0f}")
+for line in out.splitlines():
+    if "contact walls:" in line:
+        print(line.strip())
 
 
 def quadratic_fit(ts, ys):

@@ -173,11 +173,19 @@ add_test(NAME verification.implicit_rolling_disk_smooth_floor
                  --floor roller --expect slide)
 set_tests_properties(verification.implicit_rolling_disk_smooth_floor PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 300)
-# The thesis's case, no slip on a fixed floor: a = (2/3) g sin theta within 3 %, rotation and
-# spin match the travel. DISABLED: it fails for a known reason that is not the implicit step
-# (the fixed floor nodes hold the disk's lowest cell row in both directions: the disk stays put,
-# in talus-explicit too; measured figures in docs/implicit.md). Enable it with a floor that
-# lets the points lift off (a unilateral contact wall).
+# unilateral contact floor ('boundary conditions/contact', docs/implicit.md "Contact floor"): a block
+# stays on it under gravity and lifts off (free rise g t^2/2 within 1 %) when gravity is reversed,
+# while a fixed floor holds it; 1 vs 2 ranks (fast)
+add_test(NAME verification.implicit_contact_block
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_contact_block.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/block_contact_floor.prm ${_w}/implicit_contact_block)
+set_tests_properties(verification.implicit_contact_block PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 PROCESSORS 2)
+# The thesis's case, no slip on the unilateral contact floor (rolling_disk.prm): a = (2/3) g sin
+# theta within 3 %, rotation and spin match the travel. DISABLED: it fails, not by the implicit step:
+# a fixed floor glues the disk (it does not roll, in talus-explicit too); the contact floor rolls it
+# at -12 % (it hops over the floor nodes and partly slips; figures and cause in docs/implicit.md,
+# "Rolling disk"). Enable it when a floor that follows the moving contact point exists.
 add_test(NAME verification.implicit_rolling_disk
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk)

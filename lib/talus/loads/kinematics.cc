@@ -20,7 +20,8 @@ namespace talus::loads
                    const NodalSpace<dim> &               space,
                    const std::vector<unsigned char> &    flags,
                    const std::vector<PrescribedNodeDof> *prescribed,
-                   const std::vector<double> *           values)
+                   const std::vector<double> *           values,
+                   const std::vector<dealii::types::global_dof_index> *contact)
   {
     dealii::AffineConstraints<double> walls;
     walls.reinit(space.locally_relevant_dofs());
@@ -50,8 +51,53 @@ namespace talus::loads
               if (!walls.is_constrained(i))
                 walls.add_line(i);
             }
+    // the DoFs of the contact nodes currently in contact (homogeneous: the
+    // increment is zero there; a fixed/roller wall or a prescribed DoF wins)
+    if (contact)
+      for (const auto i : *contact)
+        if (!walls.is_constrained(i))
+          walls.add_line(i);
     walls.close();
     return walls;
+  }
+
+  template <int dim>
+  std::vector<ContactNode>
+  contact_wall_nodes(const BackgroundGrid<dim> &                     grid,
+                     const std::vector<dealii::types::boundary_id> &ids,
+                     const std::vector<unsigned char> &             wall_flags)
+  {
+    std::vector<ContactNode> nodes;
+    if (ids.empty())
+      return nodes;
+    const std::vector<dealii::types::boundary_id> all_ids = grid.tria.get_boundary_ids();
+    for (const auto id : ids)
+      if (std::find(all_ids.begin(), all_ids.end(), id) == all_ids.end())
+        throw InputError("boundary conditions/contact: boundary id " + std::to_string(id) +
+                         " does not exist in the grid");
+    std::vector<unsigned char> seen(wall_flags.size(), 0);
+    for (const auto &cell : grid.dof_handler.active_cell_iterators())
+      {
+        if (cell->is_artificial())
+          continue;
+        for (const unsigned int f : cell->face_indices())
+          {
+            if (!cell->face(f)->at_boundary() ||
+                std::find(ids.begin(), ids.end(), cell->face(f)->boundary_id()) == ids.end())
+              continue;
+            const unsigned int axis = f / 2; // box: faces 2d, 2d+1 normal to d
+            for (unsigned int v = 0; v < dealii::GeometryInfo<dim>::vertices_per_face; ++v)
+              {
+                const unsigned int node = grid.partitioner->global_to_local(cell->face(f)->vertex_dof_index(v, 0));
+                const unsigned int normal = grid.partitioner->global_to_local(cell->face(f)->vertex_dof_index(v, axis));
+                if (seen[node] || wall_flags[normal])
+                  continue;
+                seen[node] = 1;
+                nodes.push_back({node, axis, f % 2 ? 1 : -1, cell->face(f)->vertex(v)[axis]});
+              }
+          }
+      }
+    return nodes;
   }
 
   template <int dim>
@@ -116,6 +162,12 @@ namespace talus::loads
   prescribed_node_dofs(const BackgroundGrid<2> &, const std::vector<PrescribedVelocity<2>> &, const bool);
   template std::vector<PrescribedNodeDof>
   prescribed_node_dofs(const BackgroundGrid<3> &, const std::vector<PrescribedVelocity<3>> &, const bool);
+  template std::vector<ContactNode> contact_wall_nodes(const BackgroundGrid<2> &,
+                                                       const std::vector<dealii::types::boundary_id> &,
+                                                       const std::vector<unsigned char> &);
+  template std::vector<ContactNode> contact_wall_nodes(const BackgroundGrid<3> &,
+                                                       const std::vector<dealii::types::boundary_id> &,
+                                                       const std::vector<unsigned char> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<2> &, const std::vector<BoundaryCondition> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<3> &, const std::vector<BoundaryCondition> &);
   template dealii::AffineConstraints<double>
@@ -123,11 +175,13 @@ namespace talus::loads
                    const NodalSpace<2> &,
                    const std::vector<unsigned char> &,
                    const std::vector<PrescribedNodeDof> *,
-                   const std::vector<double> *);
+                   const std::vector<double> *,
+                   const std::vector<dealii::types::global_dof_index> *);
   template dealii::AffineConstraints<double>
   wall_constraints(const BackgroundGrid<3> &,
                    const NodalSpace<3> &,
                    const std::vector<unsigned char> &,
                    const std::vector<PrescribedNodeDof> *,
-                   const std::vector<double> *);
+                   const std::vector<double> *,
+                   const std::vector<dealii::types::global_dof_index> *);
 } // namespace talus::loads

@@ -52,7 +52,30 @@ namespace talus::loads
                    const NodalSpace<dim> &               space,
                    const std::vector<unsigned char> &    flags,
                    const std::vector<PrescribedNodeDof> *prescribed = nullptr,
-                   const std::vector<double> *           values     = nullptr);
+                   const std::vector<double> *           values     = nullptr,
+                   const std::vector<dealii::types::global_dof_index> *contact = nullptr);
+
+  /// One grid node of a unilateral contact wall (talus-implicit's 'boundary
+  /// conditions/contact'): the node (local DoF of its component 0 in the grid's
+  /// vector space, as PrescribedNodeDof::node), the axis of the wall's normal
+  /// and the sign of the outward normal (-1 on a min face, +1 on a max face).
+  struct ContactNode
+  {
+    unsigned int node;
+    unsigned int axis;
+    int          sign;
+    double       wall; ///< the wall's coordinate along `axis`
+  };
+
+  /// The nodes (owned and ghost) of the box grid's faces with one of the boundary
+  /// ids `ids`, each once; a node whose normal DoF is already flagged in
+  /// `wall_flags` (fixed/roller walls: they win at shared corners) is left out.
+  /// Throws InputError naming 'boundary conditions/contact' for an id the grid lacks.
+  template <int dim>
+  std::vector<ContactNode>
+  contact_wall_nodes(const BackgroundGrid<dim> &                     grid,
+                     const std::vector<dealii::types::boundary_id> &ids,
+                     const std::vector<unsigned char> &             wall_flags);
 
   /// The node DoFs reached by the grid-node conditions of `conditions` (target
   /// boundary: the nodes of the faces with that id; region: the nodes inside

@@ -21,6 +21,7 @@
 
 namespace talus::implicit_mpm
 {
+  using dealii::Patterns::Anything;
   using dealii::Patterns::Bool;
   using dealii::Patterns::Double;
   using dealii::Patterns::Integer;
@@ -36,6 +37,28 @@ namespace talus::implicit_mpm
                                 "> 0, required. Not limited by the explicit critical step; a step whose Newton "
                                 "iteration fails is halved and retried (at most 6 times in a row).");
     loads::declare_traction_parameters(prm, prm_file, counts.dim, true);
+    prm.enter_subsection("boundary conditions");
+    {
+      prm.declare_entry("contact", "", Anything(),
+                        "Boundary ids (comma-separated) of unilateral contact walls: a grid node of such a wall is "
+                        "held (its increment normal to the wall is zero, with 'contact friction = no slip' the "
+                        "tangential ones too) while the wall pushes on it, released when the wall would pull on it "
+                        "(the nodal reaction, internal + inertia - external force, turns tensile) and held again "
+                        "when it would move into the wall; the active set is iterated within each step "
+                        "(docs/implicit.md, 'Contact floor'). Applies in every stage.");
+      prm.declare_entry("contact friction", "no slip", Anything(),
+                        "Tangential behaviour of the 'contact' walls: 'no slip' (a node in contact sticks) or "
+                        "'frictionless' (only the normal component is held).");
+      prm.declare_entry("contact gap", "0.1", Double(0),
+                        "A contact node can be held only while the material next to it is at the wall: the gap, "
+                        "the smallest (distance to the wall - half the point size V_p^(1/dim)/2) over the points of "
+                        "the node's cells at the start of the step, at most this fraction of the cell size normal "
+                        "to the wall; a held node whose gap grew beyond it is released.");
+      prm.declare_entry("contact passes", "10", Integer(1, 1000),
+                        "Active-set passes (Newton solves) per step at most; a node that changed its state twice "
+                        "in a step stays in contact for the rest of that step.");
+    }
+    prm.leave_subsection();
     loads::declare_stage_parameters(prm, prm_file, counts.dim, false, [](dealii::ParameterHandler &p) {
       p.declare_entry("time step", "0", Double(0),
                       "Time step of the stage [s] (static: its load step); 0 = the top-level time/time step.");
@@ -134,6 +157,28 @@ namespace talus::implicit_mpm
     p.newton.line_search        = prm.get_bool("line search");
     prm.leave_subsection();
     p.newton.validate();
+    prm.enter_subsection("boundary conditions");
+    for (const auto id : parse_ids(prm.get("contact"), "boundary conditions/contact"))
+      {
+        require(id < 2 * dim, "boundary conditions/contact",
+                "boundary id " + std::to_string(id) + " is not a face of the box grid (0 .. " +
+                  std::to_string(2 * dim - 1) + ")");
+        for (const auto &bc : p.boundary_conditions)
+          require(bc.id != id, "boundary conditions/contact",
+                  "boundary " + std::to_string(id) + " is also " +
+                    (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller") + "; give it one condition");
+        p.contact_ids.push_back(static_cast<dealii::types::boundary_id>(id));
+      }
+    {
+      const std::string f = prm.get("contact friction");
+      require(f == "no slip" || f == "frictionless", "boundary conditions/contact friction",
+              "'" + f + "' is not a contact friction; allowed: no slip | frictionless (Coulomb friction is not "
+              "available yet)");
+      p.contact_no_slip = f == "no slip";
+    }
+    p.contact_passes = prm.get_integer("contact passes");
+    p.contact_gap    = prm.get_double("contact gap");
+    prm.leave_subsection();
     p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
     p.traction_stage.assign(p.tractions.size(), -1);
     {
@@ -176,6 +221,10 @@ namespace talus::implicit_mpm
                     "must not exceed the stage's duration (" + std::to_string(st.duration) + " s)");
           }
         p.stage_time_steps.push_back(h);
+        for (const auto &bc : st.boundary_conditions)
+          for (const auto id : p.contact_ids)
+            require(bc.id != id, where == "time" ? std::string("boundary conditions/contact") : where + "/boundary conditions",
+                    "boundary " + std::to_string(id) + " is a contact wall and also fixed/roller here");
         // the stage's own tractions get slots after the global ones
         for (unsigned int j = st.n_global_tractions; j < st.tractions.size(); ++j)
           {
@@ -401,8 +450,12 @@ namespace talus::implicit_mpm
               log() << "  axisymmetric: the x-min wall is the axis, u_r = 0 there ("
                     << (bc.kind == BoundaryCondition::Kind::roller ? "roller" : "fixed") << ")" << std::endl;
       }
-    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state, &contact_gap})
       space.reinit_vector(*v);
+    // every contact node starts in contact (released in the first step where
+    // the wall would pull on it); a restart starts so too
+    contact_state = 1.0;
+    contact_state.update_ghost_values();
   }
 
   template <int dim>
@@ -451,6 +504,10 @@ namespace talus::implicit_mpm
   {
     const auto &st = prm.stages[k];
     boundary_flags = loads::wall_dof_flags(grid, st.boundary_conditions);
+    contact_nodes  = loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
+    node_contact.assign(boundary_flags.size(), -1);
+    for (std::size_t k = 0; k < contact_nodes.size(); ++k)
+      node_contact[contact_nodes[k].node] = int(k);
     // the grid nodes of the stage's 'velocity k' (owned and ghost: constraints
     // of a distributed assembly must be known where a rank assembles)
     prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
@@ -469,7 +526,135 @@ namespace talus::implicit_mpm
     project_to_grid();
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
-    constraints = active.constraints_with(loads::wall_constraints(grid, space, boundary_flags, &prescribed_dofs));
+    contact_changes.assign(contact_nodes.size(), 0);
+    if (!prm.contact_ids.empty())
+      measure_contact_gaps();
+    constraints = step_constraints();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::measure_contact_gaps()
+  {
+    using L                = PropertyLayout<dim>;
+    const double far       = std::numeric_limits<double>::max();
+    contact_gap            = far;
+    contact_gap.update_ghost_values();
+    contact_gap.set_ghost_state(false); // ghost entries written below and sent to the owners (compress)
+    for (const auto &pt : points.handler)
+      {
+        const auto & cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+        const auto & x  = pt.get_location();
+        const auto   P  = pt.get_properties();
+        double       V  = P[L::volume];
+        if (prm.axisymmetric)
+          V /= 2 * M_PI * std::max(x[0], 1e-300);
+        const double half = 0.5 * std::pow(V, 1.0 / dim);
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          {
+            const int k = node_contact[cc.dofs[v * dim]];
+            if (k < 0)
+              continue;
+            const auto & c   = contact_nodes[k];
+            const auto   in  = space.node_dof(c.node, c.axis);
+            const double gap = c.sign * (c.wall - x[c.axis]) - half;
+            contact_gap(in)  = std::min(contact_gap(in), gap);
+          }
+      }
+    contact_gap.compress(dealii::VectorOperation::min);
+    contact_gap.update_ghost_values();
+    // the material has left the wall at a node in contact: released
+    const auto & owned = space.locally_owned_dofs();
+    unsigned int left  = 0;
+    for (const auto &c : contact_nodes)
+      {
+        const auto in = space.node_dof(c.node, c.axis);
+        if (owned.is_element(in) && contact_state(in) != 0.0 && contact_gap(in) > contact_gap_tolerance(c))
+          {
+            contact_state(in) = 0.0;
+            ++left;
+          }
+      }
+    contact_state.update_ghost_values();
+    gap_releases += dealii::Utilities::MPI::sum(left, comm);
+  }
+
+  template <int dim>
+  dealii::AffineConstraints<double>
+  Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact) const
+  {
+    // the contact nodes now in contact: their normal DoF, with no slip all
+    std::vector<dealii::types::global_dof_index> held;
+    if (with_contact)
+      for (const auto &c : contact_nodes)
+        {
+          const auto in = space.node_dof(c.node, c.axis);
+          if (contact_state(in) == 0.0)
+            continue;
+          for (unsigned int d = 0; d < dim; ++d)
+            if (d == c.axis || prm.contact_no_slip)
+              held.push_back(space.node_dof(c.node, d));
+        }
+    return active.constraints_with(
+      loads::wall_constraints(grid, space, boundary_flags, &prescribed_dofs, values, &held));
+  }
+
+  template <int dim>
+  std::pair<unsigned int, unsigned int>
+  Solver<dim>::update_contact(const dealii::Tensor<1, dim> &g, const double force_scale)
+  {
+    // the residual assembled without the contact constraints: at a contact
+    // DoF it is the force the wall must exert on the node, r = f_int + m a -
+    // f_ext (the residual of the other DoFs is kept)
+    Vector kept(residual);
+    auto   free_contact = step_constraints(nullptr, false);
+    std::swap(constraints, free_contact);
+    try
+      {
+        assemble(false, g);
+      }
+    catch (...)
+      {
+        std::swap(constraints, free_contact);
+        residual = kept;
+        throw;
+      }
+    std::swap(constraints, free_contact);
+    const auto & owned    = space.locally_owned_dofs();
+    const auto & pins     = active.constraints();
+    const double du_max   = du.linfty_norm();
+    // a pull below 1e-8 of the load scale and a penetration below 1e-8 of the
+    // largest increment are round-off of the Newton solve, not a change
+    const double tol_pull = 1e-8 * force_scale, tol_in = 1e-8 * du_max;
+    unsigned int released = 0, added = 0;
+    for (std::size_t k = 0; k < contact_nodes.size(); ++k)
+      {
+        const auto &c  = contact_nodes[k];
+        const auto  in = space.node_dof(c.node, c.axis);
+        if (!owned.is_element(in) || pins.is_constrained(in) || free_contact.is_constrained(in) || mass(in) == 0)
+          continue;
+        if (contact_changes[k] >= 2) // changed twice in this step: held
+          continue;
+        if (contact_state(in) != 0.0)
+          {
+            // compressive: the wall pushes the node into the domain, r . n_out < 0
+            if (residual(in) * c.sign > tol_pull)
+              {
+                contact_state(in) = 0.0;
+                ++contact_changes[k];
+                ++released;
+              }
+          }
+        else if (du(in) * c.sign > tol_in && contact_gap(in) <= contact_gap_tolerance(c))
+          {
+            contact_state(in) = 1.0;
+            ++contact_changes[k];
+            ++added;
+          }
+      }
+    residual = kept;
+    contact_state.update_ghost_values();
+    return {dealii::Utilities::MPI::sum(released, comm), dealii::Utilities::MPI::sum(added, comm)};
   }
 
   template <int dim>
@@ -531,8 +716,7 @@ namespace talus::implicit_mpm
     std::vector<double> minus_increment(prescribed_dofs.size());
     for (std::size_t k = 0; k < prescribed_dofs.size(); ++k)
       minus_increment[k] = -prescribed_increment(prescribed_dofs[k], h);
-    auto lifted = active.constraints_with(
-      loads::wall_constraints(grid, space, boundary_flags, &prescribed_dofs, &minus_increment));
+    auto lifted = step_constraints(&minus_increment);
     std::swap(constraints, lifted);
     try
       {
@@ -769,10 +953,54 @@ namespace talus::implicit_mpm
     };
     problem.step_increment_norm = [&]() { return du.l2_norm(); };
     problem.residual_reference  = [&]() { return std::max(f_ext, lifted_residual); };
-    const NewtonResult result = NewtonSolver(prm.newton).solve(problem);
+    // Newton, then (contact walls) the active set from the converged state's
+    // reactions and penetrations; a change re-solves from there
+    NewtonResult       result;
+    unsigned int       iterations = 0, passes = 0, released = 0, added = 0;
+    std::ostringstream pass_log;
+    const bool         any_contact = dealii::Utilities::MPI::sum(contact_nodes.size(), comm) > 0;
+    for (;;)
+      {
+        result = NewtonSolver(prm.newton).solve(problem);
+        iterations += result.iterations;
+        ++passes;
+        if (!result.converged || !any_contact)
+          break;
+        std::pair<unsigned int, unsigned int> changed;
+        try
+          {
+            changed = update_contact(g, f_ext);
+          }
+        catch (const NewtonFailure &e)
+          {
+            log() << "  step " << step_number + 1 << " (t = " << time + h << "): the contact reactions failed: "
+                  << e.what() << std::endl;
+            return StepOutcome::cut_back;
+          }
+        released += changed.first;
+        added += changed.second;
+        if (changed.first + changed.second == 0)
+          break;
+        pass_log << " [pass " << passes << ": " << changed.first << " released, " << changed.second << " in contact]";
+        if (passes >= prm.contact_passes)
+          {
+            // the last solution keeps the previous set; the new one starts the next step
+            log() << "  WARNING: step " << step_number + 1 << " (t = " << time + h
+                  << "): the contact active set still changed after " << passes
+                  << " passes (contact passes); the step keeps the last solve" << std::endl;
+            break;
+          }
+        constraints = step_constraints();
+        constraints.set_zero(du);
+        du.update_ghost_values();
+      }
+    result.iterations = iterations;
 
     last                   = StepReport();
     last.iterations        = result.iterations;
+    last.contact_passes    = passes;
+    last.contact_released  = released;
+    last.contact_added     = added;
     last.linear_iterations = linear_iterations;
     last.observed_order    = result.observed_order;
     {
@@ -801,6 +1029,21 @@ namespace talus::implicit_mpm
     last.history = hist.str();
     total_iterations += result.iterations;
     total_linear_iterations += linear_iterations;
+    total_contact_passes += passes;
+    total_contact_released += released;
+    total_contact_added += added;
+    if (any_contact)
+      {
+        unsigned int n = 0;
+        for (const auto &c : contact_nodes)
+          {
+            const auto in = space.node_dof(c.node, c.axis);
+            if (space.locally_owned_dofs().is_element(in) && contact_state(in) != 0.0 && mass(in) > 0 &&
+                !active.constraints().is_constrained(in))
+              ++n;
+          }
+        last.contact_nodes = dealii::Utilities::MPI::sum(n, comm);
+      }
     if (!result.converged)
       {
         log() << "  step " << step_number + 1 << " (t = " << time + h << "): Newton " << to_string(result.status)
@@ -827,7 +1070,11 @@ namespace talus::implicit_mpm
     log() << "  step " << step_number + 1 << " t = " << std::setprecision(6) << time + h << ": " << result.iterations
  << " Newton iterations, |r| " << last.history << ", order (|r|) " << std::setprecision(3)
           << result.observed_order << ", (|du|) " << last.increment_order << ", " << linear_iterations << " linear iterations (largest |b - A x|/|b| "
-          << worst_linear_residual << ")" << std::endl;
+          << worst_linear_residual << ")";
+    if (any_contact)
+      log() << "; contact: " << passes << " pass(es), " << released << " released, " << added << " in contact again, "
+            << last.contact_nodes << " nodes in contact" << pass_log.str();
+    log() << std::endl;
     return StepOutcome::done;
   }
 
@@ -943,6 +1190,13 @@ namespace talus::implicit_mpm
                                      ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")
         << (dim == 3 ? std::string() : prm.axisymmetric ? ", axisymmetric (x = radius)" : ", plane strain")
         << std::endl;
+    if (!prm.contact_ids.empty())
+      {
+        out << "  contact walls (unilateral, " << (prm.contact_no_slip ? "no slip" : "frictionless") << "): boundary";
+        for (const auto id : prm.contact_ids)
+          out << " " << id;
+        out << "; at most " << prm.contact_passes << " active-set passes per step" << std::endl;
+      }
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
         << " iterations; linear solver "
@@ -1083,6 +1337,10 @@ namespace talus::implicit_mpm
     log() << "done: " << step_number << " steps, " << n_points() << " particles, wall " << std::setprecision(4)
           << t.total << " s; Newton iterations " << total_iterations << " (cut-backs " << cut_backs
           << "), linear iterations " << total_linear_iterations << std::endl;
+    if (!prm.contact_ids.empty())
+      log() << "  contact walls: " << total_contact_passes << " Newton solves (active-set passes), "
+            << total_contact_released << " node releases, " << total_contact_added << " nodes put in contact, "
+            << gap_releases << " nodes released because the material left the wall" << std::endl;
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;

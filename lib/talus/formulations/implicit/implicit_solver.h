@@ -70,6 +70,18 @@ namespace talus::implicit_mpm
     std::vector<loads::Stage<dim>> stages;
     std::vector<double>            stage_time_steps; ///< per stage (> 0)
     bool                           staged = false;
+    /// 'boundary conditions/contact': unilateral contact walls (grid faces) whose
+    /// nodes are held while the wall pushes on them and released when it would
+    /// pull (active set inside the step; docs/implicit.md "Contact floor")
+    std::vector<dealii::types::boundary_id> contact_ids;
+    /// 'boundary conditions/contact friction': true = no slip (the tangential
+    /// components of a node in contact are held too), false = frictionless
+    bool contact_no_slip = true;
+    /// 'boundary conditions/contact passes': active-set passes per step at most
+    unsigned int contact_passes = 10;
+    /// 'boundary conditions/contact gap': a node is held only while the material
+    /// next to it is within this fraction of a cell of the wall
+    double contact_gap = 0.1;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -91,6 +103,9 @@ namespace talus::implicit_mpm
     double       residual_first = 0, residual_last = 0, observed_order = 0;
     double       increment_order = 0; ///< observed order of the increments |du_k|
     std::string  history; ///< residual norms of the iterations, for the log
+    /// contact walls: Newton solves (passes) of the step, nodes released and
+    /// put (back) in contact over its passes, nodes in contact at its end
+    unsigned int contact_passes = 0, contact_released = 0, contact_added = 0, contact_nodes = 0;
   };
 
   template <int dim>
@@ -155,6 +170,38 @@ namespace talus::implicit_mpm
     double point_force_scale = 1; ///< multiplies the point forces (unstaged static ramp)
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
+    /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,
+    /// and the contact nodes now in contact) merged with the inactive pins.
+    dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values = nullptr,
+                                                       const bool with_contact = true) const;
+    /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
+    /// normal DoF of each node, decided by the owner, ghosts updated.
+    std::vector<loads::ContactNode> contact_nodes;
+    Vector                          contact_state;
+    /// Per contact node: times it changed state in the current step (a node that
+    /// changed twice is held in contact for the rest of the step: no cycling).
+    std::vector<unsigned char> contact_changes;
+    /// Per contact node (at its normal DoF, ghosts updated): the gap between the
+    /// wall and the material next to it at the start of the step, the smallest
+    /// over the points of the node's cells of (distance of the point to the
+    /// wall) - (half its size, V_p^(1/dim) / 2). A node can be in contact only
+    /// while its gap is at most half a point size (the material is at the wall).
+    Vector              contact_gap;
+    std::vector<int>    node_contact; ///< by grid local node: index into contact_nodes or -1
+    void                measure_contact_gaps();
+    /// 'contact gap' x the cell size normal to the wall
+    double contact_gap_tolerance(const loads::ContactNode &c) const
+    {
+      return prm.contact_gap * (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+    }
+    unsigned long long gap_releases = 0; ///< nodes released because the material left the wall (all steps)
+    /// After a converged Newton solve: the wall reactions (residual at the
+    /// contact DoFs, internal + inertia - external, assembled without the
+    /// contact constraints) release the nodes pulled by the wall and the free
+    /// nodes that penetrate it are put in contact. Returns the global number
+    /// of nodes released and added. Collective.
+    std::pair<unsigned int, unsigned int> update_contact(const dealii::Tensor<1, dim> &g, const double force_scale);
+    unsigned long long total_contact_released = 0, total_contact_added = 0, total_contact_passes = 0;
     /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
     /// (Eqs. 2.6-2.9) onto the active DoFs.
     void project_to_grid();
