@@ -1,0 +1,154 @@
+"""The near-incompressible strip footing of seed 002 App. A (issue 14): the
+semi-implicit run with the modified F-bar against talus-implicit's static,
+stabilised mixed u-p on the same scene.
+
+Scene (both .prm): half model 10 m x 10 m, plane strain, rollers on both sides,
+fixed base, no gravity, E = 10 MPa, nu = 0.49, 20 kPa downwards on 0 <= x <= 3 m
+of the top face, grid h (one empty cell row above the body), 2 x 2 points per
+cell. The semi-implicit run is dynamic (load ramped over 1 s, end 1.5 s,
+hencky mohr coulomb that never yields, quadratic B-splines); the implicit run
+is static (two load steps), split Neo-Hookean (u-p takes only that model; the
+irreducible u run is also made with the Hencky model to measure the model
+difference at these strains), Q1 shape functions.
+
+Settlement (the same for both): the mean of -u_y over the top layer of points
+(initial Y the largest) with initial X <= 3 m, at the end of the run. The load
+(the same for both): the top layer of points on 0 <= X <= 3 m carries it, each
+point q V_p / (h / 2); checked: the same set of points (by initial position)
+and the total vertical force -q x 3 m in both (semi-implicit: the
+surface_force column; implicit: point_force_0_y).
+
+Checks:
+  * the loaded points and the total force agree (1e-9 relative);
+  * |S(semi-implicit, modified f-bar) / S(implicit u-p) - 1| < TOL (--tol,
+    default 0.05: the issue's criterion, at h = 0.2 m; the fast h = 0.5 m run
+    uses a wider coarse-grid bound, see docs/semi-implicit.md);
+  * the semi-implicit run is near quasi-static at its end: the kinetic energy
+    at the end is below 2 % of the work of the ramped load (F S / 2), and the
+    half range of its load_settlement (series.csv) over the last 0.5 s (after
+    the ramp) is below --dyn (default 0.05) of the end settlement;
+  * the implicit irreducible u runs with Neo-Hookean and with the Hencky model
+    agree to 1 % (the model difference at these strains);
+Reported: S(semi-implicit, none) / S(u-p) and S(implicit u) / S(u-p).
+--young=E scales nothing else: it sets E of the implicit runs (a mutant: 1.1e7
+must fail the comparison).
+Usage: check_strip_footing_up.py TOOLS_DIR SEMI_PRM IMPLICIT_PRM WORKDIR [--h=H] [--tol=T] [--dyn=D] [--young=E]
+"""
+import sys
+
+import talus_verify as tv
+
+
+def option(name, default):
+    return next((a.split("=", 1)[1] for a in sys.argv if a.startswith(f"--{name}=")), default)
+
+
+tools, semi_prm, impl_prm, work = [a for a in sys.argv if not a.startswith("--")][1:5]
+h = float(option("h", 0.5))
+tol = float(option("tol", 0.05))
+dyn = float(option("dyn", 0.05))
+young = option("young", None)
+n = round(10 / h)
+q, width = 2e4, 3.0
+
+
+def grid(text):
+    text = tv.prm_set(text, "grid/cells", f"{n}, {n + 1}")
+    return tv.prm_set(text, "grid/upper corner", f"10, {10 + h}")
+
+
+semi = grid(tv.prm_set(open(semi_prm).read(), "output/directory", "out"))
+semi = tv.prm_set(semi, "output/series interval", "0.01")
+impl = grid(tv.prm_set(open(impl_prm).read(), "output/directory", "out"))
+impl = tv.prm_set(impl, "loads/traction 0/region lower corner", f"0, {10 - h / 2}")
+if young:
+    impl = tv.prm_set(impl, "material 0/neo hookean/young modulus", young)
+
+
+def top_points(X, Y, u):
+    """(initial x, -u_y) of the top layer of points with X <= 3 m"""
+    top = max(Y)
+    return sorted((round(x, 9), -v) for x, y, v in zip(X, Y, u) if y > top - 1e-9 and x <= width + 1e-9)
+
+
+def settlement(pts):
+    return sum(v for _, v in pts) / len(pts)
+
+
+def loaded(X, Y, f):
+    return sorted((round(x, 9), round(y, 9)) for x, y, g in zip(X, Y, f) if g != 0), sum(f)
+
+
+# semi-implicit: modified f-bar and none
+res = {}
+for st in ("modified f-bar", "none"):
+    name = "semi_" + st.replace(" ", "_")
+    tv.run_tool(f"{tools}/talus-semi-implicit", tv.prm_set(semi, "semi implicit/volumetric stabilisation", st),
+                f"{work}/{name}", name)
+    s = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
+    X = [x - u for x, u in zip(s["pos_x"], s["displacement_x"])]
+    Y = [y - u for y, u in zip(s["pos_y"], s["displacement_y"])]
+    res[st] = settlement(top_points(X, Y, s["displacement_y"]))
+    if st == "modified f-bar":
+        semi_loaded = loaded(X, Y, [-f for f in s["surface_force"]])
+        series = tv.read_csv(f"{work}/{name}/out/series.csv")
+    print(f"h = {h} m, semi-implicit {st}: settlement {res[st] * 1000:.4f} mm")
+
+# implicit: u-p (Neo-Hookean, split), u (Neo-Hookean, split), u (Hencky, never yields)
+hencky = """subsection material 0
+  set model   = hencky mohr coulomb
+  set density = 2000
+  subsection hencky mohr coulomb
+    set young modulus   = %s
+    set poisson ratio   = 0.49
+    set cohesion        = 1e12
+    set friction angle  = 1
+    set dilatancy angle = 0
+  end
+end
+""" % (young or "1e7")
+runs = {"u-p": impl, "u": tv.prm_set(impl, "implicit/formulation", "irreducible")}
+start, end = runs["u"].index("subsection material 0"), runs["u"].index("set number of bodies")
+runs["u hencky"] = runs["u"][:start] + hencky + "\n" + runs["u"][end:]
+for key, text in runs.items():
+    name = "implicit_" + key.replace(" ", "_").replace("-", "")
+    tv.run_tool(f"{tools}/talus-implicit", text, f"{work}/{name}", name)
+    s = tv.read_csv(f"{work}/{name}/out/particles_final.csv")
+    X = [x - u for x, u in zip(s["pos_x"], s["u_x"])]
+    Y = [y - u for y, u in zip(s["pos_y"], s["u_y"])]
+    res[key] = settlement(top_points(X, Y, s["u_y"]))
+    if key == "u-p":
+        impl_loaded = loaded(X, Y, s["point_force_0_y"])
+    print(f"h = {h} m, implicit {key}: settlement {res[key] * 1000:.4f} mm")
+
+# the same load
+force = -q * width
+tv.check(semi_loaded[0] == impl_loaded[0] and len(semi_loaded[0]) == round(width / h * 2),
+         f"the same {len(impl_loaded[0])} loaded points (initial positions) in both runs")
+for label, (_, F) in (("semi-implicit", semi_loaded), ("implicit", impl_loaded)):
+    tv.check(abs(F / force - 1) < 1e-9, f"{label}: total vertical force {F:.6g} N/m = {force:.6g}")
+
+# quasi-static end of the semi-implicit run
+t, ek, sl = series["time"], series["kinetic_energy_soil"], series["load_settlement"]
+work_done = 0.5 * q * width * res["modified f-bar"]
+late = [v for tt, v in zip(t, sl) if tt >= t[-1] - 0.5 - 1e-9]
+half_range = 0.5 * (max(late) - min(late)) / res["modified f-bar"]
+print(f"semi-implicit end: kinetic energy {ek[-1]:.3g} J = {ek[-1] / work_done:.2%} of the load's work "
+      f"{work_done:.4g} J; load_settlement over the last 0.5 s {min(late) * 1000:.4f} .. {max(late) * 1000:.4f} mm "
+      f"(mean {sum(late) / len(late) * 1000:.4f} mm), half range {half_range:.2%} of the end value; "
+      f"series end value {sl[-1] * 1000:.4f} mm")
+tv.check(abs(sl[-1] / res["modified f-bar"] - 1) < 1e-9, "series load_settlement = the settlement of the final points")
+tv.check(ek[-1] < 0.02 * work_done, f"semi-implicit near quasi-static: E_k {ek[-1] / work_done:.2%} < 2 % of F S / 2")
+tv.check(half_range < dyn, f"semi-implicit settlement over the last 0.5 s within +-{half_range:.2%} < {dyn:.0%}")
+
+# the comparison
+r = res["modified f-bar"] / res["u-p"]
+print(f"settlement semi-implicit modified f-bar / implicit u-p = {r:.4f}; (mean over the last 0.5 s) / u-p = "
+      f"{sum(late) / len(late) / res['u-p']:.4f}")
+print(f"locking: semi-implicit none / implicit u-p = {res['none'] / res['u-p']:.4f}, semi-implicit none / modified "
+      f"f-bar = {res['none'] / res['modified f-bar']:.4f}, implicit u / u-p = {res['u'] / res['u-p']:.4f}")
+print(f"model: implicit u Hencky / Neo-Hookean = {res['u hencky'] / res['u']:.5f}")
+tv.check(abs(r - 1) < tol, f"semi-implicit modified f-bar within {tol:.0%} of implicit u-p ({r - 1:+.2%})")
+tv.check(abs(res["u hencky"] / res["u"] - 1) < 0.01,
+         f"Hencky and Neo-Hookean agree at these strains ({res['u hencky'] / res['u'] - 1:+.3%})")
+tv.finish()
