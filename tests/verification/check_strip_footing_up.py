@@ -32,6 +32,9 @@ Checks:
     within TOL of u-p;
   * the implicit irreducible u runs with Neo-Hookean and with the Hencky model
     agree to 1 % (the model difference at these strains);
+  * no checkerboard in the mean stress of the modified f-bar and the u-p runs:
+    the zigzag index of check_semi_strip_footing.py below 2e-3 (its bound for
+    the modified f-bar); reported for all runs.
 Reported: S(semi-implicit, none) / S(u-p) and S(implicit u) / S(u-p).
 --young=E: E of the implicit runs only (a mutant: 1.1e7
 must fail the comparison).
@@ -79,12 +82,28 @@ def settlement(pts):
     return sum(v for _, v in pts) / len(pts)
 
 
+def zigzag(X, Y, s):
+    """the checkerboard measure of check_semi_strip_footing.py: the mean stress on
+    the initial point lattice; per point and direction with neighbours on both
+    sides min(|dp1|, |dp2|) if the two differences change sign, else 0; the RMS
+    over the range of the mean stress"""
+    pts = {(round(x / h * 2 - 0.5), round(y / h * 2 - 0.5)): (a + b + c) / 3
+           for x, y, a, b, c in zip(X, Y, s["stress_xx"], s["stress_yy"], s["stress_zz"])}
+    z = []
+    for (i, j), v in pts.items():
+        for a, b in (((i - 1, j), (i + 1, j)), ((i, j - 1), (i, j + 1))):
+            if a in pts and b in pts:
+                d1, d2 = v - pts[a], pts[b] - v
+                z.append(min(abs(d1), abs(d2)) if d1 * d2 < 0 else 0.0)
+    return (sum(q * q for q in z) / len(z)) ** 0.5 / (max(pts.values()) - min(pts.values()))
+
+
 def loaded(X, Y, f):
     return sorted((round(x, 9), round(y, 9)) for x, y, g in zip(X, Y, f) if g != 0), sum(f)
 
 
 # semi-implicit: modified f-bar and none
-res = {}
+res, zig = {}, {}
 for st in ("modified f-bar", "none"):
     name = "semi_" + st.replace(" ", "_")
     tv.run_tool(f"{tools}/talus-semi-implicit", tv.prm_set(semi, "semi implicit/volumetric stabilisation", st),
@@ -93,10 +112,11 @@ for st in ("modified f-bar", "none"):
     X = [x - u for x, u in zip(s["pos_x"], s["displacement_x"])]
     Y = [y - u for y, u in zip(s["pos_y"], s["displacement_y"])]
     res[st] = settlement(top_points(X, Y, s["displacement_y"]))
+    zig[st] = zigzag(X, Y, s)
     if st == "modified f-bar":
         semi_loaded = loaded(X, Y, [-f for f in s["surface_force"]])
         series = tv.read_csv(f"{work}/{name}/out/series.csv")
-    print(f"h = {h} m, semi-implicit {st}: settlement {res[st] * 1000:.4f} mm")
+    print(f"h = {h} m, semi-implicit {st}: settlement {res[st] * 1000:.4f} mm, zigzag index {zig[st]:.2e}")
 
 # implicit: u-p (Neo-Hookean, split), u (Neo-Hookean, split), u (Hencky, never yields)
 hencky = """subsection material 0
@@ -121,9 +141,10 @@ for key, text in runs.items():
     X = [x - u for x, u in zip(s["pos_x"], s["u_x"])]
     Y = [y - u for y, u in zip(s["pos_y"], s["u_y"])]
     res[key] = settlement(top_points(X, Y, s["u_y"]))
+    zig[key] = zigzag(X, Y, s)
     if key == "u-p":
         impl_loaded = loaded(X, Y, s["point_force_0_y"])
-    print(f"h = {h} m, implicit {key}: settlement {res[key] * 1000:.4f} mm")
+    print(f"h = {h} m, implicit {key}: settlement {res[key] * 1000:.4f} mm, zigzag index {zig[key]:.2e}")
 
 # the same load
 force = -q * width
@@ -172,6 +193,8 @@ print(f"locking: semi-implicit none / implicit u-p = {res['none'] / res['u-p']:.
 print(f"model: implicit u Hencky / Neo-Hookean = {res['u hencky'] / res['u']:.5f}")
 tv.check(abs(r - 1) < tol, f"semi-implicit modified f-bar at 1.5 s within {tol:.0%} of implicit u-p ({r - 1:+.2%})")
 tv.check(abs(rs - 1) < tol, f"semi-implicit modified f-bar post-ramp mean within {tol:.0%} of implicit u-p ({rs - 1:+.2%})")
+for key in ("modified f-bar", "u-p"):
+    tv.check(zig[key] < 2e-3, f"{key}: no checkerboard in the mean stress (zigzag {zig[key]:.2e} < 2e-3)")
 tv.check(abs(res["u hencky"] / res["u"] - 1) < 0.01,
          f"Hencky and Neo-Hookean agree at these strains ({res['u hencky'] / res['u'] - 1:+.3%})")
 tv.finish()
