@@ -1587,14 +1587,15 @@ namespace talus::semi_implicit
   Solver<dim>::series_columns() const
   {
     return {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
-            "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume"};
+            "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume",
+            "load_settlement"};
   }
 
   template <int dim>
   std::vector<double>
   Solver<dim>::series_values(const bool)
   {
-    double ek[2] = {0, 0}, vmax[2] = {0, 0}, pmin = 0, soil_volume = 0;
+    double ek[2] = {0, 0}, vmax[2] = {0, 0}, pmin = 0, soil_volume = 0, fu = 0, fsum = 0;
     for (const bool is_soil : {true, false})
       for (const auto &pt : (is_soil ? soil : water).handler)
         {
@@ -1607,8 +1608,16 @@ namespace talus::semi_implicit
           if (!is_soil)
             pmin = std::min(pmin, P[fw.pressure]);
           else // the mixture volume of the skeleton: a 1D column's height x its width
-            soil_volume += P[L::volume];
+            {
+              soil_volume += P[L::volume];
+              // the points carrying a surface load: their force-weighted mean
+              // downward displacement (the settlement conjugate to the load)
+              fu += P[fs.surface_force] * -P[L::displacement + dim - 1];
+              fsum += P[fs.surface_force];
+            }
         }
+    fu   = dealii::Utilities::MPI::sum(fu, comm);
+    fsum = dealii::Utilities::MPI::sum(fsum, comm);
     return {dealii::Utilities::MPI::sum(ek[0], comm),
             dealii::Utilities::MPI::sum(ek[1], comm),
             dealii::Utilities::MPI::max(vmax[0], comm),
@@ -1616,7 +1625,8 @@ namespace talus::semi_implicit
             dealii::Utilities::MPI::min(pmin, comm),
             static_cast<double>(last_solve.iterations),
             last_solve.relative_residual,
-            dealii::Utilities::MPI::sum(soil_volume, comm)};
+            dealii::Utilities::MPI::sum(soil_volume, comm),
+            fsum > 0 ? fu / fsum : 0.0};
   }
 
   template <int dim>
