@@ -125,6 +125,43 @@ namespace talus::explicit_mpm
           p.end_time += st.duration;
       }
     p.numerics = parse_numerics_parameters(prm, n_bodies);
+    if (p.numerics.apic())
+      {
+        // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step, affine_offset);
+        // the passes below keep their own (FLIP) velocity transfer or were not checked with it
+        const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
+                                "FLIP velocity update, or were not checked with the affine transfer); allowed: ";
+        // linear shape functions: the transfers are implemented and unit-tested
+        // (C_p = grad v), but the collapse a = 3 blows up at Courant 0.5 and 0.2
+        // (a = f / m at nodes a point barely touches goes straight into v^L)
+        require(p.numerics.bspline(), "numerics/velocity transfer",
+                "apic needs numerics/shape function = quadratic bspline: with linear shape functions the APIC "
+                "step was measured unstable (granular column collapse, Courant 0.5 and 0.2; "
+                "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
+        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
+                std::string(p.numerics.integration == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
+                            p.numerics.integration == NumericsOptions::Integration::fem     ? "fem" :
+                                                                                              "ul-fem") +
+                  why + "mpm, or velocity transfer = flip");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing" + why + "none, or velocity transfer = flip");
+        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
+                "coupled 2-phase materials and body tractions" + why + "1-phase materials, or velocity transfer = flip");
+        require(!p.balance.enabled(), "load balancing/interval",
+                "load balancing" + why + "interval = 0, or velocity transfer = flip");
+        for (const auto &st : p.loads.stages)
+          {
+            require(st.tractions.empty(), "loads/traction",
+                    "tractions" + why + "no traction conditions, or velocity transfer = flip");
+            require(st.friction_ids.empty(), "boundary conditions/friction",
+                    "boundary friction" + why + "no friction walls, or velocity transfer = flip");
+            for (const auto &v : st.velocities)
+              require(v.target != loads::PrescribedVelocity<dim>::Target::body, "loads/velocity",
+                      "prescribed velocities of bodies (apply to = body)" + why +
+                        "apply to = boundary | region, or velocity transfer = flip");
+          }
+      }
     if (p.numerics.bspline())
       {
         // the passes that are not yet kernel templates (transfer/) walk with Q1
@@ -154,36 +191,6 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           require(p.grid_cells[d] >= shape::BSpline2<dim>::min_cells, "grid/cells",
                   "quadratic B-splines need at least 3 cells per direction (the wall treatment)");
-      }
-    if (p.numerics.apic())
-      {
-        // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step_apic);
-        // the passes below keep their own (FLIP) velocity transfer or were not checked with it
-        const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
-                                "FLIP velocity update, or were not checked with the affine transfer); allowed: ";
-        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
-                            p.numerics.integration == NumericsOptions::Integration::fem     ? "fem" :
-                                                                                              "ul-fem") +
-                  why + "mpm, or velocity transfer = flip");
-        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
-                "strain smoothing" + why + "none, or velocity transfer = flip");
-        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
-        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
-                "coupled 2-phase materials and body tractions" + why + "1-phase materials, or velocity transfer = flip");
-        require(!p.balance.enabled(), "load balancing/interval",
-                "load balancing" + why + "interval = 0, or velocity transfer = flip");
-        for (const auto &st : p.loads.stages)
-          {
-            require(st.tractions.empty(), "loads/traction",
-                    "tractions" + why + "no traction conditions, or velocity transfer = flip");
-            require(st.friction_ids.empty(), "boundary conditions/friction",
-                    "boundary friction" + why + "no friction walls, or velocity transfer = flip");
-            for (const auto &v : st.velocities)
-              require(v.target != loads::PrescribedVelocity<dim>::Target::body, "loads/velocity",
-                      "prescribed velocities of bodies (apply to = body)" + why +
-                        "apply to = boundary | region, or velocity transfer = flip");
-          }
       }
     if (p.balance.enabled())
       {

@@ -33,7 +33,8 @@ namespace talus::explicit_mpm
                       "velocity from the points' momentum) or 'apic' (affine particle-in-cell, Jiang et al. 2015: "
                       "nodal momentum sum N m_p (v_p + C_p (x_i - x_p)), v_p and the affine matrix C_p from the "
                       "updated nodal velocity; conserves linear and angular momentum in the transfers, "
-                      "docs/shape-functions.md). 'apic' needs integration = mpm and 1-phase materials, without "
+                      "docs/shape-functions.md). 'apic' needs shape function = quadratic bspline (measured unstable with linear "
+                      "shape functions), integration = mpm and 1-phase materials, without "
                       "strain smoothing, contact, tractions, prescribed body velocities or load balancing.");
     prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
                       "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
