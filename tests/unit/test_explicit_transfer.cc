@@ -75,9 +75,11 @@ TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum3D) { conservation<3>(S
 
 template <int dim>
 void
-relocation_and_momentum(const Shape shape = Shape::linear)
+relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = false)
 {
   auto p = scene<dim>(shape);
+  if (apic)
+    p.numerics.velocity_transfer = explicit_mpm::NumericsOptions::VelocityTransfer::apic;
   p.gravity = dealii::Tensor<1, dim>();
   // two small bodies slide along the bottom, one behind the other: cells become
   // active for the first time, are vacated, and are re-entered (stale nodal entries)
@@ -157,6 +159,10 @@ TEST(ExplicitTransfer, RelocationKeepsParticles3D) { relocation_and_momentum<3>(
 // the moved points equals a fresh P2G on the 4^dim patches after every step
 TEST(ExplicitTransfer, BSplineRelocationKeepsParticles2D) { relocation_and_momentum<2>(Shape::quadratic_bspline); }
 TEST(ExplicitTransfer, BSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline); }
+// the APIC step (velocity transfer = apic): same relocation, fused = fresh P2G, and sum m v_p
+// conserved without external forces (sum_i m_i v_i^L = sum_p m_p v_p, G2P returns it exactly)
+TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles2D) { relocation_and_momentum<2>(Shape::quadratic_bspline, true); }
+TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline, true); }
 
 // ---------------------------------------------------------------- APIC (issue 12)
 // numerics/velocity transfer = apic (transfer/affine_ops.h). A rigidly rotating
