@@ -75,9 +75,11 @@ TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum3D) { conservation<3>(S
 
 template <int dim>
 void
-relocation_and_momentum(const Shape shape = Shape::linear)
+relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = false)
 {
   auto p = scene<dim>(shape);
+  if (apic)
+    p.numerics.velocity_transfer = explicit_mpm::NumericsOptions::VelocityTransfer::apic;
   p.gravity = dealii::Tensor<1, dim>();
   // two small bodies slide along the bottom, one behind the other: cells become
   // active for the first time, are vacated, and are re-entered (stale nodal entries)
@@ -157,3 +159,245 @@ TEST(ExplicitTransfer, RelocationKeepsParticles3D) { relocation_and_momentum<3>(
 // the moved points equals a fresh P2G on the 4^dim patches after every step
 TEST(ExplicitTransfer, BSplineRelocationKeepsParticles2D) { relocation_and_momentum<2>(Shape::quadratic_bspline); }
 TEST(ExplicitTransfer, BSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline); }
+// the APIC step (velocity transfer = apic): same relocation, fused = fresh P2G, and sum m v_p
+// conserved without external forces (sum_i m_i v_i^L = sum_p m_p v_p, G2P returns it exactly)
+TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles2D) { relocation_and_momentum<2>(Shape::quadratic_bspline, true); }
+TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline, true); }
+
+// ---------------------------------------------------------------- APIC (issue 12)
+// numerics/velocity transfer = apic (transfer/affine_ops.h). A rigidly rotating
+// body: the P2G with the affine term must hand the grid exactly the points'
+// linear momentum sum m v and angular momentum sum m (x x v + eps : (C D)^T),
+// for any C_p (here the rotation's W plus a random perturbation); and the
+// affine transfer must reproduce the rotation's linear field exactly both ways
+// (G2P of v_i = W x_i gives v_p = W x_p, C_p = W; P2G of that gives back
+// v_i = W x_i at every node with mass), which FLIP/PIC do not (PIC loses the
+// rotation's angular momentum). Both kernels; 1 and 2 ranks.
+#include <talus/shape/bspline2_box.h>
+#include <talus/shape/q1_box.h>
+#include <talus/transfer/affine_ops.h>
+
+/// node positions into a vector of the grid's layout (component d at the DoF of component d)
+template <int dim>
+void
+node_positions(const explicit_mpm::Solver<dim> &s, talus::Vector &X)
+{
+  s.grid.reinit_vector(X);
+  for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
+    {
+      const auto &cc = s.grid.cells[c];
+      for (unsigned int v = 0; v < dealii::GeometryInfo<dim>::vertices_per_cell; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          X.local_element(cc.dofs[v * dim + d]) = cc.lower[d] + ((v >> d) & 1u) * cc.h[d];
+    }
+}
+
+/// the rotation's skew matrix W (v = W (x - x0)): about z in 2D, about (1, 2, 3)/|.| in 3D
+template <int dim>
+dealii::Tensor<2, dim>
+rotation_W(const double omega)
+{
+  dealii::Tensor<2, dim> W;
+  if constexpr (dim == 2)
+    {
+      W[0][1] = -omega;
+      W[1][0] = omega;
+    }
+  else
+    {
+      const double n = std::sqrt(14.0), a = omega / n, b = 2 * omega / n, c = 3 * omega / n;
+      W[0][1] = -c, W[1][0] = c;
+      W[0][2] = b, W[2][0] = -b;
+      W[1][2] = -a, W[2][1] = a;
+    }
+  return W;
+}
+
+template <int dim, class K>
+void
+apic_transfer(const Shape shape)
+{
+  using L = PropertyLayout<dim>;
+  auto p  = scene<dim>(shape);
+  p.numerics.velocity_transfer = explicit_mpm::NumericsOptions::VelocityTransfer::apic;
+  // the rotation about the body's centre, so the body stays in the grid
+  const auto W      = rotation_W<dim>(2.0);
+  dealii::Point<dim> x0;
+  for (unsigned int d = 0; d < dim; ++d)
+    x0[d] = 0.5;
+  dealii::Tensor<1, dim> v0;
+  v0[0] = 0.1; // plus a translation
+  p.bodies[0].velocity_field = [=](const dealii::Point<dim> &x) { return dealii::Tensor<1, dim>(W * (x - x0) + v0); };
+  // and a second, small body against the lower wall (wall half cells of the B-spline)
+  auto b2   = p.bodies[0];
+  b2.radius = 0.06;
+  b2.center[0] = 0.2;
+  b2.center[1] = shape == Shape::linear ? 0.05 : -0.2;
+  p.bodies.push_back(b2);
+  explicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
+  s.setup();
+  ASSERT_GT(s.affine_offset, 0u);
+  const unsigned int A = s.affine_offset;
+
+  // (1) P2G conservation with C_p = W + a random perturbation
+  std::mt19937                           rng(17 + dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD));
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (auto &pt : s.points.handler)
+    {
+      double *P = pt.get_properties().data();
+      for (unsigned int c = 0; c < dim; ++c)
+        for (unsigned int k = 0; k < dim; ++k)
+          P[A + c * dim + k] = W[c][k] + 0.5 * u(rng);
+    }
+  constexpr unsigned int na = dim == 2 ? 1 : 3;
+  double point_sums[dim + na] = {}, mass = 0;
+  for (auto &pt : s.points.handler)
+    {
+      const double *P = pt.get_properties().data();
+      const auto    c = pt.get_surrounding_cell()->active_cell_index();
+      for (unsigned int d = 0; d < dim; ++d)
+        point_sums[d] += P[L::mass] * P[L::velocity + d];
+      transfer::affine_angular_momentum<dim, K>(K::cell(s.grid, c), pt.get_reference_location(), pt.get_location(),
+                                                P[L::mass], P + L::velocity, P + A, point_sums + dim);
+      mass += P[L::mass];
+    }
+  talus::Vector X, Pn;
+  node_positions(s, X);
+  s.grid.reinit_vector(Pn);
+  s.scatter_point_momentum(Pn);
+  double grid_sums[dim + na] = {};
+  const unsigned int n_owned = Pn.locally_owned_size();
+  // owned nodes: the component-0 DoFs; the node's components follow from its cells
+  std::vector<std::array<unsigned int, dim>> node_dofs;
+  {
+    std::vector<char> seen(n_owned + Pn.get_partitioner()->n_ghost_indices(), 0);
+    for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
+      for (unsigned int v = 0; v < dealii::GeometryInfo<dim>::vertices_per_cell; ++v)
+        {
+          const unsigned int *dofs = s.grid.cells[c].dofs + v * dim;
+          if (dofs[0] < n_owned && !seen[dofs[0]])
+            {
+              seen[dofs[0]] = 1;
+              std::array<unsigned int, dim> a;
+              for (unsigned int d = 0; d < dim; ++d)
+                a[d] = dofs[d];
+              node_dofs.push_back(a);
+            }
+        }
+  }
+  for (const auto &a : node_dofs)
+    {
+      double x[dim], q[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          x[d] = X.local_element(a[d]);
+          q[d] = Pn.local_element(a[d]);
+          grid_sums[d] += q[d];
+        }
+      if constexpr (dim == 2)
+        grid_sums[dim] += x[0] * q[1] - x[1] * q[0];
+      else
+        {
+          grid_sums[dim + 0] += x[1] * q[2] - x[2] * q[1];
+          grid_sums[dim + 1] += x[2] * q[0] - x[0] * q[2];
+          grid_sums[dim + 2] += x[0] * q[1] - x[1] * q[0];
+        }
+    }
+  dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(point_sums, dim + na), MPI_COMM_WORLD,
+                              dealii::ArrayView<double>(point_sums, dim + na));
+  dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(grid_sums, dim + na), MPI_COMM_WORLD,
+                              dealii::ArrayView<double>(grid_sums, dim + na));
+  mass = dealii::Utilities::MPI::sum(mass, MPI_COMM_WORLD);
+  // scale: mass x speed (x lever arm 1 m): ~ mass
+  for (unsigned int d = 0; d < dim; ++d)
+    EXPECT_NEAR(grid_sums[d], point_sums[d], 1e-13 * mass) << "linear momentum, component " << d;
+  for (unsigned int d = 0; d < na; ++d)
+    {
+      EXPECT_NEAR(grid_sums[dim + d], point_sums[dim + d], 1e-13 * mass) << "angular momentum, component " << d;
+      // without the affine term the sums would differ by O(m |C| h^2): the check can fail
+      EXPECT_GT(std::abs(point_sums[dim + d]), 1e-3 * mass);
+    }
+
+  // (2) the rotation's linear nodal field v_i = W (x_i - x0) + v0 both ways
+  talus::Vector V;
+  s.grid.reinit_vector(V);
+  for (unsigned int i = 0; i < n_owned + V.get_partitioner()->n_ghost_indices(); ++i)
+    ; // filled per node below (ghosts included, from the cells)
+  for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
+    for (unsigned int v = 0; v < dealii::GeometryInfo<dim>::vertices_per_cell; ++v)
+      {
+        const unsigned int *dofs = s.grid.cells[c].dofs + v * dim;
+        for (unsigned int a = 0; a < dim; ++a)
+          {
+            double w = v0[a];
+            for (unsigned int k = 0; k < dim; ++k)
+              w += W[a][k] * (X.local_element(dofs[k]) - x0[k]);
+            V.local_element(dofs[a]) = w;
+          }
+      }
+  V.update_ghost_values(); // B-spline patches reach ghost nodes of ghost cells: take owners' values
+  const double h = 1e-3;   // any scale: du = h V
+  double       worst_v = 0, worst_C = 0;
+  transfer::for_each_active_cell(s.points, [](unsigned int) {}, [&](const unsigned int c, auto &it) {
+    const auto        cell = K::cell(s.grid, c);
+    typename K::Field du;
+    K::gather(cell, V.begin(), h, du, true);
+    typename K::Eval e;
+    K::evaluate(cell, it->get_reference_location(), e);
+    double gu[dim][dim], dx[dim];
+    transfer::default_increments<dim, K>(cell, e, du, gu, dx);
+    double *P = it->get_properties().data();
+    transfer::apic_point_velocity<dim, K>(cell, e, du, h, gu, dx, P + L::velocity, P + A);
+    const auto x = it->get_location();
+    for (unsigned int a = 0; a < dim; ++a)
+      {
+        double w = v0[a];
+        for (unsigned int k = 0; k < dim; ++k)
+          {
+            w += W[a][k] * (x[k] - x0[k]);
+            worst_C = std::max(worst_C, std::abs(P[A + a * dim + k] - W[a][k]));
+          }
+        worst_v = std::max(worst_v, std::abs(P[L::velocity + a] - w));
+      }
+  }, [](unsigned int) {});
+  worst_v = dealii::Utilities::MPI::max(worst_v, MPI_COMM_WORLD);
+  worst_C = dealii::Utilities::MPI::max(worst_C, MPI_COMM_WORLD);
+  EXPECT_LT(worst_v, 1e-12) << "G2P: v_p = W x_p";
+  EXPECT_LT(worst_C, 1e-10) << "G2P: C_p = W";
+  s.scatter_point_momentum(Pn);
+  talus::Vector M, F;
+  s.grid.reinit_vector(M);
+  s.grid.reinit_vector(F);
+  {
+    transfer::ScatterMassForce<dim, K> op{s.grid, dealii::Tensor<1, dim>(), M.begin(), F.begin()};
+    transfer::for_each_active_cell(s.points, op);
+  }
+  M.compress(dealii::VectorOperation::add);
+  double worst_node = 0;
+  unsigned int n_mass = 0;
+  for (unsigned int i = 0; i < n_owned; ++i)
+    if (M.local_element(i) > 1e-12 * mass)
+      {
+        ++n_mass;
+        worst_node = std::max(worst_node, std::abs(Pn.local_element(i) / M.local_element(i) - V.local_element(i)));
+      }
+  worst_node = dealii::Utilities::MPI::max(worst_node, MPI_COMM_WORLD);
+  EXPECT_GT(dealii::Utilities::MPI::sum(n_mass, MPI_COMM_WORLD), 0u);
+  EXPECT_LT(worst_node, 1e-12) << "P2G: v_i = W x_i at every node with mass";
+  if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+    {
+      double dl = 0, da = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        dl = std::max(dl, std::abs(grid_sums[d] - point_sums[d]) / mass);
+      for (unsigned int d = 0; d < na; ++d)
+        da = std::max(da, std::abs(grid_sums[dim + d] - point_sums[dim + d]) / mass);
+      std::cout << "  APIC " << dim << "D: |P_grid - P_points| / M " << dl << ", |L_grid - L_points| / M " << da
+                << ", G2P |v_p - W x_p| " << worst_v << ", |C_p - W| " << worst_C << ", P2G |v_i - W x_i| "
+                << worst_node << std::endl;
+    }
+}
+
+TEST(ExplicitTransfer, ApicConservesMomentumQ1_2D) { apic_transfer<2, shape::Q1Box<2>>(Shape::linear); }
+TEST(ExplicitTransfer, ApicConservesMomentumQ1_3D) { apic_transfer<3, shape::Q1Box<3>>(Shape::linear); }
+TEST(ExplicitTransfer, ApicConservesMomentumBSpline2D) { apic_transfer<2, shape::BSpline2Box<2>>(Shape::quadratic_bspline); }
+TEST(ExplicitTransfer, ApicConservesMomentumBSpline3D) { apic_transfer<3, shape::BSpline2Box<3>>(Shape::quadratic_bspline); }

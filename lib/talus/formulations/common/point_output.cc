@@ -74,7 +74,9 @@ namespace talus
     header.push_back("volume");
     for (const auto &e : set.layout.extras)
       for (unsigned int i = 0; i < e.size; ++i)
-        header.push_back(e.size == 1 ? e.name : e.name + "_" + std::string(ax[i < 3 ? i : 0]));
+        header.push_back(e.size == 1         ? e.name :
+                         e.size == dim * dim ? e.name + "_" + ax[i / dim] + ax[i % dim] : // a matrix (APIC C_p)
+                                               e.name + "_" + std::string(ax[i < 3 ? i : 0]));
     io::AtomicFile f(directory + "/particles_final.csv");
     for (unsigned int k = 0; k < header.size(); ++k)
       f.stream() << (k ? "," : "") << header[k];

@@ -12,6 +12,7 @@
 #include <talus/io/png_snapshots.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/load_control.h>
+#include <talus/transfer/affine_ops.h>
 #include <talus/transfer/point_ops.h>
 #include <talus/materials/strain_increments.h>
 
@@ -124,6 +125,43 @@ namespace talus::explicit_mpm
           p.end_time += st.duration;
       }
     p.numerics = parse_numerics_parameters(prm, n_bodies);
+    if (p.numerics.apic())
+      {
+        // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step, affine_offset);
+        // the passes below keep their own (FLIP) velocity transfer or were not checked with it
+        const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
+                                "FLIP velocity update, or were not checked with the affine transfer); allowed: ";
+        // linear shape functions: the transfers are implemented and unit-tested
+        // (C_p = grad v), but the collapse a = 3 blows up at Courant 0.5 and 0.2
+        // (a = f / m at nodes a point barely touches goes straight into v^L)
+        require(p.numerics.bspline(), "numerics/velocity transfer",
+                "apic needs numerics/shape function = quadratic bspline: with linear shape functions the APIC "
+                "step was measured unstable (granular column collapse, Courant 0.5 and 0.2; "
+                "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
+        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
+                std::string(p.numerics.integration == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
+                            p.numerics.integration == NumericsOptions::Integration::fem     ? "fem" :
+                                                                                              "ul-fem") +
+                  why + "mpm, or velocity transfer = flip");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing" + why + "none, or velocity transfer = flip");
+        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
+                "coupled 2-phase materials and body tractions" + why + "1-phase materials, or velocity transfer = flip");
+        require(!p.balance.enabled(), "load balancing/interval",
+                "load balancing" + why + "interval = 0, or velocity transfer = flip");
+        for (const auto &st : p.loads.stages)
+          {
+            require(st.tractions.empty(), "loads/traction",
+                    "tractions" + why + "no traction conditions, or velocity transfer = flip");
+            require(st.friction_ids.empty(), "boundary conditions/friction",
+                    "boundary friction" + why + "no friction walls, or velocity transfer = flip");
+            for (const auto &v : st.velocities)
+              require(v.target != loads::PrescribedVelocity<dim>::Target::body, "loads/velocity",
+                      "prescribed velocities of bodies (apply to = body)" + why +
+                        "apply to = boundary | region, or velocity transfer = flip");
+          }
+      }
     if (p.numerics.bspline())
       {
         // the passes that are not yet kernel templates (transfer/) walk with Q1
@@ -267,6 +305,10 @@ namespace talus::explicit_mpm
         free_surface = std::make_unique<FreeSurface<dim>>(*this, prm.liquid.free_surface_factor);
         free_surface->extend_layout(points.layout);
       }
+    // APIC: the affine velocity matrix C_p, a point property of APIC runs only
+    // (saved with the checkpoints like every property)
+    if (prm.numerics.apic())
+      affine_offset = points.layout.add_extra("affine_velocity", dim * dim);
     points.initialize();
     if (prm.numerics.fem())
       fem = std::make_unique<FemIntegration<dim>>(*this, prm.numerics.integration ==
@@ -584,10 +626,36 @@ namespace talus::explicit_mpm
   {
     zero_on_active(v);
     with_kernel([&](auto kernel) {
-      transfer::ScatterMomentum<dim, decltype(kernel)> op(grid, v.begin());
-      transfer::for_each_active_cell(points, op);
+      if (affine_offset)
+        {
+          transfer::ScatterAffineMomentum<dim, decltype(kernel)> op(grid, v.begin(), affine_offset);
+          transfer::for_each_active_cell(points, op);
+        }
+      else
+        {
+          transfer::ScatterMomentum<dim, decltype(kernel)> op(grid, v.begin());
+          transfer::for_each_active_cell(points, op);
+        }
     });
     v.compress(dealii::VectorOperation::add);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::apic_nodal_velocity(const double h)
+  {
+    // p^t with the affine term, then the Lagrangian nodal velocity
+    // v^L = p^t / m + h a (a after the loads: a prescribed node gets
+    // a = (vbar - v^t) / h, so v^L = vbar there), as nodal_velocity() leaves it
+    scatter_point_momentum(nodal_p);
+    const double *M = nodal_mass.begin();
+    const double *A = nodal_a.begin();
+    double *      V = nodal_p.begin();
+    for (const unsigned int i : active_dofs)
+      V[i] = (M[i] > 0 && !constrained[i]) ? V[i] / M[i] + h * A[i] : 0.0;
+    if (control)
+      control->nodal_velocities(*this);
+    nodal_p.update_ghost_values();
   }
 
   template <int dim>
@@ -721,6 +789,27 @@ namespace talus::explicit_mpm
               }
       }
     };
+
+    /// The same physics with the APIC G2P of the velocity (transfer/affine_ops.h):
+    /// v_p and C_p from the nodal velocity of the update pass (v^L), instead of
+    /// the FLIP increment of the separate G2P/P2G pass.
+    template <int dim, class K>
+    struct ApicPointUpdate : ExplicitPointUpdate<dim, K>
+    {
+      using L = PropertyLayout<dim>;
+      unsigned int affine = 0;
+      inline void
+      increments(const typename K::Cell & cell,
+                 const typename K::Eval & ev,
+                 const typename K::Field &du,
+                 double *                 P,
+                 double (&gu)[dim][dim],
+                 double (&dx)[dim])
+      {
+        transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
+        transfer::apic_point_velocity<dim, K>(cell, ev, du, this->h, gu, dx, P + L::velocity, P + affine);
+      }
+    };
   } // namespace
 
   template <int dim>
@@ -760,6 +849,28 @@ namespace talus::explicit_mpm
         transfer::Fused                    fused{update, p2g};
         transfer::for_each_active_cell(points, fused);
       }
+    local_energies = physics.e;
+    local_momentum = physics.momentum;
+    local_bad      = physics.bad;
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::g2p_update_apic_with(K, const double h)
+  {
+    std::fill(probe_values.begin(), probe_values.end(), 0.0);
+    std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
+    ApicPointUpdate<dim, K> physics{{prm.materials, points.layout.history, h, gravity, nullptr, nullptr,
+                                     need_strain_energy, probe_ids, probe_values, probe_stress},
+                                    affine_offset};
+    // as g2p_update_with: the update pass with the next step's mass and force fused
+    zero_on_active(nodal_mass);
+    zero_on_active(nodal_a);
+    transfer::UpdateAndMove<dim, K, ApicPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h, physics};
+    transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+    transfer::Fused                    fused{update, p2g};
+    transfer::for_each_active_cell(points, fused);
     local_energies = physics.e;
     local_momentum = physics.momentum;
     local_bad      = physics.bad;
@@ -808,6 +919,19 @@ namespace talus::explicit_mpm
       contact->correct_accelerations(*this, h);
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
+    if (affine_offset)
+      {
+        // APIC (contact, FEM, 2-phase, smoothing are refused with it)
+        apic_nodal_velocity(h);
+        timings.grid += seconds_since(t0);
+        t0 = Clock::now();
+        with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
+        timings.g2p += seconds_since(t0);
+        t0 = Clock::now();
+        relocate();
+        timings.relocation += seconds_since(t0);
+        return;
+      }
     if (contact)
       contact->g2p_velocity_p2g_momentum(*this, h);
     else

@@ -109,8 +109,12 @@ namespace talus::explicit_mpm
     std::pair<double, bool> check_incremental_state();
 
     /// P2G of the points' momentum m v into v (zeroed first; compressed).
-    /// Collective. Used by the loads (nodal velocity before the step).
+    /// Collective. Used by the loads (nodal velocity before the step). With
+    /// velocity transfer = apic: m (v + C_p (x_i - x_p)) (transfer/affine_ops.h).
     void scatter_point_momentum(Vector &v);
+    /// Offset of the APIC affine matrix C_p (dim x dim, row-major) in the point
+    /// properties; 0 when velocity transfer = flip (no such block).
+    unsigned int affine_offset = 0;
 
     /// Nodal lumped mass and momentum after a P2G of the current particle state
     /// (for tests): returns global sums sum_i m_i and sum_i p_i.
@@ -232,6 +236,12 @@ namespace talus::explicit_mpm
     void g2p_update(const double dt);
     template <class Kernel>
     void g2p_update_with(Kernel, const double dt);
+    /// The 1-phase step with velocity transfer = apic (after the nodal
+    /// acceleration): affine P2G of p^t, v^L = p^t / m + h a, APIC G2P fused
+    /// into the update pass.
+    void apic_nodal_velocity(const double dt);
+    template <class Kernel>
+    void g2p_update_apic_with(Kernel, const double dt);
     /// Relocation; moved points add their mass and force to the next step's sums.
     void relocate();
     void write_final_particles() const;

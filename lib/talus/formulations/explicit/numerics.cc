@@ -28,6 +28,14 @@ namespace talus::explicit_mpm
                       "docs/shape-functions.md). Quadratic B-splines need a uniform box grid with at least 3 "
                       "cells per direction and integration = mpm, without strain smoothing, contact, 2-phase "
                       "materials, tractions, friction or prescribed velocities of bodies.");
+    prm.declare_entry("velocity transfer", "flip", Selection("flip|apic"),
+                      "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
+                      "velocity from the points' momentum) or 'apic' (affine particle-in-cell, Jiang et al. 2015: "
+                      "nodal momentum sum N m_p (v_p + C_p (x_i - x_p)), v_p and the affine matrix C_p from the "
+                      "updated nodal velocity; conserves linear and angular momentum in the transfers, "
+                      "docs/shape-functions.md). 'apic' needs shape function = quadratic bspline (measured unstable with linear "
+                      "shape functions), integration = mpm and 1-phase materials, without "
+                      "strain smoothing, contact, tractions, prescribed body velocities or load balancing.");
     prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
                       "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
                       "UL-FEM): 'mpm' at the material points; "
@@ -71,6 +79,8 @@ namespace talus::explicit_mpm
     o.shape_function = prm.get("shape function") == "quadratic bspline" ?
                          NumericsOptions::ShapeFunction::quadratic_bspline :
                          NumericsOptions::ShapeFunction::linear;
+    o.velocity_transfer = prm.get("velocity transfer") == "apic" ? NumericsOptions::VelocityTransfer::apic :
+                                                                     NumericsOptions::VelocityTransfer::flip;
     {
       const std::string i = prm.get("integration");
       o.integration       = i == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed :

@@ -43,6 +43,14 @@ namespace talus::explicit_mpm
     };
     ShapeFunction shape_function = ShapeFunction::linear;
     bool bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
+    /// Velocity transfer of the 1-phase step (docs/shape-functions.md, "APIC").
+    enum class VelocityTransfer
+    {
+      flip, ///< v_p += h a(x_p), momentum re-projection (seed 000 Eqs. 4.46-4.48)
+      apic  ///< affine particle-in-cell (Jiang et al. 2015): v_p, C_p from the nodal velocity
+    };
+    VelocityTransfer velocity_transfer = VelocityTransfer::flip;
+    bool apic() const { return velocity_transfer == VelocityTransfer::apic; }
     Integration integration = Integration::mpm;
     double      fill_factor = 0.9; ///< F_fill of Eq. 6.33
     bool        mixed_linear = true; ///< MPM-MIXED cell stress linear (else constant, Eq. 6.32 alone)
