@@ -226,7 +226,6 @@ namespace talus::implicit_mpm
     not_yet(!p.results_file.empty(), "output/results file");
     not_yet(!p.probes.empty(), "output/probes");
     not_yet(p.write_grid, "output/write grid");
-    not_yet(p.balance.enabled(), "load balancing/interval");
     not_yet(bool(p.grid_mesh), "grid/source");
     check_scene_consistency(p); // grid, boundary ids, memory, bodies
     if (p.axisymmetric)
@@ -282,8 +281,9 @@ namespace talus::implicit_mpm
   Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
     : prm(p)
     , comm(c)
-    , grid(c)
+    , grid(c, p.balance.enabled())
     , points(grid, "points")
+    , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
     , space(grid, p.mixed_up ? dim + 1 : dim)
     , active(space)
     , newmark(p.gamma, p.beta)
@@ -403,6 +403,32 @@ namespace talus::implicit_mpm
       }
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
       space.reinit_vector(*v);
+    // load balancing: partition by points from the start (a restart on as many
+    // ranks has recreated its saved partition instead)
+    balance.initial();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::grid_changed()
+  {
+    space.setup();
+    if (current_stage < prm.stages.size())
+      {
+        const auto &st  = prm.stages[current_stage];
+        boundary_flags  = loads::wall_dof_flags(grid, st.boundary_conditions);
+        prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
+      }
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new})
+      space.reinit_vector(*v);
+    points.collect_active_cells();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::after_step()
+  {
+    balance.after_step(step_number, prm.progress);
   }
 
   template <int dim>
@@ -986,6 +1012,7 @@ namespace talus::implicit_mpm
     const char *ax[] = {"x", "y", "z"};
     for (unsigned int d = 0; d < dim; ++d)
       c.push_back(std::string("centre_of_mass_") + ax[d]);
+    balance.add_series_column(c);
     return c;
   }
 
@@ -1010,6 +1037,7 @@ namespace talus::implicit_mpm
     dealii::Utilities::MPI::sum(sums, comm, sums);
     for (unsigned int d = 0; d < dim; ++d)
       v.push_back(sums[d] / sums[dim]);
+    balance.add_series_value(v);
     return v;
   }
 
@@ -1041,6 +1069,7 @@ namespace talus::implicit_mpm
                                    f.set_attribute("cut-backs", std::int64_t(cut_backs));
                                    write_points(f, points);
                                    write_pvd_times(f, "output/pvd", pvd_records);
+                                   balance.write(f); // the partition of the last rebalance
                                  });
   }
 
@@ -1063,6 +1092,7 @@ namespace talus::implicit_mpm
     total_iterations        = fp->get_int("newton iterations");
     total_linear_iterations = fp->get_int("linear iterations");
     cut_backs               = fp->get_int("cut-backs");
+    balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, points, grid, "checkpoint " + fp->path());
     pvd_records = read_pvd_records(*fp, "output/pvd", "particles");
     return true;
@@ -1082,7 +1112,7 @@ namespace talus::implicit_mpm
   {
     log() << "done: " << step_number << " steps, " << n_points() << " particles, wall " << std::setprecision(4)
           << t.total << " s; Newton iterations " << total_iterations << " (cut-backs " << cut_backs
-          << "), linear iterations " << total_linear_iterations << std::endl;
+          << "), linear iterations " << total_linear_iterations << balance.summary() << std::endl;
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;
