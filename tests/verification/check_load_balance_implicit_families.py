@@ -27,6 +27,9 @@ MODE restart (c):
      gives particles_final.csv (both sets for semi-implicit) and series.csv
      byte for byte identical to the uninterrupted 2-rank run, and the
      continuation rebalanced again.
+Mutants seen failing (3 Dec 2026): weights from the soil set only -> the pond
+scene stays at imbalance 1.289 after the rebalance (a fails); talus-implicit's
+grid_changed without NodalSpace::setup() -> the 2-rank run crashes (exit 139).
 Usage: check_load_balance_implicit_families.py TOOL PRM WORKDIR MODE [TOL]
 """
 import os
