@@ -35,7 +35,6 @@ cases = [
     # checkpoints are built; a restart needs one (the foreign, other-scene and
     # other-dimension checkpoints: check_semi_restart.py)
     ("restart without a checkpoint", [("checkpoint/restart", "true")], "checkpoint/restart"),
-    ("load balancing", [("load balancing/interval", "10")], "load balancing/interval"),
     ("negative surface load", [("body 0/surface load", "-5")], "body 0/surface load"),
     ("drained boundary of 3D in 2D", [("semi implicit/drained boundaries", "2, 4")], "semi implicit/drained boundaries"),
     ("drained boundary not a number", [("semi implicit/drained boundaries", "base")], "semi implicit/drained boundaries"),

@@ -191,3 +191,16 @@ add_test(NAME verification.implicit_rolling_disk
                  ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk)
 set_tests_properties(verification.implicit_rolling_disk PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
                      TIMEOUT 600 DISABLED TRUE)
+
+# issue 15: load balancing by material points (formulations/common/load_balance.h):
+# a column collapsing in the left fifth of the box on 2 ranks, imbalance before/after
+# the rebalance and 1 vs 2 ranks with a rebalance at every check (ranks), restart
+# across rebalances byte for byte on 2 ranks (restart)
+foreach(_mode ranks restart)
+  add_test(NAME verification.implicit_load_balance_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_load_balance_implicit_families.py ${TALUS_TOOLS_DIR}/talus-implicit
+                   ${TALUS_PRM_DIR}/verification/implicit_load_balance_collapse.prm
+                   ${_w}/implicit_load_balance_${_mode} ${_mode} 1e-8)
+  set_tests_properties(verification.implicit_load_balance_${_mode} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 600 PROCESSORS 2)
+endforeach()

@@ -163,3 +163,17 @@ add_test(NAME verification.semi_implicit_norsand_initialisation
                  ${_w}/semi_implicit_norsand_initialisation)
 set_tests_properties(verification.semi_implicit_norsand_initialisation PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 900)
+
+# issue 15: load balancing by the points of both sets (soil and water): a saturated
+# column under a pond at the bottom of a tall box on 2 ranks, imbalance before/after
+# the rebalance and 1 vs 2 ranks with a rebalance at every check (ranks), restart
+# across rebalances byte for byte on 2 ranks (restart)
+foreach(_mode ranks restart)
+  add_test(NAME verification.semi_implicit_load_balance_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_load_balance_implicit_families.py
+                   ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                   ${TALUS_PRM_DIR}/verification/semi_implicit_load_balance_pond.prm
+                   ${_w}/semi_implicit_load_balance_${_mode} ${_mode} 1e-10)
+  set_tests_properties(verification.semi_implicit_load_balance_${_mode} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 600 PROCESSORS 2)
+endforeach()

@@ -148,8 +148,7 @@ namespace talus::explicit_mpm
     write_pvd_times(f, "output/grid_pvd", grid_pvd_records);
     std::vector<double> probes(probe_ids.begin(), probe_ids.end());
     f.write_global("probes/ids", probes, 1);
-    if (prm.balance.enabled()) // the partition of the last rebalance (CellId words, weight)
-      f.write_rows("balance/weights", balance_weights, 5);
+    balance.write(f); // the partition of the last rebalance
     f.commit();
 
     prune_checkpoint_files(dir, prm.checkpoint_keep, comm); // keep the newest `keep`
@@ -175,16 +174,7 @@ namespace talus::explicit_mpm
     initial_energies         = {f.get_double("initial kinetic"), f.get_double("initial strain"),
                         f.get_double("initial potential"), f.get_double("initial external work")};
     const bool         same      = f.get_int("ranks") == static_cast<std::int64_t>(n_ranks);
-    if (same && f.exists("balance/weights"))
-      {
-        // the partition of the saved run: the same weights give the same cells per rank
-        const auto rows = f.read_all("balance/weights");
-        repartition_with(rows);
-        grid_changed();
-        restored_partition = true;
-        if (rank == 0)
-          balance_weights = rows;
-      }
+    balance.restore(f); // same ranks: the saved partition (grid_changed() called)
     if (same)
       {
         read_points(f, points, grid, where);

@@ -232,6 +232,7 @@ namespace talus::explicit_mpm
     , comm(c)
     , grid(c, p.balance.enabled())
     , points(grid, "points")
+    , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
     , gravity(p.gravity)
   {}
 
@@ -400,14 +401,7 @@ namespace talus::explicit_mpm
       }
     // load balancing: partition by points from the start (a restart on as many
     // ranks has recreated its saved partition instead)
-    if (prm.balance.enabled() && dealii::Utilities::MPI::n_mpi_processes(comm) > 1 && !restored_partition)
-      {
-        const double before = imbalance();
-        rebalance();
-        log() << "  load balancing: points per rank max/mean " << std::setprecision(4) << before << " -> "
-              << imbalance() << std::endl;
-      }
-    else
+    if (!balance.initial())
       collect_active_cells();
   }
 
@@ -461,60 +455,7 @@ namespace talus::explicit_mpm
   }
 
   // ---------------------------------------------------------------- load balancing
-  template <int dim>
-  double
-  Solver<dim>::imbalance() const
-  {
-    const double       n   = points.handler.n_locally_owned_particles();
-    const double       mx  = dealii::Utilities::MPI::max(n, comm);
-    const double       sum = dealii::Utilities::MPI::sum(n, comm);
-    const unsigned int nr  = dealii::Utilities::MPI::n_mpi_processes(comm);
-    return sum > 0 ? mx * nr / sum : 1.0;
-  }
-
-  template <int dim>
-  void
-  Solver<dim>::repartition_with(const std::vector<double> &rows)
-  {
-    // rows: the 4 words of CellId::to_binary and the weight
-    std::map<dealii::CellId::binary_type, unsigned int> weight_of;
-    for (std::size_t r = 0; r + 5 <= rows.size(); r += 5)
-      {
-        dealii::CellId::binary_type key;
-        for (unsigned int k = 0; k < 4; ++k)
-          key[k] = static_cast<unsigned int>(rows[r + k]);
-        weight_of[key] = static_cast<unsigned int>(rows[r + 4]);
-      }
-    grid.repartition([&](const typename dealii::Triangulation<dim>::cell_iterator &cell) {
-      const auto it = weight_of.find(cell->id().template to_binary<dim>());
-      return it == weight_of.end() ? prm.balance.cell_weight : it->second;
-    });
-  }
-
-  template <int dim>
-  void
-  Solver<dim>::rebalance()
-  {
-    // the weights of the cells with points (the others weigh 'cell weight'),
-    // kept for checkpoints: a bitwise restart recreates the partition from them
-    balance_weights.clear();
-    for (const auto &cell : grid.tria.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          const unsigned int n = points.handler.n_particles_in_cell(cell);
-          if (n == 0)
-            continue;
-          for (const unsigned int w : cell->id().template to_binary<dim>())
-            balance_weights.push_back(w);
-          balance_weights.push_back(prm.balance.cell_weight + prm.balance.point_weight * n);
-        }
-    points.handler.prepare_for_coarsening_and_refinement();
-    repartition_with(balance_weights);
-    points.handler.unpack_after_coarsening_and_refinement();
-    grid_changed();
-    ++n_rebalances;
-  }
-
+  // (formulations/common/load_balance.h; grid_changed() is its rebuild)
   template <int dim>
   void
   Solver<dim>::grid_changed()
@@ -538,17 +479,7 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::after_step()
   {
-    if (!prm.balance.enabled() || step_number % prm.balance.interval != 0 ||
-        dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
-      return;
-    const double before = imbalance();
-    if (before <= prm.balance.threshold)
-      return;
-    rebalance();
-    const double after = imbalance();
-    if (prm.progress)
-      log() << "  step " << step_number << ": rebalanced, points per rank max/mean " << std::setprecision(4)
-            << before << " -> " << after << std::endl;
+    balance.after_step(step_number, prm.progress);
   }
 
   template <int dim>
@@ -1246,8 +1177,7 @@ namespace talus::explicit_mpm
       c.push_back(std::string("momentum_") + ax[d]);
     c.push_back("n_particles");
     c.push_back("lost_particles");
-    if (prm.balance.enabled())
-      c.push_back("imbalance");
+    balance.add_series_column(c);
     if (control && control->has_convergence())
       {
         c.push_back("force_ratio");
@@ -1318,8 +1248,7 @@ namespace talus::explicit_mpm
       r.push_back(p[d]);
     r.push_back(static_cast<double>(n_particles()));
     r.push_back(static_cast<double>(points.relocation_stats.lost));
-    if (prm.balance.enabled())
-      r.push_back(imbalance());
+    balance.add_series_value(r);
     if (control && control->has_convergence())
       {
         r.push_back(control->force_ratio);
@@ -1374,8 +1303,7 @@ namespace talus::explicit_mpm
           << "; particles moved cell " << moved << " (to other ranks " << sent
           << "), full sorts " << rs.global_sorts
           << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost;
-    if (prm.balance.enabled())
-      log() << ", rebalances " << n_rebalances;
+    log() << balance.summary();
     log() << "\n";
     log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "
           << timings.total << " s, " << std::setprecision(3) << ns << " ns/particle-step, output in "

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/load_balance.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/explicit/fem.h>
 #include <talus/formulations/explicit/forward.h>
@@ -141,13 +142,9 @@ namespace talus::explicit_mpm
     /// removed). Collective. Returns the file name.
     std::string write_checkpoint() override;
 
-    /// Largest over mean number of material points per rank (collective).
-    double imbalance() const;
-    /// Repartition the cells by weight (load balancing/cell weight + point
-    /// weight x points in the cell) and move the points with their cells;
-    /// rebuilds everything that depends on the partition. Collective.
-    void rebalance();
-    unsigned int n_rebalances = 0;
+    /// Load balancing by material points (formulations/common/load_balance.h);
+    /// its repartitions call grid_changed().
+    LoadBalance<dim> balance;
 
     // ---- the Formulation interface (the time loop's view)
     std::string              tool_name() const override { return "talus-explicit"; }
@@ -216,13 +213,6 @@ namespace talus::explicit_mpm
     /// After the partition changed: boundary flags, nodal vectors, cell lists,
     /// active DoFs and the features' grid data.
     void grid_changed();
-    /// (coarse cell id, weight) of the owned cells at the last rebalance: a
-    /// restart on as many ranks recreates the same partition from them.
-    std::vector<double> balance_weights;
-    /// Repartition with given (coarse cell id, weight) rows (restart).
-    void repartition_with(const std::vector<double> &id_weight_rows);
-    /// Set by restore_checkpoint() when it recreated the saved partition.
-    bool restored_partition = false;
     std::vector<unsigned char> dof_marker;
     /// Call f(kernel) with the shape kernel of the run (numerics/shape
     /// function): the walks of the step are templates on it.

@@ -169,6 +169,9 @@ namespace talus::implicit_mpm
                     (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller") + "; give it one condition");
         p.contact_ids.push_back(static_cast<dealii::types::boundary_id>(id));
       }
+    require(p.contact_ids.empty() || !p.balance.enabled(), "load balancing/interval",
+            "load balancing is not available with contact walls (boundary conditions/contact: their active set "
+            "is not carried through a repartition); allowed: interval = 0, or no contact walls");
     {
       const std::string f = prm.get("contact friction");
       require(f == "no slip" || f == "frictionless", "boundary conditions/contact friction",
@@ -275,7 +278,6 @@ namespace talus::implicit_mpm
     not_yet(!p.results_file.empty(), "output/results file");
     not_yet(!p.probes.empty(), "output/probes");
     not_yet(p.write_grid, "output/write grid");
-    not_yet(p.balance.enabled(), "load balancing/interval");
     not_yet(bool(p.grid_mesh), "grid/source");
     check_scene_consistency(p); // grid, boundary ids, memory, bodies
     if (p.axisymmetric)
@@ -331,8 +333,9 @@ namespace talus::implicit_mpm
   Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
     : prm(p)
     , comm(c)
-    , grid(c)
+    , grid(c, p.balance.enabled())
     , points(grid, "points")
+    , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
     , space(grid, p.mixed_up ? dim + 1 : dim)
     , active(space)
     , newmark(p.gamma, p.beta)
@@ -456,6 +459,30 @@ namespace talus::implicit_mpm
     // the wall would pull on it); a restart starts so too
     contact_state = 1.0;
     contact_state.update_ghost_values();
+    // load balancing: partition by points from the start (a restart on as many
+    // ranks has recreated its saved partition instead)
+    balance.initial();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::grid_changed()
+  {
+    space.setup();
+    if (current_stage < prm.stages.size())
+      stage_nodes(current_stage);
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state, &contact_gap})
+      space.reinit_vector(*v);
+    contact_state = 1.0; // (load balancing is refused with contact walls)
+    contact_state.update_ghost_values();
+    points.collect_active_cells();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::after_step()
+  {
+    balance.after_step(step_number, prm.progress);
   }
 
   template <int dim>
@@ -502,6 +529,14 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::enter_stage(const unsigned int k)
   {
+    stage_nodes(k);
+    idle_conditions.assign(prm.stages[k].velocities.size(), 0);
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::stage_nodes(const unsigned int k)
+  {
     const auto &st = prm.stages[k];
     boundary_flags = loads::wall_dof_flags(grid, st.boundary_conditions);
     contact_nodes  = loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
@@ -511,7 +546,6 @@ namespace talus::implicit_mpm
     // the grid nodes of the stage's 'velocity k' (owned and ghost: constraints
     // of a distributed assembly must be known where a rank assembles)
     prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
-    idle_conditions.assign(st.velocities.size(), 0);
   }
 
   template <int dim>
@@ -1240,6 +1274,7 @@ namespace talus::implicit_mpm
     const char *ax[] = {"x", "y", "z"};
     for (unsigned int d = 0; d < dim; ++d)
       c.push_back(std::string("centre_of_mass_") + ax[d]);
+    balance.add_series_column(c);
     return c;
   }
 
@@ -1264,6 +1299,7 @@ namespace talus::implicit_mpm
     dealii::Utilities::MPI::sum(sums, comm, sums);
     for (unsigned int d = 0; d < dim; ++d)
       v.push_back(sums[d] / sums[dim]);
+    balance.add_series_value(v);
     return v;
   }
 
@@ -1295,6 +1331,7 @@ namespace talus::implicit_mpm
                                    f.set_attribute("cut-backs", std::int64_t(cut_backs));
                                    write_points(f, points);
                                    write_pvd_times(f, "output/pvd", pvd_records);
+                                   balance.write(f); // the partition of the last rebalance
                                  });
   }
 
@@ -1317,6 +1354,7 @@ namespace talus::implicit_mpm
     total_iterations        = fp->get_int("newton iterations");
     total_linear_iterations = fp->get_int("linear iterations");
     cut_backs               = fp->get_int("cut-backs");
+    balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, points, grid, "checkpoint " + fp->path());
     pvd_records = read_pvd_records(*fp, "output/pvd", "particles");
     return true;
@@ -1336,7 +1374,7 @@ namespace talus::implicit_mpm
   {
     log() << "done: " << step_number << " steps, " << n_points() << " particles, wall " << std::setprecision(4)
           << t.total << " s; Newton iterations " << total_iterations << " (cut-backs " << cut_backs
-          << "), linear iterations " << total_linear_iterations << std::endl;
+          << "), linear iterations " << total_linear_iterations << balance.summary() << std::endl;
     if (!prm.contact_ids.empty())
       log() << "  contact walls: " << total_contact_passes << " Newton solves (active-set passes), "
             << total_contact_released << " node releases, " << total_contact_added << " nodes put in contact, "

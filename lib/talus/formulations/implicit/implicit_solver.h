@@ -8,6 +8,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/load_balance.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/implicit/newmark.h>
 #include <talus/formulations/implicit/newton.h>
@@ -145,11 +146,15 @@ namespace talus::implicit_mpm
     void                     rewrite_records() override;
     void                     finish(const std::string &series_csv) override;
     void                     summary(const LoopTimings &timings) override;
+    void                     after_step() override; ///< the load-balance check
 
     const Parameters<dim> &prm;
     MPI_Comm               comm;
     BackgroundGrid<dim>    grid;
     MaterialPointSet<dim>  points;
+    /// Load balancing by material points (formulations/common/load_balance.h);
+    /// its repartitions call grid_changed().
+    LoadBalance<dim>       balance;
     NodalSpace<dim>        space;
     ActiveSet<dim>         active;
     Newmark                newmark;
@@ -167,7 +172,14 @@ namespace talus::implicit_mpm
     dealii::Tensor<1, dim> apply_loads_at(const double t);
     /// Walls, prescribed nodes and the condition report of stage k.
     void enter_stage(const unsigned int k);
+    /// The wall flags, contact nodes and prescribed nodes of stage k on the current partition.
+    void stage_nodes(const unsigned int k);
     double point_force_scale = 1; ///< multiplies the point forces (unstaged static ramp)
+    /// After a repartition: what depends on the partition and lives across
+    /// steps (the space's DoFs, the wall flags and prescribed nodes of the
+    /// stage, the nodal vectors); the active set, the sparsity, the tangent and
+    /// the constraints are rebuilt by every step's prepare_step().
+    void grid_changed();
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
     /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,

@@ -7,6 +7,7 @@
 // paper's §2), so the hydrostatic pore pressure is negative.
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/load_balance.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
@@ -453,8 +454,6 @@ namespace talus::semi_implicit
                       std::to_string(p.bodies[b].material_id) + " is '" + m.model_name() +
                       "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
           }
-    require(!p.balance.enabled(), "load balancing/interval",
-            "load balancing is not available in talus-semi-implicit yet; use 0");
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
     check_scene(p);
     return p;
@@ -535,9 +534,14 @@ namespace talus::semi_implicit
     Solver(const Parameters<dim> &p, MPI_Comm comm)
       : prm(p)
       , comm(comm)
-      , grid(comm)
+      , grid(comm, p.balance.enabled())
       , soil(grid, "soil")
       , water(grid, "water")
+      , balance(grid, p.balance, {&soil, &water}, [this] {
+        grid_changed();
+        soil.collect_active_cells();
+        water.collect_active_cells();
+      })
       , pspace(grid, 1)
       , active(pspace)
     {}
@@ -566,6 +570,7 @@ namespace talus::semi_implicit
     std::string              write_checkpoint() override;
     void finish(const std::string &series_csv) override;
     void summary(const LoopTimings &timings) override;
+    void after_step() override { balance.after_step(step_number, prm.progress); } ///< the load-balance check
 
   private:
     template <class K>
@@ -590,6 +595,14 @@ namespace talus::semi_implicit
     MPI_Comm               comm;
     BackgroundGrid<dim>    grid;
     MaterialPointSet<dim>  soil, water;
+    /// Load balancing by material points of both sets (formulations/common/
+    /// load_balance.h); its repartitions call grid_changed().
+    LoadBalance<dim>       balance;
+    /// Everything of the grid's partition that lives across steps: the
+    /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
+    /// vectors; the next step rebuilds the active set and the pressure matrix.
+    void grid_changed();
+    bool partition_changed = true;
     Fields                 fs, fw; ///< offsets in the soil and the water layout
     NodalSpace<dim>        pspace; ///< the scalar pressure space
     ActiveSet<dim>         active;
@@ -653,12 +666,8 @@ namespace talus::semi_implicit
 
   template <int dim>
   void
-  Solver<dim>::setup()
+  Solver<dim>::grid_changed()
   {
-    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
-    grid.setup();
-    if (prm.bspline)
-      grid.setup_bspline_patches();
     pspace.setup();
     constrained = loads::wall_dof_flags(grid, prm.boundary_conditions);
 
@@ -703,6 +712,18 @@ namespace talus::semi_implicit
     for (Vector *v : {&Mdj, &Mjt, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
                       &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
+    partition_changed = true; // the next step rebuilds the active set and the matrix
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::setup()
+  {
+    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
+    grid.setup();
+    if (prm.bspline)
+      grid.setup_bspline_patches();
+    grid_changed();
 
     // layouts: soil points carry the solid model's history; both carry porosity
     unsigned int n_history = 0;
@@ -744,7 +765,10 @@ namespace talus::semi_implicit
         }
     dt_soil_critical = soil_critical_time_step(prm, grid.min_cell_size());
     if (restore_if_asked(prm, [this] { return restore_checkpoint(); }))
-      return; // the points, the step and the loop's state as saved
+      {
+        balance.initial(); // on another number of ranks: partition by points
+        return;            // the points, the step and the loop's state as saved
+      }
     seed();
     if (prm.geostatic)
       geostatic_state();
@@ -756,6 +780,8 @@ namespace talus::semi_implicit
           m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + soil.layout.history, m.n_history()));
       }
     dt = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
+    // load balancing: partition by the points of both sets from the start
+    balance.initial();
   }
 
   // ---------------------------------------------------------------- checkpoints
@@ -785,6 +811,7 @@ namespace talus::semi_implicit
                                    write_points(f, water, "water");
                                    write_pvd_times(f, "output/soil_pvd", pvd_records[0]);
                                    write_pvd_times(f, "output/water_pvd", pvd_records[1]);
+                                   balance.write(f); // the partition of the last rebalance
                                  });
   }
 
@@ -799,6 +826,7 @@ namespace talus::semi_implicit
     n_solves          = fp->get_int("pressure solves");
     solver_iterations = fp->get_int("pressure cg iterations");
     const std::string where = "checkpoint " + fp->path();
+    balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, soil, grid, where, "soil");
     read_points(*fp, water, grid, where, "water");
     pvd_records[0] = read_pvd_records(*fp, "output/soil_pvd", soil.name());
@@ -1143,8 +1171,9 @@ namespace talus::semi_implicit
       dp_node = 0;
     else
     {
-    if (soil.cell_set_changed() || water.cell_set_changed() || step_number == 0)
+    if (soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 || partition_changed)
       active.template reinit<K>({&soil, &water});
+    partition_changed = false;
     // free water surface: per node, whether it is a vertex of a wet and of a
     // dry cell, and whether it is a vertex of a cell next to a wet one
     // (shares a vertex with it: the layer of nodes just outside the water)
@@ -1586,9 +1615,11 @@ namespace talus::semi_implicit
   std::vector<std::string>
   Solver<dim>::series_columns() const
   {
-    return {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
-            "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume",
-            "load_settlement"};
+    std::vector<std::string> c = {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
+                                  "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume",
+                                  "load_settlement"};
+    balance.add_series_column(c);
+    return c;
   }
 
   template <int dim>
@@ -1618,15 +1649,17 @@ namespace talus::semi_implicit
         }
     fu   = dealii::Utilities::MPI::sum(fu, comm);
     fsum = dealii::Utilities::MPI::sum(fsum, comm);
-    return {dealii::Utilities::MPI::sum(ek[0], comm),
-            dealii::Utilities::MPI::sum(ek[1], comm),
-            dealii::Utilities::MPI::max(vmax[0], comm),
-            dealii::Utilities::MPI::max(vmax[1], comm),
-            dealii::Utilities::MPI::min(pmin, comm),
-            static_cast<double>(last_solve.iterations),
-            last_solve.relative_residual,
-            dealii::Utilities::MPI::sum(soil_volume, comm),
-            fsum > 0 ? fu / fsum : 0.0};
+    std::vector<double> v = {dealii::Utilities::MPI::sum(ek[0], comm),
+                             dealii::Utilities::MPI::sum(ek[1], comm),
+                             dealii::Utilities::MPI::max(vmax[0], comm),
+                             dealii::Utilities::MPI::max(vmax[1], comm),
+                             dealii::Utilities::MPI::min(pmin, comm),
+                             static_cast<double>(last_solve.iterations),
+                             last_solve.relative_residual,
+                             dealii::Utilities::MPI::sum(soil_volume, comm),
+                             fsum > 0 ? fu / fsum : 0.0};
+    balance.add_series_value(v);
+    return v;
   }
 
   template <int dim>
@@ -1709,7 +1742,7 @@ namespace talus::semi_implicit
     log() << "talus-semi-implicit: done: " << step_number << " steps, dt " << dt << " s, wall " << timings.total
           << " s (pressure solves " << seconds_solve << " s, mean "
           << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations), lost points "
-          << lost_points() << ", output in " << prm.output_directory << "/" << std::endl;
+          << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
     const double walk = prm.bspline ? shape_walk_seconds<shape::BSpline2Box<dim>>() : shape_walk_seconds<shape::Q1Box<dim>>();
