@@ -107,7 +107,7 @@ set_tests_properties(verification.explicit_mpm_mixed PROPERTIES PROCESSORS 2)
 # with 3 x 3 points per cell (coarse, cell d_i/12) on a no-slip base that acts on the points
 # (prescribed zero velocity): run-out within 15 % of seed 001 and at most 2 of its 3888 points
 # beyond the contiguous front. Measured: 1, at rest 1.7 cm ahead of the toe (with 'fixed':
-# 4 sliding points; linear: 14, farthest 0.80 m); issue 12 asked for 0: docs/shape-functions.md.
+# 4 sliding points; linear: 14, farthest 0.80 m); issue 12 asked for 0: met with APIC (next test).
 talus_verification(explicit_bar_vibration_bspline check_bar.py verification/bar_vibration_bspline.prm)
 talus_verification(explicit_column_crossing_bspline check_column_bspline.py verification/elastic_column_gravity.prm)
 add_test(NAME verification.explicit_column_collapse_a3_bspline_coarse
