@@ -36,12 +36,6 @@ base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 END_LINE = "initialisation (seed 002 App. B.4) ends"
 
 
-def by_initial_position(t):
-    idx = sorted(range(len(t["pos_x"])), key=lambda i: (round(t["pos_y"][i] - t["displacement_y"][i], 9),
-                                                       round(t["pos_x"][i] - t["displacement_x"][i], 9)))
-    return idx
-
-
 def run(name, text):
     _, out, _ = tv.run_tool(tool, text, f"{work}/{name}", name)
     soil = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
@@ -50,11 +44,10 @@ def run(name, text):
 
 
 def gap(soil, water):
-    a, b = by_initial_position(soil), by_initial_position(water)
-    if len(a) != len(b):
+    a, b = tv.by_initial_position(soil), tv.by_initial_position(water)
+    if len(a["pos_x"]) != len(b["pos_x"]):
         return float("inf")
-    return max(math.hypot(soil["pos_x"][i] - water["pos_x"][j], soil["pos_y"][i] - water["pos_y"][j])
-               for i, j in zip(a, b))
+    return max(math.hypot(xa - xb, ya - yb) for xa, ya, xb, yb in zip(a["pos_x"], a["pos_y"], b["pos_x"], b["pos_y"]))
 
 
 def reference_error(soil):

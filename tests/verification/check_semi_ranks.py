@@ -17,12 +17,8 @@ tables = {}
 for np in (1, 2):
     tv.run_tool(tool, text, f"{work}/np{np}", f"np{np}", np=np)
     for s in ("soil", "water"):
-        t = tv.read_csv(f"{work}/np{np}/out/{s}_final.csv")
-        n = len(t["pos_x"])
         # order by the initial position X = x - u (the storage order differs between runs)
-        key = sorted(range(n), key=lambda i: (round(t["pos_y"][i] - t["displacement_y"][i], 9),
-                                              round(t["pos_x"][i] - t["displacement_x"][i], 9)))
-        tables[(np, s)] = {c: [v[i] for i in key] for c, v in t.items()}
+        tables[(np, s)] = tv.by_initial_position(tv.read_csv(f"{work}/np{np}/out/{s}_final.csv"))
 for s in ("soil", "water"):
     a, b = tables[(1, s)], tables[(2, s)]
     tv.check(len(a["pos_x"]) == len(b["pos_x"]), f"{s}: same number of points ({len(a['pos_x'])}, {len(b['pos_x'])})")

@@ -89,10 +89,7 @@ for np in (1, 2):
 
 
 def by_initial_position(path):
-    t = tv.read_csv(path)
-    key = sorted(range(len(t["pos_x"])), key=lambda i: (round(t["pos_y"][i] - t["displacement_y"][i], 9),
-                                                       round(t["pos_x"][i] - t["displacement_x"][i], 9)))
-    return {c: [v[i] for i in key] for c, v in t.items()}
+    return tv.by_initial_position(tv.read_csv(path))
 
 
 shutil.copytree(os.path.join(work, "restarted_np1", "checkpoints"), os.path.join(work, "cross", "checkpoints"))

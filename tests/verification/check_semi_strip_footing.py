@@ -19,7 +19,6 @@ Usage: check_semi_strip_footing.py TOOL PRM WORKDIR [--h=H] [--np2] [--locking=R
   --locking, --zigzag-none: the bounds of the unstabilised run (default 0.95, 1e-2 for h = 0.5;
   the locking and the oscillation shrink with h: 0.974 and 1.2e-2 measured at h = 0.2)
 """
-import math
 import sys
 
 import talus_verify as tv
@@ -41,24 +40,12 @@ if h_arg:
     base = tv.prm_set(base, "grid/upper corner", f"10, {10 + h}")
 
 
-def lattice(s):
-    """mean stress on the initial point lattice (2 x 2 points per cell)"""
-    pts = {}
-    for x, y, ux, uy, a, b, c in zip(s["pos_x"], s["pos_y"], s["displacement_x"], s["displacement_y"],
-                                     s["stress_xx"], s["stress_yy"], s["stress_zz"]):
-        pts[(round((x - ux) / h * 2 - 0.5), round((y - uy) / h * 2 - 0.5))] = (a + b + c) / 3
-    return pts
-
-
-def zigzag(pts):
-    z = []
-    for (i, j), v in pts.items():
-        for a, b in (((i - 1, j), (i + 1, j)), ((i, j - 1), (i, j + 1))):
-            if a in pts and b in pts:
-                d1, d2 = v - pts[a], pts[b] - v
-                z.append(min(abs(d1), abs(d2)) if d1 * d2 < 0 else 0.0)
-    rng = max(pts.values()) - min(pts.values())
-    return math.sqrt(sum(q * q for q in z) / len(z)) / rng
+def zigzag(s):
+    """the checkerboard measure (talus_verify.zigzag_index) of the mean stress on the initial
+    point lattice (2 x 2 points per cell)"""
+    X = [x - u for x, u in zip(s["pos_x"], s["displacement_x"])]
+    Y = [y - u for y, u in zip(s["pos_y"], s["displacement_y"])]
+    return tv.zigzag_index(X, Y, [(a + b + c) / 3 for a, b, c in zip(s["stress_xx"], s["stress_yy"], s["stress_zz"])], h)
 
 
 def settlement(s):
@@ -72,7 +59,7 @@ for st in ("none", "f-bar", "modified f-bar"):
     name = st.replace(" ", "_")
     _, out, _ = tv.run_tool(tool, tv.prm_set(base, "semi implicit/volumetric stabilisation", st), f"{work}/{name}", name)
     s = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
-    res[st] = (zigzag(lattice(s)), settlement(s))
+    res[st] = (zigzag(s), settlement(s))
     print(f"h = {h} m, {st}: zigzag index {res[st][0]:.2e}, settlement {res[st][1] * 1000:.3f} mm")
 ratio = res["none"][1] / res["modified f-bar"][1]
 print(f"settlement without stabilisation / with modified f-bar = {ratio:.3f} (f-bar: "

@@ -83,19 +83,8 @@ def settlement(pts):
 
 
 def zigzag(X, Y, s):
-    """the checkerboard measure of check_semi_strip_footing.py: the mean stress on
-    the initial point lattice; per point and direction with neighbours on both
-    sides min(|dp1|, |dp2|) if the two differences change sign, else 0; the RMS
-    over the range of the mean stress"""
-    pts = {(round(x / h * 2 - 0.5), round(y / h * 2 - 0.5)): (a + b + c) / 3
-           for x, y, a, b, c in zip(X, Y, s["stress_xx"], s["stress_yy"], s["stress_zz"])}
-    z = []
-    for (i, j), v in pts.items():
-        for a, b in (((i - 1, j), (i + 1, j)), ((i, j - 1), (i, j + 1))):
-            if a in pts and b in pts:
-                d1, d2 = v - pts[a], pts[b] - v
-                z.append(min(abs(d1), abs(d2)) if d1 * d2 < 0 else 0.0)
-    return (sum(q * q for q in z) / len(z)) ** 0.5 / (max(pts.values()) - min(pts.values()))
+    """the checkerboard measure of check_semi_strip_footing.py on the mean stress"""
+    return tv.zigzag_index(X, Y, [(a + b + c) / 3 for a, b, c in zip(s["stress_xx"], s["stress_yy"], s["stress_zz"])], h)
 
 
 def loaded(X, Y, f):

@@ -123,6 +123,29 @@ def read_csv(path):
     return {h: [value(r[i]) for r in data] for i, h in enumerate(header)}
 
 
+def by_initial_position(t):
+    """A table (read_csv) of material points reordered by their initial position X = x - u
+    (y first, then x, rounded to 1e-9): the storage order differs between runs (ranks, restarts)."""
+    key = sorted(range(len(t["pos_x"])), key=lambda i: (round(t["pos_y"][i] - t["displacement_y"][i], 9),
+                                                       round(t["pos_x"][i] - t["displacement_x"][i], 9)))
+    return {c: [v[i] for i in key] for c, v in t.items()}
+
+
+def zigzag_index(X, Y, p, h):
+    """Checkerboard measure of a point field p (e.g. the mean stress) on the initial lattice of
+    2 x 2 points per cell of size h (X, Y the initial positions): per point and direction with
+    neighbours on both sides min(|dp1|, |dp2|) if the two differences change sign, else 0; the RMS
+    over the range of p (a smooth or stepped field gives 0, a checkerboard its amplitude)."""
+    pts = {(round(x / h * 2 - 0.5), round(y / h * 2 - 0.5)): v for x, y, v in zip(X, Y, p)}
+    z = []
+    for (i, j), v in pts.items():
+        for a, b in (((i - 1, j), (i + 1, j)), ((i, j - 1), (i, j + 1))):
+            if a in pts and b in pts:
+                d1, d2 = v - pts[a], pts[b] - v
+                z.append(min(abs(d1), abs(d2)) if d1 * d2 < 0 else 0.0)
+    return (sum(q * q for q in z) / len(z)) ** 0.5 / (max(pts.values()) - min(pts.values()))
+
+
 def relative_differences(a, b, columns=None):
     """Per column of two equally ordered tables (read_csv): max |a - b| / max |a| (the scale is 1
     for a column of zeros). Default columns: every column of a but 'id'."""

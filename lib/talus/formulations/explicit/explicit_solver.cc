@@ -139,9 +139,7 @@ namespace talus::explicit_mpm
                 "step was measured unstable (granular column collapse, Courant 0.5 and 0.2; "
                 "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
-                            p.numerics.integration == NumericsOptions::Integration::fem     ? "fem" :
-                                                                                              "ul-fem") +
+                std::string(p.numerics.integration_name()) +
                   why + "mpm, or velocity transfer = flip");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + why + "none, or velocity transfer = flip");
@@ -168,9 +166,7 @@ namespace talus::explicit_mpm
         const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
                                 "(its particle passes use linear shape functions); allowed: ";
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
-                            p.numerics.integration == NumericsOptions::Integration::fem     ? "fem" :
-                                                                                              "ul-fem") +
+                std::string(p.numerics.integration_name()) +
                   why + "mpm");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + why + "none");

@@ -51,6 +51,14 @@ namespace talus::explicit_mpm
     };
     VelocityTransfer velocity_transfer = VelocityTransfer::flip;
     bool apic() const { return velocity_transfer == VelocityTransfer::apic; }
+    /// The .prm word of `integration` (mpm, mpm-mixed, fem, ul-fem).
+    const char *integration_name() const
+    {
+      return integration == Integration::fem       ? "fem" :
+             integration == Integration::ul_fem    ? "ul-fem" :
+             integration == Integration::mpm_mixed ? "mpm-mixed" :
+                                                     "mpm";
+    }
     Integration integration = Integration::mpm;
     double      fill_factor = 0.9; ///< F_fill of Eq. 6.33
     bool        mixed_linear = true; ///< MPM-MIXED cell stress linear (else constant, Eq. 6.32 alone)

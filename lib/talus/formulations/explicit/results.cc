@@ -58,14 +58,7 @@ namespace talus::explicit_mpm
     out.set_attribute("format", std::string(io::results_format));
     out.set_attribute("version", std::int64_t(io::results_version));
     out.set_attribute("dimension", std::int64_t(dim));
-    {
-      const auto  i    = prm.numerics.integration;
-      const char *mode = i == NumericsOptions::Integration::fem       ? "fem" :
-                         i == NumericsOptions::Integration::ul_fem    ? "ul-fem" :
-                         i == NumericsOptions::Integration::mpm_mixed ? "mpm-mixed" :
-                                                                        "mpm";
-      out.set_attribute("integration", std::string(mode));
-    }
+    out.set_attribute("integration", std::string(prm.numerics.integration_name()));
     out.set_attribute("ranks", std::int64_t(dealii::Utilities::MPI::n_mpi_processes(comm)));
     out.set_attribute("time", time);
     out.set_attribute("steps", std::int64_t(step_number));
