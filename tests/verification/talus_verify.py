@@ -80,7 +80,7 @@ def startup_failure(returncode, text):
     return returncode not in (0, 2) and any(m in text for m in MPI_STARTUP_MARKERS)
 
 
-def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None):
+def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None, timeout=3000):
     """Write <workdir>/<name>.prm, run the tool (under mpirun if np > 1).
 
     Returns (returncode, stdout, stderr). Fails the test if the return code is
@@ -96,7 +96,7 @@ def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None):
         cmd = ["mpirun", "--oversubscribe", "-np", str(np)] + cmd
     env = child_env(extra_env)
     with (mpirun_session(env) if np > 1 else contextlib.nullcontext()):
-        p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=3000)
+        p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=timeout)
     if startup_failure(p.returncode, p.stdout + p.stderr):
         sys.stderr.write(p.stderr[-3000:])
         fail(f"{name}: {os.path.basename(tool)} could not start (MPI start-up failure, exit {p.returncode}); "
