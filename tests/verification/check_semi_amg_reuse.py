@@ -1,0 +1,94 @@
+"""Reuse of the pressure solve's ML AMG hierarchy between steps (issue 14).
+
+Scene: the consolidation column (both point sets, free water surface) under a
+sudden 10 kPa surface load, so the soil settles and the points cross cells
+(the pressure DoF set changes now and then). STEPS steps.
+
+1. Reuse (the default `pressure preconditioner rebuild interval` = 100): the
+   summary's AMG set-ups are at most (pressure DoF set rebuilds) + (multiples
+   of the interval among the steps) + 1, and the series' last
+   `pressure_amg_setups` says the same; far fewer than the solves. No
+   fallback (CG never failed with a kept hierarchy).
+2. Interval 1 (a new hierarchy every step, the behaviour before the reuse):
+   one set-up per solve.
+3. Both runs end within the solver tolerance of each other: every point's
+   position, velocity, stress and pore pressure within BOUND (relative to the
+   column's largest value). The check can fail: the same scene at a pressure
+   solver tolerance of 1e-6 (both runs at interval 1, so only the tolerance
+   differs) must differ from the 1e-10 run by more than BOUND.
+4. The mean CG iterations with a kept hierarchy stay small (<= 4 x those of
+   the interval-1 run + 2): a stale hierarchy costs iterations, not accuracy.
+Usage: check_semi_amg_reuse.py TOOL PRM WORKDIR   (PRM: the consolidation column)
+"""
+import os
+import re
+import shutil
+import sys
+
+import talus_verify as tv
+
+STEPS = 600
+BOUND = 1e-7
+
+tool, prm_path, work = sys.argv[1:4]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+base = open(prm_path).read()
+for k, v in {"time/end time": str(STEPS * 3e-4), "time/time step": "3e-4", "output/vtu interval": "0",
+             "output/series interval": "0", "output/final particles csv": "true", "output/progress": "false",
+             "body 0/surface load": "1e4"}.items():
+    base = tv.prm_set(base, k, v)
+
+
+def run(name, **entries):
+    t = tv.prm_set(base, "output/directory", os.path.join(work, name))
+    for k, v in entries.items():
+        t = tv.prm_set(t, k.replace("__", "/").replace("_", " "), v)
+    _, out, _ = tv.run_tool(tool, t, os.path.join(work, "prm"), name)
+    m = re.search(r"done: (\d+) steps.*mean ([0-9.e+-]+) CG iterations; AMG set-ups (\d+) \(interval (\d+), "
+                  r"fallbacks (\d+)\), pressure DoF set rebuilds (\d+)", out)
+    if not m:
+        sys.stdout.write(out)
+        tv.fail(f"{name}: no summary line with the AMG set-ups")
+    steps, iters, setups, interval, fallbacks, rebuilds = (float(m.group(2)) if i == 2 else int(m.group(i))
+                                                           for i in range(1, 7))
+    series = tv.read_csv(os.path.join(work, name, "series.csv"))
+    d = os.path.join(work, name)
+    points = [tv.by_initial_position(tv.read_csv(os.path.join(d, f))) for f in ("soil_final.csv", "water_final.csv")]
+    print(f"{name}: {steps} steps, interval {interval}, AMG set-ups {setups}, pressure DoF set rebuilds {rebuilds}, "
+          f"mean CG iterations {iters:.2f}, fallbacks {fallbacks}")
+    return dict(steps=steps, iters=iters, setups=setups, fallbacks=fallbacks, rebuilds=rebuilds,
+                series_setups=int(series["pressure_amg_setups"][-1]), points=points)
+
+
+def max_difference(a, b):
+    cols = ["pos_x", "pos_y", "velocity_x", "velocity_y", "stress_xx", "stress_yy", "pore_pressure"]
+    worst = 0.0
+    for ta, tb in zip(a["points"], b["points"]):
+        if len(ta["pos_x"]) != len(tb["pos_x"]):
+            return float("inf")
+        diffs = tv.relative_differences(ta, tb, [c for c in cols if c in ta])
+        worst = max([worst] + list(diffs.values()))
+    return worst
+
+
+reuse = run("reuse")
+every = run("every_step", semi_implicit__pressure_preconditioner_rebuild_interval="1")
+loose = run("every_step_tolerance_1e-6", semi_implicit__pressure_preconditioner_rebuild_interval="1",
+            semi_implicit__pressure_solver_tolerance="1e-6")
+
+multiples = reuse["steps"] // 100 + 1  # steps 0, 100, ... (the step number before the step)
+tv.check(reuse["setups"] <= reuse["rebuilds"] + multiples + 1,
+         f"reuse: AMG set-ups {reuse['setups']} <= DoF set rebuilds {reuse['rebuilds']} + {multiples} + 1")
+tv.check(reuse["setups"] < reuse["steps"] / 4, f"reuse: AMG set-ups {reuse['setups']} < steps / 4")
+tv.check(reuse["series_setups"] == reuse["setups"],
+         f"reuse: series pressure_amg_setups {reuse['series_setups']} = summary {reuse['setups']}")
+tv.check(reuse["fallbacks"] == 0, "reuse: no fallback rebuild")
+tv.check(every["setups"] == every["steps"], f"interval 1: AMG set-ups {every['setups']} = steps {every['steps']}")
+d = max_difference(every, reuse)
+tv.check(d <= BOUND, f"reuse vs every step: largest relative difference {d:.3g} <= {BOUND:g}")
+d_loose = max_difference(every, loose)
+tv.check(d_loose > BOUND, f"the comparison can fail: tolerance 1e-6 vs 1e-10 differ by {d_loose:.3g} > {BOUND:g}")
+tv.check(reuse["iters"] <= 4 * every["iters"] + 2,
+         f"mean CG iterations with reuse {reuse['iters']:.2f} <= 4 x {every['iters']:.2f} + 2")
+tv.finish()
