@@ -18,7 +18,10 @@ changes with the points.
    quantity relative to its largest magnitude over all points and components). The check can fail: the same scene at a pressure
    solver tolerance of 1e-6 (both runs at interval 1, so only the tolerance
    differs) must differ from the 1e-10 run by more than BOUND.
-4. The mean CG iterations with a kept hierarchy stay small (<= 4 x those of
+4. 1 vs 2 ranks with the reuse: the 2-rank run (its own partition, its own
+   hierarchies, the same rebuild steps) within BOUND of the 1-rank interval-1
+   run, with the same number of set-ups as the 1-rank reuse run.
+5. The mean CG iterations with a kept hierarchy stay small (<= 4 x those of
    the interval-1 run + 2): a stale hierarchy costs iterations, not accuracy.
 Usage: check_semi_amg_reuse.py TOOL PRM WORKDIR   (PRM: the bench slope)
 """
@@ -42,11 +45,11 @@ for k, v in {"time/end time": str(STEPS * 5e-4), "time/time step": "5e-4", "outp
     base = tv.prm_set(base, k, v)
 
 
-def run(name, **entries):
+def run(name, np=1, **entries):
     t = tv.prm_set(base, "output/directory", os.path.join(work, name))
     for k, v in entries.items():
         t = tv.prm_set(t, k.replace("__", "/").replace("_", " "), v)
-    _, out, _ = tv.run_tool(tool, t, os.path.join(work, "prm"), name)
+    _, out, _ = tv.run_tool(tool, t, os.path.join(work, "prm"), name, np=np)
     m = re.search(r"done: (\d+) steps.*mean ([0-9.e+-]+) CG iterations; AMG set-ups (\d+) \(interval (\d+), "
                   r"fallbacks (\d+)\), pressure DoF set rebuilds (\d+)", out)
     if not m:
@@ -86,6 +89,7 @@ def max_difference(a, b):
 
 reuse = run("reuse")
 every = run("every_step", semi_implicit__pressure_preconditioner_rebuild_interval="1")
+reuse2 = run("reuse_np2", np=2)
 loose = run("every_step_tolerance_1e-6", semi_implicit__pressure_preconditioner_rebuild_interval="1",
             semi_implicit__pressure_solver_tolerance="1e-6")
 
@@ -102,6 +106,10 @@ tv.check(d <= BOUND, f"reuse vs every step: largest relative difference {d:.3g} 
 d_loose, q = max_difference(every, loose)
 tv.check(d_loose > BOUND,
          f"the comparison can fail: tolerance 1e-6 vs 1e-10 differ by {d_loose:.3g} ({q}) > {BOUND:g}")
+d2, q = max_difference(every, reuse2)
+tv.check(d2 <= BOUND, f"2 ranks with reuse vs 1 rank every step: largest relative difference {d2:.3g} ({q}) <= {BOUND:g}")
+tv.check(reuse2["setups"] == reuse["setups"],
+         f"2 ranks: AMG set-ups {reuse2['setups']} = 1 rank's {reuse['setups']} (the rebuild decision is global)")
 tv.check(reuse["iters"] <= 4 * every["iters"] + 2,
          f"mean CG iterations with reuse {reuse['iters']:.2f} <= 4 x {every['iters']:.2f} + 2")
 tv.finish()
