@@ -150,7 +150,10 @@ namespace talus
     LinearSolveInfo info;
     info.method = "CG + AMG (ML)";
     if (rebuilt)
-      info.iterations = cg(A, x, b, options, *amg);
+      {
+        info.iterations  = cg(A, x, b, options, *amg);
+        fresh_iterations = info.iterations;
+      }
     else
       {
         // a kept hierarchy: if CG fails with it (a preconditioner too far from
@@ -166,7 +169,14 @@ namespace talus
             ++fallbacks;
             x = x0;
             build(A, options, constant_modes);
-            info.iterations = cg(A, x, b, options, *amg);
+            info.iterations  = cg(A, x, b, options, *amg);
+            fresh_iterations = info.iterations;
+          }
+        // the matrix has drifted far from the hierarchy's: a new one next time
+        if (!rebuilt && info.iterations > 2 * fresh_iterations + 10)
+          {
+            stale = true;
+            ++slow_solves;
           }
       }
     info.relative_residual = relative_residual(A, x, b);

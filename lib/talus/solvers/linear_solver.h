@@ -58,8 +58,11 @@ namespace talus
   /// solve). A kept hierarchy was built from an older matrix: CG still
   /// converges to the same tolerance, in a few more iterations. It is rebuilt
   /// at the next solve after invalidate() and at every solve whose `step` is a
-  /// multiple of the rebuild interval, so the rebuilds depend only on the step
-  /// number and on the caller's invalidate() calls: a restarted run rebuilds
+  /// multiple of the rebuild interval, and after a slow solve: one with a kept
+  /// hierarchy that needed more than 2 x + 10 the iterations of the first
+  /// solve with that hierarchy (the matrix has drifted too far from it). The
+  /// rebuilds so depend only on the step number, on the states since the last
+  /// rebuild and on the caller's invalidate() calls: a restarted run rebuilds
   /// where the uninterrupted one does if the caller invalidates at every
   /// checkpoint write (and at its first step, where it builds anyway).
   /// ML's finest level keeps a reference to A's Epetra matrix (not a copy):
@@ -91,6 +94,8 @@ namespace talus
     unsigned long long n_setups() const { return setups; }
     void               set_n_setups(const unsigned long long n) { setups = n; }
     unsigned long long n_fallbacks() const { return fallbacks; }
+    /// Solves after which the next one rebuilds because they were slow.
+    unsigned long long n_slow_solves() const { return slow_solves; }
     /// Wall time spent in the ML set-up [s] and whether the last solve built one.
     double setup_seconds() const { return seconds_setup; }
     bool   last_solve_rebuilt() const { return rebuilt; }
@@ -103,7 +108,8 @@ namespace talus
     std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg;
     unsigned int       interval = 1;
     bool               stale    = true, rebuilt = false;
-    unsigned long long setups = 0, fallbacks = 0;
+    unsigned long long setups = 0, fallbacks = 0, slow_solves = 0;
+    unsigned int       fresh_iterations = 0; ///< of the first solve with the current hierarchy
     double             seconds_setup = 0;
   };
 } // namespace talus

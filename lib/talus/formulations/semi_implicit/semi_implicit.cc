@@ -84,7 +84,8 @@ namespace talus::semi_implicit
       prm.declare_entry("pressure preconditioner rebuild interval", "100", dealii::Patterns::Integer(1),
                         "The ML AMG hierarchy of the pressure solve is kept between steps and rebuilt at "
                         "every step whose number is a multiple of this, whenever the pressure DoF set (the "
-                        "active nodes) changes, after a checkpoint is written and at a restart; CG reaches "
+                        "active nodes) changes, after a checkpoint is written, at a restart and after a "
+                        "solve that needed more than 2 x + 10 the CG iterations of the hierarchy's first; CG reaches "
                         "the same tolerance with a kept hierarchy in a few more iterations. 1 = rebuilt at "
                         "every step. An integer >= 1.");
       prm.declare_entry("pressure smoothing", "linear", Selection("linear|mass weighted|none"),
@@ -1515,6 +1516,9 @@ namespace talus::semi_implicit
   void
   Solver<dim>::end_initialisation()
   {
+    // the conductivity jumps to k0: the pressure matrix with it (at the same
+    // step in a restarted run)
+    pressure_solver.invalidate();
     unsigned long long n = 0;
     for (auto &pt : soil.handler)
       {
@@ -1782,7 +1786,8 @@ namespace talus::semi_implicit
           << " s (pressure solves " << seconds_solve << " s, mean "
           << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations; AMG set-ups "
           << pressure_solver.n_setups() << " (interval " << prm.pressure_rebuild_interval << ", fallbacks "
-          << pressure_solver.n_fallbacks() << "), pressure DoF set rebuilds " << n_pattern_changes << "), lost points "
+          << pressure_solver.n_fallbacks() << ", after slow solves " << pressure_solver.n_slow_solves()
+          << "), pressure DoF set rebuilds " << n_pattern_changes << "), lost points "
           << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
