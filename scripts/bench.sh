@@ -204,7 +204,7 @@ def semi(tag, reps=(1,)):  # the run of least wall time among the repetitions
 def semi_run(path):
     t = open(path).read()
     m = re.search(rf"done: (\d+) steps, dt {NUM} s, wall {NUM} s \(pressure solves {NUM} s", t)
-    b = re.search(rf"breakdown \[s\]: P2N {NUM}, grid {NUM}, Poisson assembly {NUM}, pressure solve {NUM}, "
+    b = re.search(rf"breakdown \[s\]: P2N {NUM}, grid {NUM}, Poisson assembly {NUM}, pressure solve {NUM}(?: \(AMG set-up [\d.e+-]+\))?, "
                   rf"N2P {NUM}, update\+stress {NUM}, relocation {NUM}; points soil (\d+) water (\d+); "
                   rf"shape functions: one stencil walk over both sets {NUM} s", t)
     r = dict(steps=int(m.group(1)), dt=float(m.group(2)), wall=float(m.group(3)))

@@ -47,6 +47,13 @@ cases = [
     ("initialisation with a plastic model", [("initial state/initialisation time", "0.1"),
                                              ("material 0/model", "hencky mohr coulomb")], "material 0/model"),
     ("surface load acts at", [("body 0/surface load acts at", "points")], "surface load acts at"),
+    # the AMG hierarchy's rebuild interval: an integer >= 1
+    ("rebuild interval 0", [("semi implicit/pressure preconditioner rebuild interval", "0")],
+     "pressure preconditioner rebuild interval"),
+    ("rebuild interval negative", [("semi implicit/pressure preconditioner rebuild interval", "-5")],
+     "pressure preconditioner rebuild interval"),
+    ("rebuild interval not an integer", [("semi implicit/pressure preconditioner rebuild interval", "2.5")],
+     "pressure preconditioner rebuild interval"),
     ("surface load on water", [("body 0/surface load", "1e4"), ("number of bodies", "2"), ("body 1/phase", "water"),
                                ("body 1/surface load", "1e3"), ("body 1/upper corner", "0.075, 1.05"),
                                ("body 1/lower corner", "0, 1")], "body 1/surface load"),

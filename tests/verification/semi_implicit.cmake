@@ -36,6 +36,14 @@ add_test(NAME verification.semi_implicit_consolidation
                  ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm ${_w}/semi_implicit_consolidation 0.03)
 set_tests_properties(verification.semi_implicit_consolidation PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 
+# the pressure solve's AMG hierarchy kept between steps: set-ups bounded, the
+# result within the solver tolerance of a rebuild at every step, on 1 and 2 ranks
+add_test(NAME verification.semi_implicit_amg_reuse
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_amg_reuse.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/bench/semi_implicit_slope.prm ${_w}/semi_implicit_amg_reuse)
+set_tests_properties(verification.semi_implicit_amg_reuse PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
+
 # 1 vs 2 ranks on the consolidation column to 1e-8
 add_test(NAME verification.semi_implicit_np1_np2
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_ranks.py ${TALUS_TOOLS_DIR}/talus-semi-implicit

@@ -5,8 +5,53 @@
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 
+#include <chrono>
+#include <stdexcept>
+
 namespace talus
 {
+  namespace
+  {
+    dealii::TrilinosWrappers::PreconditionAMG::AdditionalData
+    amg_data(const LinearSolverOptions &options, const std::vector<std::vector<bool>> &constant_modes)
+    {
+      dealii::TrilinosWrappers::PreconditionAMG::AdditionalData amg;
+      amg.elliptic              = true;
+      amg.higher_order_elements = false;
+      amg.aggregation_threshold = options.aggregation_threshold;
+      amg.smoother_sweeps       = options.smoother_sweeps;
+      amg.constant_modes        = constant_modes;
+      return amg;
+    }
+
+    /// CG to |b - A x| <= tol |b|; returns the iterations
+    unsigned int
+    cg(const dealii::TrilinosWrappers::SparseMatrix &   A,
+       Vector &                                         x,
+       const Vector &                                   b,
+       const LinearSolverOptions &                      options,
+       const dealii::TrilinosWrappers::PreconditionAMG &preconditioner)
+    {
+      // AztecOO's criterion is absolute (|r| <= tol, unscaled)
+      dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b.l2_norm());
+      dealii::TrilinosWrappers::SolverCG solver(control);
+      solver.solve(A, x, b, preconditioner);
+      return control.last_step();
+    }
+
+    double
+    relative_residual(const dealii::TrilinosWrappers::SparseMatrix &A, const Vector &x, const Vector &b)
+    {
+      // the residual, independent of the solver's own measure
+      Vector r;
+      r.reinit(b, true);
+      A.vmult(r, x);
+      r.sadd(-1.0, 1.0, b);
+      const double b_norm = b.l2_norm();
+      return b_norm > 0 ? r.l2_norm() / b_norm : r.l2_norm();
+    }
+  } // namespace
+
   LinearSolveInfo
   solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A,
                Vector &                                      x,
@@ -57,26 +102,84 @@ namespace talus
     else
       {
         info.method = "CG + AMG (ML)";
-        dealii::TrilinosWrappers::PreconditionAMG::AdditionalData amg;
-        amg.elliptic              = true;
-        amg.higher_order_elements = false;
-        amg.aggregation_threshold = options.aggregation_threshold;
-        amg.smoother_sweeps       = options.smoother_sweeps;
-        amg.constant_modes        = constant_modes;
         dealii::TrilinosWrappers::PreconditionAMG amg_preconditioner;
-        amg_preconditioner.initialize(A, amg);
-        // AztecOO's criterion is absolute (|r| <= tol, unscaled)
-        dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b_norm);
-        dealii::TrilinosWrappers::SolverCG solver(control);
-        solver.solve(A, x, b, amg_preconditioner);
-        info.iterations = control.last_step();
+        amg_preconditioner.initialize(A, amg_data(options, constant_modes));
+        info.iterations = cg(A, x, b, options, amg_preconditioner);
       }
-    // the residual, independent of the solver's own measure
-    Vector r;
-    r.reinit(b, true);
-    A.vmult(r, x);
-    r.sadd(-1.0, 1.0, b);
-    info.relative_residual = b_norm > 0 ? r.l2_norm() / b_norm : r.l2_norm();
+    info.relative_residual = relative_residual(A, x, b);
+    return info;
+  }
+
+  ReusedAMGSolver::ReusedAMGSolver()  = default;
+  ReusedAMGSolver::~ReusedAMGSolver() = default;
+
+  void
+  ReusedAMGSolver::set_rebuild_interval(const unsigned int n)
+  {
+    if (n == 0)
+      throw std::invalid_argument("ReusedAMGSolver: the rebuild interval must be >= 1");
+    interval = n;
+  }
+
+  void
+  ReusedAMGSolver::build(const dealii::TrilinosWrappers::SparseMatrix &A,
+                         const LinearSolverOptions &                   options,
+                         const std::vector<std::vector<bool>> &        constant_modes)
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    amg.reset(); // free the old hierarchy first (it references A's Epetra matrix)
+    amg = std::make_unique<dealii::TrilinosWrappers::PreconditionAMG>();
+    amg->initialize(A, amg_data(options, constant_modes));
+    stale   = false;
+    rebuilt = true;
+    ++setups;
+    seconds_setup += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  LinearSolveInfo
+  ReusedAMGSolver::solve(const dealii::TrilinosWrappers::SparseMatrix &A,
+                         Vector &                                      x,
+                         const Vector &                                b,
+                         const LinearSolverOptions &                   options,
+                         const unsigned long long                      step,
+                         const std::vector<std::vector<bool>> &        constant_modes)
+  {
+    rebuilt = false;
+    if (stale || !amg || step % interval == 0)
+      build(A, options, constant_modes);
+    LinearSolveInfo info;
+    info.method = "CG + AMG (ML)";
+    if (rebuilt)
+      {
+        info.iterations  = cg(A, x, b, options, *amg);
+        fresh_iterations = info.iterations;
+      }
+    else
+      {
+        // a kept hierarchy: if CG fails with it (a preconditioner too far from
+        // A), start again from the same guess with a fresh one. Deterministic:
+        // a restarted run meets the same failure at the same step.
+        Vector x0(x);
+        try
+          {
+            info.iterations = cg(A, x, b, options, *amg);
+          }
+        catch (const std::exception &)
+          {
+            ++fallbacks;
+            x = x0;
+            build(A, options, constant_modes);
+            info.iterations  = cg(A, x, b, options, *amg);
+            fresh_iterations = info.iterations;
+          }
+        // the matrix has drifted far from the hierarchy's: a new one next time
+        if (!rebuilt && info.iterations > 2 * fresh_iterations + 10)
+          {
+            stale = true;
+            ++slow_solves;
+          }
+      }
+    info.relative_residual = relative_residual(A, x, b);
     return info;
   }
 } // namespace talus

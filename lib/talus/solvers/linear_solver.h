@@ -7,12 +7,14 @@
 
 #include <talus/grid/background_grid.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace dealii::TrilinosWrappers
 {
   class SparseMatrix;
+  class PreconditionAMG;
 }
 
 namespace talus
@@ -50,4 +52,64 @@ namespace talus
                                const Vector &                                b,
                                const LinearSolverOptions &                   options,
                                const std::vector<std::vector<bool>> &        constant_modes = {});
+
+  /// CG + ML AMG whose hierarchy is kept from one solve to the next (the ML
+  /// set-up has a fixed cost of ~3 ms per call, most of a small system's
+  /// solve). A kept hierarchy was built from an older matrix: CG still
+  /// converges to the same tolerance, in a few more iterations. It is rebuilt
+  /// at the next solve after invalidate() and at every solve whose `step` is a
+  /// multiple of the rebuild interval, and after a slow solve: one with a kept
+  /// hierarchy that needed more than 2 x + 10 the iterations of the first
+  /// solve with that hierarchy (the matrix has drifted too far from it). The
+  /// rebuilds so depend only on the step number, on the states since the last
+  /// rebuild and on the caller's invalidate() calls: a restarted run rebuilds
+  /// where the uninterrupted one does if the caller invalidates at every
+  /// checkpoint write (and at its first step, where it builds anyway).
+  /// ML's finest level keeps a reference to A's Epetra matrix (not a copy):
+  /// refill A's values in place (A = 0, assemble) between rebuilds, and call
+  /// invalidate() whenever A is reinit (a new Epetra object) or changes shape.
+  class ReusedAMGSolver
+  {
+  public:
+    ReusedAMGSolver();
+    ~ReusedAMGSolver();
+
+    /// 1: a new hierarchy at every solve (no reuse). >= 1.
+    void         set_rebuild_interval(unsigned int n);
+    unsigned int rebuild_interval() const { return interval; }
+    /// The next solve builds a new hierarchy.
+    void invalidate() { stale = true; }
+
+    /// Solve A x = b as solve_linear with `options.method` cg_amg. When CG
+    /// with a kept hierarchy fails (throws), the hierarchy is rebuilt and the
+    /// solve repeated once (counted in n_fallbacks()). Collective.
+    LinearSolveInfo solve(const dealii::TrilinosWrappers::SparseMatrix &A,
+                          Vector &                                      x,
+                          const Vector &                                b,
+                          const LinearSolverOptions &                   options,
+                          unsigned long long                            step,
+                          const std::vector<std::vector<bool>> &        constant_modes = {});
+
+    /// Hierarchies built so far (settable: a checkpoint carries the count).
+    unsigned long long n_setups() const { return setups; }
+    void               set_n_setups(const unsigned long long n) { setups = n; }
+    unsigned long long n_fallbacks() const { return fallbacks; }
+    /// Solves after which the next one rebuilds because they were slow.
+    unsigned long long n_slow_solves() const { return slow_solves; }
+    /// Wall time spent in the ML set-up [s] and whether the last solve built one.
+    double setup_seconds() const { return seconds_setup; }
+    bool   last_solve_rebuilt() const { return rebuilt; }
+
+  private:
+    void build(const dealii::TrilinosWrappers::SparseMatrix &A,
+               const LinearSolverOptions &                   options,
+               const std::vector<std::vector<bool>> &        constant_modes);
+
+    std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg;
+    unsigned int       interval = 1;
+    bool               stale    = true, rebuilt = false;
+    unsigned long long setups = 0, fallbacks = 0, slow_solves = 0;
+    unsigned int       fresh_iterations = 0; ///< of the first solve with the current hierarchy
+    double             seconds_setup = 0;
+  };
 } // namespace talus

@@ -81,6 +81,13 @@ namespace talus::semi_implicit
       prm.declare_entry("pressure solver tolerance", "1e-10", Double(0, 1e-2),
                         "Relative residual |b - A x| / |b| at which CG + ML AMG stops on the pressure-"
                         "increment Poisson equation.");
+      prm.declare_entry("pressure preconditioner rebuild interval", "100", dealii::Patterns::Integer(1),
+                        "The ML AMG hierarchy of the pressure solve is kept between steps and rebuilt at "
+                        "every step whose number is a multiple of this, whenever the pressure DoF set (the "
+                        "active nodes) changes, after a checkpoint is written, at a restart and after a "
+                        "solve that needed more than 2 x + 10 the CG iterations of the hierarchy's first; CG reaches "
+                        "the same tolerance with a kept hierarchy in a few more iterations. 1 = rebuilt at "
+                        "every step. An integer >= 1.");
       prm.declare_entry("pressure smoothing", "linear", Selection("linear|mass weighted|none"),
                         "mass weighted: the water points' pore pressure is replaced by the mass-weighted "
                         "map and remap through the nodes at every step (Eq. 77); it is biased by O(h grad p) "
@@ -307,6 +314,7 @@ namespace talus::semi_implicit
     p.unit_weight_gravity   = prm.get_double("unit weight gravity");
     p.free_surface_fraction = prm.get_double("free surface volume fraction");
     p.pressure_tolerance    = prm.get_double("pressure solver tolerance");
+    p.pressure_rebuild_interval = prm.get_integer("pressure preconditioner rebuild interval");
     p.kozeny_carman         = prm.get_bool("kozeny carman");
     p.pressure_smoothing    = prm.get("pressure smoothing") != "none";
     p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
@@ -607,6 +615,12 @@ namespace talus::semi_implicit
     NodalSpace<dim>        pspace; ///< the scalar pressure space
     ActiveSet<dim>         active;
     dealii::TrilinosWrappers::SparseMatrix A;
+    /// CG + ML AMG with the hierarchy kept between steps (solvers/linear_solver.h);
+    /// invalidated when A is reinit and at every checkpoint write
+    ReusedAMGSolver                        pressure_solver;
+    /// steps of this run (not of a checkpoint's past: a restart rebuilds once
+    /// more) that built a new pressure DoF set, sparsity and matrix
+    unsigned long long                     n_pattern_changes = 0;
     Vector                                 rhs, dp_solution;
 
     // per grid local DoF: the node's component-0 DoF, component, prescribed zero
@@ -640,7 +654,7 @@ namespace talus::semi_implicit
     // diagnostics
     LinearSolveInfo    last_solve;
     unsigned long long solver_iterations = 0, n_solves = 0;
-    double             seconds_solve = 0;
+    double             seconds_solve = 0; ///< CG + AMG set-ups
     double             dt_soil_critical = 0;
     // wall-clock phases of the step (a few clock reads per step; the solve is
     // seconds_solve): P2N, nodal updates, Poisson set-up and assembly, N2P
@@ -803,10 +817,14 @@ namespace talus::semi_implicit
   std::string
   Solver<dim>::write_checkpoint()
   {
+    // the run restarted from this checkpoint builds a new hierarchy at its first
+    // solve: so does this one, so that both go on bitwise alike
+    pressure_solver.invalidate();
     return write_checkpoint_file(prm, *this, checkpoint_format, checkpoint_version,
                                  scene_signature(prm, soil.layout.n_properties()), comm, [&](io::H5File &f) {
                                    f.set_attribute("pressure solves", std::int64_t(n_solves));
                                    f.set_attribute("pressure cg iterations", std::int64_t(solver_iterations));
+                                   f.set_attribute("pressure amg setups", std::int64_t(pressure_solver.n_setups()));
                                    write_points(f, soil, "soil");
                                    write_points(f, water, "water");
                                    write_pvd_times(f, "output/soil_pvd", pvd_records[0]);
@@ -825,6 +843,9 @@ namespace talus::semi_implicit
       return false;
     n_solves          = fp->get_int("pressure solves");
     solver_iterations = fp->get_int("pressure cg iterations");
+    // (absent in checkpoints written before the AMG reuse)
+    if (fp->has_attribute("pressure amg setups"))
+      pressure_solver.set_n_setups(fp->get_int("pressure amg setups"));
     const std::string where = "checkpoint " + fp->path();
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, soil, grid, where, "soil");
@@ -949,7 +970,8 @@ namespace talus::semi_implicit
         << ", " << ns << " soil + " << nw << " water points\n"
         << "  time step " << dt << " s (soil skeleton critical step " << dt_soil_critical << " s"
         << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant)) << "), pressure: CG + ML AMG to "
-        << prm.pressure_tolerance << " relative residual" << std::endl;
+        << prm.pressure_tolerance << " relative residual, AMG rebuilt every "
+        << prm.pressure_rebuild_interval << " steps" << std::endl;
   }
 
   // ---------------------------------------------------------------- the step
@@ -1171,8 +1193,18 @@ namespace talus::semi_implicit
       dp_node = 0;
     else
     {
-    if (soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 || partition_changed)
-      active.template reinit<K>({&soil, &water});
+    // the pressure DoF set: rebuilt (with the sparsity, the matrix and the AMG
+    // hierarchy) only when a point set's cells changed on some rank. The
+    // decision is global: ActiveSet::reinit and the AMG set-up are collective.
+    const bool new_pattern = dealii::Utilities::MPI::max(
+                               unsigned(soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 ||
+                                        partition_changed || A.m() == 0),
+                               comm) != 0;
+    if (new_pattern)
+      {
+        active.template reinit<K>({&soil, &water});
+        ++n_pattern_changes;
+      }
     partition_changed = false;
     // free water surface: per node, whether it is a vertex of a wet and of a
     // dry cell, and whether it is a vertex of a cell next to a wet one
@@ -1237,7 +1269,13 @@ namespace talus::semi_implicit
         }
     dirichlet.close();
     const auto constraints = active.constraints_with(dirichlet);
-    active.reinit_matrix(A);
+    if (new_pattern)
+      {
+        active.reinit_matrix(A); // a new Epetra matrix: the kept hierarchy referenced the old one
+        pressure_solver.invalidate();
+      }
+    else
+      A = 0; // same pattern: refill the values in place
     pspace.reinit_vector(rhs);
     pspace.reinit_vector(dp_solution);
     {
@@ -1255,8 +1293,9 @@ namespace talus::semi_implicit
       LinearSolverOptions options;
       options.method             = LinearSolverOptions::Method::cg_amg;
       options.relative_tolerance = prm.pressure_tolerance;
+      pressure_solver.set_rebuild_interval(prm.pressure_rebuild_interval);
       if (rhs.l2_norm() > 0)
-        last_solve = solve_linear(A, dp_solution, rhs, options);
+        last_solve = pressure_solver.solve(A, dp_solution, rhs, options, step_number);
       else
         last_solve = {"cg_amg", 0, 0.0};
       constraints.distribute(dp_solution);
@@ -1477,6 +1516,9 @@ namespace talus::semi_implicit
   void
   Solver<dim>::end_initialisation()
   {
+    // the conductivity jumps to k0: the pressure matrix with it (at the same
+    // step in a restarted run)
+    pressure_solver.invalidate();
     unsigned long long n = 0;
     for (auto &pt : soil.handler)
       {
@@ -1617,7 +1659,7 @@ namespace talus::semi_implicit
   {
     std::vector<std::string> c = {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
                                   "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume",
-                                  "load_settlement"};
+                                  "load_settlement", "pressure_amg_setups"};
     balance.add_series_column(c);
     return c;
   }
@@ -1657,7 +1699,8 @@ namespace talus::semi_implicit
                              static_cast<double>(last_solve.iterations),
                              last_solve.relative_residual,
                              dealii::Utilities::MPI::sum(soil_volume, comm),
-                             fsum > 0 ? fu / fsum : 0.0};
+                             fsum > 0 ? fu / fsum : 0.0,
+                             static_cast<double>(pressure_solver.n_setups())};
     balance.add_series_value(v);
     return v;
   }
@@ -1741,13 +1784,17 @@ namespace talus::semi_implicit
   {
     log() << "talus-semi-implicit: done: " << step_number << " steps, dt " << dt << " s, wall " << timings.total
           << " s (pressure solves " << seconds_solve << " s, mean "
-          << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations), lost points "
+          << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations; AMG set-ups "
+          << pressure_solver.n_setups() << " (interval " << prm.pressure_rebuild_interval << ", fallbacks "
+          << pressure_solver.n_fallbacks() << ", after slow solves " << pressure_solver.n_slow_solves()
+          << "), pressure DoF set rebuilds " << n_pattern_changes << "), lost points "
           << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
     const double walk = prm.bspline ? shape_walk_seconds<shape::BSpline2Box<dim>>() : shape_walk_seconds<shape::Q1Box<dim>>();
     log() << std::setprecision(4) << "  breakdown [s]: P2N " << phase.p2n << ", grid " << phase.grid << ", Poisson assembly "
-          << phase.poisson << ", pressure solve " << seconds_solve << ", N2P " << phase.n2p << ", update+stress "
+          << phase.poisson << ", pressure solve " << seconds_solve << " (AMG set-up "
+          << pressure_solver.setup_seconds() << "), N2P " << phase.n2p << ", update+stress "
           << phase.stress << ", relocation " << phase.relocation << "; points soil "
           << soil.handler.n_global_particles() << " water " << water.handler.n_global_particles()
           << "; shape functions: one stencil walk over both sets " << walk << " s" << std::endl;

@@ -73,6 +73,10 @@ namespace talus::semi_implicit
     double unit_weight_gravity      = 9.81;  ///< g of the drag (Eq. 15), kept when the body force is 0
     double free_surface_fraction    = 0.5;   ///< a cell is wet when its water volume / cell volume >= this
     double pressure_tolerance       = 1e-10; ///< CG relative residual of the Poisson solve
+    /// the ML hierarchy of the Poisson solve is rebuilt at every step that is a
+    /// multiple of this (and when the pressure DoF set changes, at checkpoints);
+    /// 1: every step
+    unsigned int pressure_rebuild_interval = 100;
     bool   kozeny_carman            = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
     bool   pressure_smoothing       = true;  ///< Eq. 77 map-remap of the pore pressure every step
     bool   linear_smoothing         = true;  ///< the map carries each point's value by its gradient
