@@ -52,6 +52,8 @@ if args.floor:
     for kind in ("fixed", "roller", "contact"):
         if kind == args.floor or f"set {kind}" in text:
             text = tv.prm_set(text, f"boundary conditions/{kind}", "2" if kind == args.floor else "")
+    if args.floor != "contact":  # the contact wall's own entries go with it
+        text = re.sub(r"^\s*set\s+contact\s+(method|friction|penalty|gap|passes)\b.*$", "", text, flags=re.M)
 # talus-critical-dt reads the shared scene entries only: give it the scene with
 # a fixed floor (the floor does not enter the explicit critical step)
 crit_text = text
