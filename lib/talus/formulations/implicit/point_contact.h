@@ -9,19 +9,25 @@
 // 'contact' walls of implicit_solver.cc).
 //
 // Per point and wall (a point carries no surface; its extent r_p = V_p^(1/dim)/2,
-// the half side of the square/cube of its volume; axisymmetric: of its area):
-//   gap   g  = s (w - x_a) - r_p      (s = +-1 outward normal of the box face, w its
-//                                      coordinate on axis a, x = x_n + N Du)
-//   pen   p  = max(0, -g)
+// the half side of the square/cube of its volume; axisymmetric: of its area).
+// The contact acts at the point's contact spot, the material at x_p + s r_p e_a
+// (towards the wall), whose shape values are N_i + s r_p dN_i/dx_a (exact for Q1,
+// linear along an axis): the spot turns with the material, so the disk rolls
+// about its contact and not about the point's centre (docs/implicit.md).
+//   gap   g  = s (w - x_a)            (x the spot, x = x_n + N Du; s = +-1 the
+//                                      outward normal of the box face, w its
+//                                      coordinate on axis a)
+//   pen   p  = max(0, -g)             active per Newton iterate
 //   k_n   = penalty x M V_p / h_a^2   (M the constrained modulus of the point's
 //                                      material, h_a the cell size normal to the wall)
-//   f     = -k_n p n_out + f_t        (external force on the point; r_i -= N_i f)
+//   f     = -k_n p n_out + f_t        (external force at the spot; r_i -= N_i f,
+//                                      K_ij += N_i N_j (-df/dx))
 //   f_t   = -k_t (x_t - X_anchor)     stick (k_t = k_n), or -mu k_n p t  slip
 //                                      (t = the slip direction) when k_t |x_t - X_anchor| > mu k_n p
-// The anchor is the point's tangential position at the start of the step in
+// The anchor is the spot's tangential position at the start of the step in
 // which it touched the wall (kept while it stays in contact, moved to the
-// Coulomb limit when it slips); it lives in the point's properties, so it
-// migrates with the point and is in the checkpoints.
+// Coulomb limit when it slips; dropped when it leaves); it lives in the point's
+// properties, so it migrates with the point and is in the checkpoints.
 #pragma once
 
 #include <talus/grid/nodal_space.h>
@@ -87,8 +93,9 @@ namespace talus::implicit_mpm
     const std::vector<ContactPlane> &walls() const { return planes; }
     unsigned int offset() const { return offset_; }
 
-    /// The per-point law (exposed for the tests): at x (current position),
-    /// x_n, with the point's extent r, stiffness k and anchor state of wall w;
+    /// The per-spot law: at x (current position of the contact spot), x_n (at
+    /// the start of the step), with the offset r (0: x is the spot), stiffness
+    /// k and anchor state of wall w;
     /// writes the force on the point (f), its derivative df/dx (D, row-major
     /// dim x dim), and returns 0 (no contact), 1 (stick) or 2 (slip).
     struct Law
