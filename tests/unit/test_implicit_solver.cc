@@ -136,5 +136,32 @@ namespace
   {
     EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, axisymmetric, 1.0, bottom_roller), 1e-8);
   }
+  // contact walls on the points (point_contact.h): a floor (boundary 2) under the block, whose
+  // bottom row of points touches it (gap 0 with the extent r_p = V_p^(1/dim)/2); the random
+  // iterate pushes about half of them into it. The penalty terms (normal, stick, Coulomb slip
+  // with its non-symmetric tangent) act at the points' contact spots.
+  const std::string point_floor = " set fixed = 0\n set contact = 2\n set contact method = points\n";
+  TEST(ImplicitTangent, PointContactNoSlip2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, "", 1.0, point_floor), 1e-6);
+  }
+  TEST(ImplicitTangent, PointContactFrictionless2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, "", 1.0,
+                               point_floor + " set contact friction = frictionless\n"),
+              1e-6);
+  }
+  TEST(ImplicitTangent, PointContactCoulomb2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, "", 1.0,
+                               point_floor + " set contact friction = 0.3\n set contact penalty = 10\n"),
+              1e-6);
+  }
+  TEST(ImplicitTangent, PointContactCoulomb3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2, 0, 9.81, "", 1.0,
+                               point_floor + " set contact friction = 0.3\n set contact penalty = 10\n"),
+              1e-6);
+  }
   TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
 } // namespace

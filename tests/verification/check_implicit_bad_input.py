@@ -8,6 +8,10 @@ the right exit code, no NaN written.
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
+  * contact walls on the points: a misspelt 'contact method', 'points' without
+    contact walls, a penalty <= 0 or not a number, a penalty with the node
+    method, a negative or malformed Coulomb coefficient, the node method's
+    'contact gap'/'contact passes' with points, Coulomb friction with cg amg;
   * Newton that cannot converge (max iterations 1 with a tolerance no single
     iteration meets): every step is cut back max_cut_backs times, then the run
     stops with exit 3 and says so; series.csv holds only finite values;
@@ -26,6 +30,8 @@ tools, prm_path, work = sys.argv[1:4]
 tool = f"{tools}/talus-implicit"
 shutil.rmtree(work, ignore_errors=True)
 base = tv.prm_set(open(prm_path).read(), "output/directory", "must_not_exist")
+points_base = tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"), "boundary conditions/contact method",
+                        "points")
 cases = {
     "no finite-strain form": (tv.prm_set(base, "material 0/model", "linear elastic"),
                               ["material 0/model", "linear elastic", "finite-strain", "neo hookean"]),
@@ -62,6 +68,30 @@ cases = {
     "contact with load balancing": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
                                                "load balancing/interval", "10"),
                                     ["load balancing/interval", "contact walls"]),
+    # contact walls on the points (contact method = points)
+    "contact method misspelt": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
+                                           "boundary conditions/contact method", "point"),
+                                ["boundary conditions/contact method", "'point'", "nodes | points"]),
+    "contact method points without walls": (tv.prm_set(base, "boundary conditions/contact method", "points"),
+                                            ["boundary conditions/contact method", "needs contact walls"]),
+    "contact penalty zero": (tv.prm_set(points_base, "boundary conditions/contact penalty", "0"),
+                             ["boundary conditions/contact penalty", "'0'", "> 0"]),
+    "contact penalty not a number": (tv.prm_set(points_base, "boundary conditions/contact penalty", "stiff"),
+                                     ["boundary conditions/contact penalty", "'stiff'"]),
+    "contact penalty on nodes": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
+                                            "boundary conditions/contact penalty", "10"),
+                                 ["boundary conditions/contact penalty", "contact method = points"]),
+    "contact friction negative": (tv.prm_set(points_base, "boundary conditions/contact friction", "-0.2"),
+                                  ["boundary conditions/contact friction", "'-0.2'", "mu >= 0"]),
+    "contact friction with trailing text": (tv.prm_set(points_base, "boundary conditions/contact friction", "0.3x"),
+                                            ["boundary conditions/contact friction", "'0.3x'"]),
+    "contact gap on points": (tv.prm_set(points_base, "boundary conditions/contact gap", "0.2"),
+                              ["boundary conditions/contact gap", "contact method = nodes"]),
+    "contact passes on points": (tv.prm_set(points_base, "boundary conditions/contact passes", "3"),
+                                 ["boundary conditions/contact passes", "contact method = nodes"]),
+    "coulomb friction with cg amg": (tv.prm_set(tv.prm_set(points_base, "boundary conditions/contact friction", "0.3"),
+                                                "linear solver/method", "cg amg"),
+                                     ["linear solver/method", "non-symmetric", "direct"]),
     "velocity on a missing boundary": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
                                                   "loads/velocity 0/boundary id", "7"),
                                        ["loads/velocity 0/boundary id", "does not exist"]),

@@ -20,8 +20,13 @@ Checks (--expect roll, the default):
   * Newton converged in every step, the run reached its end time.
 --expect slide (the smooth-floor case, --floor roller): a within 3 % of g sin theta,
 |omega R| < 3 % of v_c, and the rolling checks above must fail (they can fail).
-Usage: check_implicit_rolling_disk.py TOOLS_DIR PRM WORKDIR [--floor fixed|roller] [--expect roll|slide]
-       [--set entry=value ...]
+--expect coulomb (a Coulomb floor with mu < tan(theta) / 3: the disk slides with friction): a within 1 % of
+g (sin theta - mu cos theta) (mu from 'contact friction'), and the three rolling checks must fail.
+--disk-mesh MESH_PRM: first run talus-mesh on MESH_PRM (parameter_files/mesh/rolling_disk_polar.prm:
+the polar-meshed disk whose points lie on rings) in WORKDIR and give its particle file to body 0
+(the .prm's own 'particle file' path is relative to the repository root).
+Usage: check_implicit_rolling_disk.py TOOLS_DIR PRM WORKDIR [--floor fixed|roller|contact] [--expect roll|slide]
+       [--disk-mesh MESH_PRM] [--set entry=value ...]
 """
 import argparse
 import math
@@ -37,9 +42,19 @@ ap.add_argument("prm")
 ap.add_argument("work")
 ap.add_argument("--floor", choices=["fixed", "roller", "contact"], default=None,
                 help="override boundary 2 of the .prm (contact: talus-implicit's unilateral no-slip wall)")
-ap.add_argument("--expect", choices=["roll", "slide"], default="roll")
+ap.add_argument("--expect", choices=["roll", "slide", "coulomb"], default="roll")
 ap.add_argument("--set", action="append", default=[], help="entry=value, e.g. time/end time=0.1")
+ap.add_argument("--disk-mesh", default=None, help="talus-mesh .prm of the disk's particle file")
 args = ap.parse_args()
+os.makedirs(args.work, exist_ok=True)
+if args.disk_mesh:
+    # the particle file of the disk, made here (paths of the mesh .prm: relative to the repository root)
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(args.disk_mesh))))
+    mtext = open(args.disk_mesh).read().replace("meshes/", os.path.join(repo, "meshes") + "/")
+    mtext = re.sub(r"output/mesh/[^/\s]+/", "mesh/", mtext)
+    tv.run_tool(f"{args.tools}/talus-mesh", mtext, args.work, "mesh")
+    args.set = ["body 0/shape=file", "body 0/particle file=" + os.path.join(os.path.abspath(args.work), "mesh",
+                                                                             "disk.h5")] + args.set
 
 text = tv.prm_set(open(args.prm).read(), "output/directory", "out")
 text = tv.prm_set(text, "output/series interval", "0")
@@ -52,6 +67,8 @@ if args.floor:
     for kind in ("fixed", "roller", "contact"):
         if kind == args.floor or f"set {kind}" in text:
             text = tv.prm_set(text, f"boundary conditions/{kind}", "2" if kind == args.floor else "")
+    if args.floor != "contact":  # the contact wall's own entries go with it
+        text = re.sub(r"^\s*set\s+contact\s+(method|friction|penalty|gap|passes)\b.*$", "", text, flags=re.M)
 # talus-critical-dt reads the shared scene entries only: give it the scene with
 # a fixed floor (the floor does not enter the explicit critical step)
 crit_text = text
@@ -157,6 +174,15 @@ if args.expect == "roll":
     tv.check(turn_ok, f"no slip: rotation x R within 3 % of the travel "
                       f"({(-phi * R / travel - 1) if travel else float('nan'):+.3%})")
     tv.check(spin_ok, f"no slip: omega R within 3 % of v_c ({(-omega * R / vm[0] - 1) if vm[0] else float('nan'):+.3%})")
+elif args.expect == "coulomb":
+    mu = float(entry("boundary conditions/contact friction"))
+    cos_theta = -g_vec[1] / g
+    a_mu = g * (sin_theta - mu * cos_theta)
+    tv.check(mu < math.tan(math.asin(sin_theta)) / 3, f"mu = {mu} < tan(theta)/3: the disk must slip")
+    tv.check(abs(a / a_mu - 1) < 0.01, f"Coulomb floor: a within 1 % of g (sin - mu cos) = {a_mu:.5f} "
+                                       f"({a / a_mu - 1:+.3%})")
+    tv.check(not roll_ok and not turn_ok and not spin_ok,
+             "the rolling checks fail on the Coulomb floor (acceleration, rotation and spin each)")
 else:
     tv.check(abs(a / a_slide - 1) < 0.03, f"smooth floor: a within 3 % of g sin theta ({a / a_slide - 1:+.3%})")
     tv.check(vm[0] > 0 and abs(omega * R) < 0.03 * vm[0], f"smooth floor: |omega R| < 3 % of v_c "

@@ -164,14 +164,33 @@ add_test(NAME verification.implicit_prescribed_displacement
                  ${TALUS_PRM_DIR}/implicit/block_prescribed_displacement.prm ${_w}/implicit_prescribed_displacement)
 set_tests_properties(verification.implicit_prescribed_displacement PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
-# rolling disk (seed 001 §4.5.2), docs/implicit.md "Rolling disk": Neo-Hookean disk on the grid
-# floor, gravity tilted by 30 deg, dt ~ 19 x the explicit critical step. The smooth (roller)
-# floor: a = g sin theta within 3 %, no spin, and the rolling checks must fail on it (fast).
+# rolling disk (seed 001 §4.5.2), docs/implicit.md "Rolling disk": Neo-Hookean disk (polar-meshed,
+# points on rings: its particle file made by talus-mesh from parameter_files/mesh/rolling_disk_polar.prm)
+# on the grid floor, gravity tilted by 30 deg, dt ~ 19 x the explicit critical step. The smooth
+# (roller) floor: a = g sin theta within 3 %, no spin, and the rolling checks must fail on it (fast).
 add_test(NAME verification.implicit_rolling_disk_smooth_floor
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk_smooth_floor
-                 --floor roller --expect slide)
+                 --floor roller --expect slide --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm)
 set_tests_properties(verification.implicit_rolling_disk_smooth_floor PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 300)
+# the point contact floor made frictionless (the mutant of the no-slip floor): slides at g sin
+# theta within 3 %, no spin, the rolling checks fail (fast)
+add_test(NAME verification.implicit_rolling_disk_frictionless
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk_frictionless
+                 --expect slide --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm
+                 "--set=boundary conditions/contact friction=frictionless")
+set_tests_properties(verification.implicit_rolling_disk_frictionless PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 300)
+# Coulomb friction on the point contact floor, mu = 0.1 < tan(theta)/3: the disk slides with
+# friction, a = g (sin theta - mu cos theta) within 1 %, the rolling checks fail (fast)
+add_test(NAME verification.implicit_rolling_disk_coulomb
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk_coulomb
+                 --expect coulomb --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm
+                 "--set=boundary conditions/contact friction=0.1")
+set_tests_properties(verification.implicit_rolling_disk_coulomb PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 300)
 # unilateral contact floor ('boundary conditions/contact', docs/implicit.md "Contact floor"): a block
 # stays on it under gravity and lifts off (free rise g t^2/2 within 1 %) when gravity is reversed,
@@ -181,16 +200,24 @@ add_test(NAME verification.implicit_contact_block
                  ${TALUS_PRM_DIR}/implicit/block_contact_floor.prm ${_w}/implicit_contact_block)
 set_tests_properties(verification.implicit_contact_block PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
-# The thesis's case, no slip on the unilateral contact floor (rolling_disk.prm): a = (2/3) g sin
-# theta within 3 %, rotation and spin match the travel. DISABLED: it fails, not by the implicit step:
-# a fixed floor glues the disk (it does not roll, in talus-explicit too); the contact floor rolls it
-# at -12 % (it hops over the floor nodes and partly slips; figures and cause in docs/implicit.md,
-# "Rolling disk"). Enable it when a floor that follows the moving contact point exists.
+# The thesis's case, no slip on the contact floor acting on the points (rolling_disk.prm, contact
+# method = points, penalty 0.3): a = (2/3) g sin theta within 3 %, rotation and spin match the travel
+# within 3 %, dt >= 10 x the explicit critical step (fast, ~10 s). docs/implicit.md "Rolling disk".
 add_test(NAME verification.implicit_rolling_disk
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
-                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk)
-set_tests_properties(verification.implicit_rolling_disk PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
-                     TIMEOUT 600 DISABLED TRUE)
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk
+                 --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm)
+set_tests_properties(verification.implicit_rolling_disk PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+# checkpoint/restart with the point contact floor (its stick anchors and contact flags live in the
+# points' properties): the column collapse a = 1.2 on a no-slip point contact floor, bitwise (fast)
+add_test(NAME verification.implicit_checkpoint_restart_point_contact
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart_point_contact
+                 "boundary conditions/fixed=" "boundary conditions/contact=2"
+                 "boundary conditions/contact method=points")
+set_tests_properties(verification.implicit_checkpoint_restart_point_contact PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 
 # issue 15: load balancing by material points (formulations/common/load_balance.h):
 # a column collapsing in the left fifth of the box on 2 ranks, imbalance before/after

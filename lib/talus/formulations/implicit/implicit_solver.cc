@@ -47,8 +47,10 @@ namespace talus::implicit_mpm
                         "when it would move into the wall; the active set is iterated within each step "
                         "(docs/implicit.md, 'Contact floor'). Applies in every stage.");
       prm.declare_entry("contact friction", "no slip", Anything(),
-                        "Tangential behaviour of the 'contact' walls: 'no slip' (a node in contact sticks) or "
-                        "'frictionless' (only the normal component is held).");
+                        "Tangential behaviour of the 'contact' walls: 'no slip' (a node / point in contact sticks), "
+                        "'frictionless' (only the normal component is held / pushed) or, with 'contact method = "
+                        "points' only, a Coulomb coefficient mu >= 0 (stick while the tangential penalty force is at "
+                        "most mu times the normal one, else slip at that force).");
       prm.declare_entry("contact gap", "0.1", Double(0),
                         "A contact node can be held only while the material next to it is at the wall: the gap, "
                         "the smallest (distance to the wall - half the point size V_p^(1/dim)/2) over the points of "
@@ -57,6 +59,17 @@ namespace talus::implicit_mpm
       prm.declare_entry("contact passes", "10", Integer(1, 1000),
                         "Active-set passes (Newton solves) per step at most; a node that changed its state twice "
                         "in a step stays in contact for the rest of that step.");
+      prm.declare_entry("contact method", "nodes", Anything(),
+                        "How the 'contact' walls act: 'nodes' (the grid nodes of the wall are held or free, an active "
+                        "set per step; 'contact gap' and 'contact passes' apply) or 'points' (a rigid plane pushes on "
+                        "the material points that penetrate it, point extent r_p = V_p^(1/dim)/2, by a penalty inside "
+                        "Newton with its consistent tangent; tangentially a penalty on the slip since the point "
+                        "touched the wall (no slip) or Coulomb friction; docs/implicit.md, 'Contact walls on the "
+                        "points').");
+      prm.declare_entry("contact penalty", "1", Anything(),
+                        "contact method = points: the penalty factor kappa > 0 of the normal and tangential "
+                        "stiffness per point, k = kappa M V_p / h^2 (M the constrained modulus of the point's "
+                        "material, V_p its volume, h the cell size normal to the wall).");
     }
     prm.leave_subsection();
     loads::declare_stage_parameters(prm, prm_file, counts.dim, false, [](dealii::ParameterHandler &p) {
@@ -173,14 +186,63 @@ namespace talus::implicit_mpm
             "load balancing is not available with contact walls (boundary conditions/contact: their active set "
             "is not carried through a repartition); allowed: interval = 0, or no contact walls");
     {
+      const std::string method = prm.get("contact method");
+      require(method == "nodes" || method == "points", "boundary conditions/contact method",
+              "'" + method + "' is not a contact method; allowed: nodes | points");
+      p.contact_on_points = method == "points";
       const std::string f = prm.get("contact friction");
-      require(f == "no slip" || f == "frictionless", "boundary conditions/contact friction",
-              "'" + f + "' is not a contact friction; allowed: no slip | frictionless (Coulomb friction is not "
-              "available yet)");
+      double            mu = -1;
+      if (p.contact_on_points && f != "no slip" && f != "frictionless")
+        {
+          std::size_t used = 0;
+          try
+            {
+              mu = std::stod(f, &used);
+            }
+          catch (...)
+            {
+              used = 0;
+            }
+          require(used == f.size() && used > 0 && std::isfinite(mu) && mu >= 0, "boundary conditions/contact friction",
+                  "'" + f + "' is not a contact friction; allowed: no slip | frictionless | a Coulomb coefficient "
+                  "mu >= 0 (contact method = points)");
+        }
+      else
+        require(f == "no slip" || f == "frictionless", "boundary conditions/contact friction",
+                "'" + f + "' is not a contact friction; allowed: no slip | frictionless (a Coulomb coefficient "
+                "needs 'contact method = points')");
       p.contact_no_slip = f == "no slip";
+      p.contact_mu      = f == "no slip" ? std::numeric_limits<double>::infinity() : f == "frictionless" ? 0.0 : mu;
+      const std::string k = prm.get("contact penalty");
+      double            kappa = -1;
+      std::size_t       used  = 0;
+      try
+        {
+          kappa = std::stod(k, &used);
+        }
+      catch (...)
+        {
+          used = 0;
+        }
+      require(used == k.size() && used > 0 && std::isfinite(kappa) && kappa > 0, "boundary conditions/contact penalty",
+              "'" + k + "' is not a penalty factor; allowed: a number > 0 (k = penalty x M V_p / h^2)");
+      p.contact_penalty = kappa;
     }
     p.contact_passes = prm.get_integer("contact passes");
     p.contact_gap    = prm.get_double("contact gap");
+    if (p.contact_on_points)
+      {
+        // the node active set's entries mean nothing on the points: refused, not ignored
+        require(p.contact_passes == 10, "boundary conditions/contact passes",
+                "applies to 'contact method = nodes' only; remove it (contact method = points)");
+        require(p.contact_gap == 0.1, "boundary conditions/contact gap",
+                "applies to 'contact method = nodes' only; remove it (contact method = points)");
+        require(!p.contact_ids.empty(), "boundary conditions/contact method",
+                "'points' needs contact walls: give their boundary ids in 'boundary conditions/contact'");
+      }
+    else
+      require(p.contact_penalty == 1, "boundary conditions/contact penalty",
+              "applies to 'contact method = points' only; remove it or set 'contact method = points'");
     prm.leave_subsection();
     p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
     p.traction_stage.assign(p.tractions.size(), -1);
@@ -245,6 +307,11 @@ namespace talus::implicit_mpm
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
     prm.leave_subsection();
+    require(!p.contact_on_points || p.contact_mu == 0 || std::isinf(p.contact_mu) ||
+              p.linear.method == LinearSolverOptions::Method::direct,
+            "linear solver/method",
+            "Coulomb friction on the contact walls gives a non-symmetric tangent: use 'direct' (or contact friction "
+            "= no slip | frictionless with cg amg)");
 
     for (unsigned int k = 0; k < p.materials.size(); ++k)
       {
@@ -360,6 +427,23 @@ namespace talus::implicit_mpm
     point_forces.extend_layout(points.layout, prm.tractions.size());
     if (prm.axisymmetric)
       radius_offset = points.layout.add_extra("radius", 1);
+    if (prm.contact_on_points)
+      {
+        // the contact walls as planes (box faces: id = 2 axis + (0 lower | 1 upper))
+        std::vector<ContactPlane> planes;
+        for (const auto id : prm.contact_ids)
+          {
+            ContactPlane c;
+            c.axis = id / 2;
+            c.sign = id % 2 ? 1 : -1;
+            c.wall = c.sign < 0 ? prm.grid_lower[c.axis] : prm.grid_upper[c.axis];
+            c.cell = (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+            planes.push_back(c);
+          }
+        point_contact = std::make_unique<PointContact<dim>>(planes, prm.contact_penalty, prm.contact_mu,
+                                                            prm.materials, prm.axisymmetric);
+        point_contact->extend_layout(points.layout);
+      }
     if (prm.mixed_up)
       {
         pressure_offset = points.layout.add_extra("pressure", 1);
@@ -393,6 +477,8 @@ namespace talus::implicit_mpm
             if (prm.mixed_up) // the mean of the initial stress
               P[pressure_offset] = dealii::trace(L::get_stress(P.data())) / 3.0;
           }
+        if (point_contact)
+          point_contact->initialize_points(points);
         dt = prm.stage_time_steps[0];
       }
     require(current_stage < prm.stages.size(), "checkpoint/restart",
@@ -539,7 +625,8 @@ namespace talus::implicit_mpm
   {
     const auto &st = prm.stages[k];
     boundary_flags = loads::wall_dof_flags(grid, st.boundary_conditions);
-    contact_nodes  = loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
+    contact_nodes  = prm.contact_on_points ? std::vector<loads::ContactNode>() :
+                                             loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
     node_contact.assign(boundary_flags.size(), -1);
     for (std::size_t k = 0; k < contact_nodes.size(); ++k)
       node_contact[contact_nodes[k].node] = int(k);
@@ -561,8 +648,10 @@ namespace talus::implicit_mpm
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
     contact_changes.assign(contact_nodes.size(), 0);
-    if (!prm.contact_ids.empty())
+    if (!prm.contact_ids.empty() && !point_contact)
       measure_contact_gaps();
+    if (point_contact) // x_n of the points, read by the contact terms of the step
+      point_contact->start_step(points);
     constraints = step_constraints();
   }
 
@@ -865,6 +954,8 @@ namespace talus::implicit_mpm
     const bool any_failed = dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0;
     if (any_failed)
       throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
+    if (point_contact) // the penalty walls on the points (point_contact.h)
+      point_contact->assemble(points, active, constraints, du, with_tangent ? &tangent : nullptr, residual);
     if (dynamic())
       {
         // lumped inertia and mass-proportional damping at the nodes:
@@ -1086,6 +1177,15 @@ namespace talus::implicit_mpm
         return StepOutcome::cut_back;
       }
 
+    if (point_contact)
+      {
+        // the stick anchors and contact flags of the converged increment
+        last.point_contact = point_contact->commit(points, space, du);
+        total_point_contacts += last.point_contact.new_contacts;
+        total_point_releases += last.point_contact.released;
+        total_point_slip_steps += last.point_contact.slipping;
+        worst_penetration_ratio = std::max(worst_penetration_ratio, last.point_contact.max_penetration_ratio);
+      }
     // convective phase
     const auto start = Clock::now();
     if (dynamic())
@@ -1105,6 +1205,11 @@ namespace talus::implicit_mpm
  << " Newton iterations, |r| " << last.history << ", order (|r|) " << std::setprecision(3)
           << result.observed_order << ", (|du|) " << last.increment_order << ", " << linear_iterations << " linear iterations (largest |b - A x|/|b| "
           << worst_linear_residual << ")";
+    if (point_contact)
+      log() << "; contact (points): " << last.point_contact.in_contact << " in contact (" << last.point_contact.slipping
+            << " slipping, " << last.point_contact.new_contacts << " new, " << last.point_contact.released
+            << " released), normal force " << last.point_contact.normal_force << ", largest penetration / r_p "
+            << last.point_contact.max_penetration_ratio;
     if (any_contact)
       log() << "; contact: " << passes << " pass(es), " << released << " released, " << added << " in contact again, "
             << last.contact_nodes << " nodes in contact" << pass_log.str();
@@ -1226,10 +1331,18 @@ namespace talus::implicit_mpm
         << std::endl;
     if (!prm.contact_ids.empty())
       {
-        out << "  contact walls (unilateral, " << (prm.contact_no_slip ? "no slip" : "frictionless") << "): boundary";
+        out << "  contact walls (unilateral, "
+            << (prm.contact_no_slip ? std::string("no slip")
+                : prm.contact_mu == 0 ? std::string("frictionless")
+                                      : "Coulomb mu = " + std::to_string(prm.contact_mu))
+            << "): boundary";
         for (const auto id : prm.contact_ids)
           out << " " << id;
-        out << "; at most " << prm.contact_passes << " active-set passes per step" << std::endl;
+        if (point_contact)
+          out << "; on the material points: penalty k = " << prm.contact_penalty
+              << " x M V_p / h^2, point extent V_p^(1/dim)/2" << std::endl;
+        else
+          out << "; at most " << prm.contact_passes << " active-set passes per step" << std::endl;
       }
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
@@ -1274,6 +1387,9 @@ namespace talus::implicit_mpm
     const char *ax[] = {"x", "y", "z"};
     for (unsigned int d = 0; d < dim; ++d)
       c.push_back(std::string("centre_of_mass_") + ax[d]);
+    if (point_contact)
+      for (const char *n : {"contact_points", "contact_slipping", "contact_normal_force", "contact_tangential_force"})
+        c.push_back(n);
     balance.add_series_column(c);
     return c;
   }
@@ -1299,6 +1415,13 @@ namespace talus::implicit_mpm
     dealii::Utilities::MPI::sum(sums, comm, sums);
     for (unsigned int d = 0; d < dim; ++d)
       v.push_back(sums[d] / sums[dim]);
+    if (point_contact)
+      {
+        const auto &s = last.point_contact; // zeros before the first step
+        const bool  a = after_step;
+        for (const double x : {double(s.in_contact), double(s.slipping), s.normal_force, s.tangential_force})
+          v.push_back(a ? x : 0.0);
+      }
     balance.add_series_value(v);
     return v;
   }
@@ -1375,7 +1498,11 @@ namespace talus::implicit_mpm
     log() << "done: " << step_number << " steps, " << n_points() << " particles, wall " << std::setprecision(4)
           << t.total << " s; Newton iterations " << total_iterations << " (cut-backs " << cut_backs
           << "), linear iterations " << total_linear_iterations << balance.summary() << std::endl;
-    if (!prm.contact_ids.empty())
+    if (point_contact)
+      log() << "  contact walls on the points: " << total_point_contacts << " points came into contact, "
+            << total_point_releases << " left it, " << total_point_slip_steps
+            << " point-steps slipping; largest penetration / r_p " << worst_penetration_ratio << std::endl;
+    else if (!prm.contact_ids.empty())
       log() << "  contact walls: " << total_contact_passes << " Newton solves (active-set passes), "
             << total_contact_released << " node releases, " << total_contact_added << " nodes put in contact, "
             << gap_releases << " nodes released because the material left the wall" << std::endl;

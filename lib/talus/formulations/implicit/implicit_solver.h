@@ -12,6 +12,7 @@
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/implicit/newmark.h>
 #include <talus/formulations/implicit/newton.h>
+#include <talus/formulations/implicit/point_contact.h>
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
 #include <talus/materials/neo_hookean.h>
@@ -25,6 +26,7 @@
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 
+#include <limits>
 #include <memory>
 #include <type_traits>
 #include <string>
@@ -83,6 +85,14 @@ namespace talus::implicit_mpm
     /// 'boundary conditions/contact gap': a node is held only while the material
     /// next to it is within this fraction of a cell of the wall
     double contact_gap = 0.1;
+    /// 'boundary conditions/contact method = points': the 'contact' walls act on
+    /// the material points by a penalty inside Newton (point_contact.h) instead
+    /// of holding grid nodes (docs/implicit.md "Contact walls on the points")
+    bool contact_on_points = false;
+    /// 'boundary conditions/contact penalty': k_n = penalty x M V_p / h^2 (points)
+    double contact_penalty = 1;
+    /// points: the Coulomb coefficient of 'contact friction' (+inf: no slip, 0: frictionless)
+    double contact_mu = std::numeric_limits<double>::infinity();
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -107,6 +117,8 @@ namespace talus::implicit_mpm
     /// contact walls: Newton solves (passes) of the step, nodes released and
     /// put (back) in contact over its passes, nodes in contact at its end
     unsigned int contact_passes = 0, contact_released = 0, contact_added = 0, contact_nodes = 0;
+    /// contact walls on the points: the converged step's contact figures
+    PointContactStats point_contact;
   };
 
   template <int dim>
@@ -214,6 +226,10 @@ namespace talus::implicit_mpm
     /// of nodes released and added. Collective.
     std::pair<unsigned int, unsigned int> update_contact(const dealii::Tensor<1, dim> &g, const double force_scale);
     unsigned long long total_contact_released = 0, total_contact_added = 0, total_contact_passes = 0;
+    /// 'contact method = points': the penalty walls on the points (null otherwise)
+    std::unique_ptr<PointContact<dim>> point_contact;
+    unsigned long long total_point_contacts = 0, total_point_releases = 0, total_point_slip_steps = 0;
+    double             worst_penetration_ratio = 0;
     /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
     /// (Eqs. 2.6-2.9) onto the active DoFs.
     void project_to_grid();
