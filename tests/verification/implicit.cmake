@@ -221,7 +221,7 @@ set_tests_properties(verification.implicit_strip_footing_prandtl PROPERTIES LABE
 add_test(NAME verification.implicit_strip_footing_prandtl_full
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_prandtl.prm ${_w}/implicit_strip_footing_prandtl_full
-                 --h=0.05 --du=0.001 --settlement=0.1 --window=0.05,0.1 --tol=0.03 --u-settlement=0.02
+                 --h=0.05 --du=0.001 --settlement=2.0 --window=0.05,0.1 --tol=0.03 --u-settlement=0.02
                  --rise=0.5,1,2)
 set_tests_properties(verification.implicit_strip_footing_prandtl_full PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
                      TIMEOUT 3600 DISABLED TRUE)
