@@ -42,6 +42,9 @@ cases = {
     "mixed up with a pressure-dependent yield": (
         tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "material 0/model", "hencky mohr coulomb"),
         ["material 0/model", "mixed up", "hencky mohr coulomb", "j2 plasticity", "pressure"]),
+    "moving velocity regions with restart": (
+        tv.prm_set(tv.prm_set(base, "implicit/velocity regions follow", "true"), "checkpoint/restart", "if available"),
+        ["implicit/velocity regions follow", "restart"]),
     "mixed up in a dynamic run": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "implicit/analysis",
                                              "dynamic"), ["implicit/formulation", "static"]),
     "mixed up with cg amg": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "linear solver/method",
