@@ -28,7 +28,7 @@ plateau check of the fast test (--tol=0.10); the u formulation the zigzag bound
 of u-p (and u-p the bound of u).
 Usage: check_strip_footing_prandtl.py TOOLS_DIR PRM WORKDIR [--h=H] [--ppd=N] [--du=D] [--settlement=S]
        [--window=A,B] [--tol=T] [--rise=S1,...] [--max-its=N] [--u-settlement=S] [--zig-u=Z] [--zig-up=Z]
-       [--ranks=N] [--yield=Y] [--fixed-nodes]
+       [--ranks=N] [--yield=Y] [--fixed-nodes] [--line-search]
 """
 import math
 import sys
@@ -72,6 +72,8 @@ def scene(settlement):
     text = tv.prm_set(text, "time/end time", str(round(settlement / du)))
     if yield_stress:
         text = tv.prm_set(text, "material 0/j2 plasticity/yield stress", yield_stress)
+    if "--line-search" in sys.argv:  # h = 0.05 m needs it (docs/implicit.md)
+        text = tv.prm_set(text, "newton/line search", "true")
     if fixed_nodes:
         text = tv.prm_set(text, "implicit/velocity regions follow", "false")
     return text
