@@ -3,7 +3,8 @@ the right exit code, no NaN written.
   * input errors (exit 2, one message starting 'talus-implicit: error:' naming
     the entry, nothing written): a model without a finite-strain form, a zero
     time step, gamma out of range, nu = 0.5, an entry of a feature not built yet,
-    mixed u-p without the split Neo-Hookean energy, in a dynamic run or with an
+    mixed u-p without the split Neo-Hookean energy or with a pressure-dependent
+    yield (hencky mohr coulomb), in a dynamic run or with an
     iterative solver, a traction with both 'traction' and 'total force';
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
@@ -44,6 +45,12 @@ cases = {
                                                                                    "singular"]),
     "mixed up without the split energy": (tv.prm_set(base, "implicit/formulation", "mixed up"),
                                           ["material 0/model", "mixed up", "volumetric energy = split"]),
+    "mixed up with a pressure-dependent yield": (
+        tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "material 0/model", "hencky mohr coulomb"),
+        ["material 0/model", "mixed up", "hencky mohr coulomb", "j2 plasticity", "pressure"]),
+    "moving velocity regions with restart": (
+        tv.prm_set(tv.prm_set(base, "implicit/velocity regions follow", "true"), "checkpoint/restart", "if available"),
+        ["implicit/velocity regions follow", "restart"]),
     "mixed up in a dynamic run": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "implicit/analysis",
                                              "dynamic"), ["implicit/formulation", "static"]),
     "mixed up with cg amg": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "linear solver/method",

@@ -54,6 +54,15 @@ namespace talus::materials
 
     double elastic_energy_density(const Stress &sigma) const override;
 
+    /// The split of the mixed u-p driver: J p = K (J^2 - 1)/2, i.e. p(J) = K U'(J)
+    /// with the U of the split Neo-Hookean; the yield function depends on s
+    /// only and the flow is isochoric (J is the elastic and the total one).
+    bool   has_volumetric_split() const override { return true; }
+    double split_pressure(const double J) const override { return 0.5 * K * (J - 1.0 / J); }
+    double split_dpressure_dJ(const double J) const override { return 0.5 * K * (1.0 + 1.0 / (J * J)); }
+    double split_bulk_modulus() const override { return K; }
+    double split_shear_modulus() const override { return mu; }
+
     double shear_modulus() const { return mu; }
     double bulk_modulus() const { return K; }
     double yield_stress() const { return sigma_y; }

@@ -16,6 +16,7 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <functional>
+#include <stdexcept>
 #include <map>
 
 namespace talus::materials
@@ -68,6 +69,65 @@ namespace talus::materials
   {
     throw InputError("material '" + name + "': model '" + model_name() +
                      "' has no finite-strain form; choose one of the finite-strain models");
+  }
+
+  namespace
+  {
+    [[noreturn]] void
+    no_split(const Material &m)
+    {
+      throw std::logic_error("model '" + m.model_name() + "' has no volumetric/deviatoric split");
+    }
+  } // namespace
+
+  double
+  Material::split_pressure(const double) const
+  {
+    no_split(*this);
+  }
+
+  double
+  Material::split_dpressure_dJ(const double) const
+  {
+    no_split(*this);
+  }
+
+  double
+  Material::split_bulk_modulus() const
+  {
+    no_split(*this);
+  }
+
+  double
+  Material::split_shear_modulus() const
+  {
+    no_split(*this);
+  }
+
+  void
+  Material::split_update(const dealii::Tensor<2, 3> &dF,
+                         ArrayView<const double>     history_old,
+                         ArrayView<double>           history_new,
+                         Stress &                    tau_dev,
+                         double &                    J,
+                         dealii::Tensor<4, 3> *      dtau_dev_ddF) const
+  {
+    if (!has_volumetric_split())
+      no_split(*this);
+    Stress tau;
+    finite_strain_update(dF, history_old, history_new, tau, dtau_dev_ddF);
+    J                    = kirchhoff_jacobian(ArrayView<const double>(history_new.data(), history_new.size()));
+    const double p       = split_pressure(J);
+    tau_dev              = tau - J * p * dealii::unit_symmetric_tensor<3>();
+    if (!dtau_dev_ddF)
+      return;
+    // d (J p(J)) / d dF_kl = (p + J p') dJ / d dF_kl, dJ / d dF_kl = J dF^-1_lk
+    const double               dJp  = (p + J * split_dpressure_dJ(J)) * J;
+    const dealii::Tensor<2, 3> Finv = invert(dF);
+    for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int k = 0; k < 3; ++k)
+        for (unsigned int l = 0; l < 3; ++l)
+          (*dtau_dev_ddF)[i][i][k][l] -= dJp * Finv[l][k];
   }
 
   Stress

@@ -94,6 +94,35 @@ namespace talus::materials
     /// (Initial stresses make it differ from the driver's volume ratio.)
     virtual double kirchhoff_jacobian(ArrayView<const double> /*history*/) const { return 1.0; }
 
+    /// ---- Volumetric/deviatoric split (the mixed u-p driver, seed 001 ch. 5).
+    /// A model has it when tau = J p(J) I + tau_dev with p a function of
+    /// J = kirchhoff_jacobian(history) alone, J_{n+1} = J_n det dF (isochoric
+    /// plastic flow) and a deviatoric response that does not depend on the
+    /// pressure (no pressure-dependent yield): then the nodal pressure of u-p can
+    /// replace p(J). Neo-Hookean (split energy) and J2 have it; Mohr-Coulomb
+    /// (phi > 0) and Nor-Sand do not.
+    virtual bool has_volumetric_split() const { return false; }
+    /// p(J): the mean Cauchy stress of the volumetric part [Pa] (tension positive)
+    virtual double split_pressure(const double J) const;
+    /// dp/dJ [Pa]
+    virtual double split_dpressure_dJ(const double J) const;
+    /// the bulk modulus K = J dp/dJ at J = 1 (the u-p pressure rows are scaled by 1/K)
+    virtual double split_bulk_modulus() const;
+    /// the elastic shear modulus G (the u-p stabilisation weight alpha V / G)
+    virtual double split_shear_modulus() const;
+    /// One step of a model with the split, from finite_strain_update(): J, the
+    /// deviatoric part tau_dev = tau - J p(J) I and (if asked) its derivative
+    /// d tau_dev / d dF = d tau / d dF - I (x) (p + J p') J dF^-T. One place for
+    /// every model: the models provide p(J) only. The subtraction loses about
+    /// log10(K/G) digits of tau_dev; a model used near incompressibility may
+    /// override it with its deviatoric part computed directly (Neo-Hookean).
+    virtual void split_update(const dealii::Tensor<2, 3> &dF,
+                      ArrayView<const double>     history_old,
+                      ArrayView<double>           history_new,
+                      Stress &                    tau_dev,
+                      double &                    J,
+                      dealii::Tensor<4, 3> *      dtau_dev_ddF) const;
+
     /// Strain energy density increment is computed by the driver from stresses;
     /// this returns the elastic strain energy density of a stress state (for energy
     /// diagnostics), W = 1/2 sigma : C^-1 : sigma. Zero when not meaningful.

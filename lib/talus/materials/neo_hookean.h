@@ -83,14 +83,22 @@ namespace talus::materials
     ///   c_vol = J p (I (x) I - 2 I_sym)
     /// (the full displacement-form tangent adds J^2 dp/dJ I (x) I).
     static dealii::Tensor<4, 3> volumetric_spatial_tangent(const double J, const double p);
-    /// Deviatoric part of one step: tau_dev and (optionally) d tau_dev / d dF,
-    /// history as in finite_strain_update().
+    /// The split of the mixed u-p driver (Material::split_update): with the
+    /// split energy, p(J) = K U'(J) above.
+    bool   has_volumetric_split() const override { return energy_form == Energy::split; }
+    double split_pressure(const double J) const override { return pressure(J); }
+    double split_dpressure_dJ(const double J) const override { return dpressure_dJ(J); }
+    double split_bulk_modulus() const override { return bulk_modulus(); }
+    double split_shear_modulus() const override { return mu; }
+    /// tau_dev = mu dev(J^-2/3 b) and its tangent (Eq. 3.52) computed directly,
+    /// not as tau - J p I: at nu = 0.499999 (K/G = 5e5) the difference would
+    /// lose 6 digits (the u-p tangent test at that nu sees it: 2e-7 vs 9e-11)
     void split_update(const dealii::Tensor<2, 3> &dF,
                       ArrayView<const double>     history_old,
                       ArrayView<double>           history_new,
                       Stress &                    tau_dev,
                       double &                    J,
-                      dealii::Tensor<4, 3> *      dtau_dev_ddF) const;
+                      dealii::Tensor<4, 3> *      dtau_dev_ddF) const override;
 
     double shear_modulus() const { return mu; }
     double lame_lambda() const { return lambda; }

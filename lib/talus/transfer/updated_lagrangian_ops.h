@@ -324,8 +324,10 @@ namespace talus::transfer
   ///         = sum_p V_{n+1} (sigma_dev + p_p I) grad_{x_{n+1}} N_i - f_ext   (Eq. 5.6)
   ///   R_p,i = sum_p V_{n+1} N_i (U'(J) - p_p / K) - S_ij p_j           (Eq. 5.7 / K, 5.16)
   /// with j = det dF, J = J_n j, p_p = N p (the nodal pressure, not the
-  /// model's), tau_dev = mu dev(J^-2/3 b) and U of the split Neo-Hookean model
-  /// (materials/neo_hookean.h: p = K U'(J)). The pressure row is divided by K
+  /// model's), K U'(J) = p(J) and tau_dev = tau - J p(J) I of any model with
+  /// the volumetric/deviatoric split (Material::split_update: split
+  /// Neo-Hookean, J2; the plastic history is advanced in the commit, once per
+  /// step, from the converged state). The pressure row is divided by K
   /// (Kratos's form: the blocks are of one scale and K_pu = K_up^T at J = 1).
   /// S is the PPP stabilisation (Eqs. 5.14-5.19), over the points of one grid
   /// cell, with w_p = alpha V_n / G_p on the volume at the start of the step:
@@ -337,8 +339,8 @@ namespace talus::transfer
   template <int dim>
   struct MixedUpForce
   {
-    /// per material id: the split Neo-Hookean model (checked when read)
-    const std::vector<const materials::NeoHookean *> *models = nullptr;
+    /// per material id: a model with has_volumetric_split() (checked when read)
+    const std::vector<const materials::Material *> *models = nullptr;
     unsigned int                                      history_offset = 0;
     dealii::Tensor<1, dim>                            gravity;
     const loads::PointForces<dim> *                   point_forces = nullptr;
@@ -390,8 +392,8 @@ namespace talus::transfer
       double                     pp   = 0;
       for (unsigned int a = 0; a < p.n; ++a)
         pp += p.N[a] * ls.u[p.local[a] * nc + dim];
-      const double K = m.bulk_modulus(), w = alpha * Vn / m.shear_modulus();
-      const double Up = m.pressure(J) / K, Upp = m.dpressure_dJ(J) / K;
+      const double K = m.split_bulk_modulus(), w = alpha * Vn / m.split_shear_modulus();
+      const double Up = m.split_pressure(J) / K, Upp = m.split_dpressure_dJ(J) / K;
       // first Piola form of (sigma_dev + p I) V_{n+1}: Pk_ib
       double Pk[dim][dim];
       scaled_piola<dim>(c, tau_dev, Finv, Pk);

@@ -97,10 +97,15 @@ namespace talus::implicit_mpm
                         "irreducible: the nodal displacement only; mixed up: displacement and the nodal pressure "
                         "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
                         "pressure projection (seed 001 ch. 5; static analysis, neo hookean with 'volumetric energy "
-                        "= split', direct linear solver).");
+                        "= split' or j2 plasticity, direct linear solver).");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
+      prm.declare_entry("velocity regions follow", "false", Bool(),
+                        "true: the region of each 'loads/velocity k' with 'apply to = region' moves with the "
+                        "displacement that condition has prescribed so far, so the prescribed nodes are chosen "
+                        "anew each step at the current position of a rigid plate pressed into the material (they "
+                        "jump a grid row when the shifted region does); false: the nodes are fixed in space.");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
                         "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
                         "body of revolution about the y axis (x = radius, grid lower x >= 0; seed 001 App. C): a "
@@ -157,6 +162,7 @@ namespace talus::implicit_mpm
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
+    p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
@@ -330,12 +336,14 @@ namespace talus::implicit_mpm
                 "'mixed up' needs 'direct' (the u-p system is indefinite; no block preconditioner yet)");
         for (unsigned int k = 0; k < p.materials.size(); ++k)
           {
-            const auto *nh = dynamic_cast<const materials::NeoHookean *>(p.materials[k].get());
-            require(nh && nh->energy() == materials::NeoHookean::Energy::split,
-                    "material " + std::to_string(k) + "/model",
-                    "'mixed up' needs the volumetric/deviatoric split: model 'neo hookean' with 'volumetric energy = "
-                    "split' (got '" + p.materials[k]->model_name() +
-                      (nh ? "' with 'volumetric energy = coupled')" : "')"));
+            // the split (materials/material.h): the nodal pressure replaces p(J); a
+            // yield that depends on the pressure would need it inside the return
+            const auto &m = *p.materials[k];
+            require(m.has_volumetric_split(), "material " + std::to_string(k) + "/model",
+                    "'mixed up' needs a volumetric/deviatoric split with a pressure-independent deviatoric response; "
+                    "allowed: 'neo hookean' with 'volumetric energy = split', 'j2 plasticity' (got '" + m.model_name() +
+                      (dynamic_cast<const materials::NeoHookean *>(&m) ? "' with 'volumetric energy = coupled')"
+                                                                        : "': its yield depends on the pressure or it has no split)"));
           }
       }
     // what the implicit family does not offer yet: refused, not ignored
@@ -346,6 +354,9 @@ namespace talus::implicit_mpm
     not_yet(!p.probes.empty(), "output/probes");
     not_yet(p.write_grid, "output/write grid");
     not_yet(bool(p.grid_mesh), "grid/source");
+    require(!p.moving_velocity_regions || p.restart == Parameters<dim>::Restart::no, "implicit/velocity regions follow",
+            "restarting with moving velocity regions is not available yet (the region shifts are not in the "
+            "checkpoint); set it to false or start from t = 0");
     check_scene_consistency(p); // grid, boundary ids, memory, bodies
     if (p.axisymmetric)
       {
@@ -448,7 +459,7 @@ namespace talus::implicit_mpm
       {
         pressure_offset = points.layout.add_extra("pressure", 1);
         for (const auto &m : prm.materials)
-          split_models.push_back(dynamic_cast<const materials::NeoHookean *>(m.get()));
+          split_models.push_back(m.get());
       }
     points.initialize();
 
@@ -617,6 +628,7 @@ namespace talus::implicit_mpm
   {
     stage_nodes(k);
     idle_conditions.assign(prm.stages[k].velocities.size(), 0);
+    region_shift.assign(prm.stages[k].velocities.size(), dealii::Tensor<1, dim>());
   }
 
   template <int dim>
@@ -642,6 +654,18 @@ namespace talus::implicit_mpm
     if (prm.axisymmetric) // r_n of every point, read by the residual and the convective phase
       for (auto &pt : points.handler)
         pt.get_properties()[radius_offset] = pt.get_location()[0];
+    if (prm.moving_velocity_regions)
+      {
+        // the regions shifted by what their conditions have prescribed so far
+        auto velocities = prm.stages[current_stage].velocities;
+        for (unsigned int k = 0; k < velocities.size(); ++k)
+          if (velocities[k].target == loads::PrescribedVelocity<dim>::Target::region)
+            {
+              velocities[k].lower += region_shift[k];
+              velocities[k].upper += region_shift[k];
+            }
+        prescribed_dofs = loads::prescribed_node_dofs(grid, velocities, false);
+      }
     active.template reinit<shape::Q1Box<dim>>({&points});
     active.reinit_matrix(tangent);
     project_to_grid();
@@ -704,7 +728,8 @@ namespace talus::implicit_mpm
 
   template <int dim>
   dealii::AffineConstraints<double>
-  Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact) const
+  Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact,
+                                const bool with_prescribed) const
   {
     // the contact nodes now in contact: their normal DoF, with no slip all
     std::vector<dealii::types::global_dof_index> held;
@@ -719,7 +744,8 @@ namespace talus::implicit_mpm
               held.push_back(space.node_dof(c.node, d));
         }
     return active.constraints_with(
-      loads::wall_constraints(grid, space, boundary_flags, &prescribed_dofs, values, &held));
+      loads::wall_constraints(grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values,
+                              &held));
   }
 
   template <int dim>
@@ -781,15 +807,62 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
-  double
-  Solver<dim>::prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const
+  dealii::Tensor<1, dim>
+  Solver<dim>::condition_increment(const unsigned int k, const double h) const
   {
     // v f integrated over [t, t + h] by the trapezoidal rule (exact for constant
     // and piecewise-linear time functions whose kinks fall on step ends)
     const auto & st = prm.stages[current_stage];
-    const auto & pv = st.velocities[p.condition];
-    const double t0 = p.condition < st.n_global_velocities ? 0.0 : stage_start_time; // stage loads: stage time
-    return pv.velocity[p.component] * 0.5 * (pv.function.value(time - t0) + pv.function.value(time + h - t0)) * h;
+    const auto & pv = st.velocities[k];
+    const double t0 = k < st.n_global_velocities ? 0.0 : stage_start_time; // stage loads: stage time
+    return pv.velocity * (0.5 * (pv.function.value(time - t0) + pv.function.value(time + h - t0)) * h);
+  }
+
+  template <int dim>
+  double
+  Solver<dim>::prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const
+  {
+    return condition_increment(p.condition, h)[p.component];
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::prescribed_reaction(const dealii::Tensor<1, dim> &g)
+  {
+    // the residual r = f_int - f_ext assembled without the prescribed lines: at
+    // a prescribed DoF it is the force the node exerts on the material (the
+    // same device as the contact reactions); the other DoFs keep theirs
+    Vector kept(residual);
+    auto   free_prescribed = step_constraints(nullptr, true, false);
+    std::swap(constraints, free_prescribed);
+    try
+      {
+        assemble(false, g);
+      }
+    catch (...)
+      {
+        std::swap(constraints, free_prescribed);
+        residual = kept;
+        throw;
+      }
+    std::swap(constraints, free_prescribed);
+    const auto &owned = space.locally_owned_dofs();
+    const auto &pins  = active.constraints();
+    std::vector<double>                          f(dim, 0.0);
+    std::vector<dealii::types::global_dof_index> seen; // a node of two conditions counts once
+    for (const auto &p : prescribed_dofs)
+      {
+        const auto i = space.node_dof(p.node, p.component);
+        if (!owned.is_element(i) || pins.is_constrained(i) || free_prescribed.is_constrained(i) ||
+            std::find(seen.begin(), seen.end(), i) != seen.end())
+          continue;
+        seen.push_back(i);
+        f[p.component] += residual(i);
+      }
+    dealii::Utilities::MPI::sum(f, comm, f);
+    for (unsigned int d = 0; d < dim; ++d)
+      last.prescribed_force[d] = f[d];
+    residual = kept;
   }
 
   template <int dim>
@@ -1177,6 +1250,22 @@ namespace talus::implicit_mpm
         return StepOutcome::cut_back;
       }
 
+    if (any_velocity_condition()) // collective: the same on every rank
+      {
+        try
+          {
+            prescribed_reaction(g);
+          }
+        catch (const NewtonFailure &e)
+          {
+            log() << "  step " << step_number + 1 << " (t = " << time + h
+                  << "): the reactions of the prescribed nodes failed: " << e.what() << std::endl;
+            return StepOutcome::cut_back;
+          }
+      }
+    for (unsigned int k = 0; k < region_shift.size(); ++k)
+      region_shift[k] += condition_increment(k, h);
+
     if (point_contact)
       {
         // the stick anchors and contact flags of the converged increment
@@ -1390,6 +1479,9 @@ namespace talus::implicit_mpm
     if (point_contact)
       for (const char *n : {"contact_points", "contact_slipping", "contact_normal_force", "contact_tangential_force"})
         c.push_back(n);
+    if (any_velocity_condition())
+      for (unsigned int d = 0; d < dim; ++d)
+        c.push_back(std::string("prescribed_force_") + ax[d]);
     balance.add_series_column(c);
     return c;
   }
@@ -1422,6 +1514,9 @@ namespace talus::implicit_mpm
         for (const double x : {double(s.in_contact), double(s.slipping), s.normal_force, s.tangential_force})
           v.push_back(a ? x : 0.0);
       }
+    if (any_velocity_condition())
+      for (unsigned int d = 0; d < dim; ++d)
+        v.push_back(after_step ? last.prescribed_force[d] : 0.0);
     balance.add_series_value(v);
     return v;
   }

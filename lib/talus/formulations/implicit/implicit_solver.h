@@ -93,6 +93,11 @@ namespace talus::implicit_mpm
     double contact_penalty = 1;
     /// points: the Coulomb coefficient of 'contact friction' (+inf: no slip, 0: frictionless)
     double contact_mu = std::numeric_limits<double>::infinity();
+    /// 'implicit/velocity regions follow': the region of each 'velocity k' with
+    /// 'apply to = region' moves with the displacement it has prescribed so far
+    /// (a rigid plate pressed into the material keeps acting on the nodes at its
+    /// current position); false: the nodes are fixed in space
+    bool moving_velocity_regions = false;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -119,6 +124,10 @@ namespace talus::implicit_mpm
     unsigned int contact_passes = 0, contact_released = 0, contact_added = 0, contact_nodes = 0;
     /// contact walls on the points: the converged step's contact figures
     PointContactStats point_contact;
+    /// 'loads/velocity k': the force the prescribed nodes exert on the material
+    /// at the converged step (the residual f_int - f_ext at their DoFs), summed
+    /// over the nodes of all conditions, per component
+    double prescribed_force[3] = {0, 0, 0};
   };
 
   template <int dim>
@@ -197,7 +206,8 @@ namespace talus::implicit_mpm
     /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,
     /// and the contact nodes now in contact) merged with the inactive pins.
     dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values = nullptr,
-                                                       const bool with_contact = true) const;
+                                                       const bool with_contact = true,
+                                                       const bool with_prescribed = true) const;
     /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
     /// normal DoF of each node, decided by the owner, ghosts updated.
     std::vector<loads::ContactNode> contact_nodes;
@@ -256,11 +266,26 @@ namespace talus::implicit_mpm
     unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int; ///< mixed u-p: p_p
     /// axisymmetric: the point's radius r_n at the start of the step (set by prepare_step)
     unsigned int radius_offset = dealii::numbers::invalid_unsigned_int;
-    std::vector<const materials::NeoHookean *> split_models; ///< mixed u-p, per material id
+    std::vector<const materials::Material *> split_models; ///< mixed u-p, per material id
     dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
     std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
     std::vector<loads::PrescribedNodeDof>   prescribed_dofs; ///< of 'loads/velocity k' (owned + ghost)
     std::vector<unsigned char>              idle_conditions; ///< per condition: reported as acting on nothing
+    /// per condition of the stage: the displacement it has prescribed so far
+    /// (the shift of its region with 'velocity regions follow')
+    std::vector<dealii::Tensor<1, dim>> region_shift;
+    /// some stage has 'velocity k' conditions (series columns prescribed_force_*)
+    bool any_velocity_condition() const
+    {
+      for (const auto &st : prm.stages)
+        if (!st.velocities.empty())
+          return true;
+      return false;
+    }
+    /// the displacement condition k of the stage prescribes over [time, time + h]
+    dealii::Tensor<1, dim> condition_increment(const unsigned int k, const double h) const;
+    /// the reaction of the prescribed nodes at the converged iterate (StepReport)
+    void prescribed_reaction(const dealii::Tensor<1, dim> &g);
     /// The displacement of a prescribed DoF over the step [t, t + h].
     double prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const;
     /// du before Newton: one linear solve with the prescribed increments lifted

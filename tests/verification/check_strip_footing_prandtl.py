@@ -1,0 +1,157 @@
+"""Rigid strip footing on undrained soil (seed 001 thesis §6.2, issue 13): the
+stabilised mixed u-p formulation of talus-implicit with a plastic model (J2,
+sigma_y = sqrt(3) c_u: Tresca in plane strain), displacement control
+(parameter_files/implicit/strip_footing_prandtl.prm; the scene and the choices
+not in the thesis are documented there and in docs/implicit.md).
+
+The load: q = -prescribed_force_y / (B / 2) of series.csv (the reaction of the
+footing's prescribed nodes, half model), normalised by c_u = 100 Pa; the
+settlement s = --du x step.
+
+Checks:
+  * q / c_u within --tol (default 3 %) of 2 + pi at every step with s / B in
+    the plateau window --window (default 0.02, 0.04);
+  * --rise=S1,S2,...: q / c_u keeps rising at large settlement: the mean over
+    the steps within 1 % of B of each S_k is larger than that of S_{k-1} and
+    the first is above the plateau (thesis Fig. 6.8);
+  * Newton: every step converged (the run reached the end) in at most
+    --max-its iterations (default 12); the mean and the largest count reported;
+  * --u-settlement=S (0 skips): the irreducible u formulation on the same scene
+    to S: its mean stress oscillates, the u-p one does not: zigzag index
+    (talus_verify.zigzag_index: RMS of the sign-changing neighbour differences of
+    the point mean stress over its range, on the initial 2 x 2 lattice) of u above
+    --zig-u, of u-p below --zig-up at the same settlement;
+  * --ranks=N (0 skips): the u-p run of the first N steps on 1 and 2 ranks:
+    q per step within 1e-8 relative.
+Variants that must fail (docs/implicit.md): --yield=190.53 (sigma_y + 10 %) the
+plateau check of the fast test (--tol=0.10); the u formulation the zigzag bound
+of u-p (and u-p the bound of u).
+Usage: check_strip_footing_prandtl.py TOOLS_DIR PRM WORKDIR [--h=H] [--ppd=N] [--du=D] [--settlement=S]
+       [--window=A,B] [--tol=T] [--rise=S1,...] [--max-its=N] [--u-settlement=S] [--zig-u=Z] [--zig-up=Z]
+       [--ranks=N] [--yield=Y] [--fixed-nodes] [--line-search]
+"""
+import math
+import sys
+import time
+
+import talus_verify as tv
+
+
+def option(name, default):
+    return next((a.split("=", 1)[1] for a in sys.argv if a.startswith(f"--{name}=")), default)
+
+
+tools, prm_path, work = [a for a in sys.argv if not a.startswith("--")][1:4]
+h = float(option("h", 0.1))
+ppd = int(option("ppd", 2))
+du = float(option("du", 0.002))
+s_end = float(option("settlement", 0.04))
+window = [float(v) for v in option("window", "0.02,0.04").split(",")]
+tol = float(option("tol", 0.03))
+rise = [float(v) for v in option("rise", "").split(",") if v]
+max_its = int(option("max-its", 12))
+u_settlement = float(option("u-settlement", 0))
+zig_u, zig_up = float(option("zig-u", 0.025)), float(option("zig-up", 0.012))
+ranks = int(option("ranks", 0))
+yield_stress = option("yield", None)
+fixed_nodes = "--fixed-nodes" in sys.argv
+B, c_u, depth, width = 1.0, 100.0, 2.0, 3.0
+prandtl = 2 + math.pi
+
+
+def scene(settlement):
+    text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+    text = tv.prm_set(text, "grid/upper corner", f"{width}, {depth + 2 * h}")
+    text = tv.prm_set(text, "grid/cells", f"{round(width / h)}, {round((depth + 2 * h) / h)}")
+    text = tv.prm_set(text, "body 0/particles per direction", str(ppd))
+    # the row at or above the top layer of points (depth h / (2 n)) under the footing
+    top = h / (2 * ppd)
+    text = tv.prm_set(text, "loads/velocity 0/region lower corner", f"0, {depth - top}")
+    text = tv.prm_set(text, "loads/velocity 0/region upper corner", f"{B / 2}, {depth + h - top}")
+    text = tv.prm_set(text, "loads/velocity 0/velocity", f"0, {-du}")
+    text = tv.prm_set(text, "time/end time", str(round(settlement / du)))
+    if yield_stress:
+        text = tv.prm_set(text, "material 0/j2 plasticity/yield stress", yield_stress)
+    if "--line-search" in sys.argv:  # h = 0.05 m needs it (docs/implicit.md)
+        text = tv.prm_set(text, "newton/line search", "true")
+    if fixed_nodes:
+        text = tv.prm_set(text, "implicit/velocity regions follow", "false")
+    return text
+
+
+def run(text, name, np=1):
+    start = time.time()
+    tv.run_tool(f"{tools}/talus-implicit", text, f"{work}/{name}", name, np=np)
+    wall = time.time() - start
+    s = tv.read_csv(f"{work}/{name}/out/series.csv")
+    rows = [k for k, t in enumerate(s["time"]) if t > 0]
+    settle = [s["time"][k] * du for k in rows]
+    q = [-s["prescribed_force_y"][k] / (B / 2) / c_u for k in rows]
+    its = [int(s["newton_iterations"][k]) for k in rows]
+    order = [s["increment_order"][k] for k in rows]
+    return settle, q, its, order, wall
+
+
+def zigzag(name):
+    p = tv.read_csv(f"{work}/{name}/out/particles_final.csv")
+    X = [x - u for x, u in zip(p["pos_x"], p["u_x"])]
+    Y = [y - u for y, u in zip(p["pos_y"], p["u_y"])]
+    mean = [(a + b + c) / 3 for a, b, c in zip(p["stress_xx"], p["stress_yy"], p["stress_zz"])]
+    return tv.zigzag_index(X, Y, mean, h)
+
+
+up = scene(s_end)
+settle, q, its, order, wall = run(up, "up")
+print(f"u-p, h = {h} m, {ppd} x {ppd} points per cell, {du} m per step, {len(q)} steps to s = {settle[-1]:.4g} m: "
+      f"{wall:.1f} s")
+print("  s/B      q/c_u    vs 2+pi   Newton its  order(|du|)")
+marks = sorted(set([0.005, 0.01, 0.02, 0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0] + window))
+for m in marks:
+    k = min(range(len(settle)), key=lambda i: abs(settle[i] - m * B))
+    if abs(settle[k] - m * B) < 0.5 * du + 1e-12:
+        print(f"  {settle[k] / B:7.4f}  {q[k]:7.4f}  {q[k] / prandtl - 1:+7.2%}   {its[k]:3d}        {order[k]:.2f}")
+
+tv.check(abs(settle[-1] - s_end) < 1e-9 * max(1, s_end), f"the run reached s = {s_end} m ({len(q)} steps)")
+in_window = [(s, v) for s, v in zip(settle, q) if window[0] * B - 1e-12 <= s <= window[1] * B + 1e-12]
+worst = max(in_window, key=lambda sv: abs(sv[1] / prandtl - 1))
+mean_w = sum(v for _, v in in_window) / len(in_window)
+print(f"plateau s/B in [{window[0]}, {window[1]}]: {len(in_window)} steps, q/c_u {min(v for _, v in in_window):.4f} .. "
+      f"{max(v for _, v in in_window):.4f}, mean {mean_w:.4f} ({mean_w / prandtl - 1:+.2%} from 2 + pi = {prandtl:.4f})")
+tv.check(abs(worst[1] / prandtl - 1) < tol,
+         f"q/c_u within {tol:.0%} of 2 + pi over the plateau (worst {worst[1]:.4f} at s/B = {worst[0] / B:.4f}, "
+         f"{worst[1] / prandtl - 1:+.2%})")
+print(f"Newton iterations per step: mean {sum(its) / len(its):.2f}, largest {max(its)}; increment order: median "
+      f"{sorted(o for o in order if o == o)[len(order) // 2] if any(o == o for o in order) else float('nan'):.2f}")
+tv.check(max(its) <= max_its, f"Newton converged in at most {max_its} iterations per step (largest {max(its)})")
+
+if rise:
+    means = []
+    for r in rise:
+        near = [v for s, v in zip(settle, q) if abs(s - r * B) <= 0.01 * B + 1e-12]
+        means.append(sum(near) / len(near))
+    print("large settlement: " + ", ".join(f"s/B = {r}: q/c_u {m:.4f}" for r, m in zip(rise, means)))
+    tv.check(means[0] > mean_w and all(b > a for a, b in zip(means, means[1:])),
+             f"q/c_u keeps rising at large settlement (plateau {mean_w:.4f}, then "
+             + ", ".join(f"{m:.4f}" for m in means) + ")")
+
+if u_settlement > 0:
+    n_u = round(u_settlement / du)
+    short = tv.prm_set(up, "time/end time", str(n_u))
+    if n_u != len(q):  # else the u-p run above ends there
+        run(short, "up_short")
+    su, qu, itsu, _, wall_u = run(tv.prm_set(short, "implicit/formulation", "irreducible"), "u")
+    z_u, z_up = zigzag("u"), zigzag("up_short" if n_u != len(q) else "up")
+    print(f"s = {u_settlement} m: zigzag index of the mean stress: u {z_u:.3e}, u-p {z_up:.3e} (ratio {z_u / z_up:.1f}); "
+          f"q/c_u u {qu[-1]:.4f}, u-p {q[n_u - 1]:.4f}; u run {wall_u:.1f} s, Newton its mean "
+          f"{sum(itsu) / len(itsu):.2f}, largest {max(itsu)}")
+    tv.check(z_up < zig_up, f"u-p: no pressure oscillation (zigzag {z_up:.3e} < {zig_up})")
+    tv.check(z_u > zig_u, f"u: the pressure oscillates (zigzag {z_u:.3e} > {zig_u})")
+
+if ranks > 0:
+    short = tv.prm_set(up, "time/end time", str(ranks))
+    _, q1, its1, _, _ = run(short, "ranks_1")
+    _, q2, its2, _, _ = run(short, "ranks_2", np=2)
+    d = max(abs(a - b) / abs(a) for a, b in zip(q1, q2))
+    print(f"1 vs 2 ranks, {ranks} steps: largest relative difference of q {d:.2e}; Newton its {its1} vs {its2}")
+    tv.check(len(q1) == len(q2) and d < 1e-8, f"1 vs 2 ranks: q per step within 1e-8 ({d:.2e})")
+tv.finish()
