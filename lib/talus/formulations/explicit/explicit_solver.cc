@@ -190,14 +190,13 @@ namespace talus::explicit_mpm
       }
     if (p.balance.enabled())
       {
-        // these features keep per-cell or per-node data that a repartition does not carry yet
-        const std::string why = " is not available with load balancing yet (allowed with it: the 1-phase and "
-                                "2-phase MPM steps with loads, damping, stages, free-surface output); set load balancing/"
-                                "interval = 0, or ";
+        // FEM / UL-FEM keep state on the grid between steps (the nodal displacement
+        // of the mesh and the fixed Gauss-point seeding) that a repartition does
+        // not carry (docs/scaling.md)
+        const std::string why = " is not available with load balancing (allowed with it: the 1-phase and "
+                                "2-phase MPM steps with loads, damping, stages, free-surface output, contact, "
+                                "strain smoothing, MPM-MIXED); set load balancing/interval = 0, or ";
         require(!p.numerics.fem(), "load balancing/interval", "numerics/integration = fem | ul-fem" + why + "integration = mpm");
-        require(!p.numerics.contact(), "load balancing/interval", "contact" + why + "no contact pairs");
-        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "load balancing/interval",
-                "strain smoothing" + why + "strain smoothing = none");
       }
     if (p.numerics.fem())
       {
@@ -465,6 +464,10 @@ namespace talus::explicit_mpm
       free_surface->grid_changed();
     if (two_phase)
       two_phase->grid_changed();
+    if (contact)
+      contact->grid_changed();
+    if (smoothing)
+      smoothing->grid_changed(grid);
     collect_active_cells();
     if (control)
       control->grid_changed(*this); // nodes of prescribed velocities and friction
@@ -630,7 +633,7 @@ namespace talus::explicit_mpm
         const materials::Material *   material;
       };
 
-      inline void
+      inline DEAL_II_ALWAYS_INLINE void
       increments(const typename K::Cell & cell,
                  const typename K::Eval & ev,
                  const typename K::Field &du,
@@ -685,7 +688,7 @@ namespace talus::explicit_mpm
       static constexpr bool              updates_whole_cells = true;
       std::vector<materials::RateUpdate> batch = {};
       template <class CellPoint>
-      inline void
+      inline DEAL_II_ALWAYS_INLINE void
       update_cell(const unsigned int c, const typename K::Cell &cell, const unsigned int n, CellPoint *points)
       {
         if (batch.size() < n)
@@ -730,7 +733,7 @@ namespace talus::explicit_mpm
           }
       }
 
-      inline void
+      inline DEAL_II_ALWAYS_INLINE void
       moved(const transfer::PointIterator<dim> &it,
             const double *                      P,
             const dealii::Point<dim> &          x,
