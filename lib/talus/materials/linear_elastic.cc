@@ -36,23 +36,6 @@ namespace talus::materials
     return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
   }
 
-  namespace
-  {
-    // the update of one point, inlined into both the per-point and the per-cell call
-    inline DEAL_II_ALWAYS_INLINE void
-    elastic_update(const double two_G, const double lame_lambda, const Strain &d_eps, const Spin &d_omega,
-                   Stress &sigma)
-    {
-      const double G      = 0.5 * two_G;
-      const double lambda = lame_lambda;
-      sigma               = apply_jaumann_rotation(sigma, d_omega);
-      const double tr     = trace(d_eps);
-      sigma += 2 * G * d_eps;
-      for (unsigned int i = 0; i < 3; ++i)
-        sigma[i][i] += lambda * tr;
-    }
-  } // namespace
-
   void
   LinearElastic::update_stress(const Strain &d_eps,
                                const Spin &  d_omega,
@@ -60,15 +43,19 @@ namespace talus::materials
                                Stress &sigma,
                                ArrayView<double>) const
   {
-    elastic_update(two_G, lame_lambda, d_eps, d_omega, sigma);
+    const double G      = 0.5 * two_G;
+    const double lambda = lame_lambda;
+    sigma               = apply_jaumann_rotation(sigma, d_omega);
+    const double tr     = trace(d_eps);
+    sigma += 2 * G * d_eps;
+    for (unsigned int i = 0; i < 3; ++i)
+      sigma[i][i] += lambda * tr;
   }
 
   void
   LinearElastic::update_stresses(RateUpdate *points, const unsigned int n, const double dt) const
   {
-    (void)dt;
-    for (unsigned int k = 0; k < n; ++k)
-      elastic_update(two_G, lame_lambda, points[k].d_eps, points[k].d_omega, points[k].sigma);
+    update_stresses_with(*this, points, n, dt);
   }
 
   double

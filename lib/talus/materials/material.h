@@ -35,7 +35,7 @@ namespace talus::materials
 
   /// Jaumann-rate rotation of the stress over one step by the exactly orthogonal
   /// Cayley (Hughes-Winget) rotation of the spin increment d_omega = skew(grad du).
-  inline DEAL_II_ALWAYS_INLINE Stress apply_jaumann_rotation(const Stress &sigma, const Spin &d_omega);
+  inline Stress apply_jaumann_rotation(const Stress &sigma, const Spin &d_omega);
 
   /// One point of a batched rate-form update (Material::update_stresses): the
   /// increments of the step and the stress and history, updated in place.
@@ -145,8 +145,7 @@ namespace talus::materials
                              ArrayView<double>(points[k].history, nh));
   }
 
-  // forced inline: gcc -O2 keeps it out of line otherwise (measured, docs/dealii-9.4-notes.md)
-  inline DEAL_II_ALWAYS_INLINE Stress
+  inline Stress
   apply_jaumann_rotation(const Stress &sigma, const Spin &w)
   {
     // Objective integration of the Jaumann rate over one step: sigma <- Q sigma Q^T

@@ -30,7 +30,7 @@ namespace talus::transfer
       for (unsigned int i = 0; i < distance && it != end; ++i)
         ++it;
     }
-    inline DEAL_II_ALWAYS_INLINE void
+    inline void
     next(const bool with_location)
     {
       if (it == end)

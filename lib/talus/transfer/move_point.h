@@ -11,7 +11,7 @@ namespace talus::transfer
   /// returned), false if it left (the set's relocation will place it; the walk
   /// must not touch it again).
   template <int dim>
-  inline DEAL_II_ALWAYS_INLINE bool
+  inline bool
   place_moved_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
                     typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
                     const dealii::Point<dim> &x, dealii::Point<dim> &xi)

@@ -633,7 +633,7 @@ namespace talus::explicit_mpm
         const materials::Material *   material;
       };
 
-      inline DEAL_II_ALWAYS_INLINE void
+      inline void
       increments(const typename K::Cell & cell,
                  const typename K::Eval & ev,
                  const typename K::Field &du,
@@ -688,7 +688,7 @@ namespace talus::explicit_mpm
       static constexpr bool              updates_whole_cells = true;
       std::vector<materials::RateUpdate> batch = {};
       template <class CellPoint>
-      inline DEAL_II_ALWAYS_INLINE void
+      inline void
       update_cell(const unsigned int c, const typename K::Cell &cell, const unsigned int n, CellPoint *points)
       {
         if (batch.size() < n)
@@ -733,7 +733,7 @@ namespace talus::explicit_mpm
           }
       }
 
-      inline DEAL_II_ALWAYS_INLINE void
+      inline void
       moved(const transfer::PointIterator<dim> &it,
             const double *                      P,
             const dealii::Point<dim> &          x,
