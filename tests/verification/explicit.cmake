@@ -136,3 +136,8 @@ set_tests_properties(verification.faults_tools PROPERTIES LABELS "fast" ENVIRONM
 # imbalance after rebalancing, bitwise restart across rebalances on 2 ranks)
 talus_verification(explicit_load_balance check_load_balance.py verification/load_balance_collapse.prm)
 set_tests_properties(verification.explicit_load_balance PROPERTIES PROCESSORS 2)
+
+# issue 15: load balancing with strain smoothing (cell, nodal) and contact (1 vs 2
+# ranks rebalancing at every check, bitwise restart across rebalances; FEM refused)
+talus_verification(explicit_load_balance_features check_load_balance_features.py verification/load_balance_collapse.prm)
+set_tests_properties(verification.explicit_load_balance_features PROPERTIES PROCESSORS 2)

@@ -52,6 +52,12 @@ namespace talus::materials
       sigma[i][i] += lambda * tr;
   }
 
+  void
+  LinearElastic::update_stresses(RateUpdate *points, const unsigned int n, const double dt) const
+  {
+    update_stresses_with(*this, points, n, dt);
+  }
+
   double
   LinearElastic::elastic_energy_density(const Stress &s) const
   {

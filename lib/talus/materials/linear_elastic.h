@@ -20,6 +20,7 @@ namespace talus::materials
                               const double      dt,
                               Stress &          sigma,
                               ArrayView<double> history) const override;
+    void        update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
     double      elastic_energy_density(const Stress &sigma) const override;
 
     double young_modulus() const { return E; }

@@ -21,45 +21,6 @@
 
 namespace talus::materials
 {
-  Stress
-  apply_jaumann_rotation(const Stress &sigma, const Spin &w)
-  {
-    // Objective integration of the Jaumann rate over one step: sigma <- Q sigma Q^T
-    // with the Cayley (Hughes-Winget) rotation Q = (I - W/2)^-1 (I + W/2). In closed
-    // form, with A = W/2 and a its axial vector: Q = I + 2/(1+|a|^2) (A + A^2).
-    // Q is exactly orthogonal, so stress invariants are preserved to round-off,
-    // and Q sigma Q^T = sigma + W sigma - sigma W + O(|W|^2).
-    // Written out with plain doubles: this runs once per material point and step.
-    const double a0 = 0.5 * w[2][1], a1 = 0.5 * w[0][2], a2 = 0.5 * w[1][0];
-    const double aa = a0 * a0 + a1 * a1 + a2 * a2;
-    if (aa == 0.0)
-      return sigma;
-    const double c = 2.0 / (1.0 + aa);
-    // A = [[0,-a2,a1],[a2,0,-a0],[-a1,a0,0]], A^2 = a a^T - |a|^2 I
-    double Q[3][3];
-    Q[0][0] = 1.0 + c * (a0 * a0 - aa);
-    Q[1][1] = 1.0 + c * (a1 * a1 - aa);
-    Q[2][2] = 1.0 + c * (a2 * a2 - aa);
-    Q[0][1] = c * (-a2 + a0 * a1);
-    Q[1][0] = c * (a2 + a0 * a1);
-    Q[0][2] = c * (a1 + a0 * a2);
-    Q[2][0] = c * (-a1 + a0 * a2);
-    Q[1][2] = c * (-a0 + a1 * a2);
-    Q[2][1] = c * (a0 + a1 * a2);
-    const double S[3][3] = {{sigma[0][0], sigma[0][1], sigma[0][2]},
-                            {sigma[0][1], sigma[1][1], sigma[1][2]},
-                            {sigma[0][2], sigma[1][2], sigma[2][2]}};
-    double       QS[3][3];
-    for (unsigned int i = 0; i < 3; ++i)
-      for (unsigned int j = 0; j < 3; ++j)
-        QS[i][j] = Q[i][0] * S[0][j] + Q[i][1] * S[1][j] + Q[i][2] * S[2][j];
-    Stress r;
-    for (unsigned int i = 0; i < 3; ++i)
-      for (unsigned int j = i; j < 3; ++j)
-        r[i][j] = QS[i][0] * Q[j][0] + QS[i][1] * Q[j][1] + QS[i][2] * Q[j][2];
-    return r;
-  }
-
   void
   Material::finite_strain_update(const dealii::Tensor<2, 3> &,
                                  ArrayView<const double>,

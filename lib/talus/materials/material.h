@@ -35,7 +35,17 @@ namespace talus::materials
 
   /// Jaumann-rate rotation of the stress over one step by the exactly orthogonal
   /// Cayley (Hughes-Winget) rotation of the spin increment d_omega = skew(grad du).
-  Stress apply_jaumann_rotation(const Stress &sigma, const Spin &d_omega);
+  inline Stress apply_jaumann_rotation(const Stress &sigma, const Spin &d_omega);
+
+  /// One point of a batched rate-form update (Material::update_stresses): the
+  /// increments of the step and the stress and history, updated in place.
+  struct RateUpdate
+  {
+    Strain  d_eps;
+    Spin    d_omega;
+    Stress  sigma;
+    double *history;
+  };
 
   class Material
   {
@@ -72,6 +82,18 @@ namespace talus::materials
                                const double      dt,
                                Stress &          sigma,
                                ArrayView<double> history) const = 0;
+
+    /// The same for n points of one cell (the explicit update pass calls it once
+    /// per cell and model instead of once per point). Default: update_stress()
+    /// per point; a model overrides it with update_stresses_with() below, which
+    /// calls its own update_stress() non-virtually (inlined in the model's file).
+    virtual void update_stresses(RateUpdate *points, const unsigned int n, const double dt) const
+    {
+      const unsigned int nh = n_history();
+      for (unsigned int k = 0; k < n; ++k)
+        update_stress(points[k].d_eps, points[k].d_omega, dt, points[k].sigma,
+                      ArrayView<double>(points[k].history, nh));
+    }
 
     /// ---- Finite-strain form (implicit updated-Lagrangian and semi-implicit
     /// drivers, seed 001 ch. 3, seed 002 §4.3). Models without it return false.
@@ -139,6 +161,59 @@ namespace talus::materials
 
     double rho = 0.0;
   };
+
+  /// Material::update_stresses of a model Model: its update_stress() called
+  /// qualified (no virtual dispatch), so it is inlined into the loop.
+  template <class Model>
+  inline void
+  update_stresses_with(const Model &m, RateUpdate *points, const unsigned int n, const double dt)
+  {
+    const unsigned int nh = m.n_history();
+    for (unsigned int k = 0; k < n; ++k)
+      m.Model::update_stress(points[k].d_eps, points[k].d_omega, dt, points[k].sigma,
+                             ArrayView<double>(points[k].history, nh));
+  }
+
+  inline Stress
+  apply_jaumann_rotation(const Stress &sigma, const Spin &w)
+  {
+    // Objective integration of the Jaumann rate over one step: sigma <- Q sigma Q^T
+    // with the Cayley (Hughes-Winget) rotation Q = (I - W/2)^-1 (I + W/2). In closed
+    // form, with A = W/2 and a its axial vector: Q = I + 2/(1+|a|^2) (A + A^2).
+    // Q is exactly orthogonal, so stress invariants are preserved to round-off,
+    // and Q sigma Q^T = sigma + W sigma - sigma W + O(|W|^2).
+    // Written out with plain doubles on the raw entries of sigma (deal.II order
+    // 00, 11, 22, 01, 02, 12), inline: it runs once per material point and step.
+    const double a0 = 0.5 * w[2][1], a1 = 0.5 * w[0][2], a2 = 0.5 * w[1][0];
+    const double aa = a0 * a0 + a1 * a1 + a2 * a2;
+    if (aa == 0.0)
+      return sigma;
+    const double c = 2.0 / (1.0 + aa);
+    // A = [[0,-a2,a1],[a2,0,-a0],[-a1,a0,0]], A^2 = a a^T - |a|^2 I
+    double Q[3][3];
+    Q[0][0] = 1.0 + c * (a0 * a0 - aa);
+    Q[1][1] = 1.0 + c * (a1 * a1 - aa);
+    Q[2][2] = 1.0 + c * (a2 * a2 - aa);
+    Q[0][1] = c * (-a2 + a0 * a1);
+    Q[1][0] = c * (a2 + a0 * a1);
+    Q[0][2] = c * (a1 + a0 * a2);
+    Q[2][0] = c * (-a1 + a0 * a2);
+    Q[1][2] = c * (-a0 + a1 * a2);
+    Q[2][1] = c * (a0 + a1 * a2);
+    const double s00 = sigma.access_raw_entry(0), s11 = sigma.access_raw_entry(1), s22 = sigma.access_raw_entry(2),
+                 s01 = sigma.access_raw_entry(3), s02 = sigma.access_raw_entry(4), s12 = sigma.access_raw_entry(5);
+    const double S[3][3] = {{s00, s01, s02}, {s01, s11, s12}, {s02, s12, s22}};
+    double       QS[3][3];
+    for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int j = 0; j < 3; ++j)
+        QS[i][j] = Q[i][0] * S[0][j] + Q[i][1] * S[1][j] + Q[i][2] * S[2][j];
+    Stress r;
+    constexpr unsigned int raw[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int j = i; j < 3; ++j)
+        r.access_raw_entry(raw[i][j]) = QS[i][0] * Q[j][0] + QS[i][1] * Q[j][1] + QS[i][2] * Q[j][2];
+    return r;
+  }
 
   /// Elastic strain energy density 1/2 s : C^-1 : s of isotropic linear
   /// elasticity with Young's modulus E and Poisson's ratio nu.

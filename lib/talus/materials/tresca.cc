@@ -114,4 +114,9 @@ namespace talus::materials
   {
     return isotropic_elastic_energy_density(E, nu, s);
   }
+  void
+  Tresca::update_stresses(RateUpdate *points, const unsigned int n, const double dt) const
+  {
+    update_stresses_with(*this, points, n, dt);
+  }
 } // namespace talus::materials

@@ -28,6 +28,7 @@ namespace talus::materials
                          const double      dt,
                          Stress &          sigma,
                          ArrayView<double> history) const override;
+    void update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
     double elastic_energy_density(const Stress &sigma) const override;
 
     enum : unsigned int

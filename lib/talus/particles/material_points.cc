@@ -54,38 +54,6 @@ namespace talus
     return r;
   }
 
-  template <int dim>
-  dealii::SymmetricTensor<2, 3>
-  PropertyLayout<dim>::get_stress(const double *p)
-  {
-    dealii::SymmetricTensor<2, 3> s;
-    s[0][0] = p[stress + 0];
-    s[1][1] = p[stress + 1];
-    s[2][2] = p[stress + 2];
-    s[0][1] = p[stress + 3];
-    if constexpr (dim == 3)
-      {
-        s[1][2] = p[stress + 4];
-        s[0][2] = p[stress + 5];
-      }
-    return s;
-  }
-
-  template <int dim>
-  void
-  PropertyLayout<dim>::set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p)
-  {
-    p[stress + 0] = s[0][0];
-    p[stress + 1] = s[1][1];
-    p[stress + 2] = s[2][2];
-    p[stress + 3] = s[0][1];
-    if constexpr (dim == 3)
-      {
-        p[stress + 4] = s[1][2];
-        p[stress + 5] = s[0][2];
-      }
-  }
-
   // ------------------------------------------------------------ bodies
   template <int dim>
   bool

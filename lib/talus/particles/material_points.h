@@ -74,6 +74,39 @@ namespace talus
     static void set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p);
   };
 
+  // inline: the update pass reads and writes the stress of every point and step
+  template <int dim>
+  inline dealii::SymmetricTensor<2, 3>
+  PropertyLayout<dim>::get_stress(const double *p)
+  {
+    dealii::SymmetricTensor<2, 3> s;
+    s[0][0] = p[stress + 0];
+    s[1][1] = p[stress + 1];
+    s[2][2] = p[stress + 2];
+    s[0][1] = p[stress + 3];
+    if constexpr (dim == 3)
+      {
+        s[1][2] = p[stress + 4];
+        s[0][2] = p[stress + 5];
+      }
+    return s;
+  }
+
+  template <int dim>
+  inline void
+  PropertyLayout<dim>::set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p)
+  {
+    p[stress + 0] = s[0][0];
+    p[stress + 1] = s[1][1];
+    p[stress + 2] = s[2][2];
+    p[stress + 3] = s[0][1];
+    if constexpr (dim == 3)
+      {
+        p[stress + 4] = s[1][2];
+        p[stress + 5] = s[0][2];
+      }
+  }
+
   /// t = -V sigma of the point with properties P (the in-plane part in 2D): the
   /// integrand of the internal force f_int,i = -sum_p t grad N_i(x_p).
   template <int dim>

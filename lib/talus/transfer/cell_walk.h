@@ -54,6 +54,22 @@ namespace talus::transfer
   template <int dim>
   using PointIterator = typename dealii::Particles::ParticleHandler<dim>::particle_iterator;
 
+  /// Whether an op walks the points of a cell itself: `whole_cell(c, n, pt,
+  /// ahead)` instead of begin_cell/point/end_cell (the explicit update pass,
+  /// which updates the stresses of a cell in one call per model).
+  template <class Op>
+  constexpr auto
+  walks_whole_cells(int) -> decltype(Op::whole_cells, bool())
+  {
+    return Op::whole_cells;
+  }
+  template <class Op>
+  constexpr bool
+  walks_whole_cells(long)
+  {
+    return false;
+  }
+
   /// The walk. `Op::prefetch_location` (a static constexpr bool) says whether
   /// the op reads the points' locations (then they are prefetched too).
   template <int dim, class Op>
@@ -64,10 +80,15 @@ namespace talus::transfer
     Prefetcher<dim> ahead(set.handler, prefetch_distance);
     for (const auto [c, n_in_cell] : set.active_cells())
       {
-        op.begin_cell(c);
-        for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(Op::prefetch_location))
-          op.point(c, pt);
-        op.end_cell(c);
+        if constexpr (walks_whole_cells<Op>(0))
+          op.whole_cell(c, n_in_cell, pt, ahead); // advances pt and ahead by n_in_cell
+        else
+          {
+            op.begin_cell(c);
+            for (unsigned int k = 0; k < n_in_cell; ++k, ++pt, ahead.next(Op::prefetch_location))
+              op.point(c, pt);
+            op.end_cell(c);
+          }
       }
   }
 
@@ -131,6 +152,14 @@ namespace talus::transfer
     First &                      first;
     Second &                     second;
     static constexpr bool        prefetch_location = First::prefetch_location || Second::prefetch_location;
+    /// a first op that walks whole cells runs second on the points that stayed
+    static constexpr bool        whole_cells       = walks_whole_cells<First>(0);
+    template <class It, class Ahead>
+    inline void
+    whole_cell(const unsigned int c, const unsigned int n, It &it, Ahead &ahead)
+    {
+      first.whole_cell(c, n, it, ahead, second);
+    }
     inline void
     begin_cell(const unsigned int c)
     {

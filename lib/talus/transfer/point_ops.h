@@ -236,6 +236,25 @@ namespace talus::transfer
     }
   };
 
+  /// An op that does nothing (a Fused second op when no P2G is fused).
+  struct NoOp
+  {
+    static constexpr bool prefetch_location = false;
+    inline void           begin_cell(unsigned int) {}
+    template <class It>
+    inline bool
+    point(unsigned int, It &)
+    {
+      return true;
+    }
+    template <class It, class Xi>
+    inline bool
+    point_at(unsigned int, It &, const Xi &)
+    {
+      return true;
+    }
+    inline void end_cell(unsigned int) {}
+  };
   /// The update of the points from the nodal velocity V over a step h: the
   /// displacement increment du = h V is interpolated (Eq. 4.51) and its
   /// gradient handed to the formulation's point physics (strain, stress,
@@ -310,6 +329,84 @@ namespace talus::transfer
     inline void
     end_cell(const unsigned int)
     {}
+
+    /// Physics with `static constexpr bool updates_whole_cells = true` and
+    /// update_cell(c, cell, n, points) (points[k].P, .gu, .state) update the
+    /// stresses of a whole cell at once: the walk then calls
+    /// whole_cell(), which does per point exactly what point() does, in three
+    /// loops: increments; the physics' update of all n points; move, moved()
+    /// and the fused second op (same arithmetic and the same order of every
+    /// sum as point() by point(): bitwise the same results).
+    template <class Ph>
+    static constexpr auto
+    has_update_cell(int) -> decltype(Ph::updates_whole_cells, bool())
+    {
+      return Ph::updates_whole_cells;
+    }
+    template <class Ph>
+    static constexpr bool
+    has_update_cell(long)
+    {
+      return false;
+    }
+    static constexpr bool whole_cells = has_update_cell<Physics>(0);
+
+    /// One point of whole_cell() between its loops.
+    struct CellPoint
+    {
+      double                       gu[dim][dim];
+      double                       dx[dim];
+      double *                     P;
+      typename Physics::PointState state;
+    };
+    std::vector<CellPoint>          scratch;
+    std::vector<PointIterator<dim>> iterators;
+
+    template <class Ahead, class Second>
+    inline void
+    whole_cell(const unsigned int c, const unsigned int n, PointIterator<dim> &it, Ahead &ahead, Second &second)
+    {
+      using L = PropertyLayout<dim>;
+      begin_cell(c);
+      second.begin_cell(c);
+      if (scratch.size() < n)
+        scratch.resize(n);
+      iterators.clear();
+      for (unsigned int k = 0; k < n; ++k, ++it, ahead.next(prefetch_location))
+        {
+          CellPoint &q = scratch[k];
+          q.P          = it->get_properties().data();
+          typename K::Eval e;
+          K::evaluate(cell, it->get_reference_location(), e);
+          physics.increments(cell, e, du, q.P, q.gu, q.dx);
+          iterators.push_back(it);
+        }
+      physics.update_cell(c, cell, n, scratch.data());
+      for (unsigned int k = 0; k < n; ++k)
+        {
+          CellPoint &q = scratch[k];
+          auto &     p = iterators[k];
+          auto       x = p->get_location();
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              x[d] += q.dx[d];
+              q.P[L::displacement + d] += q.dx[d];
+            }
+          physics.moved(p, q.P, x, q.state);
+          if (place_moved_point(set, grid, c, p, x, xi_new))
+            second.point_at(c, p, xi_new);
+        }
+      second.end_cell(c);
+      end_cell(c);
+    }
+    /// the same without a fused second op
+    template <class Ahead>
+    inline void
+    whole_cell(const unsigned int c, const unsigned int n, PointIterator<dim> &it, Ahead &ahead)
+    {
+      NoOp none;
+      whole_cell(c, n, it, ahead, none);
+    }
   };
 
   /// Default kinematics of UpdateAndMove: the gradient and the interpolated
@@ -380,17 +477,4 @@ namespace talus::transfer
     {}
   };
 
-  /// An op that does nothing (a Fused second op when no P2G is fused).
-  struct NoOp
-  {
-    static constexpr bool prefetch_location = false;
-    inline void           begin_cell(unsigned int) {}
-    template <class It>
-    inline bool
-    point(unsigned int, It &)
-    {
-      return true;
-    }
-    inline void end_cell(unsigned int) {}
-  };
 } // namespace talus::transfer

@@ -47,6 +47,21 @@ namespace talus::explicit_mpm
 
   template <int dim>
   void
+  Contact<dim>::grid_changed()
+  {
+    for (auto &f : fields)
+      {
+        grid.reinit_vector(f.mass);
+        grid.reinit_vector(f.force);
+        grid.reinit_vector(f.momentum);
+        grid.reinit_vector(f.gradient);
+      }
+    node_marker.clear();
+    nodes.clear();
+  }
+
+  template <int dim>
+  void
   Contact<dim>::collect_nodes(const Solver<dim> &s)
   {
     // owned nodes among the active DoFs (their component-0 DoF identifies them)

@@ -190,14 +190,13 @@ namespace talus::explicit_mpm
       }
     if (p.balance.enabled())
       {
-        // these features keep per-cell or per-node data that a repartition does not carry yet
-        const std::string why = " is not available with load balancing yet (allowed with it: the 1-phase and "
-                                "2-phase MPM steps with loads, damping, stages, free-surface output); set load balancing/"
-                                "interval = 0, or ";
+        // FEM / UL-FEM keep state on the grid between steps (the nodal displacement
+        // of the mesh and the fixed Gauss-point seeding) that a repartition does
+        // not carry (docs/scaling.md)
+        const std::string why = " is not available with load balancing (allowed with it: the 1-phase and "
+                                "2-phase MPM steps with loads, damping, stages, free-surface output, contact, "
+                                "strain smoothing, MPM-MIXED); set load balancing/interval = 0, or ";
         require(!p.numerics.fem(), "load balancing/interval", "numerics/integration = fem | ul-fem" + why + "integration = mpm");
-        require(!p.numerics.contact(), "load balancing/interval", "contact" + why + "no contact pairs");
-        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "load balancing/interval",
-                "strain smoothing" + why + "strain smoothing = none");
       }
     if (p.numerics.fem())
       {
@@ -465,6 +464,10 @@ namespace talus::explicit_mpm
       free_surface->grid_changed();
     if (two_phase)
       two_phase->grid_changed();
+    if (contact)
+      contact->grid_changed();
+    if (smoothing)
+      smoothing->grid_changed(grid);
     collect_active_cells();
     if (control)
       control->grid_changed(*this); // nodes of prescribed velocities and friction
@@ -679,6 +682,57 @@ namespace talus::explicit_mpm
           P[L::volume] = cell_volume;
       }
 
+      /// update() for the n points of cell c (UpdateAndMove::whole_cell): the
+      /// same arithmetic per point, with one update_stresses() call per run of
+      /// points of one model instead of a virtual call per point.
+      static constexpr bool              updates_whole_cells = true;
+      std::vector<materials::RateUpdate> batch = {};
+      template <class CellPoint>
+      inline void
+      update_cell(const unsigned int c, const typename K::Cell &cell, const unsigned int n, CellPoint *points)
+      {
+        if (batch.size() < n)
+          batch.resize(n);
+        for (unsigned int k = 0; k < n; ++k)
+          {
+            materials::RateUpdate &r = batch[k];
+            if constexpr (dim == 2) // the out-of-plane entries stay zero
+              {
+                r.d_eps   = materials::Strain();
+                r.d_omega = materials::Spin();
+              }
+            materials::strain_and_spin_increments<dim>(points[k].gu, r.d_eps, r.d_omega);
+            if (smoothing) // §6.7.1: smoothed volumetric part
+              smoothing->apply(c, r.d_eps);
+            r.sigma   = L::get_stress(points[k].P);
+            r.history = points[k].P + history;
+          }
+        for (unsigned int k0 = 0; k0 < n;)
+          {
+            const double material = points[k0].P[L::material];
+            unsigned int k1       = k0 + 1;
+            while (k1 < n && points[k1].P[L::material] == material)
+              ++k1;
+            materials[static_cast<unsigned int>(material)]->update_stresses(batch.data() + k0, k1 - k0, h);
+            for (unsigned int k = k0; k < k1; ++k)
+              points[k].state.material = materials[static_cast<unsigned int>(material)].get();
+            k0 = k1;
+          }
+        double cell_volume = 1.0; // see update()
+        for (unsigned int d = 0; d < dim; ++d)
+          cell_volume *= cell.cc->h[d];
+        for (unsigned int k = 0; k < n; ++k)
+          {
+            double *P = points[k].P;
+            L::set_stress(batch[k].sigma, P);
+            points[k].state.sigma = batch[k].sigma;
+            const double dvol     = trace(batch[k].d_eps);
+            P[L::volume] *= (1.0 + dvol); // Eq. 4.50
+            if (P[L::volume] > cell_volume)
+              P[L::volume] = cell_volume;
+          }
+      }
+
       inline void
       moved(const transfer::PointIterator<dim> &it,
             const double *                      P,
@@ -818,10 +872,10 @@ namespace talus::explicit_mpm
       });
     });
     p2g_ready = !sorted && !prm.numerics.extended_p2g();
-    // with B-splines a cell's stencil is 4^dim nodes: recompute the active DoFs
-    // only when the set of cells with points changed (Q1: every step, as the
-    // order of the list follows the cells and bitwise restarts rely on it)
-    if (!prm.numerics.bspline() || points.cell_set_changed())
+    // recompute the active DoFs only when the set of cells with points changed:
+    // otherwise the cell list holds the same cells in the same order (only
+    // counts changed), and the DoF list would come out identical, order included
+    if (points.cell_set_changed())
       collect_active_dofs();
   }
 

@@ -311,6 +311,15 @@ namespace talus::explicit_mpm
 
   template <int dim>
   void
+  StrainSmoothing<dim>::grid_changed(const BackgroundGrid<dim> &grid)
+  {
+    cell_value.assign(grid.cells.size(), 0.0);
+    if (kind == NumericsOptions::Smoothing::nodal)
+      grid.reinit_vector(nodal);
+  }
+
+  template <int dim>
+  void
   StrainSmoothing<dim>::compute(const Solver<dim> &s, const double dt)
   {
     using F                   = shape::Q1Factorised<dim>;

@@ -100,6 +100,10 @@ namespace talus::explicit_mpm
     StrainSmoothing(const BackgroundGrid<dim> &grid, NumericsOptions::Smoothing kind);
     /// From the nodal velocities of the solver (nodal_p after nodal_velocity()).
     void compute(const Solver<dim> &s, double dt);
+    /// After a repartition: the cell values and the nodal vector re-sized for
+    /// the new local mesh (both are recomputed every step from the nodal
+    /// velocities, so nothing has to travel).
+    void grid_changed(const BackgroundGrid<dim> &grid);
     /// Replace the volumetric part of d_eps (in-plane trace in 2D) by the cell value.
     inline void
     apply(const unsigned int cell, materials::Strain &d_eps) const
@@ -130,6 +134,10 @@ namespace talus::explicit_mpm
   public:
     Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies);
 
+    /// After a repartition: the per-body nodal fields re-sized for the new DoF
+    /// numbering (every step fills them from the points: P2G, contact law), the
+    /// node marker cleared; the contact node list is collected every step.
+    void grid_changed();
     /// Lagrangian phase: after nodal_acceleration(), the corrected per-body
     /// accelerations a~_b = (v~_b - v_b^t) / dt (Eq. 6.21).
     void correct_accelerations(Solver<dim> &s, double dt);
