@@ -231,6 +231,16 @@ foreach(_mode ranks restart)
   set_tests_properties(verification.implicit_load_balance_${_mode} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                        TIMEOUT 600 PROCESSORS 2)
 endforeach()
+# the same with contact walls on the points (a Coulomb floor): their state is in
+# the point properties and travels with the points through the repartitions
+foreach(_mode ranks restart)
+  add_test(NAME verification.implicit_load_balance_contact_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_load_balance_implicit_families.py ${TALUS_TOOLS_DIR}/talus-implicit
+                   ${TALUS_PRM_DIR}/verification/implicit_load_balance_contact.prm
+                   ${_w}/implicit_load_balance_contact_${_mode} ${_mode} 1e-8)
+  set_tests_properties(verification.implicit_load_balance_contact_${_mode} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 600 PROCESSORS 2)
+endforeach()
 
 # Rigid strip footing on undrained soil (seed 001 §6.2): mixed u-p with J2
 # (sigma_y = sqrt(3) c_u), displacement control, the footing's nodes following it;

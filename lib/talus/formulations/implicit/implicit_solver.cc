@@ -188,14 +188,19 @@ namespace talus::implicit_mpm
                     (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller") + "; give it one condition");
         p.contact_ids.push_back(static_cast<dealii::types::boundary_id>(id));
       }
-    require(p.contact_ids.empty() || !p.balance.enabled(), "load balancing/interval",
-            "load balancing is not available with contact walls (boundary conditions/contact: their active set "
-            "is not carried through a repartition); allowed: interval = 0, or no contact walls");
     {
       const std::string method = prm.get("contact method");
       require(method == "nodes" || method == "points", "boundary conditions/contact method",
               "'" + method + "' is not a contact method; allowed: nodes | points");
       p.contact_on_points = method == "points";
+      // walls on the points keep their state (stick anchors, flags) in the
+      // point properties, which travel with the points through a repartition;
+      // walls on the nodes keep an active set per grid node between steps,
+      // which a repartition does not carry
+      require(p.contact_ids.empty() || p.contact_on_points || !p.balance.enabled(), "load balancing/interval",
+              "load balancing is not available with contact walls on the nodes (boundary conditions/contact "
+              "method = nodes: their active set per node is not carried through a repartition); allowed: "
+              "interval = 0, or contact method = points");
       const std::string f = prm.get("contact friction");
       double            mu = -1;
       if (p.contact_on_points && f != "no slip" && f != "frictionless")
@@ -570,7 +575,7 @@ namespace talus::implicit_mpm
       stage_nodes(current_stage);
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state, &contact_gap})
       space.reinit_vector(*v);
-    contact_state = 1.0; // (load balancing is refused with contact walls)
+    contact_state = 1.0; // (load balancing is refused with contact walls on the nodes)
     contact_state.update_ghost_values();
     points.collect_active_cells();
   }
