@@ -13,7 +13,7 @@ wide grid: partitioned by cells, one rank holds nearly all points. Checks:
      bitwise identically (particles_final.csv byte for byte) through further
      rebalances;
   4. load balancing together with a feature whose grid data a repartition does
-     not carry yet (FEM integration) is refused with exit 2 naming the entry;
+     not carry yet (UL-FEM integration) is refused with exit 2 naming the entry;
   5. points crossing the rank boundary (translating_bar.prm on 2 ranks, no load
      balancing) are sent to their new owner point to point: no collective full
      sort in the whole run (the log's count), points did move to the other
@@ -81,8 +81,8 @@ tv.check(filecmp.cmp(f"{work}/uninterrupted.csv", f"{work}/out_restart/particles
          "the continuation is bitwise identical to the uninterrupted run (particles_final.csv)")
 
 # 4. refused combination
-rc, out, err = tv.run_tool(tool, tv.prm_set(base, "numerics/integration", "fem"), work, "refused", expect_rc=2)
-tv.check("load balancing/interval" in out + err, "load balancing with FEM integration is refused naming the entry")
+rc, out, err = tv.run_tool(tool, tv.prm_set(base, "numerics/integration", "ul-fem"), work, "refused", expect_rc=2)
+tv.check("load balancing/interval" in out + err, "load balancing with UL-FEM integration is refused naming the entry")
 
 # 5. points crossing ranks every few steps: no full sort
 import os

@@ -190,13 +190,16 @@ namespace talus::explicit_mpm
       }
     if (p.balance.enabled())
       {
-        // FEM / UL-FEM keep state on the grid between steps (the nodal displacement
-        // of the mesh and the fixed Gauss-point seeding) that a repartition does
-        // not carry (docs/scaling.md)
+        // UL-FEM keeps the displacement of its moving mesh on the grid between
+        // steps, which a repartition does not carry (docs/scaling.md); FEM's
+        // state is on its Gauss points (the mesh is fixed), which travel with
+        // their cells
         const std::string why = " is not available with load balancing (allowed with it: the 1-phase and "
                                 "2-phase MPM steps with loads, damping, stages, free-surface output, contact, "
-                                "strain smoothing, MPM-MIXED); set load balancing/interval = 0, or ";
-        require(!p.numerics.fem(), "load balancing/interval", "numerics/integration = fem | ul-fem" + why + "integration = mpm");
+                                "strain smoothing, MPM-MIXED, and integration = fem); set load balancing/interval "
+                                "= 0, or ";
+        require(p.numerics.integration != NumericsOptions::Integration::ul_fem, "load balancing/interval",
+                "numerics/integration = ul-fem" + why + "integration = mpm | fem");
       }
     if (p.numerics.fem())
       {
@@ -468,6 +471,8 @@ namespace talus::explicit_mpm
       contact->grid_changed();
     if (smoothing)
       smoothing->grid_changed(grid);
+    if (fem)
+      fem->grid_changed();
     collect_active_cells();
     if (control)
       control->grid_changed(*this); // nodes of prescribed velocities and friction

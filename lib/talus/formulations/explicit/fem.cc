@@ -16,6 +16,15 @@ namespace talus::explicit_mpm
     : s(solver)
     , ul(updated_lagrangian)
   {
+    collect_vertices();
+    if (ul)
+      s.grid.reinit_vector(nodal_u);
+  }
+
+  template <int dim>
+  void
+  FemIntegration<dim>::collect_vertices()
+  {
     const auto &grid = s.grid;
     vertices.assign(grid.cells.size() * nv * dim, 0.0);
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
@@ -23,8 +32,15 @@ namespace talus::explicit_mpm
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)
             vertices[(c * nv + v) * dim + d] = grid.cell_iterators[c]->vertex(v)[d];
-    if (ul)
-      grid.reinit_vector(nodal_u);
+  }
+
+  template <int dim>
+  void
+  FemIntegration<dim>::grid_changed()
+  {
+    Assert(!ul, dealii::ExcMessage("ul-fem keeps its mesh displacement on the grid: no repartition"));
+    collect_vertices();
+    moving_dofs.clear();
   }
 
   template <int dim>

@@ -52,6 +52,11 @@ namespace talus::explicit_mpm
     /// next step's mass and force (fused). Moves the nodes for ul-fem.
     void update(double dt);
 
+    /// After a repartition (load balancing, fem only: ul-fem is refused with
+    /// it): the vertex table of the new active cells. The state of fem is on
+    /// the Gauss points, which moved with their cells.
+    void grid_changed();
+
     bool updated_lagrangian() const { return ul; }
     /// ul-fem: accumulated nodal displacements (owned + ghost entries of the
     /// cells that hold points are kept current without communication).
@@ -68,6 +73,8 @@ namespace talus::explicit_mpm
     /// local DoF indices (owned + ghost) of the cells that hold points
     std::vector<unsigned int> moving_dofs;
     void collect_moving_dofs();
+    /// the reference vertex table from the triangulation
+    void collect_vertices();
     /// current vertex coordinates of cell c
     void current_vertices(unsigned int c, double (&X)[nv][dim]) const;
   };
