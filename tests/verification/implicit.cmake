@@ -98,7 +98,7 @@ add_test(NAME verification.implicit_checkpoint_restart_consistent_mass
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart_consistent_mass
                  "implicit/mass matrix=consistent")
-set_tests_properties(verification.implicit_checkpoint_restart_consistent_mass PROPERTIES LABELS "fast"
+set_tests_properties(verification.implicit_checkpoint_restart_consistent_mass PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 
 # tractions (loads/point_forces): oedometric block under a top traction, u_y and
