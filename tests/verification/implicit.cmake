@@ -243,6 +243,13 @@ add_test(NAME verification.implicit_rolling_disk
                  --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm)
 set_tests_properties(verification.implicit_rolling_disk PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600)
+# the same with implicit/mass matrix = consistent (docs/implicit.md "Lumped or consistent mass")
+add_test(NAME verification.implicit_rolling_disk_consistent
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk_consistent
+                 --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm --set "implicit/mass matrix=consistent")
+set_tests_properties(verification.implicit_rolling_disk_consistent PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
 # checkpoint/restart with the point contact floor (its stick anchors and contact flags live in the
 # points' properties): the column collapse a = 1.2 on a no-slip point contact floor, bitwise (fast)
 add_test(NAME verification.implicit_checkpoint_restart_point_contact
