@@ -183,4 +183,33 @@ namespace
               1e-6);
   }
   TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
+
+  // 'mass matrix = consistent': M_ij = sum_p m_p N_i N_j in the residual (M a,
+  // alpha_R M v) and in the tangent (coef M) on the free DoFs. With h = 0.01 s
+  // the inertia (1/(beta h^2) m_p ~ 6e5 N/m per point) is as large as the
+  // stiffness, so a wrong factor or a wrong block shows.
+  const std::string consistent = " set mass matrix = consistent\n";
+  const std::string consistent_damped = " set mass matrix = consistent\n set rayleigh alpha = 1.5\n";
+  TEST(ImplicitTangent, ConsistentMassDynamic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent), 1e-6);
+  }
+  TEST(ImplicitTangent, ConsistentMassRayleighAfterSteps2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 2, 9.81, consistent_damped), 1e-6);
+  }
+  TEST(ImplicitTangent, ConsistentMassDynamic3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent_damped), 1e-6);
+  }
+  TEST(ImplicitTangent, ConsistentMassAxisymmetricDynamic)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, axisymmetric + consistent_damped, 1.0,
+                               bottom_roller),
+              1e-8);
+  }
+  TEST(ImplicitTangent, ConsistentMassPointContact2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent, 1.0, point_floor), 1e-6);
+  }
 } // namespace

@@ -16,7 +16,8 @@ spacing of its upward zero crossings over 0.35 s (4 crossings).
 Checks per grid: the run reached the end, at most 3 Newton iterations per step,
 >= 3 crossings, the period within TOL of the trapezoidal period, and closer to
 it than to the exact one (the elongation, 1.8e-3, is resolved).
-Usage: check_implicit_axisymmetric_breathing.py TOOLS_DIR PRM WORKDIR TOL N1 [N2 ...]  (N: cells per metre)
+Usage: check_implicit_axisymmetric_breathing.py TOOLS_DIR PRM WORKDIR TOL N1 [N2 ...] [ENTRY=VALUE ...]
+(N: cells per metre; ENTRY=VALUE: further .prm settings, e.g. implicit/mass matrix=consistent)
 """
 import math
 import sys
@@ -25,7 +26,8 @@ import time
 import talus_verify as tv
 
 tools, prm_path, work, tol = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
-ns = [int(n) for n in sys.argv[5:]]
+ns = [int(n) for n in sys.argv[5:] if "=" not in n]
+settings = [kv.split("=", 1) for kv in sys.argv[5:] if "=" in kv]
 E, nu, rho, a, b, dt, t_end = 1e7, 0.3, 1000.0, 1.0, 2.0, 0.002, 0.35
 lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
 M = lam + 2 * mu
@@ -67,6 +69,8 @@ print(f"fundamental radial mode: k = {k_lo:.6f} 1/m, T = {T_exact:.6f} s; trapez
 base = open(prm_path).read()
 for entry, value in (("implicit/analysis", "dynamic"), ("time/time step", f"{dt}"), ("time/end time", f"{t_end}"),
                      ("output/directory", "out"), ("output/final particles csv", "false")):
+    base = tv.prm_set(base, entry, value)
+for entry, value in settings:
     base = tv.prm_set(base, entry, value)
 for n in ns:
     name = f"n{n}"

@@ -40,6 +40,8 @@ cases = {
     "gamma out of range": (tv.prm_set(base, "implicit/newmark gamma", "0.4"), ["newmark gamma", "0.4"]),
     "incompressible": (tv.prm_set(base, "material 0/neo hookean/poisson ratio", "0.5"), ["poisson ratio", "0.5"]),
     "feature not built yet": (tv.prm_set(base, "output/probes", "4, 0.5"), ["output/probes", "not available"]),
+    "mass matrix misspelt": (tv.prm_set(base, "implicit/mass matrix", "consistant"),
+                             ["mass matrix", "consistant", "lumped|consistent"]),
     "damping in a static run": (tv.prm_set(base, "implicit/rayleigh alpha", "1"), ["rayleigh alpha", "dynamic"]),
     "static without supports": (tv.prm_set(base, "boundary conditions/fixed", ""), ["boundary conditions", "static",
                                                                                    "singular"]),

@@ -36,6 +36,28 @@ add_test(NAME verification.implicit_bar_vibration
                  ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${_w}/implicit_bar_vibration)
 set_tests_properties(verification.implicit_bar_vibration PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 
+# implicit/mass matrix = lumped | consistent on the bar's first mode, coarse grids, small dt:
+# periods vs the FE dispersion relation of each mass (1e-3), lumped above / consistent below
+# 4L/c, order >= 1.8; 2D (3 grids) and 3D (2 grids)
+add_test(NAME verification.implicit_bar_mass
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bar_mass.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${_w}/implicit_bar_mass 2 4 8 16)
+set_tests_properties(verification.implicit_bar_mass PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+add_test(NAME verification.implicit_bar_mass_3d
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bar_mass.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${_w}/implicit_bar_mass_3d 3 4 8)
+set_tests_properties(verification.implicit_bar_mass_3d PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+# 1 vs 2 ranks with the consistent mass: the cantilever made dynamic (gravity from t = 0,
+# 20 steps of 0.01 s: it swings; the bar's 1D fields came out identical, too easy)
+add_test(NAME verification.implicit_ranks_cantilever_dynamic_consistent
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm
+                 ${_w}/implicit_ranks_cantilever_dynamic_consistent "implicit/analysis=dynamic"
+                 "implicit/mass matrix=consistent" "time/end time=0.2" "time/time step=0.01"
+                 "implicit/ramp loads=false")
+set_tests_properties(verification.implicit_ranks_cantilever_dynamic_consistent PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+
 # bad input, Newton failure, singular system: messages, exit codes, no NaN
 add_test(NAME verification.implicit_bad_input
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bad_input.py ${TALUS_TOOLS_DIR}
@@ -76,6 +98,12 @@ add_test(NAME verification.implicit_checkpoint_restart
                  ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart)
 set_tests_properties(verification.implicit_checkpoint_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+add_test(NAME verification.implicit_checkpoint_restart_consistent_mass
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart_consistent_mass
+                 "implicit/mass matrix=consistent")
+set_tests_properties(verification.implicit_checkpoint_restart_consistent_mass PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 
 # tractions (loads/point_forces): oedometric block under a top traction, u_y and
 # sigma_yy vs the small-strain answer, on 1 and 2 ranks
@@ -157,6 +185,12 @@ add_test(NAME verification.implicit_axisymmetric_breathing
                  1e-3 16 32)
 set_tests_properties(verification.implicit_axisymmetric_breathing PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 300)
+add_test(NAME verification.implicit_axisymmetric_breathing_consistent
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_axisymmetric_breathing.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/thick_cylinder_axisymmetric.prm
+                 ${_w}/implicit_axisymmetric_breathing_consistent 1e-3 16 32 "implicit/mass matrix=consistent")
+set_tests_properties(verification.implicit_axisymmetric_breathing_consistent PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 300)
 # prescribed grid-node displacements (loads/velocity k, AffineConstraints): homogeneous
 # small-strain compression to round-off on 1 and 2 ranks, and a large-strain compression
 add_test(NAME verification.implicit_prescribed_displacement
@@ -208,6 +242,13 @@ add_test(NAME verification.implicit_rolling_disk
                  ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk
                  --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm)
 set_tests_properties(verification.implicit_rolling_disk PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+# the same with implicit/mass matrix = consistent (docs/implicit.md "Lumped or consistent mass")
+add_test(NAME verification.implicit_rolling_disk_consistent
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk.prm ${_w}/implicit_rolling_disk_consistent
+                 --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm --set "implicit/mass matrix=consistent")
+set_tests_properties(verification.implicit_rolling_disk_consistent PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600)
 # checkpoint/restart with the point contact floor (its stick anchors and contact flags live in the
 # points' properties): the column collapse a = 1.2 on a no-slip point contact floor, bitwise (fast)

@@ -21,6 +21,47 @@
 
 namespace talus::implicit_mpm
 {
+  namespace
+  {
+    /// The consistent inertia of one point on the displacement components
+    /// (`with_matrix`, `with_vector` as the walk's integrand flags):
+    /// b_ic += m_p N_i sum_j N_j w_jc (w: the nodal a + alpha_R v, the walk's
+    /// field) and A_ic,jc += coef m_p N_i N_j. Summed over the points this is
+    /// M w and coef M with M_ij = sum_p m_p N_i N_j (its row sums are the lumped
+    /// masses); a pressure component (mixed u-p) carries no mass.
+    template <int dim, bool with_matrix, bool with_vector>
+    struct ConsistentInertia
+    {
+      double                coef = 0;
+      static constexpr bool matrix = with_matrix, vector = with_vector;
+      template <int d_, unsigned int nc, class PN>
+      inline void
+      add(const double *P, const PN &p, transfer::LocalSystem &ls) const
+      {
+        static_assert(nc >= dim && d_ == dim, "ConsistentInertia: the displacement components come first");
+        const double m = P[PropertyLayout<dim>::mass];
+        if constexpr (with_vector)
+          {
+            double w[dim] = {};
+            for (unsigned int j = 0; j < p.n; ++j)
+              for (unsigned int c = 0; c < dim; ++c)
+                w[c] += p.N[j] * ls.u[p.local[j] * nc + c];
+            for (unsigned int i = 0; i < p.n; ++i)
+              for (unsigned int c = 0; c < dim; ++c)
+                ls.b[p.local[i] * nc + c] += m * p.N[i] * w[c];
+          }
+        if constexpr (with_matrix)
+          for (unsigned int i = 0; i < p.n; ++i)
+            for (unsigned int j = 0; j < p.n; ++j)
+              {
+                const double v = coef * m * p.N[i] * p.N[j];
+                for (unsigned int c = 0; c < dim; ++c)
+                  ls.a(p.local[i] * nc + c, p.local[j] * nc + c) += v;
+              }
+      }
+    };
+  } // namespace
+
   using dealii::Patterns::Anything;
   using dealii::Patterns::Bool;
   using dealii::Patterns::Double;
@@ -87,9 +128,13 @@ namespace talus::implicit_mpm
       prm.declare_entry("rayleigh alpha", "0", Double(0),
                         "Mass-proportional Rayleigh damping C = alpha M [1/s] (dynamic only; the column "
                         "collapse of thesis §6.1 uses 1.5).");
-      prm.declare_entry("mass matrix", "lumped", Selection("lumped"),
-                        "Inertia with the lumped mass M_ii = sum_p m_p N_i(x_p) (Kratos MPM's choice; "
-                        "docs/implicit.md says why).");
+      prm.declare_entry("mass matrix", "lumped", Selection("lumped|consistent"),
+                        "dynamic: the mass matrix of the inertia M a and of the damping alpha M v. lumped: "
+                        "M_ii = sum_p m_p N_i(x_p) (the default: Kratos MPM's choice, positive for every node "
+                        "a point touches); consistent: M_ij = sum_p m_p N_i(x_p) N_j(x_p) per component (thesis "
+                        "Eq. 4.36; singular where a lone point is the only support of several nodes). The "
+                        "projection of v_p and a_p to the nodes is lumped in both (docs/implicit.md). No effect "
+                        "in a static analysis.");
       prm.declare_entry("ramp loads", "true", Bool(),
                         "static: body forces grow linearly from 0 at t = 0 to their full value at the end "
                         "time (load stepping); false: full loads from the first step.");
@@ -158,6 +203,7 @@ namespace talus::implicit_mpm
     p.gamma          = prm.get_double("newmark gamma");
     p.beta           = prm.get_double("newmark beta");
     p.rayleigh_alpha = prm.get_double("rayleigh alpha");
+    p.consistent_mass = prm.get("mass matrix") == "consistent";
     p.ramp_loads     = prm.get_bool("ramp loads");
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
@@ -555,7 +601,7 @@ namespace talus::implicit_mpm
               log() << "  axisymmetric: the x-min wall is the axis, u_r = 0 there ("
                     << (bc.kind == BoundaryCondition::Kind::roller ? "roller" : "fixed") << ")" << std::endl;
       }
-    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state, &contact_gap})
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap})
       space.reinit_vector(*v);
     // every contact node starts in contact (released in the first step where
     // the wall would pull on it); a restart starts so too
@@ -573,7 +619,7 @@ namespace talus::implicit_mpm
     space.setup();
     if (current_stage < prm.stages.size())
       stage_nodes(current_stage);
-    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &contact_state, &contact_gap})
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap})
       space.reinit_vector(*v);
     contact_state = 1.0; // (load balancing is refused with contact walls on the nodes)
     contact_state.update_ghost_values();
@@ -1034,7 +1080,9 @@ namespace talus::implicit_mpm
       throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
     if (point_contact) // the penalty walls on the points (point_contact.h)
       point_contact->assemble(points, active, constraints, du, with_tangent ? &tangent : nullptr, residual);
-    if (dynamic())
+    if (dynamic() && prm.consistent_mass)
+      add_consistent_inertia(with_tangent);
+    else if (dynamic())
       {
         // lumped inertia and mass-proportional damping at the nodes:
         // r_i += m_i (a_i + alpha v_i), tangent_ii += m_i (1/(beta h^2) + alpha gamma/(beta h))
@@ -1058,6 +1106,52 @@ namespace talus::implicit_mpm
     seconds_assembly += seconds_since(start);
     ++n_assemblies;
     return residual.l2_norm();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::add_consistent_inertia(const bool with_tangent)
+  {
+    // The inertia and damping with the consistent mass: r += M (a + alpha_R v),
+    // tangent += (1/(beta h^2) + alpha_R gamma/(beta h)) M. As with the lumped
+    // mass, only the free DoFs carry inertia: w = 0 at every DoF constrained in
+    // this assembly (walls, held contact nodes, prescribed and inactive nodes),
+    // so a constrained node neither feels nor exerts an inertial force.
+    const auto & owned = space.locally_owned_dofs();
+    const double alpha = prm.rayleigh_alpha;
+    for (unsigned int k = 0; k < inertia_field.locally_owned_size(); ++k)
+      {
+        const auto i = owned.nth_index_in_set(k);
+        if (mass.local_element(k) == 0 || constraints.is_constrained(i))
+          {
+            inertia_field.local_element(k) = 0.0;
+            continue;
+          }
+        const double u = du.local_element(k), v = v_n.local_element(k), a = a_n.local_element(k);
+        inertia_field.local_element(k) = newmark.acceleration(u, v, a) + alpha * newmark.velocity(u, v, a);
+      }
+    inertia_field.update_ghost_values();
+    const double coef = newmark.tangent_factors(alpha, 0).mass;
+    // The matrix and the vector go through the constraints in one call unless
+    // the constraints are inhomogeneous (the lifted predictor of prescribed
+    // nodes): there the combined call would move -coef M_ij g_j to the residual,
+    // an inertia of the prescribed nodes that the residual (w = 0 there) does not have.
+    with_components([&](auto nc) {
+      constexpr unsigned int n = decltype(nc)::value;
+      if (with_tangent && !constraints.has_inhomogeneities())
+        transfer::assemble<dim, shape::Q1Box<dim>, n>({&points}, active, constraints,
+                                                      ConsistentInertia<dim, true, true>{coef}, &tangent, &residual,
+                                                      &inertia_field);
+      else
+        {
+          if (with_tangent)
+            transfer::assemble<dim, shape::Q1Box<dim>, n>({&points}, active, constraints,
+                                                          ConsistentInertia<dim, true, false>{coef}, &tangent, nullptr);
+          transfer::assemble<dim, shape::Q1Box<dim>, n>({&points}, active, constraints,
+                                                        ConsistentInertia<dim, false, true>{coef}, nullptr, &residual,
+                                                        &inertia_field);
+        }
+    });
   }
 
   template <int dim>
@@ -1411,7 +1505,7 @@ namespace talus::implicit_mpm
   {
     out << "  grid: " << grid.tria.n_global_active_cells() << " cells; " << n_points() << " material points" << std::endl;
     out << "  analysis: " << (dynamic() ? "dynamic (Newmark gamma = " : "static (")
-        << (dynamic() ? std::to_string(prm.gamma) + ", beta = " + std::to_string(prm.beta) + ", lumped mass" +
+        << (dynamic() ? std::to_string(prm.gamma) + ", beta = " + std::to_string(prm.beta) + (prm.consistent_mass ? ", consistent mass" : ", lumped mass") +
                           (prm.rayleigh_alpha > 0 ? ", Rayleigh alpha = " + std::to_string(prm.rayleigh_alpha) : "")
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
         << "), time step " << dt << std::endl;
