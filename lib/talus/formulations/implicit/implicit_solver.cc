@@ -106,6 +106,10 @@ namespace talus::implicit_mpm
                         "displacement that condition has prescribed so far, so the prescribed nodes are chosen "
                         "anew each step at the current position of a rigid plate pressed into the material (they "
                         "jump a grid row when the shifted region does); false: the nodes are fixed in space.");
+      prm.declare_entry("negligible nodal mass", "0", Double(0, 1),
+                        "Displacement DoFs of an active node whose lumped mass is below this fraction of the "
+                        "largest nodal mass of the step are held at zero increment (nodes touched by the corner "
+                        "of a point's support only, e.g. at a heaving free surface); 0 = off.");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
                         "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
                         "body of revolution about the y axis (x = radius, grid lower x >= 0; seed 001 App. C): a "
@@ -163,6 +167,7 @@ namespace talus::implicit_mpm
     p.stabilisation  = prm.get_double("stabilisation factor");
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
+    p.negligible_mass         = prm.get_double("negligible nodal mass");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
@@ -669,6 +674,7 @@ namespace talus::implicit_mpm
     active.template reinit<shape::Q1Box<dim>>({&points});
     active.reinit_matrix(tangent);
     project_to_grid();
+    find_negligible_nodes();
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
     contact_changes.assign(contact_nodes.size(), 0);
@@ -743,9 +749,47 @@ namespace talus::implicit_mpm
             if (d == c.axis || prm.contact_no_slip)
               held.push_back(space.node_dof(c.node, d));
         }
+    held.insert(held.end(), negligible_dofs.begin(), negligible_dofs.end());
     return active.constraints_with(
       loads::wall_constraints(grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values,
                               &held));
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::find_negligible_nodes()
+  {
+    // A node touched only by the far corner of a point's support (a point
+    // heaving into an empty cell row) has a tiny mass and a stiffness from
+    // that one point only; with a perfectly plastic model it has none in the
+    // flow direction and Newton breaks down. Such DoFs are held at zero
+    // increment for the step (the reading notes' choice, §7: the thesis is
+    // silent); a prescribed or wall DoF keeps its own line.
+    negligible_dofs.clear();
+    if (!(prm.negligible_mass > 0))
+      return;
+    double m_max = 0;
+    for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
+      if (space.component(k) < dim)
+        m_max = std::max(m_max, mass.local_element(k));
+    m_max = dealii::Utilities::MPI::max(m_max, comm);
+    const double limit = prm.negligible_mass * m_max;
+    mass.update_ghost_values();
+    std::vector<unsigned char> seen(mass.locally_owned_size() + mass.get_partitioner()->n_ghost_indices(), 0);
+    for (const auto &cell : grid.tria.active_cell_iterators())
+      if (!cell->is_artificial())
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          for (unsigned int k = 0; k < dim; ++k)
+            {
+              const auto i = space.node_dof(grid.cells[cell->active_cell_index()].dofs[v * dim], k);
+              const auto j = mass.get_partitioner()->global_to_local(i);
+              if (seen[j] || !active.is_active(i))
+                continue;
+              seen[j] = 1;
+              if (mass(i) < limit)
+                negligible_dofs.push_back(i);
+            }
+    mass.zero_out_ghost_values();
   }
 
   template <int dim>
@@ -1118,7 +1162,10 @@ namespace talus::implicit_mpm
     du = 0;
     du.update_ghost_values();
     lifted_residual = 0;
-    if (!prescribed_dofs.empty())
+    // collective: the predictor assembles and solves on every rank, also on a
+    // rank none of whose nodes is prescribed (else the ranks part ways and the
+    // run hangs in the next collective)
+    if (dealii::Utilities::MPI::logical_or(!prescribed_dofs.empty(), comm))
       {
         try
           {

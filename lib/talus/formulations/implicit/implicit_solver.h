@@ -98,6 +98,10 @@ namespace talus::implicit_mpm
     /// (a rigid plate pressed into the material keeps acting on the nodes at its
     /// current position); false: the nodes are fixed in space
     bool moving_velocity_regions = false;
+    /// 'implicit/negligible nodal mass': displacement DoFs of an active node
+    /// whose lumped mass is below this fraction of the largest nodal mass are
+    /// held at zero increment for the step (0: off)
+    double negligible_mass = 0;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -243,6 +247,8 @@ namespace talus::implicit_mpm
     /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
     /// (Eqs. 2.6-2.9) onto the active DoFs.
     void project_to_grid();
+    /// negligible_dofs from the step's lumped masses (prm.negligible_mass)
+    void find_negligible_nodes();
     /// Residual (and tangent) at the iterate du (ghosts up to date); returns |r|.
     double assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g);
     /// Mixed u-p: the nodal pressure predictor of Eq. 5.20 into the pressure
@@ -274,6 +280,8 @@ namespace talus::implicit_mpm
     /// per condition of the stage: the displacement it has prescribed so far
     /// (the shift of its region with 'velocity regions follow')
     std::vector<dealii::Tensor<1, dim>> region_shift;
+    /// displacement DoFs (relevant) of nodes of negligible mass, held this step
+    std::vector<dealii::types::global_dof_index> negligible_dofs;
     /// some stage has 'velocity k' conditions (series columns prescribed_force_*)
     bool any_velocity_condition() const
     {
