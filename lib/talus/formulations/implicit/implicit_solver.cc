@@ -140,6 +140,9 @@ namespace talus::implicit_mpm
       prm.declare_entry("method", "direct", Selection("direct|cg amg"),
                         "direct: Amesos KLU; cg amg: conjugate gradients with ML algebraic multigrid "
                         "(symmetric tangents only: elastic models).");
+      prm.declare_entry("direct package", "klu", Selection("klu|mumps"),
+                        "direct: the Amesos package, KLU or MUMPS (MUMPS is much faster on the indefinite mixed "
+                        "u-p tangent, whose pivoting fills KLU's factors).");
       prm.declare_entry("relative tolerance", "1e-10", Double(0, 1), "cg amg: |b - A x| <= tol |b|.");
       prm.declare_entry("max iterations", "1000", Integer(1), "cg amg: iteration limit.");
     }
@@ -315,6 +318,7 @@ namespace talus::implicit_mpm
     prm.enter_subsection("linear solver");
     p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
                                                     : LinearSolverOptions::Method::cg_amg;
+    p.linear.direct_package     = prm.get("direct package") == "mumps" ? "Amesos_Mumps" : "Amesos_Klu";
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
     prm.leave_subsection();
@@ -1483,7 +1487,7 @@ namespace talus::implicit_mpm
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
         << " iterations; linear solver "
-        << (prm.linear.method == LinearSolverOptions::Method::direct ? "direct (KLU)" : "CG + ML AMG") << std::endl;
+        << (prm.linear.method == LinearSolverOptions::Method::direct ? "direct (" + prm.linear.direct_package + ")" : std::string("CG + ML AMG")) << std::endl;
   }
 
   template <int dim>
