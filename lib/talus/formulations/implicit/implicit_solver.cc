@@ -107,8 +107,8 @@ namespace talus::implicit_mpm
                         "anew each step at the current position of a rigid plate pressed into the material (they "
                         "jump a grid row when the shifted region does); false: the nodes are fixed in space.");
       prm.declare_entry("negligible nodal mass", "0", Double(0, 1),
-                        "Displacement DoFs of an active node whose lumped mass is below this fraction of the "
-                        "largest nodal mass of the step are held at zero increment (nodes touched by the corner "
+                        "The DoFs (displacement and, in mixed u-p, pressure) of an active node whose lumped mass is "
+                        "below this fraction of the largest nodal mass of the step are held at zero increment (nodes touched by the corner "
                         "of a point's support only, e.g. at a heaving free surface); 0 = off.");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
                         "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
@@ -766,7 +766,7 @@ namespace talus::implicit_mpm
     // A node touched only by the far corner of a point's support (a point
     // heaving into an empty cell row) has a tiny mass and a stiffness from
     // that one point only; with a perfectly plastic model it has none in the
-    // flow direction and Newton breaks down. Such DoFs are held at zero
+    // flow direction and Newton breaks down. Such nodes' DoFs are held at zero
     // increment for the step (the reading notes' choice, §7: the thesis is
     // silent); a prescribed or wall DoF keeps its own line.
     negligible_dofs.clear();
@@ -778,21 +778,28 @@ namespace talus::implicit_mpm
         m_max = std::max(m_max, mass.local_element(k));
     m_max = dealii::Utilities::MPI::max(m_max, comm);
     const double limit = prm.negligible_mass * m_max;
+    // every component of such a node is held, in u-p its pressure too: the
+    // pressure row scales with the node's tiny point volume (V N / K and the
+    // stabilisation) and left free it kept the system near-singular (h = 0.1 m
+    // footing: increments of 1e5 .. 1e7 in converged steps, breakdown at
+    // s = 0.084 m; held: docs/implicit.md, "Rigid strip footing")
+    const unsigned int n_held = space.n_components();
     mass.update_ghost_values();
     std::vector<unsigned char> seen(mass.locally_owned_size() + mass.get_partitioner()->n_ghost_indices(), 0);
     for (const auto &cell : grid.tria.active_cell_iterators())
       if (!cell->is_artificial())
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-          for (unsigned int k = 0; k < dim; ++k)
-            {
-              const auto i = space.node_dof(grid.cells[cell->active_cell_index()].dofs[v * dim], k);
-              const auto j = mass.get_partitioner()->global_to_local(i);
-              if (seen[j] || !active.is_active(i))
-                continue;
-              seen[j] = 1;
-              if (mass(i) < limit)
-                negligible_dofs.push_back(i);
-            }
+          {
+            const unsigned int node = grid.cells[cell->active_cell_index()].dofs[v * dim];
+            const auto         i0   = space.node_dof(node, 0);
+            const auto         j    = mass.get_partitioner()->global_to_local(i0);
+            if (seen[j] || !active.is_active(i0))
+              continue;
+            seen[j] = 1;
+            if (mass(i0) < limit)
+              for (unsigned int k = 0; k < n_held; ++k)
+                negligible_dofs.push_back(space.node_dof(node, k));
+          }
     mass.zero_out_ghost_values();
   }
 

@@ -98,9 +98,9 @@ namespace talus::implicit_mpm
     /// (a rigid plate pressed into the material keeps acting on the nodes at its
     /// current position); false: the nodes are fixed in space
     bool moving_velocity_regions = false;
-    /// 'implicit/negligible nodal mass': displacement DoFs of an active node
-    /// whose lumped mass is below this fraction of the largest nodal mass are
-    /// held at zero increment for the step (0: off)
+    /// 'implicit/negligible nodal mass': the DoFs (displacement and, in u-p,
+    /// pressure) of an active node whose lumped mass is below this fraction of
+    /// the largest nodal mass are held at zero increment for the step (0: off)
     double negligible_mass = 0;
     NewtonSettings newton;
     LinearSolverOptions linear;
@@ -280,7 +280,7 @@ namespace talus::implicit_mpm
     /// per condition of the stage: the displacement it has prescribed so far
     /// (the shift of its region with 'velocity regions follow')
     std::vector<dealii::Tensor<1, dim>> region_shift;
-    /// displacement DoFs (relevant) of nodes of negligible mass, held this step
+    /// DoFs (relevant, every component) of nodes of negligible mass, held this step
     std::vector<dealii::types::global_dof_index> negligible_dofs;
     /// some stage has 'velocity k' conditions (series columns prescribed_force_*)
     bool any_velocity_condition() const
