@@ -50,6 +50,10 @@ cases = {
     "mixed up with a pressure-dependent yield": (
         tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "material 0/model", "hencky mohr coulomb"),
         ["material 0/model", "mixed up", "hencky mohr coulomb", "j2 plasticity", "pressure"]),
+    "negligible nodal mass out of range": (tv.prm_set(base, "implicit/negligible nodal mass", "2"),
+                                           ["negligible nodal mass", "2"]),
+    "unknown direct package": (tv.prm_set(base, "linear solver/direct package", "superlu"),
+                               ["direct package", "superlu"]),
     "moving velocity regions with restart": (
         tv.prm_set(tv.prm_set(base, "implicit/velocity regions follow", "true"), "checkpoint/restart", "if available"),
         ["implicit/velocity regions follow", "restart"]),

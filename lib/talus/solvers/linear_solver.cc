@@ -63,9 +63,9 @@ namespace talus
     const double    b_norm = b.l2_norm();
     if (options.method == LinearSolverOptions::Method::direct)
       {
-        info.method = "direct (Amesos_Klu)";
+        info.method = "direct (" + options.direct_package + ")";
         dealii::SolverControl                           control(1, 0);
-        dealii::TrilinosWrappers::SolverDirect::AdditionalData data(false, "Amesos_Klu");
+        dealii::TrilinosWrappers::SolverDirect::AdditionalData data(false, options.direct_package);
         dealii::TrilinosWrappers::SolverDirect          solver(control, data);
         solver.initialize(A);
         solver.solve(x, b);

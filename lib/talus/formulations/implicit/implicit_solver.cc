@@ -151,6 +151,10 @@ namespace talus::implicit_mpm
                         "displacement that condition has prescribed so far, so the prescribed nodes are chosen "
                         "anew each step at the current position of a rigid plate pressed into the material (they "
                         "jump a grid row when the shifted region does); false: the nodes are fixed in space.");
+      prm.declare_entry("negligible nodal mass", "0", Double(0, 1),
+                        "The DoFs (displacement and, in mixed u-p, pressure) of an active node whose lumped mass is "
+                        "below this fraction of the largest nodal mass of the step are held at zero increment (nodes touched by the corner "
+                        "of a point's support only, e.g. at a heaving free surface); 0 = off.");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
                         "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
                         "body of revolution about the y axis (x = radius, grid lower x >= 0; seed 001 App. C): a "
@@ -181,6 +185,9 @@ namespace talus::implicit_mpm
       prm.declare_entry("method", "direct", Selection("direct|cg amg"),
                         "direct: Amesos KLU; cg amg: conjugate gradients with ML algebraic multigrid "
                         "(symmetric tangents only: elastic models).");
+      prm.declare_entry("direct package", "klu", Selection("klu|mumps"),
+                        "direct: the Amesos package, KLU or MUMPS (MUMPS is much faster on the indefinite mixed "
+                        "u-p tangent, whose pivoting fills KLU's factors).");
       prm.declare_entry("relative tolerance", "1e-10", Double(0, 1), "cg amg: |b - A x| <= tol |b|.");
       prm.declare_entry("max iterations", "1000", Integer(1), "cg amg: iteration limit.");
     }
@@ -209,6 +216,7 @@ namespace talus::implicit_mpm
     p.stabilisation  = prm.get_double("stabilisation factor");
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
+    p.negligible_mass         = prm.get_double("negligible nodal mass");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
@@ -361,6 +369,7 @@ namespace talus::implicit_mpm
     prm.enter_subsection("linear solver");
     p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
                                                     : LinearSolverOptions::Method::cg_amg;
+    p.linear.direct_package     = prm.get("direct package") == "mumps" ? "Amesos_Mumps" : "Amesos_Klu";
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
     prm.leave_subsection();
@@ -720,6 +729,7 @@ namespace talus::implicit_mpm
     active.template reinit<shape::Q1Box<dim>>({&points});
     active.reinit_matrix(tangent);
     project_to_grid();
+    find_negligible_nodes();
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
     contact_changes.assign(contact_nodes.size(), 0);
@@ -794,9 +804,54 @@ namespace talus::implicit_mpm
             if (d == c.axis || prm.contact_no_slip)
               held.push_back(space.node_dof(c.node, d));
         }
+    held.insert(held.end(), negligible_dofs.begin(), negligible_dofs.end());
     return active.constraints_with(
       loads::wall_constraints(grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values,
                               &held));
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::find_negligible_nodes()
+  {
+    // A node touched only by the far corner of a point's support (a point
+    // heaving into an empty cell row) has a tiny mass and a stiffness from
+    // that one point only; with a perfectly plastic model it has none in the
+    // flow direction and Newton breaks down. Such nodes' DoFs are held at zero
+    // increment for the step (the reading notes' choice, §7: the thesis is
+    // silent); a prescribed or wall DoF keeps its own line.
+    negligible_dofs.clear();
+    if (!(prm.negligible_mass > 0))
+      return;
+    double m_max = 0;
+    for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
+      if (space.component(k) < dim)
+        m_max = std::max(m_max, mass.local_element(k));
+    m_max = dealii::Utilities::MPI::max(m_max, comm);
+    const double limit = prm.negligible_mass * m_max;
+    // every component of such a node is held, in u-p its pressure too: the
+    // pressure row scales with the node's tiny point volume (V N / K and the
+    // stabilisation) and left free it kept the system near-singular (h = 0.1 m
+    // footing: increments of 1e5 .. 1e7 in converged steps, breakdown at
+    // s = 0.084 m; held: docs/implicit.md, "Rigid strip footing")
+    const unsigned int n_held = space.n_components();
+    mass.update_ghost_values();
+    std::vector<unsigned char> seen(mass.locally_owned_size() + mass.get_partitioner()->n_ghost_indices(), 0);
+    for (const auto &cell : grid.tria.active_cell_iterators())
+      if (!cell->is_artificial())
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          {
+            const unsigned int node = grid.cells[cell->active_cell_index()].dofs[v * dim];
+            const auto         i0   = space.node_dof(node, 0);
+            const auto         j    = mass.get_partitioner()->global_to_local(i0);
+            if (seen[j] || !active.is_active(i0))
+              continue;
+            seen[j] = 1;
+            if (mass(i0) < limit)
+              for (unsigned int k = 0; k < n_held; ++k)
+                negligible_dofs.push_back(space.node_dof(node, k));
+          }
+    mass.zero_out_ghost_values();
   }
 
   template <int dim>
@@ -1217,7 +1272,10 @@ namespace talus::implicit_mpm
     du = 0;
     du.update_ghost_values();
     lifted_residual = 0;
-    if (!prescribed_dofs.empty())
+    // collective: the predictor assembles and solves on every rank, also on a
+    // rank none of whose nodes is prescribed (else the ranks part ways and the
+    // run hangs in the next collective)
+    if (dealii::Utilities::MPI::logical_or(!prescribed_dofs.empty(), comm))
       {
         try
           {
@@ -1535,7 +1593,7 @@ namespace talus::implicit_mpm
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
         << " iterations; linear solver "
-        << (prm.linear.method == LinearSolverOptions::Method::direct ? "direct (KLU)" : "CG + ML AMG") << std::endl;
+        << (prm.linear.method == LinearSolverOptions::Method::direct ? "direct (" + prm.linear.direct_package + ")" : std::string("CG + ML AMG")) << std::endl;
   }
 
   template <int dim>

@@ -102,6 +102,10 @@ namespace talus::implicit_mpm
     /// (a rigid plate pressed into the material keeps acting on the nodes at its
     /// current position); false: the nodes are fixed in space
     bool moving_velocity_regions = false;
+    /// 'implicit/negligible nodal mass': the DoFs (displacement and, in u-p,
+    /// pressure) of an active node whose lumped mass is below this fraction of
+    /// the largest nodal mass are held at zero increment for the step (0: off)
+    double negligible_mass = 0;
     NewtonSettings newton;
     LinearSolverOptions linear;
   };
@@ -250,6 +254,8 @@ namespace talus::implicit_mpm
     /// 'mass matrix = consistent': r += M (a + alpha_R v) and tangent += coef M at
     /// the iterate du, with M_ij = sum_p m_p N_i N_j on the free DoFs.
     void add_consistent_inertia(const bool with_tangent);
+    /// negligible_dofs from the step's lumped masses (prm.negligible_mass)
+    void find_negligible_nodes();
     /// Residual (and tangent) at the iterate du (ghosts up to date); returns |r|.
     double assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g);
     /// Mixed u-p: the nodal pressure predictor of Eq. 5.20 into the pressure
@@ -281,6 +287,8 @@ namespace talus::implicit_mpm
     /// per condition of the stage: the displacement it has prescribed so far
     /// (the shift of its region with 'velocity regions follow')
     std::vector<dealii::Tensor<1, dim>> region_shift;
+    /// DoFs (relevant, every component) of nodes of negligible mass, held this step
+    std::vector<dealii::types::global_dof_index> negligible_dofs;
     /// some stage has 'velocity k' conditions (series columns prescribed_force_*)
     bool any_velocity_condition() const
     {
