@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace talus::transfer
 {
@@ -62,7 +64,6 @@ namespace talus::transfer
     Vector *                                    b;
     const Epetra_CrsMatrix *                    E = nullptr;
     bool                                        usable = false, wrote = false;
-    unsigned long long                          dropped = 0;
     /// per partitioner-local index: 0 free, 1 fixed to 0, 2 fixed to value[l]
     std::vector<unsigned char> state;
     std::vector<double>        value;
@@ -133,6 +134,15 @@ namespace talus::transfer
       return (s >> 32) == stamp ? static_cast<long>(s & 0xffffffffULL) : -1;
     }
 
+    /// deal.II's SparseMatrix::add throws (ExcTrilinosError, Epetra's ierr 2)
+    /// for a non-zero entry outside the pattern; so does this
+    [[noreturn]] static void
+    outside_pattern(const dealii::types::global_dof_index row, const dealii::types::global_dof_index col)
+    {
+      throw std::runtime_error("transfer::FixedValueDistributor: a non-zero matrix entry (" + std::to_string(row) +
+                               ", " + std::to_string(col) + ") outside the sparsity pattern");
+    }
+
     void
     distribute(const unsigned int                                  m,
                const double *                                      Al,
@@ -159,7 +169,7 @@ namespace talus::transfer
       const auto        to_int  = [](const dealii::types::global_dof_index g) { return static_cast<int>(g); };
 
       // Epetra column index of every local DoF (-1: not in the column map, in
-      // no pattern row here: its entries are dropped, as Epetra drops them)
+      // no pattern row here)
       column.resize(m);
       for (unsigned int i = 0; i < m; ++i)
         column[i] = col_map.LID(to_int(dofs[i]));
@@ -182,7 +192,7 @@ namespace talus::transfer
                   if (q >= 0)
                     row_values[q] += a;
                   else
-                    ++dropped;
+                    outside_pattern(dofs[r], dofs[c]);
                 }
               wrote = true;
             }
@@ -259,7 +269,7 @@ namespace talus::transfer
                   if (q >= 0)
                     row_values[q] += d;
                   else
-                    ++dropped;
+                    outside_pattern(dofs[i], dofs[i]);
                   wrote = true;
                 }
               else
@@ -297,11 +307,6 @@ namespace talus::transfer
                                     const std::vector<dealii::types::global_dof_index> &dofs)
   {
     impl->distribute(m, A_local, b_local, stride, dofs);
-  }
-  unsigned long long
-  FixedValueDistributor::n_dropped() const
-  {
-    return impl->dropped;
   }
 
   template <int dim>

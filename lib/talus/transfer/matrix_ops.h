@@ -263,9 +263,8 @@ namespace talus::transfer
   /// added straight into Epetra's row storage (a merge along the sorted row
   /// instead of a global-to-local look-up and a binary search per entry) and
   /// the constraint state is read from an array instead of the IndexSet.
-  /// Rows of other ranks go through SparseMatrix::add as before. An entry
-  /// outside A's pattern is dropped, as Epetra does (SumIntoGlobalValues: ierr 2,
-  /// which deal.II ignores in Release), and counted (n_dropped()).
+  /// Rows of other ranks go through SparseMatrix::add as before. A non-zero
+  /// entry outside A's pattern throws, as deal.II's add does.
   class FixedValueDistributor
   {
   public:
@@ -284,7 +283,6 @@ namespace talus::transfer
                     const double *                                      b_local,
                     unsigned int                                        stride,
                     const std::vector<dealii::types::global_dof_index> &dofs);
-    unsigned long long n_dropped() const;
 
   private:
     struct Impl;
@@ -361,8 +359,6 @@ namespace talus::transfer
     double diag_sum = 0, diag_count = 0;
     /// the fast distribution (constraints that only fix values), or null
     std::unique_ptr<FixedValueDistributor> fast;
-    /// entries outside A's pattern dropped so far (counted on the fast path only)
-    unsigned long long n_dropped() const { return fast ? fast->n_dropped() : 0; }
 
     inline void
     begin_cell(const unsigned int c)

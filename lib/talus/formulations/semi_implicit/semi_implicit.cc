@@ -631,8 +631,6 @@ namespace talus::semi_implicit
     /// steps of this run (not of a checkpoint's past: a restart rebuilds once
     /// more) that built a new pressure DoF set, sparsity and matrix
     unsigned long long                     n_pattern_changes = 0;
-    /// Poisson matrix entries outside the pattern (dropped; all ranks, summed at the end)
-    unsigned long long n_pattern_drops = 0;
     Vector                                 rhs, dp_solution;
 
     // per grid local DoF: the node's component-0 DoF, component, prescribed zero
@@ -1298,7 +1296,6 @@ namespace talus::semi_implicit
       transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> aw(active, constraints, water_terms, &A, &rhs);
       transfer::for_each_active_cell(water, aw);
       transfer::finish_assembly(active, as.diag_sum + aw.diag_sum, as.diag_count + aw.diag_count, &A, &rhs);
-      n_pattern_drops += as.n_dropped() + aw.n_dropped();
     }
     add_lap(phase.poisson);
     {
@@ -1811,9 +1808,6 @@ namespace talus::semi_implicit
           << phase.stress << ", relocation " << phase.relocation << "; points soil "
           << soil.handler.n_global_particles() << " water " << water.handler.n_global_particles()
           << "; shape functions: one stencil walk over both sets " << walk << " s" << std::endl;
-    const auto drops = dealii::Utilities::MPI::sum(n_pattern_drops, comm);
-    if (drops > 0)
-      log() << "  pressure matrix: " << drops << " entries outside the sparsity pattern dropped" << std::endl;
   }
 
   // ================================================================ tool entry points
