@@ -27,6 +27,7 @@
 #include <tuple>
 #include <type_traits>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -252,6 +253,42 @@ namespace talus::transfer
                         dealii::TrilinosWrappers::SparseMatrix *        A,
                         Vector *                                        b);
 
+  /// distribute_local for constraints that only fix values (u_i = g_i: every
+  /// line without entries, e.g. ActiveSet::constraints_with(Dirichlet)) into a
+  /// filled Trilinos matrix: the same sums as deal.II's
+  /// AffineConstraints::distribute_local_to_global (the same values added to
+  /// the same entries, the inhomogeneity terms of b subtracted in the same
+  /// order, the same diagonal for constrained rows), so the assembled system
+  /// is bitwise the one of distribute_local; but the locally owned rows are
+  /// added straight into Epetra's row storage (a merge along the sorted row
+  /// instead of a global-to-local look-up and a binary search per entry) and
+  /// the constraint state is read from an array instead of the IndexSet.
+  /// Rows of other ranks go through SparseMatrix::add as before. A non-zero
+  /// entry outside A's pattern throws, as deal.II's add does.
+  class FixedValueDistributor
+  {
+  public:
+    FixedValueDistributor(const dealii::AffineConstraints<double> &           constraints,
+                          const dealii::Utilities::MPI::Partitioner &         partitioner,
+                          dealii::TrilinosWrappers::SparseMatrix *            A,
+                          Vector *                                            b);
+    ~FixedValueDistributor();
+    /// Whether the fast path applies: A given, filled, with sorted local
+    /// indices; every constraint line without entries and on a DoF of the
+    /// partitioner; b null or on the partitioner. Otherwise use distribute_local.
+    bool usable() const;
+    /// As distribute_local (A_local given; b_local may be null when b is).
+    void distribute(unsigned int                                        m,
+                    const double *                                      A_local,
+                    const double *                                      b_local,
+                    unsigned int                                        stride,
+                    const std::vector<dealii::types::global_dof_index> &dofs);
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl;
+  };
+
   /// After a walk: compress A and b; give every locally owned inactive row the
   /// diagonal `mean |diagonal|` of all local matrices (diag_sum / diag_count
   /// over all ranks), so that the system stays regular and well scaled.
@@ -294,6 +331,13 @@ namespace talus::transfer
       if (space.n_components() != nc)
         throw std::logic_error("transfer::AssembleSystem: nc differs from the space's number of components");
       std::fill(std::begin(local_of_slot), std::end(local_of_slot), dealii::numbers::invalid_unsigned_int);
+      if (Integrand::matrix && A != nullptr)
+        {
+          fast = std::make_unique<FixedValueDistributor>(constraints, *space.partitioner(), A,
+                                                         Integrand::vector ? b : nullptr);
+          if (!fast->usable())
+            fast.reset();
+        }
     }
     const BackgroundGrid<dim> &              grid;
     const NodalSpace<dim> &                  space;
@@ -313,6 +357,8 @@ namespace talus::transfer
     std::vector<dealii::types::global_dof_index> dofs;
     /// sum of |diagonal| and count of the local matrices (the scale of inactive rows)
     double diag_sum = 0, diag_count = 0;
+    /// the fast distribution (constraints that only fix values), or null
+    std::unique_ptr<FixedValueDistributor> fast;
 
     inline void
     begin_cell(const unsigned int c)
@@ -383,7 +429,10 @@ namespace talus::transfer
         for (unsigned int i = 0; i < m; ++i)
           diag_sum += std::abs(Al[i * max_rows + i]);
       diag_count += m;
-      distribute_local(constraints,
+      if (fast)
+        fast->distribute(m, Al.data(), Integrand::vector ? bl.data() : nullptr, max_rows, dofs);
+      else
+        distribute_local(constraints,
                        m,
                        Integrand::matrix ? Al.data() : nullptr,
                        Integrand::vector ? bl.data() : nullptr,

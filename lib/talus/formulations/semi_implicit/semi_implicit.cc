@@ -511,15 +511,25 @@ namespace talus::semi_implicit
         static_assert(nc == 1, "PoissonWithFlux: a scalar space");
         const double V = P[PropertyLayout<dim>::volume];
         const double a = P[coefficient] * V;
+        // symmetric: each product once, added at (i, j) and (j, i) (the same
+        // value either way: bitwise the full loop)
         for (unsigned int i = 0; i < p.n; ++i)
           {
             double fg = 0;
-            for (unsigned int j = 0; j < p.n; ++j)
+            {
+              double gg = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                gg += p.G[i][d] * p.G[i][d];
+              ls.a(p.local[i], p.local[i]) += a * gg;
+            }
+            for (unsigned int j = i + 1; j < p.n; ++j)
               {
                 double gg = 0;
                 for (unsigned int d = 0; d < dim; ++d)
                   gg += p.G[i][d] * p.G[j][d];
-                ls.a(p.local[i], p.local[j]) += a * gg;
+                const double v = a * gg;
+                ls.a(p.local[i], p.local[j]) += v;
+                ls.a(p.local[j], p.local[i]) += v;
               }
             for (unsigned int d = 0; d < dim; ++d)
               fg += P[flux + d] * p.G[i][d];
