@@ -262,6 +262,66 @@ namespace
     EXPECT_EQ(sum(wrong), 0u);
   }
 
+  // ------------------------------------------------------------------ kept pattern
+  /// couplings_covered: one point per cell sits on the cell centre, where a
+  /// B-spline window touches 2 nodes per direction (the outer ones carry value
+  /// and gradient 0). Moving a point to 0.3 of its cell (same cell, same cell
+  /// set) brings in the node below: the kept pattern no longer holds its
+  /// couplings. Q1 touches all 2^dim vertices wherever the point is.
+  template <int dim, class K>
+  void
+  kept_pattern_detects_window_shift()
+  {
+    const unsigned int n_cells = 4;
+    Scene<dim> s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
+                 {{filled<dim>(0.25), filled<dim>(0.75), 1000, 1}}, is_bspline<K>);
+    NodalSpace<dim> space(s.grid, 1);
+    space.setup();
+    ActiveSet<dim> active(space);
+    EXPECT_FALSE(active.template couplings_covered<K>(s.set_pointers())) << "never built";
+    active.template reinit<K>(s.set_pointers());
+    const auto all_covered = [&]() {
+      return dealii::Utilities::MPI::min(unsigned(active.template couplings_covered<K>(s.set_pointers())),
+                                         MPI_COMM_WORLD) == 1;
+    };
+    EXPECT_TRUE(all_covered());
+
+    // move the first point of rank 0 (if it holds one) within its cell
+    auto &set = *s.sets[0];
+    const bool moves = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0 && set.handler.n_locally_owned_particles() > 0;
+    if (moves)
+      {
+        auto               it  = set.handler.begin();
+        dealii::Point<dim> ref = it->get_reference_location();
+        ref[0]                 = 0.3;
+        it->set_reference_location(ref);
+        dealii::Point<dim> x = it->get_surrounding_cell()->center();
+        x[0] += (ref[0] - 0.5) / n_cells;
+        it->set_location(x);
+      }
+    const unsigned int n_moved = dealii::Utilities::MPI::sum(unsigned(moves), MPI_COMM_WORLD);
+    ASSERT_EQ(n_moved, 1u);
+    EXPECT_EQ(all_covered(), !is_bspline<K>) << "a shifted B-spline window must leave the kept pattern";
+    active.template reinit<K>(s.set_pointers());
+    EXPECT_TRUE(all_covered()) << "after a rebuild the pattern holds the points' couplings again";
+    // a point of a second set in a cell the pattern was not built for
+    Scene<dim> other(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
+                     {{filled<dim>(0), filled<dim>(0.25), 1000, 1}}, is_bspline<K>);
+    NodalSpace<dim> other_space(other.grid, 1);
+    other_space.setup();
+    ActiveSet<dim> other_active(other_space);
+    other_active.template reinit<K>(other.set_pointers());
+    EXPECT_EQ(dealii::Utilities::MPI::min(unsigned(other_active.template couplings_covered<K>(s.set_pointers())),
+                                          MPI_COMM_WORLD),
+              0u)
+      << "points in cells without a kept pattern";
+  }
+
+  TEST(ActiveSet, KeptPatternWindowShiftQ1_2D) { kept_pattern_detects_window_shift<2, Q1_2>(); }
+  TEST(ActiveSet, KeptPatternWindowShiftQ1_3D) { kept_pattern_detects_window_shift<3, Q1_3>(); }
+  TEST(ActiveSet, KeptPatternWindowShiftBSpline2D) { kept_pattern_detects_window_shift<2, BS_2>(); }
+  TEST(ActiveSet, KeptPatternWindowShiftBSpline3D) { kept_pattern_detects_window_shift<3, BS_3>(); }
+
   TEST(ActiveSet, SparsityActiveRegionOnlyQ1_2D) { sparsity_active_region_only<2, Q1_2>(); }
   TEST(ActiveSet, SparsityActiveRegionOnlyQ1_3D) { sparsity_active_region_only<3, Q1_3>(); }
   TEST(ActiveSet, SparsityActiveRegionOnlyBSpline2D) { sparsity_active_region_only<2, BS_2>(); }

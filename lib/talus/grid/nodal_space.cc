@@ -16,6 +16,137 @@
 
 namespace talus
 {
+  namespace
+  {
+    /// The bits of a node's recorded neighbours: 2 words per node, one bit per
+    /// lattice offset of a neighbour within one point stencil.
+    constexpr unsigned int offset_words = 2;
+
+    /// For kernel K: the bit naming the lattice offset from stencil slot a to
+    /// slot b. A cell's stencil slots are a lattice of B^dim nodes (B = 2: the
+    /// Q1 vertices; B = 4: the B-spline patch, slot = p_0 + 4 p_1 + 16 p_2);
+    /// one point's slots lie within W per direction (W = 2 or 3), so an
+    /// offset per direction is in [-(W - 1), W - 1]: (2W - 1)^dim <= 125 bits.
+    template <int dim, class K>
+    struct PairOffsets
+    {
+      static constexpr unsigned int root(const unsigned int n)
+      {
+        unsigned int r = 1;
+        while (dim == 1 ? r < n : dim == 2 ? r * r < n : r * r * r < n)
+          ++r;
+        return r;
+      }
+      static constexpr unsigned int B = root(K::n_nodes), W = root(K::n_point_nodes), span = 2 * W - 1;
+      static_assert(dim == 1 ? span <= 128 : dim == 2 ? span * span <= 128 : span * span * span <= 128,
+                    "ActiveSet: a stencil's offsets must fit 128 bits");
+      static constexpr unsigned char far = 255; // never within one point's stencil
+      unsigned char bit[K::n_nodes][K::n_nodes];
+
+      PairOffsets()
+      {
+        for (unsigned int a = 0; a < K::n_nodes; ++a)
+          for (unsigned int b = 0; b < K::n_nodes; ++b)
+            {
+              unsigned int index = 0, scale = 1, pa = a, pb = b;
+              bool         near  = true;
+              for (unsigned int d = 0; d < dim; ++d, scale *= span, pa /= B, pb /= B)
+                {
+                  const int o = int(pb % B) - int(pa % B);
+                  near        = near && o >= -int(W - 1) && o <= int(W - 1);
+                  index += unsigned(o + int(W - 1)) * scale;
+                }
+              bit[a][b] = near ? static_cast<unsigned char>(index) : far;
+            }
+      }
+      static const PairOffsets &
+      table()
+      {
+        static const PairOffsets t;
+        return t;
+      }
+      inline void
+      set(std::uint64_t *bits, const unsigned int a, const unsigned int b) const
+      {
+        const unsigned int i = bit[a][b];
+        if (i != far)
+          bits[i / 64] |= std::uint64_t(1) << (i % 64);
+      }
+      inline bool
+      is_set(const std::uint64_t *bits, const unsigned int a, const unsigned int b) const
+      {
+        const unsigned int i = bit[a][b];
+        return i != far && (bits[i / 64] >> (i % 64) & 1) != 0;
+      }
+    };
+
+    /// OR `words` 64-bit words per local index (owned + ghost of `part`) over
+    /// the ranks that hold the index: the owner ORs in its ghosts' words, then
+    /// every ghost gets the owner's result. Collective.
+    void
+    or_over_ranks(const dealii::Utilities::MPI::Partitioner &part, const MPI_Comm comm, const unsigned int words,
+                  std::vector<std::uint64_t> &data)
+    {
+      if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
+        return;
+      const unsigned int    n_owned = part.locally_owned_size();
+      std::vector<unsigned> imports;
+      imports.reserve(part.n_import_indices());
+      for (const auto &[first, end] : part.import_indices())
+        for (unsigned int i = first; i < end; ++i)
+          imports.push_back(i);
+      const int                  tag = 4711;
+      std::vector<std::uint64_t> buffer(imports.size() * words);
+      std::vector<MPI_Request>   requests;
+      const auto                 wait = [&]() {
+        MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+        requests.clear();
+      };
+      // ghosts -> owners
+      unsigned int offset = 0;
+      for (const auto &[rank, count] : part.import_targets())
+        {
+          requests.emplace_back();
+          MPI_Irecv(buffer.data() + std::size_t(offset) * words, int(count * words), MPI_UINT64_T, int(rank), tag, comm,
+                    &requests.back());
+          offset += count;
+        }
+      offset = n_owned;
+      for (const auto &[rank, count] : part.ghost_targets())
+        {
+          requests.emplace_back();
+          MPI_Isend(data.data() + std::size_t(offset) * words, int(count * words), MPI_UINT64_T, int(rank), tag, comm,
+                    &requests.back());
+          offset += count;
+        }
+      wait();
+      for (std::size_t k = 0; k < imports.size(); ++k)
+        for (unsigned int w = 0; w < words; ++w)
+          data[std::size_t(imports[k]) * words + w] |= buffer[k * words + w];
+      // owners -> ghosts
+      for (std::size_t k = 0; k < imports.size(); ++k)
+        for (unsigned int w = 0; w < words; ++w)
+          buffer[k * words + w] = data[std::size_t(imports[k]) * words + w];
+      offset = n_owned;
+      for (const auto &[rank, count] : part.ghost_targets())
+        {
+          requests.emplace_back();
+          MPI_Irecv(data.data() + std::size_t(offset) * words, int(count * words), MPI_UINT64_T, int(rank), tag + 1,
+                    comm, &requests.back());
+          offset += count;
+        }
+      offset = 0;
+      for (const auto &[rank, count] : part.import_targets())
+        {
+          requests.emplace_back();
+          MPI_Isend(buffer.data() + std::size_t(offset) * words, int(count * words), MPI_UINT64_T, int(rank), tag + 1,
+                    comm, &requests.back());
+          offset += count;
+        }
+      wait();
+    }
+  } // namespace
+
   template <int dim>
   NodalSpace<dim>::NodalSpace(const BackgroundGrid<dim> &grid_, const unsigned int n_components)
     : grid(grid_)
@@ -116,9 +247,23 @@ namespace talus
     space.reinit_vector(touched_dofs);
     std::vector<unsigned char> cell_active(grid.cells.size(), 0);
     std::vector<dealii::types::global_dof_index> cols;
+    const PairOffsets<dim, K> &offsets = PairOffsets<dim, K>::table();
+    kernel_nodes                       = K::n_nodes;
+    cell_recorded.assign(grid.cells.size(), 0);
+    const unsigned int n_grid_nodes = grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices();
+    node_neighbours.assign(std::size_t(n_grid_nodes) * offset_words, 0);
 
     auto sink = [&](const unsigned int c, const typename K::Cell &cell, const auto &touched, const auto &pairs) {
       cell_active[c] = 1;
+      cell_recorded[c] = 1;
+      for (unsigned int a = 0; a < K::n_nodes; ++a)
+        if (touched[a])
+          {
+            std::uint64_t *bits = node_neighbours.data() + std::size_t(cell.dofs[a * dim]) * offset_words;
+            for (unsigned int b = 0; b < K::n_nodes; ++b)
+              if (pairs[a * K::n_nodes + b])
+                offsets.set(bits, a, b);
+          }
       for (unsigned int a = 0; a < K::n_nodes; ++a)
         {
           if (!touched[a])
@@ -143,6 +288,9 @@ namespace talus
         transfer::CollectCouplings<dim, K, decltype(sink)> op(grid, sink);
         transfer::for_each_active_cell(*set, op);
       }
+    // every rank that holds a node knows all of its couplings: the check of a
+    // later step is then exact on any number of ranks
+    or_over_ranks(*grid.partitioner, grid.comm, offset_words, node_neighbours);
 
     // a DoF is active if a point of any rank touches it
     touched_dofs.compress(dealii::VectorOperation::add);
@@ -187,6 +335,81 @@ namespace talus
     pattern->reinit(owned, owned, dsp, grid.comm);
   }
 
+  namespace
+  {
+    /// The walk of ActiveSet::couplings_covered: per point, every pair of the
+    /// stencil slots it touches (as CollectCouplings) must be recorded at the
+    /// first node of the pair.
+    template <int dim, class K>
+    struct CheckCouplings
+    {
+      CheckCouplings(const BackgroundGrid<dim> &       grid,
+                     const std::vector<unsigned char> &cell_recorded,
+                     const std::vector<std::uint64_t> &node_neighbours,
+                     const PairOffsets<dim, K> &       offsets)
+        : grid(grid)
+        , cell_recorded(cell_recorded)
+        , node_neighbours(node_neighbours)
+        , offsets(offsets)
+      {}
+      const BackgroundGrid<dim> &       grid;
+      const std::vector<unsigned char> &cell_recorded;
+      const std::vector<std::uint64_t> &node_neighbours;
+      const PairOffsets<dim, K> &       offsets;
+      static constexpr bool             prefetch_location = false;
+      typename K::Cell                  cell;
+      bool                              recorded = false, covered = true;
+
+      inline void
+      begin_cell(const unsigned int c)
+      {
+        recorded = cell_recorded[c] != 0;
+        covered  = covered && recorded;
+        if (recorded)
+          cell = K::cell(grid, c);
+      }
+      inline bool
+      point(const unsigned int, transfer::PointIterator<dim> &it)
+      {
+        if (!recorded || !covered)
+          return true;
+        unsigned int slot[K::n_point_nodes], t[K::n_point_nodes], n = 0;
+        double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+        K::point_stencil(cell, it->get_reference_location(), slot, N, G);
+        for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+          if (transfer::touches<dim>(N[w], G[w]))
+            t[n++] = slot[w];
+        for (unsigned int a = 0; a < n; ++a)
+          {
+            const std::uint64_t *bits = node_neighbours.data() + std::size_t(cell.dofs[t[a] * dim]) * offset_words;
+            for (unsigned int b = 0; b < n; ++b)
+              covered = covered && offsets.is_set(bits, t[a], t[b]);
+          }
+        return true;
+      }
+      inline void
+      end_cell(const unsigned int)
+      {}
+    };
+  } // namespace
+
+  template <int dim>
+  template <class K>
+  bool
+  ActiveSet<dim>::couplings_covered(const std::vector<MaterialPointSet<dim> *> &sets) const
+  {
+    if (kernel_nodes != K::n_nodes || cell_recorded.size() != space.grid.cells.size())
+      return false; // never built with this kernel, or the grid changed since
+    CheckCouplings<dim, K> op(space.grid, cell_recorded, node_neighbours, PairOffsets<dim, K>::table());
+    for (auto *set : sets)
+      {
+        transfer::for_each_active_cell(*set, op);
+        if (!op.covered)
+          return false;
+      }
+    return true;
+  }
+
   template <int dim>
   dealii::AffineConstraints<double>
   ActiveSet<dim>::constraints_with(const dealii::AffineConstraints<double> &dirichlet) const
@@ -222,4 +445,8 @@ namespace talus
   template void ActiveSet<3>::reinit<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &);
   template void ActiveSet<2>::reinit<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &);
   template void ActiveSet<3>::reinit<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &);
+  template bool ActiveSet<2>::couplings_covered<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
+  template bool ActiveSet<3>::couplings_covered<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
+  template bool ActiveSet<2>::couplings_covered<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
+  template bool ActiveSet<3>::couplings_covered<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
 } // namespace talus

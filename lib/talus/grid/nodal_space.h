@@ -13,6 +13,11 @@
 // pinned to zero. The Trilinos sparsity couples the DoFs of nodes that share a
 // point's stencil (all components with all components), plus the diagonal of
 // every row; so an inactive row holds its diagonal only.
+//
+// A family that keeps the pattern over several steps (the semi-implicit
+// pressure) asks `couplings_covered` whether the points still couple only node
+// pairs the pattern holds: a point can shift its B-spline window inside its
+// cell (a half-cell line) without changing the set of cells.
 #pragma once
 
 #include <talus/grid/background_grid.h>
@@ -20,6 +25,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/lac/affine_constraints.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -101,6 +107,18 @@ namespace talus
     template <class K>
     void reinit(const std::vector<MaterialPointSet<dim> *> &sets);
 
+    /// Whether every point of `sets` on this rank couples only node pairs that
+    /// the points (of any rank) coupled at the last reinit<K>, so that the kept
+    /// sparsity and active DoFs still hold its couplings, and lies in a cell
+    /// that held points then. reinit ORs each node's couplings over the ranks
+    /// that hold the node, so the answer does not depend on the partition.
+    /// Pairs are named by lattice offset: the grid must be a uniform box for
+    /// the B-spline (as setup_bspline_patches requires); for Q1 every point
+    /// touches its whole cell. One pass over the points, stencils only; not
+    /// collective (combine the answers over ranks).
+    template <class K>
+    bool couplings_covered(const std::vector<MaterialPointSet<dim> *> &sets) const;
+
     /// Locally owned cells holding points of any set (active_cell_index, ascending).
     const std::vector<unsigned int> &cells() const { return active_cells; }
     /// Active DoFs among the owned and among the relevant ones.
@@ -135,5 +153,12 @@ namespace talus
     size_type                                 n_active_global = 0;
     dealii::AffineConstraints<double>         inactive;
     std::unique_ptr<dealii::TrilinosWrappers::SparsityPattern> pattern;
+    /// What reinit recorded for couplings_covered: per cell whether points
+    /// held it; per node (grid local index) the neighbours the points of any
+    /// rank coupled it to, as bits over the lattice offsets (within one stencil)
+    /// from it, kernel_nodes the kernel's stencil size.
+    std::vector<unsigned char>  cell_recorded;
+    std::vector<std::uint64_t>  node_neighbours;
+    unsigned int                kernel_nodes = 0;
   };
 } // namespace talus

@@ -143,6 +143,17 @@ namespace talus::transfer
                                ", " + std::to_string(col) + ") outside the sparsity pattern");
     }
 
+    /// open row += v at local column lc (global row, col: for the error)
+    inline void
+    add_in_open_row(const int lc, const double v, const dealii::types::global_dof_index row,
+                    const dealii::types::global_dof_index col)
+    {
+      const long q = position(lc);
+      if (q < 0)
+        outside_pattern(row, col);
+      row_values[q] += v;
+    }
+
     void
     distribute(const unsigned int                                  m,
                const double *                                      Al,
@@ -188,11 +199,7 @@ namespace talus::transfer
                   const double a = row[c];
                   if (a == 0.0)
                     continue;
-                  const long q = position(column[c]);
-                  if (q >= 0)
-                    row_values[q] += a;
-                  else
-                    outside_pattern(dofs[r], dofs[c]);
+                  add_in_open_row(column[c], a, dofs[r], dofs[c]);
                 }
               wrote = true;
             }
@@ -265,11 +272,7 @@ namespace talus::transfer
               if (lr >= 0)
                 {
                   open_row(lr);
-                  const long q = position(column[i]);
-                  if (q >= 0)
-                    row_values[q] += d;
-                  else
-                    outside_pattern(dofs[i], dofs[i]);
+                  add_in_open_row(column[i], d, dofs[i], dofs[i]);
                   wrote = true;
                 }
               else

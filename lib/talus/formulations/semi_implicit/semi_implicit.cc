@@ -631,6 +631,8 @@ namespace talus::semi_implicit
     /// steps of this run (not of a checkpoint's past: a restart rebuilds once
     /// more) that built a new pressure DoF set, sparsity and matrix
     unsigned long long                     n_pattern_changes = 0;
+    /// of which: the cells were the same, but a point's stencil left the kept pattern
+    unsigned long long                     n_pattern_window_changes = 0;
     Vector                                 rhs, dp_solution;
 
     // per grid local DoF: the node's component-0 DoF, component, prescribed zero
@@ -1206,14 +1208,19 @@ namespace talus::semi_implicit
     // the pressure DoF set: rebuilt (with the sparsity, the matrix and the AMG
     // hierarchy) only when a point set's cells changed on some rank. The
     // decision is global: ActiveSet::reinit and the AMG set-up are collective.
-    const bool new_pattern = dealii::Utilities::MPI::max(
-                               unsigned(soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 ||
-                                        partition_changed || A.m() == 0),
-                               comm) != 0;
+    // A point can also shift its B-spline window inside its cell (a half-cell
+    // line) onto a pair the kept pattern lacks: couplings_covered checks that.
+    const bool cells_changed = soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 ||
+                               partition_changed || A.m() == 0;
+    const bool window_moved = !cells_changed && !active.template couplings_covered<K>({&soil, &water});
+    const unsigned int why  = dealii::Utilities::MPI::max(cells_changed ? 2u : window_moved ? 1u : 0u, comm);
+    const bool new_pattern  = why != 0;
     if (new_pattern)
       {
         active.template reinit<K>({&soil, &water});
         ++n_pattern_changes;
+        if (why == 1)
+          ++n_pattern_window_changes;
       }
     partition_changed = false;
     // free water surface: per node, whether it is a vertex of a wet and of a
@@ -1797,7 +1804,8 @@ namespace talus::semi_implicit
           << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations; AMG set-ups "
           << pressure_solver.n_setups() << " (interval " << prm.pressure_rebuild_interval << ", fallbacks "
           << pressure_solver.n_fallbacks() << ", after slow solves " << pressure_solver.n_slow_solves()
-          << "), pressure DoF set rebuilds " << n_pattern_changes << "), lost points "
+          << "), pressure DoF set rebuilds " << n_pattern_changes << " (" << n_pattern_window_changes
+          << " for a stencil outside the kept pattern)), lost points "
           << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
