@@ -416,6 +416,134 @@ namespace
   TEST(ConsistentMass, RowSumsAreLumpedMassBSpline2D) { consistent_mass<2, BS_2>(); }
   TEST(ConsistentMass, RowSumsAreLumpedMassBSpline3D) { consistent_mass<3, BS_3>(); }
 
+  // ------------------------------------------------------------------ distribution
+  /// transfer::FixedValueDistributor against deal.II's distribute_local on the
+  /// same local systems: every cell with points gets a pseudo-random local
+  /// matrix and vector over its stencil nodes, with constraints that pin the
+  /// inactive DoFs and fix some active ones to zero or to a value. The
+  /// matrices and right-hand sides must agree bit for bit (the distributor's
+  /// contract). Then a non-zero entry outside the pattern: both paths throw.
+  template <int dim, class K, unsigned int nc>
+  void
+  fixed_value_distributor_matches_deal_ii()
+  {
+    Scene<dim> s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, 8),
+                 {{filled<dim>(0), filled<dim>(0.5), 1800, 2}}, is_bspline<K>);
+    NodalSpace<dim> space(s.grid, nc);
+    space.setup();
+    ActiveSet<dim> active(space);
+    active.template reinit<K>(s.set_pointers());
+    // fix the DoFs of the nodes on x = 0 (to 0) and on y = 0 (to a value)
+    const auto dirichlet = space.constraints_where([](const dealii::Point<dim> &x, unsigned int k, double &v) {
+      if (x[0] < 1e-12)
+        return v = 0.0, true;
+      if (x[1] < 1e-12)
+        return v = 0.25 + 0.5 * x[0] + k, true;
+      return false;
+    });
+    const auto constraints = active.constraints_with(dirichlet);
+
+    dealii::TrilinosWrappers::SparseMatrix A_fast, A_dealii;
+    active.reinit_matrix(A_fast);
+    active.reinit_matrix(A_dealii);
+    Vector b_fast, b_dealii;
+    space.reinit_vector(b_fast);
+    space.reinit_vector(b_dealii);
+    transfer::FixedValueDistributor fast(constraints, *space.partitioner(), &A_fast, &b_fast);
+    ASSERT_TRUE(fast.usable());
+
+    // local systems over the nodes each cell's points touch (as AssembleSystem)
+    unsigned long long seed = 12345, n_cells = 0;
+    const auto         random = [&seed]() {
+      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+      return double(seed >> 11) / double(1ull << 53) - 0.5;
+    };
+    std::vector<dealii::types::global_dof_index> dofs;
+    std::vector<double>                          Al, bl;
+    for (const unsigned int c : active.cells())
+      {
+        const auto   cell = K::cell(s.grid, c);
+        unsigned int used[K::n_nodes] = {}, n_used = 0;
+        std::vector<unsigned int> slots;
+        for (unsigned int sl = 0; sl < K::n_nodes; ++sl)
+          if (cell.dofs[sl * dim] != dealii::numbers::invalid_unsigned_int &&
+              active.node_active(cell.dofs[sl * dim]))
+            used[n_used++] = sl;
+        // only pairs that share a point's stencil are in the pattern: for the
+        // B-spline take the cell's first-quadrant window (the points at 0.25)
+        dofs.clear();
+        for (unsigned int q = 0; q < n_used; ++q)
+          {
+            const unsigned int sl = used[q];
+            bool               in = true;
+            if constexpr (is_bspline<K>)
+              for (unsigned int d = 0, m = 1; d < dim; ++d, m *= 4)
+                in = in && (sl / m) % 4 <= 2;
+            if (in)
+              for (unsigned int k = 0; k < nc; ++k)
+                dofs.push_back(space.node_dof(cell.dofs[sl * dim], k));
+          }
+        const unsigned int m = dofs.size();
+        Al.assign(m * m, 0.0);
+        bl.assign(m, 0.0);
+        for (unsigned int i = 0; i < m; ++i)
+          {
+            bl[i] = random();
+            for (unsigned int j = 0; j < m; ++j)
+              Al[i * m + j] = (i == j ? 4.0 : 0.0) + random();
+          }
+        Al[m - 1] = 0.0; // an exact zero: elided by both paths
+        fast.distribute(m, Al.data(), bl.data(), m, dofs);
+        transfer::distribute_local(constraints, m, Al.data(), bl.data(), m, dofs, &A_dealii, &b_dealii);
+        ++n_cells;
+      }
+    A_fast.compress(dealii::VectorOperation::add);
+    A_dealii.compress(dealii::VectorOperation::add);
+    b_fast.compress(dealii::VectorOperation::add);
+    b_dealii.compress(dealii::VectorOperation::add);
+    EXPECT_GT(sum(n_cells), 0u);
+    const double norm = A_dealii.frobenius_norm();
+    EXPECT_GT(norm, 0.0);
+    A_fast.add(-1.0, A_dealii);
+    EXPECT_EQ(A_fast.frobenius_norm(), 0.0) << "matrices differ (scale " << norm << ")";
+    EXPECT_GT(b_dealii.l2_norm(), 0.0);
+    b_fast -= b_dealii;
+    EXPECT_EQ(b_fast.l2_norm(), 0.0);
+
+    // a coupling outside the pattern between two free owned DoFs far apart
+    // (one rank: the corner region's extremes); both paths must refuse it
+    if (dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
+      {
+        const auto &part = *space.partitioner();
+        dealii::types::global_dof_index near = dealii::numbers::invalid_dof_index, far = near;
+        double                          rmin = 1e9, rmax = -1;
+        for (const auto i : active.active_owned_dofs())
+          if (!constraints.is_constrained(i))
+            {
+              const auto & x = space.position(part.global_to_local(i));
+              const double r = x.norm();
+              if (r < rmin)
+                rmin = r, near = i;
+              if (r > rmax)
+                rmax = r, far = i;
+            }
+        ASSERT_NE(near, far);
+        ASSERT_GT(rmax - rmin, 0.3);
+        dofs  = {near, far};
+        Al    = {1.0, 1.0, 1.0, 1.0};
+        bl    = {0.0, 0.0};
+        transfer::FixedValueDistributor fast2(constraints, part, &A_fast, &b_fast);
+        EXPECT_ANY_THROW(fast2.distribute(2, Al.data(), bl.data(), 2, dofs));
+        EXPECT_ANY_THROW(transfer::distribute_local(constraints, 2, Al.data(), bl.data(), 2, dofs, &A_dealii, &b_dealii))
+          << "deal.II's distribute_local_to_global into a Trilinos matrix is expected to refuse it too";
+      }
+  }
+
+  TEST(FixedValueDistributor, MatchesDealIIQ1_2D) { fixed_value_distributor_matches_deal_ii<2, Q1_2, 2>(); }
+  TEST(FixedValueDistributor, MatchesDealIIQ1_3D_Scalar) { fixed_value_distributor_matches_deal_ii<3, Q1_3, 1>(); }
+  TEST(FixedValueDistributor, MatchesDealIIBSpline2D_Scalar) { fixed_value_distributor_matches_deal_ii<2, BS_2, 1>(); }
+  TEST(FixedValueDistributor, MatchesDealIIBSpline3D) { fixed_value_distributor_matches_deal_ii<3, BS_3, 3>(); }
+
   // ------------------------------------------------------------------ elastic
   /// Solve the static elastic problem K u = f on the points of s with the
   /// Dirichlet conditions `bc` (by node position); returns u with ghosts.
