@@ -620,6 +620,8 @@ namespace talus::semi_implicit
     /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
     /// vectors; the next step rebuilds the active set and the pressure matrix.
     void grid_changed();
+    /// the next step rebuilds the pressure DoF set (after a repartition and
+    /// after a checkpoint write)
     bool partition_changed = true;
     Fields                 fs, fw; ///< offsets in the soil and the water layout
     NodalSpace<dim>        pspace; ///< the scalar pressure space
@@ -830,8 +832,11 @@ namespace talus::semi_implicit
   Solver<dim>::write_checkpoint()
   {
     // the run restarted from this checkpoint builds a new hierarchy at its first
-    // solve: so does this one, so that both go on bitwise alike
+    // solve: so does this one, so that both go on bitwise alike. The same for
+    // the pressure DoF set: a kept one remembers the couplings of its build
+    // step, which decide later rebuilds (ActiveSet::couplings_covered)
     pressure_solver.invalidate();
+    partition_changed = true;
     return write_checkpoint_file(prm, *this, checkpoint_format, checkpoint_version,
                                  scene_signature(prm, soil.layout.n_properties()), comm, [&](io::H5File &f) {
                                    f.set_attribute("pressure solves", std::int64_t(n_solves));
