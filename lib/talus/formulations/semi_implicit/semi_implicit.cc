@@ -1211,10 +1211,10 @@ namespace talus::semi_implicit
     else
     {
     // the pressure DoF set: rebuilt (with the sparsity, the matrix and the AMG
-    // hierarchy) only when a point set's cells changed on some rank. The
-    // decision is global: ActiveSet::reinit and the AMG set-up are collective.
-    // A point can also shift its B-spline window inside its cell (a half-cell
-    // line) onto a pair the kept pattern lacks: couplings_covered checks that.
+    // hierarchy) only when a point set's cells changed on some rank, or a
+    // point's B-spline window moved (a half-cell line) onto a pair the kept
+    // pattern lacks (couplings_covered). The decision is global:
+    // ActiveSet::reinit and the AMG set-up are collective.
     const bool cells_changed = soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 ||
                                partition_changed || A.m() == 0;
     const bool window_moved = !cells_changed && !active.template couplings_covered<K>({&soil, &water});
