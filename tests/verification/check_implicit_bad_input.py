@@ -9,6 +9,8 @@ the right exit code, no NaN written.
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
+  * the rigid footing: its span reversed, with two values in 2D, not a number; normal z in 2D;
+    penalty 0; with contact walls on the nodes;
   * contact walls on the points: a misspelt 'contact method', 'points' without
     contact walls, a penalty <= 0 or not a number, a penalty with the node
     method, a negative or malformed Coulomb coefficient, the node method's
@@ -33,6 +35,11 @@ shutil.rmtree(work, ignore_errors=True)
 base = tv.prm_set(open(prm_path).read(), "output/directory", "must_not_exist")
 points_base = tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"), "boundary conditions/contact method",
                         "points")
+footing_base = base
+for entry, value in (("rigid footing/enabled", "true"), ("rigid footing/level", "1"),
+                     ("rigid footing/lower corner", "0"), ("rigid footing/upper corner", "0.5"),
+                     ("rigid footing/velocity", "-0.001")):
+    footing_base = tv.prm_set(footing_base, entry, value)
 cases = {
     "no finite-strain form": (tv.prm_set(base, "material 0/model", "linear elastic"),
                               ["material 0/model", "linear elastic", "finite-strain", "neo hookean"]),
@@ -105,6 +112,19 @@ cases = {
     "coulomb friction with cg amg": (tv.prm_set(tv.prm_set(points_base, "boundary conditions/contact friction", "0.3"),
                                                 "linear solver/method", "cg amg"),
                                      ["linear solver/method", "non-symmetric", "direct"]),
+    # the rigid footing on the points
+    "footing span reversed": (tv.prm_set(footing_base, "rigid footing/upper corner", "-1"),
+                              ["rigid footing/upper corner", "lower corner"]),
+    "footing span with two values in 2D": (tv.prm_set(footing_base, "rigid footing/lower corner", "0, 0"),
+                                           ["rigid footing/lower corner", "1 value"]),
+    "footing normal z in 2D": (tv.prm_set(footing_base, "rigid footing/normal axis", "z"),
+                               ["rigid footing/normal axis", "x | y"]),
+    "footing penalty zero": (tv.prm_set(footing_base, "rigid footing/penalty", "0"),
+                             ["rigid footing/penalty", "> 0"]),
+    "footing span not a number": (tv.prm_set(footing_base, "rigid footing/upper corner", "half"),
+                                  ["rigid footing/upper corner", "half"]),
+    "footing with contact walls on the nodes": (tv.prm_set(footing_base, "boundary conditions/contact", "3"),
+                                                ["rigid footing/enabled", "contact method = points"]),
     "velocity on a missing boundary": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
                                                   "loads/velocity 0/boundary id", "7"),
                                        ["loads/velocity 0/boundary id", "does not exist"]),

@@ -27,6 +27,10 @@ Checks:
     --zig-u, of u-p below --zig-up at the same settlement;
   * --ranks=N (0 skips): the u-p run of the first N steps on 1 and 2 ranks:
     q per step within 1e-8 relative.
+  * --points: the footing as a rigid plane on the material points ('rigid footing' of
+    parameter_files/implicit/strip_footing_points.prm): q = footing_force / (B/2 + h/2) (the
+    reaction is linear in the half width with intercept h/2 here too; --width-b2: / (B/2)),
+    s = 2 m - footing_level; --edge, --smooth act on the plane.
 Variants that must fail (docs/implicit.md): --yield=190.53 (sigma_y + 10 %) the
 plateau check of the fast test (--tol=0.05); the u formulation the zigzag bound
 of u-p (and u-p the bound of u).
@@ -36,7 +40,7 @@ per cell in [0, 1] x [1, 2]), --negligible=F (implicit/negligible nodal mass).
 Usage: check_strip_footing_prandtl.py TOOLS_DIR PRM WORKDIR [--h=H] [--ppd=N] [--du=D] [--settlement=S]
        [--window=A,B] [--no-window] [--peak=S] [--tol=T] [--rise=S1,...] [--max-its=N] [--u-settlement=S]
        [--zig-u=Z] [--zig-up=Z] [--ranks=N] [--yield=Y] [--fixed-nodes] [--line-search] [--width-b2]
-       [--edge=X] [--alpha=A] [--smooth] [--fine-ppd=N] [--negligible=F]
+       [--edge=X] [--alpha=A] [--smooth] [--fine-ppd=N] [--negligible=F] [--points]
 """
 import math
 import sys
@@ -76,8 +80,10 @@ prandtl = 2 + math.pi
 # x = 0, h, ..., x_e (x_e the last node within the footing) carry the tributary widths of nodal forces,
 # [0, h/2], ..., [x_e - h/2, x_e + h/2]: x_e + h/2 (measured: the reaction is linear in x_e with
 # intercept 0.053 m at h = 0.1 m). --width-b2 divides by B/2 instead (the earlier measure).
-x_edge = math.floor(edge / h + 1e-9) * h
+points = "--points" in sys.argv  # the rigid footing on the points (no prescribed nodes)
+x_edge = edge if points else math.floor(edge / h + 1e-9) * h
 loaded_width = B / 2 if "--width-b2" in sys.argv else x_edge + h / 2
+tv.check(not (points and (fine_ppd or fixed_nodes)), "--points takes neither --fine-ppd nor --fixed-nodes")
 
 
 def scene(settlement):
@@ -87,9 +93,15 @@ def scene(settlement):
     text = tv.prm_set(text, "body 0/particles per direction", str(ppd))
     # the row at or above the top layer of points (depth h / (2 n)) under the footing
     top = h / (2 * ppd)
-    text = tv.prm_set(text, "loads/velocity 0/region lower corner", f"0, {depth - top}")
-    text = tv.prm_set(text, "loads/velocity 0/region upper corner", f"{edge}, {depth + h - top}")
-    if smooth:
+    if points:
+        text = tv.prm_set(text, "rigid footing/upper corner", f"{edge}")
+        text = tv.prm_set(text, "rigid footing/velocity", f"{-du}")
+        if smooth:
+            text = tv.prm_set(text, "rigid footing/interface", "smooth")
+    else:
+        text = tv.prm_set(text, "loads/velocity 0/region lower corner", f"0, {depth - top}")
+        text = tv.prm_set(text, "loads/velocity 0/region upper corner", f"{edge}, {depth + h - top}")
+    if smooth and not points:
         text = tv.prm_set(text, "loads/velocity 0/components", "y")
         text = tv.prm_set(text, "loads/velocity 0/velocity", f"{-du}")
     if negligible:
@@ -111,7 +123,8 @@ def scene(settlement):
             for key, val in (("name", f"soil{b}"), ("shape", "box"), ("lower corner", lo), ("upper corner", hi),
                              ("particles per direction", str(ppd))):
                 text = tv.prm_set(text, f"body {b}/{key}", val)
-    text = tv.prm_set(text, "loads/velocity 0/velocity", f"0, {-du}")
+    if not points:
+        text = tv.prm_set(text, "loads/velocity 0/velocity", f"0, {-du}")
     text = tv.prm_set(text, "time/end time", str(round(settlement / du)))
     if yield_stress:
         text = tv.prm_set(text, "material 0/j2 plasticity/yield stress", yield_stress)
@@ -128,8 +141,12 @@ def run(text, name, np=1):
     wall = time.time() - start
     s = tv.read_csv(f"{work}/{name}/out/series.csv")
     rows = [k for k, t in enumerate(s["time"]) if t > 0]
-    settle = [s["time"][k] * du for k in rows]
-    q = [-s["prescribed_force_y"][k] / loaded_width / c_u for k in rows]
+    if points:
+        settle = [depth - s["footing_level"][k] for k in rows]
+        q = [s["footing_force"][k] / loaded_width / c_u for k in rows]
+    else:
+        settle = [s["time"][k] * du for k in rows]
+        q = [-s["prescribed_force_y"][k] / loaded_width / c_u for k in rows]
     its = [int(s["newton_iterations"][k]) for k in rows]
     order = [s["increment_order"][k] for k in rows]
     return settle, q, its, order, wall
@@ -157,7 +174,10 @@ def sampled_load(name):
 up = scene(s_end)
 settle, q, its, order, wall = run(up, "up")
 q_sampled, n_sampled = sampled_load("up")
-print(f"the load: q = -prescribed_force_y / {loaded_width:.4g} m (last footing node x = {x_edge:.4g} m)")
+if points:
+    print(f"the load: q = footing_force / {loaded_width:.4g} m (rigid footing on the points, half width {edge:.4g} m)")
+else:
+    print(f"the load: q = -prescribed_force_y / {loaded_width:.4g} m (last footing node x = {x_edge:.4g} m)")
 print(f"u-p, h = {h} m, {ppd} x {ppd} points per cell, {du} m per step, {len(q)} steps to s = {settle[-1]:.4g} m: "
       f"{wall:.1f} s")
 print("  s/B      q/c_u    vs 2+pi   Newton its  order(|du|)")

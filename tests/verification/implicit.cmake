@@ -321,3 +321,32 @@ add_test(NAME verification.implicit_strip_footing_negligible_mass
                  --settlement=0.12 --negligible=0.01 --tol=0.05 --rise=0.1,0.12 --ranks=28)
 set_tests_properties(verification.implicit_strip_footing_negligible_mass PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1200 PROCESSORS 2)
+# The same footing as a rigid plane on the material points ('rigid footing',
+# parameter_files/implicit/strip_footing_points.prm; docs/implicit.md "Rigid
+# footing on the points"): no grid row is prescribed, so nothing jumps a row;
+# q = footing_force / (B/2 + h/2). fast: h = 0.1 m to s = 0.06 B, q/c_u within
+# 3 % of 2 + pi over s/B in [0.02, 0.06] (measured mean -0.03 %, worst +2.78 %;
+# sigma_y + 10 % fails with +12 %), 1 vs 2 ranks over 10 steps (1.1e-10).
+# verify: the thesis's h = 0.05 m over [0.01, 0.034] B (measured mean -0.83 %,
+# worst -2.73 %); and h = 0.1 m to s = 0.19 B (the node footing stops at
+# 0.13 B): reaches it, Newton at most 25 iterations (measured 17); the load is
+# reported, not checked (no steady rise: 5.30 .. 5.57 after the plateau, with
+# one-step spikes when the top points cross a cell face).
+add_test(NAME verification.implicit_strip_footing_points
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points
+                 --points --settlement=0.06 --window=0.02,0.06 --tol=0.03 --ranks=10)
+set_tests_properties(verification.implicit_strip_footing_points PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 PROCESSORS 2)
+add_test(NAME verification.implicit_strip_footing_points_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points_full
+                 --points --h=0.05 --settlement=0.034 --window=0.01,0.034 --tol=0.03)
+set_tests_properties(verification.implicit_strip_footing_points_full PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
+                     TIMEOUT 1200)
+add_test(NAME verification.implicit_strip_footing_points_large
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points_large
+                 --points --settlement=0.19 --window=0.02,0.06 --tol=0.03 --max-its=25)
+set_tests_properties(verification.implicit_strip_footing_points_large PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1200)

@@ -164,6 +164,34 @@ namespace talus::implicit_mpm
                         "automatically. Irreducible formulation only; 3D: leave 'plane strain'.");
     }
     prm.leave_subsection();
+    prm.enter_subsection("rigid footing");
+    {
+      prm.declare_entry("enabled", "false", Bool(),
+                        "true: a rigid footing is pressed into the material at a prescribed rate: its base, a plane "
+                        "of finite span, pushes on the material points by a penalty inside Newton (as 'contact "
+                        "method = points'), so the loaded points move with the material and no grid row is "
+                        "prescribed; its reaction is the series column footing_force (docs/implicit.md, 'Rigid "
+                        "footing on the points').");
+      prm.declare_entry("normal axis", "y", Selection("x|y|z"), "The axis normal to the footing's base.");
+      prm.declare_entry("side", "above", Selection("above|below"),
+                        "above: the footing lies on the upper side of its base (the material below it, pushed "
+                        "towards -axis when it moves down); below: the reverse.");
+      prm.declare_entry("level", "0", Double(), "The base's coordinate along the normal axis at t = 0 [m].");
+      prm.declare_entry("lower corner", "", Anything(),
+                        "The base's span along the other axes (in increasing axis order; 1 value in 2D, 2 in 3D): "
+                        "lower ends [m]. A point acts on the base while its contact spot is within the span at "
+                        "the start of the step.");
+      prm.declare_entry("upper corner", "", Anything(), "Upper ends of the base's span [m].");
+      prm.declare_entry("velocity", "0", Double(),
+                        "Rate of the base along the normal axis [m per unit time; static analysis: per unit of "
+                        "load time, e.g. -0.002 with time step 1 = 2 mm per step].");
+      prm.declare_entry("interface", "rough", Selection("rough|smooth"),
+                        "rough: a point in contact sticks to the base (no slip); smooth: frictionless.");
+      prm.declare_entry("penalty", "1", Double(0),
+                        "kappa > 0 of the normal and tangential penalty k = kappa M V_p / h^2 (as 'contact "
+                        "penalty').");
+    }
+    prm.leave_subsection();
     prm.enter_subsection("newton");
     {
       prm.declare_entry("max iterations", "20", Integer(1), "Linear solves per step before the step is cut back.");
@@ -220,6 +248,34 @@ namespace talus::implicit_mpm
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
+    prm.enter_subsection("rigid footing");
+    {
+      auto &f   = p.footing;
+      f.enabled = prm.get_bool("enabled");
+      if (f.enabled)
+        {
+          const std::string axis = prm.get("normal axis");
+          f.axis                 = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+          require(f.axis < dim, "rigid footing/normal axis", "'z' needs a 3D scene; allowed: x | y");
+          f.sign     = prm.get("side") == "above" ? 1 : -1;
+          f.level    = prm.get_double("level");
+          f.velocity = prm.get_double("velocity");
+          f.friction = prm.get("interface") == "rough" ? std::numeric_limits<double>::infinity() : 0.0;
+          f.penalty  = prm.get_double("penalty");
+          require(f.penalty > 0, "rigid footing/penalty", "must be > 0");
+          for (const std::string entry : {"lower corner", "upper corner"})
+            {
+              const auto v = parse_doubles(prm.get(entry), "rigid footing/" + entry);
+              require(v.size() == dim - 1, "rigid footing/" + entry,
+                      "needs " + std::to_string(dim - 1) + " value(s): the span along the axes other than the normal");
+              for (unsigned int k = 0; k + 1 < dim; ++k)
+                (entry == "lower corner" ? f.lower : f.upper)[k] = v[k];
+            }
+          for (unsigned int k = 0; k + 1 < dim; ++k)
+            require(f.lower[k] < f.upper[k], "rigid footing/upper corner", "must exceed 'lower corner'");
+        }
+    }
+    prm.leave_subsection();
     prm.enter_subsection("newton");
     p.newton.max_iterations     = prm.get_integer("max iterations");
     p.newton.residual_relative  = prm.get_double("residual relative");
@@ -373,6 +429,9 @@ namespace talus::implicit_mpm
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
     prm.leave_subsection();
+    require(!p.footing.enabled || p.contact_ids.empty() || p.contact_on_points, "rigid footing/enabled",
+            "a rigid footing acts on the material points; with contact walls set 'boundary conditions/contact "
+            "method = points'");
     require(!p.contact_on_points || p.contact_mu == 0 || std::isinf(p.contact_mu) ||
               p.linear.method == LinearSolverOptions::Method::direct,
             "linear solver/method",
@@ -498,21 +557,43 @@ namespace talus::implicit_mpm
     point_forces.extend_layout(points.layout, prm.tractions.size());
     if (prm.axisymmetric)
       radius_offset = points.layout.add_extra("radius", 1);
-    if (prm.contact_on_points)
+    if (prm.contact_on_points || prm.footing.enabled)
       {
         // the contact walls as planes (box faces: id = 2 axis + (0 lower | 1 upper))
         std::vector<ContactPlane> planes;
-        for (const auto id : prm.contact_ids)
+        for (const auto id : prm.contact_on_points ? prm.contact_ids : std::vector<dealii::types::boundary_id>())
           {
             ContactPlane c;
-            c.axis = id / 2;
-            c.sign = id % 2 ? 1 : -1;
-            c.wall = c.sign < 0 ? prm.grid_lower[c.axis] : prm.grid_upper[c.axis];
-            c.cell = (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+            c.axis     = id / 2;
+            c.sign     = id % 2 ? 1 : -1;
+            c.wall     = c.sign < 0 ? prm.grid_lower[c.axis] : prm.grid_upper[c.axis];
+            c.cell     = (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+            c.penalty  = prm.contact_penalty;
+            c.friction = prm.contact_mu;
             planes.push_back(c);
           }
-        point_contact = std::make_unique<PointContact<dim>>(planes, prm.contact_penalty, prm.contact_mu,
-                                                            prm.materials, prm.axisymmetric);
+        if (prm.footing.enabled)
+          {
+            const auto  &f = prm.footing;
+            ContactPlane c;
+            c.axis     = f.axis;
+            c.sign     = f.sign;
+            c.wall_0   = f.level;
+            c.wall     = c.wall_n = f.level; // set_time moves it every step
+            c.velocity = f.velocity;
+            c.cell     = (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+            c.penalty  = f.penalty;
+            c.friction = f.friction;
+            c.bounded  = true;
+            c.footing  = true;
+            for (unsigned int k = 0; k + 1 < dim; ++k)
+              {
+                c.lower[k] = f.lower[k];
+                c.upper[k] = f.upper[k];
+              }
+            planes.push_back(c);
+          }
+        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric);
         point_contact->extend_layout(points.layout);
       }
     if (prm.mixed_up)
@@ -1246,6 +1327,8 @@ namespace talus::implicit_mpm
   Solver<dim>::advance_by(const double h)
   {
     newmark.set_time_step(h);
+    if (point_contact) // a footing's base to where it is at the step's start and end
+      point_contact->set_time(time, time + h);
     prepare_step();
     const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
     // the external force scale |f_ext| (lumped nodal masses times g)
@@ -1456,6 +1539,8 @@ namespace talus::implicit_mpm
             << " slipping, " << last.point_contact.new_contacts << " new, " << last.point_contact.released
             << " released), normal force " << last.point_contact.normal_force << ", largest penetration / r_p "
             << last.point_contact.max_penetration_ratio;
+    if (prm.footing.enabled)
+      log() << "; footing force " << last.point_contact.footing_force;
     if (any_contact)
       log() << "; contact: " << passes << " pass(es), " << released << " released, " << added << " in contact again, "
             << last.contact_nodes << " nodes in contact" << pass_log.str();
@@ -1590,6 +1675,17 @@ namespace talus::implicit_mpm
         else
           out << "; at most " << prm.contact_passes << " active-set passes per step" << std::endl;
       }
+    if (prm.footing.enabled)
+      {
+        const auto &f    = prm.footing;
+        const char *ax[] = {"x", "y", "z"};
+        out << "  rigid footing on the points: base " << ax[f.axis] << " = " << f.level << " + " << f.velocity
+            << " t, span";
+        for (unsigned int k = 0; k + 1 < dim; ++k)
+          out << " [" << f.lower[k] << ", " << f.upper[k] << "]";
+        out << ", " << (std::isinf(f.friction) ? "rough (no slip)" : "smooth") << ", penalty k = " << f.penalty
+            << " x M V_p / h^2" << std::endl;
+      }
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
         << " iterations; linear solver "
@@ -1636,6 +1732,9 @@ namespace talus::implicit_mpm
     if (point_contact)
       for (const char *n : {"contact_points", "contact_slipping", "contact_normal_force", "contact_tangential_force"})
         c.push_back(n);
+    if (prm.footing.enabled)
+      for (const char *n : {"footing_level", "footing_force", "footing_points_behind"})
+        c.push_back(n);
     if (any_velocity_condition())
       for (unsigned int d = 0; d < dim; ++d)
         c.push_back(std::string("prescribed_force_") + ax[d]);
@@ -1670,6 +1769,12 @@ namespace talus::implicit_mpm
         const bool  a = after_step;
         for (const double x : {double(s.in_contact), double(s.slipping), s.normal_force, s.tangential_force})
           v.push_back(a ? x : 0.0);
+      }
+    if (prm.footing.enabled)
+      {
+        v.push_back(prm.footing.level + prm.footing.velocity * time);
+        v.push_back(after_step ? last.point_contact.footing_force : 0.0);
+        v.push_back(after_step ? double(last.point_contact.behind_footing) : 0.0);
       }
     if (any_velocity_condition())
       for (unsigned int d = 0; d < dim; ++d)
@@ -1751,7 +1856,7 @@ namespace talus::implicit_mpm
           << t.total << " s; Newton iterations " << total_iterations << " (cut-backs " << cut_backs
           << "), linear iterations " << total_linear_iterations << balance.summary() << std::endl;
     if (point_contact)
-      log() << "  contact walls on the points: " << total_point_contacts << " points came into contact, "
+      log() << "  contact on the points (walls, footing): " << total_point_contacts << " points came into contact, "
             << total_point_releases << " left it, " << total_point_slip_steps
             << " point-steps slipping; largest penetration / r_p " << worst_penetration_ratio << std::endl;
     else if (!prm.contact_ids.empty())

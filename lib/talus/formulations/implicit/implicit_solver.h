@@ -97,6 +97,18 @@ namespace talus::implicit_mpm
     double contact_penalty = 1;
     /// points: the Coulomb coefficient of 'contact friction' (+inf: no slip, 0: frictionless)
     double contact_mu = std::numeric_limits<double>::infinity();
+    /// 'rigid footing': a rigid plane of finite span pressed into the material at
+    /// a prescribed rate, acting on the points by the contact penalty
+    /// (point_contact.h); its reaction is the footing force
+    struct Footing
+    {
+      bool         enabled = false;
+      unsigned int axis    = 1;  ///< normal axis
+      int          sign    = 1;  ///< +1: the footing is on the upper side of its base
+      double       level = 0, velocity = 0, penalty = 1;
+      double       lower[2] = {0, 0}, upper[2] = {0, 0};
+      double       friction = std::numeric_limits<double>::infinity(); ///< rough: no slip; smooth: 0
+    } footing;
     /// 'implicit/velocity regions follow': the region of each 'velocity k' with
     /// 'apply to = region' moves with the displacement it has prescribed so far
     /// (a rigid plate pressed into the material keeps acting on the nodes at its

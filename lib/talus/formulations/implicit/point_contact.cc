@@ -11,16 +11,57 @@
 namespace talus::implicit_mpm
 {
   template <int dim>
-  PointContact<dim>::PointContact(std::vector<ContactPlane> planes_, const double penalty_, const double friction_,
+  PointContact<dim>::PointContact(std::vector<ContactPlane> planes_,
                                   const std::vector<std::shared_ptr<const materials::Material>> &materials,
                                   const bool axisymmetric_)
     : planes(std::move(planes_))
-    , penalty(penalty_)
-    , friction(friction_)
     , axisymmetric(axisymmetric_)
   {
     for (const auto &m : materials)
       modulus.push_back(m->constrained_modulus());
+  }
+
+  template <int dim>
+  void
+  PointContact<dim>::set_time(const double t_n, const double t)
+  {
+    for (auto &c : planes)
+      if (c.velocity != 0)
+        {
+          c.wall_n = c.wall_0 + c.velocity * t_n;
+          c.wall   = c.wall_0 + c.velocity * t;
+        }
+  }
+
+  template <int dim>
+  bool
+  PointContact<dim>::any_footing() const
+  {
+    for (const auto &c : planes)
+      if (c.footing)
+        return true;
+    return false;
+  }
+
+  template <int dim>
+  int
+  PointContact<dim>::acts_on(const ContactPlane &c, const double *xs_n, const double r) const
+  {
+    if (!c.bounded)
+      return 1;
+    unsigned int k = 0;
+    for (unsigned int t = 0; t < dim; ++t)
+      if (t != c.axis)
+        {
+          if (xs_n[t] < c.lower[k] || xs_n[t] > c.upper[k])
+            return 0;
+          ++k;
+        }
+    // the spot at the start of the step no deeper than the point's extent
+    // behind the plane's start-of-step position (a stiff penalty keeps the
+    // points in contact far shallower; deeper is a point that came round the
+    // footing's edge)
+    return c.sign * (c.wall_n - xs_n[c.axis]) >= -2 * r ? 1 : -1;
   }
 
   template <int dim>
@@ -64,7 +105,7 @@ namespace talus::implicit_mpm
     // axisymmetric: V is the ring's volume; the extent is that of the point's area
     const double A  = axisymmetric ? V / (2 * M_PI * std::max(P[offset_], 1e-300)) : V;
     r               = 0.5 * std::pow(A, 1.0 / dim);
-    k               = penalty * modulus[static_cast<unsigned int>(P[L::material])] * V / (c.cell * c.cell);
+    k               = c.penalty * modulus[static_cast<unsigned int>(P[L::material])] * V / (c.cell * c.cell);
   }
 
   template <int dim>
@@ -88,7 +129,8 @@ namespace talus::implicit_mpm
     out.pen          = pen;
     out.f[a]         = -k * pen * c.sign;
     out.D[a][a]      = -k;
-    if (frictionless())
+    const double friction = c.friction;
+    if (friction == 0)
       return 1;
     // the slip since the point touched the wall
     const bool held = state[dim] != 0.0;
@@ -100,7 +142,7 @@ namespace talus::implicit_mpm
         s2 += s[t] * s[t];
       }
     const double kt = k, sn = std::sqrt(s2);
-    if (no_slip() || kt * sn <= friction * k * pen)
+    if (friction == std::numeric_limits<double>::infinity() || kt * sn <= friction * k * pen)
       {
         for (unsigned int t = 0; t < dim; ++t)
           if (t != a)
@@ -160,6 +202,11 @@ namespace talus::implicit_mpm
                 for (unsigned int i = 0; i < p.n; ++i)
                   x[c] += Ns[i] * ls.u[p.local[i] * nc + c];
               }
+            if (const int on = pc->acts_on(planes[w], xs_n, r); on != 1)
+              {
+                stats->behind_footing += on == -1;
+                continue;
+              }
             typename PointContact<dim>::Law law;
             const int state = pc->law(planes[w], x, xs_n, P + pc->offset() + dim + w * (dim + 1), 0.0, k, law);
             if (state == 0)
@@ -171,6 +218,8 @@ namespace talus::implicit_mpm
               if (c != planes[w].axis)
                 ft2 += law.f[c] * law.f[c];
             stats->normal_force += std::abs(law.f[planes[w].axis]);
+            if (planes[w].footing)
+              stats->footing_force -= planes[w].sign * law.f[planes[w].axis];
             stats->tangential_force += std::sqrt(ft2);
             stats->max_penetration_ratio = std::max(stats->max_penetration_ratio, law.pen / r);
             // the force acts at the spot: r_i -= N_i f; K_ij -= N_i N_j df/dx
@@ -197,8 +246,11 @@ namespace talus::implicit_mpm
     void
     sum_stats(PointContactStats &s, const MPI_Comm comm)
     {
-      double v[4] = {double(s.in_contact), double(s.slipping), double(s.new_contacts), double(s.released)};
-      dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 4), comm, dealii::ArrayView<double>(v, 4));
+      double v[5] = {double(s.in_contact), double(s.slipping), double(s.new_contacts), double(s.released),
+                     double(s.behind_footing)};
+      dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 5), comm, dealii::ArrayView<double>(v, 5));
+      s.behind_footing        = static_cast<unsigned long long>(v[4]);
+      s.footing_force         = dealii::Utilities::MPI::sum(s.footing_force, comm);
       s.in_contact            = static_cast<unsigned long long>(v[0]);
       s.slipping              = static_cast<unsigned long long>(v[1]);
       s.new_contacts          = static_cast<unsigned long long>(v[2]);
@@ -257,7 +309,9 @@ namespace talus::implicit_mpm
               x[c]    = xs_n[c] + val[c] + o * grad[c][a];
             }
           Law       law;
-          const int s = this->law(planes[w], x, xs_n, state, 0.0, k, law);
+          const int on = acts_on(planes[w], xs_n, r);
+          stats.behind_footing += on == -1;
+          const int s = on == 1 ? this->law(planes[w], x, xs_n, state, 0.0, k, law) : 0;
           if (s == 0)
             {
               stats.released += state[dim] != 0.0;
@@ -269,6 +323,8 @@ namespace talus::implicit_mpm
           ++stats.in_contact;
           stats.slipping += s == 2;
           stats.normal_force += std::abs(law.f[planes[w].axis]);
+          if (planes[w].footing)
+            stats.footing_force -= planes[w].sign * law.f[planes[w].axis];
           double ft2 = 0;
           for (unsigned int c = 0; c < dim; ++c)
             if (c != planes[w].axis)

@@ -6,7 +6,9 @@
 // point touched the wall: a stick anchor per point and wall), frictionless, or
 // Coulomb friction (stick/slip return with mu). The contact point moves with
 // the material instead of jumping between grid nodes (the node-based
-// 'contact' walls of implicit_solver.cc).
+// 'contact' walls of implicit_solver.cc). The same law serves a rigid
+// footing: a plane of finite span moving at a prescribed rate (docs/implicit.md,
+// "Rigid footing on the points").
 //
 // Per point and wall (a point carries no surface; its extent r_p = V_p^(1/dim)/2,
 // the half side of the square/cube of its volume; axisymmetric: of its area).
@@ -44,13 +46,30 @@
 
 namespace talus::implicit_mpm
 {
-  /// One rigid plane: the box face `axis`, outward normal `sign` e_axis, at `wall`.
+  /// One rigid plane: normal along `axis`, outward normal `sign` e_axis (the
+  /// material is on the other side), at coordinate `wall`. A box face of the
+  /// grid (a contact wall), or the base of a rigid footing: bounded along the
+  /// other axes and moving along its normal.
   struct ContactPlane
   {
     unsigned int axis = 0;
     int          sign = -1;
     double       wall = 0;
-    double       cell = 1; ///< cell size normal to the wall (the penalty's h)
+    double       cell = 1; ///< cell size normal to the plane (the penalty's h)
+    double       penalty  = 1;                                        ///< kappa: k_n = kappa M V_p / h^2
+    double       friction = std::numeric_limits<double>::infinity(); ///< +inf no slip, 0 frictionless, else mu
+    /// a footing's base: wall = wall_0 + velocity t at the end of the step,
+    /// wall_n at its start (set_time)
+    double wall_0 = 0, velocity = 0, wall_n = 0;
+    /// a footing's base acts only on points whose contact spot lies, at the
+    /// start of the step, within [lower, upper] along the other axes (in
+    /// increasing axis order) and not deeper than the point's extent behind the
+    /// plane (a point beside the footing that flows over its edge is not pulled
+    /// through the footing: docs/implicit.md, "Rigid footing on the points")
+    bool   bounded = false;
+    double lower[2] = {0, 0}, upper[2] = {0, 0};
+    /// its normal force is reported as the footing's reaction
+    bool footing = false;
   };
 
   /// Totals of one assembly or of a converged step (global: summed over ranks).
@@ -58,6 +77,8 @@ namespace talus::implicit_mpm
   {
     unsigned long long in_contact = 0, slipping = 0, new_contacts = 0, released = 0;
     double             normal_force = 0, tangential_force = 0; ///< sums of |f_n|, |f_t| over the points
+    double             footing_force = 0; ///< sum of f_n over the points on footing planes (along -sign e_axis)
+    unsigned long long behind_footing = 0; ///< points within a footing's span but deeper than their extent (ignored)
     double             max_penetration_ratio = 0; ///< largest p / r_p
   };
 
@@ -65,8 +86,7 @@ namespace talus::implicit_mpm
   class PointContact
   {
   public:
-    /// friction: +inf = no slip, 0 = frictionless, else the Coulomb coefficient mu.
-    PointContact(std::vector<ContactPlane> planes, const double penalty, const double friction,
+    PointContact(std::vector<ContactPlane> planes,
                  const std::vector<std::shared_ptr<const materials::Material>> &materials, const bool axisymmetric);
 
     /// Adds the block 'contact' (x_n, then per wall: anchor (dim) and flag) to
@@ -76,6 +96,14 @@ namespace talus::implicit_mpm
     void initialize_points(MaterialPointSet<dim> &points) const;
     /// Start of a step: x_n of every point (read by the assemblies of the step).
     void start_step(MaterialPointSet<dim> &points) const;
+    /// The moving planes (footings) to their positions at the start (t_n) and
+    /// the end (t) of the step.
+    void set_time(const double t_n, const double t);
+    /// Whether plane c acts on a point whose contact spot was at xs_n at the
+    /// start of the step (extent r): 1 yes (always for an unbounded wall), 0 the
+    /// spot is outside the plane's span, -1 within it but behind the plane.
+    int acts_on(const ContactPlane &c, const double *xs_n, const double r) const;
+    bool any_footing() const;
     /// Residual (and tangent) terms at the iterate du (ghosts up to date),
     /// added with `constraints` to A (may be null) and b; compresses both.
     /// Returns the figures of this iterate. Collective.
@@ -86,10 +114,6 @@ namespace talus::implicit_mpm
     /// stick anchors and contact flags of the converged increment. Collective.
     PointContactStats commit(MaterialPointSet<dim> &points, const NodalSpace<dim> &space, const Vector &du) const;
 
-    bool         no_slip() const { return friction == std::numeric_limits<double>::infinity(); }
-    bool         frictionless() const { return friction == 0; }
-    double       friction_coefficient() const { return friction; }
-    double       penalty_factor() const { return penalty; }
     const std::vector<ContactPlane> &walls() const { return planes; }
     unsigned int offset() const { return offset_; }
 
@@ -110,7 +134,6 @@ namespace talus::implicit_mpm
 
   private:
     std::vector<ContactPlane> planes;
-    double                    penalty, friction;
     std::vector<double>       modulus; ///< per material: constrained modulus M
     bool                      axisymmetric;
     unsigned int              offset_ = 0;
