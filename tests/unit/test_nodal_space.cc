@@ -280,6 +280,9 @@ namespace
     ActiveSet<dim> active(space);
     EXPECT_FALSE(active.template couplings_covered<K>(s.set_pointers())) << "never built";
     active.template reinit<K>(s.set_pointers());
+    EXPECT_FALSE(active.template couplings_covered<K>(s.set_pointers())) << "built without recording the couplings";
+    const auto record = ActiveSet<dim>::Couplings::record;
+    active.template reinit<K>(s.set_pointers(), record);
     const auto all_covered = [&]() {
       return dealii::Utilities::MPI::min(unsigned(active.template couplings_covered<K>(s.set_pointers())),
                                          MPI_COMM_WORLD) == 1;
@@ -302,7 +305,7 @@ namespace
     const unsigned int n_moved = dealii::Utilities::MPI::sum(unsigned(moves), MPI_COMM_WORLD);
     ASSERT_EQ(n_moved, 1u);
     EXPECT_EQ(all_covered(), !is_bspline<K>) << "a shifted B-spline window must leave the kept pattern";
-    active.template reinit<K>(s.set_pointers());
+    active.template reinit<K>(s.set_pointers(), record);
     EXPECT_TRUE(all_covered()) << "after a rebuild the pattern holds the points' couplings again";
     // a point of a second set in a cell the pattern was not built for
     Scene<dim> other(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
@@ -310,7 +313,7 @@ namespace
     NodalSpace<dim> other_space(other.grid, 1);
     other_space.setup();
     ActiveSet<dim> other_active(other_space);
-    other_active.template reinit<K>(other.set_pointers());
+    other_active.template reinit<K>(other.set_pointers(), record);
     EXPECT_EQ(dealii::Utilities::MPI::min(unsigned(other_active.template couplings_covered<K>(s.set_pointers())),
                                           MPI_COMM_WORLD),
               0u)

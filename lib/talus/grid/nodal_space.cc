@@ -233,7 +233,7 @@ namespace talus
   template <int dim>
   template <class K>
   void
-  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets)
+  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings)
   {
     const auto &       grid = space.grid;
     const unsigned int nc   = space.n_components();
@@ -245,35 +245,31 @@ namespace talus
     dealii::DynamicSparsityPattern dsp(relevant);
     Vector                         touched_dofs;
     space.reinit_vector(touched_dofs);
-    std::vector<unsigned char> cell_active(grid.cells.size(), 0);
     std::vector<dealii::types::global_dof_index> cols;
     const PairOffsets<dim, K> &offsets = PairOffsets<dim, K>::table();
-    kernel_nodes                       = K::n_nodes;
-    cell_recorded.assign(grid.cells.size(), 0);
+    const bool                 record  = couplings == Couplings::record;
+    cell_holds_points.assign(grid.cells.size(), 0);
+    recorded_kernel_nodes           = record ? K::n_nodes : 0;
     const unsigned int n_grid_nodes = grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices();
-    node_neighbours.assign(std::size_t(n_grid_nodes) * offset_words, 0);
+    node_neighbours.assign(record ? std::size_t(n_grid_nodes) * offset_words : 0, 0);
 
     auto sink = [&](const unsigned int c, const typename K::Cell &cell, const auto &touched, const auto &pairs) {
-      cell_active[c] = 1;
-      cell_recorded[c] = 1;
-      for (unsigned int a = 0; a < K::n_nodes; ++a)
-        if (touched[a])
-          {
-            std::uint64_t *bits = node_neighbours.data() + std::size_t(cell.dofs[a * dim]) * offset_words;
-            for (unsigned int b = 0; b < K::n_nodes; ++b)
-              if (pairs[a * K::n_nodes + b])
-                offsets.set(bits, a, b);
-          }
+      cell_holds_points[c] = 1;
       for (unsigned int a = 0; a < K::n_nodes; ++a)
         {
           if (!touched[a])
             continue;
-          const unsigned int ga = cell.dofs[a * dim];
+          const unsigned int ga   = cell.dofs[a * dim];
+          std::uint64_t *    bits = record ? node_neighbours.data() + std::size_t(ga) * offset_words : nullptr;
           cols.clear();
           for (unsigned int b = 0; b < K::n_nodes; ++b)
             if (pairs[a * K::n_nodes + b])
-              for (unsigned int k = 0; k < nc; ++k)
-                cols.push_back(space.node_dof(cell.dofs[b * dim], k));
+              {
+                if (record)
+                  offsets.set(bits, a, b);
+                for (unsigned int k = 0; k < nc; ++k)
+                  cols.push_back(space.node_dof(cell.dofs[b * dim], k));
+              }
           std::sort(cols.begin(), cols.end());
           for (unsigned int k = 0; k < nc; ++k)
             {
@@ -290,7 +286,8 @@ namespace talus
       }
     // every rank that holds a node knows all of its couplings: the check of a
     // later step is then exact on any number of ranks
-    or_over_ranks(*grid.partitioner, grid.comm, offset_words, node_neighbours);
+    if (record)
+      or_over_ranks(*grid.partitioner, grid.comm, offset_words, node_neighbours);
 
     // a DoF is active if a point of any rank touches it
     touched_dofs.compress(dealii::VectorOperation::add);
@@ -308,8 +305,8 @@ namespace talus
     n_active_global = dealii::Utilities::MPI::sum<unsigned long long>(active_owned.n_elements(), grid.comm);
 
     active_cells.clear();
-    for (unsigned int c = 0; c < cell_active.size(); ++c)
-      if (cell_active[c])
+    for (unsigned int c = 0; c < cell_holds_points.size(); ++c)
+      if (cell_holds_points[c])
         active_cells.push_back(c);
 
     const unsigned int n_grid_local = grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices();
@@ -398,9 +395,9 @@ namespace talus
   bool
   ActiveSet<dim>::couplings_covered(const std::vector<MaterialPointSet<dim> *> &sets) const
   {
-    if (kernel_nodes != K::n_nodes || cell_recorded.size() != space.grid.cells.size())
-      return false; // never built with this kernel, or the grid changed since
-    CheckCouplings<dim, K> op(space.grid, cell_recorded, node_neighbours, PairOffsets<dim, K>::table());
+    if (recorded_kernel_nodes != K::n_nodes || cell_holds_points.size() != space.grid.cells.size())
+      return false; // not recorded (with this kernel), or the grid changed since
+    CheckCouplings<dim, K> op(space.grid, cell_holds_points, node_neighbours, PairOffsets<dim, K>::table());
     for (auto *set : sets)
       {
         transfer::for_each_active_cell(*set, op);
@@ -441,10 +438,14 @@ namespace talus
   template class NodalSpace<3>;
   template class ActiveSet<2>;
   template class ActiveSet<3>;
-  template void ActiveSet<2>::reinit<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &);
-  template void ActiveSet<3>::reinit<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &);
-  template void ActiveSet<2>::reinit<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &);
-  template void ActiveSet<3>::reinit<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &);
+  template void ActiveSet<2>::reinit<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &,
+                                                            ActiveSet<2>::Couplings);
+  template void ActiveSet<3>::reinit<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &,
+                                                            ActiveSet<3>::Couplings);
+  template void ActiveSet<2>::reinit<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &,
+                                                            ActiveSet<2>::Couplings);
+  template void ActiveSet<3>::reinit<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &,
+                                                            ActiveSet<3>::Couplings);
   template bool ActiveSet<2>::couplings_covered<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
   template bool ActiveSet<3>::couplings_covered<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
   template bool ActiveSet<2>::couplings_covered<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;

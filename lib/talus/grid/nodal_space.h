@@ -101,14 +101,24 @@ namespace talus
     explicit ActiveSet(const NodalSpace<dim> &space);
     ~ActiveSet();
 
+    /// Whether reinit records the node couplings for couplings_covered (and
+    /// exchanges them between ranks): only a caller that keeps the pattern
+    /// over later steps needs them.
+    enum class Couplings
+    {
+      skip,
+      record
+    };
+
     /// The active region of the points of `sets` (one pass over each) with the
     /// stencil of kernel K (shape::Q1Box<dim> or shape::BSpline2Box<dim>; the
     /// latter needs grid.setup_bspline_patches()). Collective.
     template <class K>
-    void reinit(const std::vector<MaterialPointSet<dim> *> &sets);
+    void reinit(const std::vector<MaterialPointSet<dim> *> &sets, Couplings couplings = Couplings::skip);
 
     /// Whether every point of `sets` on this rank couples only node pairs that
-    /// the points (of any rank) coupled at the last reinit<K>, so that the kept
+    /// the points (of any rank) coupled at the last reinit<K> (with
+    /// Couplings::record; false after any other reinit), so that the kept
     /// sparsity and active DoFs still hold its couplings, and lies in a cell
     /// that held points then. reinit ORs each node's couplings over the ranks
     /// that hold the node, so the answer does not depend on the partition.
@@ -153,12 +163,14 @@ namespace talus
     size_type                                 n_active_global = 0;
     dealii::AffineConstraints<double>         inactive;
     std::unique_ptr<dealii::TrilinosWrappers::SparsityPattern> pattern;
-    /// What reinit recorded for couplings_covered: per cell whether points
-    /// held it; per node (grid local index) the neighbours the points of any
-    /// rank coupled it to, as bits over the lattice offsets (within one stencil)
-    /// from it, kernel_nodes the kernel's stencil size.
-    std::vector<unsigned char>  cell_recorded;
-    std::vector<std::uint64_t>  node_neighbours;
-    unsigned int                kernel_nodes = 0;
+    /// Per cell whether points held it at the last reinit (active_cells are
+    /// the owned ones among them).
+    std::vector<unsigned char> cell_holds_points;
+    /// What reinit recorded for couplings_covered (Couplings::record): per node
+    /// (grid local index) the neighbours the points of any rank coupled it to,
+    /// as bits over the lattice offsets (within one stencil) from it;
+    /// recorded_kernel_nodes the kernel's stencil size, 0 when not recorded.
+    std::vector<std::uint64_t> node_neighbours;
+    unsigned int               recorded_kernel_nodes = 0;
   };
 } // namespace talus

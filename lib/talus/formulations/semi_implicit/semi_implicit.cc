@@ -1222,7 +1222,7 @@ namespace talus::semi_implicit
     const bool new_pattern  = why != 0;
     if (new_pattern)
       {
-        active.template reinit<K>({&soil, &water});
+        active.template reinit<K>({&soil, &water}, ActiveSet<dim>::Couplings::record);
         ++n_pattern_changes;
         if (why == 1)
           ++n_pattern_window_changes;
