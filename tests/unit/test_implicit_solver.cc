@@ -182,6 +182,25 @@ namespace
                                point_floor + " set contact friction = 0.3\n set contact penalty = 10\n"),
               1e-6);
   }
+  // a rigid footing on the points (point_contact.h, 'rigid footing'): its base on the block's
+  // top face (y = 0.5) over part of it (x in [0.3, 1], 3D also z in [0.1, 0.4]), so the top
+  // points inside the span touch it and those outside do not; the random iterate pushes about
+  // half of the touching ones into it. (The footing section follows the boundary conditions'.)
+  std::string
+  footing(const int dim, const std::string &interface)
+  {
+    return std::string(" set fixed = 2\nend\nsubsection rigid footing\n set enabled = true\n set level = 0.5\n") +
+           " set lower corner = 0.3" + (dim == 3 ? ", 0.1" : "") + "\n set upper corner = 1" +
+           (dim == 3 ? ", 0.4" : "") + "\n set velocity = -0.01\n set interface = " + interface + "\n";
+  }
+  TEST(ImplicitTangent, RigidFootingRough2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, "", 1.0, footing(2, "rough")), 1e-6);
+  }
+  TEST(ImplicitTangent, RigidFootingSmooth3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2, 0, 9.81, "", 1.0, footing(3, "smooth")), 1e-6);
+  }
   TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
 
   // 'mass matrix = consistent': M_ij = sum_p m_p N_i N_j in the residual (M a,
