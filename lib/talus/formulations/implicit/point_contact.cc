@@ -34,16 +34,6 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
-  bool
-  PointContact<dim>::any_footing() const
-  {
-    for (const auto &c : planes)
-      if (c.footing)
-        return true;
-    return false;
-  }
-
-  template <int dim>
   int
   PointContact<dim>::acts_on(const ContactPlane &c, const double *xs_n, const double r) const
   {

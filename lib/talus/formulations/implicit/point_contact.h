@@ -103,7 +103,6 @@ namespace talus::implicit_mpm
     /// start of the step (extent r): 1 yes (always for an unbounded wall), 0 the
     /// spot is outside the plane's span, -1 within it but behind the plane.
     int acts_on(const ContactPlane &c, const double *xs_n, const double r) const;
-    bool any_footing() const;
     /// Residual (and tangent) terms at the iterate du (ghosts up to date),
     /// added with `constraints` to A (may be null) and b; compresses both.
     /// Returns the figures of this iterate. Collective.
