@@ -326,11 +326,13 @@ set_tests_properties(verification.implicit_strip_footing_prandtl_full PROPERTIES
 # shift after the footing row's jump at 0.075 B, where q dips to 3.5; not the
 # thesis's smooth rise, docs/implicit.md). 1 vs 2 ranks over the first 28 steps
 # (measured <= 1.4e-11; from step 29 the runs take different cut-back paths in
-# the near-singular stretch and differ by 5e-2 .. 9e-2).
+# the near-singular stretch and differ by 5e-2 .. 9e-2). The rank comparison
+# runs with KLU: with MUMPS, which does not repeat bitwise on 2 ranks, the test
+# failed once in six runs (2026-12-03); with KLU 1.44e-11.
 add_test(NAME verification.implicit_strip_footing_negligible_mass
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_prandtl.prm ${_w}/implicit_strip_footing_negligible_mass
-                 --settlement=0.12 --negligible=0.01 --tol=0.05 --rise=0.1,0.12 --ranks=28)
+                 --settlement=0.12 --negligible=0.01 --tol=0.05 --rise=0.1,0.12 --ranks=28 --ranks-klu)
 set_tests_properties(verification.implicit_strip_footing_negligible_mass PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1200 PROCESSORS 2)
 # The same footing as a rigid plane on the material points ('rigid footing',
