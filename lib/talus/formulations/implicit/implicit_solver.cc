@@ -561,13 +561,16 @@ namespace talus::implicit_mpm
       {
         // the contact walls as planes (box faces: id = 2 axis + (0 lower | 1 upper))
         std::vector<ContactPlane> planes;
+        const auto cell_size = [&](const unsigned int axis) {
+          return (prm.grid_upper[axis] - prm.grid_lower[axis]) / prm.grid_cells[axis];
+        };
         for (const auto id : prm.contact_on_points ? prm.contact_ids : std::vector<dealii::types::boundary_id>())
           {
             ContactPlane c;
             c.axis     = id / 2;
             c.sign     = id % 2 ? 1 : -1;
             c.wall     = c.sign < 0 ? prm.grid_lower[c.axis] : prm.grid_upper[c.axis];
-            c.cell     = (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+            c.cell     = cell_size(c.axis);
             c.penalty  = prm.contact_penalty;
             c.friction = prm.contact_mu;
             planes.push_back(c);
@@ -581,10 +584,9 @@ namespace talus::implicit_mpm
             c.wall_0   = f.level;
             c.wall     = c.wall_n = f.level; // set_time moves it every step
             c.velocity = f.velocity;
-            c.cell     = (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
+            c.cell     = cell_size(c.axis);
             c.penalty  = f.penalty;
             c.friction = f.friction;
-            c.bounded  = true;
             c.footing  = true;
             for (unsigned int k = 0; k + 1 < dim; ++k)
               {

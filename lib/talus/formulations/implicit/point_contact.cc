@@ -37,7 +37,7 @@ namespace talus::implicit_mpm
   int
   PointContact<dim>::acts_on(const ContactPlane &c, const double *xs_n, const double r) const
   {
-    if (!c.bounded)
+    if (!c.footing)
       return 1;
     unsigned int k = 0;
     for (unsigned int t = 0; t < dim; ++t)

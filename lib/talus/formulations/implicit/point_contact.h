@@ -61,15 +61,15 @@ namespace talus::implicit_mpm
     /// a footing's base: wall = wall_0 + velocity t at the end of the step,
     /// wall_n at its start (set_time)
     double wall_0 = 0, velocity = 0, wall_n = 0;
-    /// a footing's base acts only on points whose contact spot lies, at the
-    /// start of the step, within [lower, upper] along the other axes (in
-    /// increasing axis order) and not deeper than the point's extent behind the
-    /// plane (a point beside the footing that flows over its edge is not pulled
-    /// through the footing: docs/implicit.md, "Rigid footing on the points")
-    bool   bounded = false;
+    /// a footing's base (its normal force is reported as the footing's
+    /// reaction) acts only on points whose contact spot lies, at the start of
+    /// the step, within [lower, upper] along the other axes (in increasing axis
+    /// order) and not deeper than the point's extent behind the plane (a point
+    /// beside the footing that flows over its edge is not pulled through the
+    /// footing: docs/implicit.md, "Rigid footing on the points"); a wall is
+    /// unbounded
+    bool   footing = false;
     double lower[2] = {0, 0}, upper[2] = {0, 0};
-    /// its normal force is reported as the footing's reaction
-    bool footing = false;
   };
 
   /// Totals of one assembly or of a converged step (global: summed over ranks).
@@ -100,7 +100,7 @@ namespace talus::implicit_mpm
     /// the end (t) of the step.
     void set_time(const double t_n, const double t);
     /// Whether plane c acts on a point whose contact spot was at xs_n at the
-    /// start of the step (extent r): 1 yes (always for an unbounded wall), 0 the
+    /// start of the step (extent r): 1 yes (always for a wall), 0 the
     /// spot is outside the plane's span, -1 within it but behind the plane.
     int acts_on(const ContactPlane &c, const double *xs_n, const double r) const;
     /// Residual (and tangent) terms at the iterate du (ghosts up to date),
