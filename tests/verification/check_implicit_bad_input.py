@@ -64,8 +64,6 @@ cases = {
     "moving velocity regions with restart": (
         tv.prm_set(tv.prm_set(base, "implicit/velocity regions follow", "true"), "checkpoint/restart", "if available"),
         ["implicit/velocity regions follow", "restart"]),
-    "mixed up in a dynamic run": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "implicit/analysis",
-                                             "dynamic"), ["implicit/formulation", "static"]),
     "mixed up with cg amg": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "linear solver/method",
                                         "cg amg"), ["linear solver/method", "direct"]),
     "traction and total force": (tv.prm_set(tv.prm_set(tv.prm_set(base, "loads/number of tractions", "1"),

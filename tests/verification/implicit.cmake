@@ -58,6 +58,23 @@ add_test(NAME verification.implicit_ranks_cantilever_dynamic_consistent
 set_tests_properties(verification.implicit_ranks_cantilever_dynamic_consistent PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 
+# dynamic mixed u-p: the bar's period (trapezoidal rule) and the cantilever's bending
+# period against Timoshenko at nu = 0.3 and 0.4999 (u locks there, u-p does not)
+add_test(NAME verification.implicit_up_dynamic
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_up_dynamic.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${TALUS_PRM_DIR}/implicit/cantilever_vibration.prm
+                 ${_w}/implicit_up_dynamic)
+set_tests_properties(verification.implicit_up_dynamic PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+# 1 vs 2 ranks, dynamic mixed u-p with the consistent mass and Rayleigh damping
+add_test(NAME verification.implicit_ranks_up_dynamic
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_vibration.prm ${_w}/implicit_ranks_up_dynamic
+                 "implicit/formulation=mixed up" "material 0/neo hookean/volumetric energy=split"
+                 "material 0/neo hookean/poisson ratio=0.4999" "implicit/mass matrix=consistent"
+                 "implicit/rayleigh alpha=0.5" "time/end time=0.4")
+set_tests_properties(verification.implicit_ranks_up_dynamic PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+
 # bad input, Newton failure, singular system: messages, exit codes, no NaN
 add_test(NAME verification.implicit_bad_input
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bad_input.py ${TALUS_TOOLS_DIR}

@@ -449,8 +449,6 @@ namespace talus::implicit_mpm
       }
     if (p.mixed_up)
       {
-        require(p.analysis == Parameters<dim>::Analysis::quasi_static, "implicit/formulation",
-                "'mixed up' is available for 'analysis = static' only (the dynamic u-p form is not verified yet)");
         require(p.linear.method == LinearSolverOptions::Method::direct, "linear solver/method",
                 "'mixed up' needs 'direct' (the u-p system is indefinite; no block preconditioner yet)");
         for (unsigned int k = 0; k < p.materials.size(); ++k)
@@ -1166,10 +1164,16 @@ namespace talus::implicit_mpm
       return;
     v_n = 0;
     a_n = 0;
-    transfer::assemble<dim, shape::Q1Box<dim>, dim>(sets, active, pins, transfer::NodalProjection<dim>{L::velocity},
+    // mixed u-p: onto the displacement components of the u-p space (the
+    // pressure components get no mass, hence no inertia)
+    with_components([&](auto nc) {
+      constexpr unsigned int n = decltype(nc)::value;
+      transfer::assemble<dim, shape::Q1Box<dim>, n>(sets, active, pins, transfer::NodalProjection<dim>{L::velocity},
                                                     nullptr, &v_n);
-    transfer::assemble<dim, shape::Q1Box<dim>, dim>(sets, active, pins,
-                                                    transfer::NodalProjection<dim>{acceleration_offset}, nullptr, &a_n);
+      transfer::assemble<dim, shape::Q1Box<dim>, n>(sets, active, pins,
+                                                    transfer::NodalProjection<dim>{acceleration_offset}, nullptr,
+                                                    &a_n);
+    });
     for (unsigned int i = 0; i < mass.locally_owned_size(); ++i)
       {
         const double m = mass.local_element(i);
