@@ -338,11 +338,10 @@ namespace talus
     /// The walk of ActiveSet::couplings_covered: per point, every pair of the
     /// stencil slots it touches (as CollectCouplings) must be recorded at the
     /// first node of the pair. For the B-spline the touched slots come from the
-    /// 1D factors alone (transfer::touched_window_slots), and the pairs are
-    /// checked once per cell and window: the points of a cell share a handful
-    /// of windows (first slot and zero factors per direction), and the answer
-    /// depends on nothing else. This check was 5.5 % of a landslide step with
-    /// the full stencil and every pair per point (docs/semi-implicit.md).
+    /// 1D factors alone (transfer::touched_window_slots, no products), and the
+    /// pairs of a node are tested as one mask (WindowMasks). The check with the
+    /// full stencil and a bit test per pair was 5.5 % of a landslide step
+    /// (docs/semi-implicit.md).
     template <int dim, class K>
     struct CheckCouplings
     {
@@ -364,10 +363,6 @@ namespace talus
       bool                              recorded = false, covered = true;
 
       static constexpr bool bspline = std::is_same_v<K, shape::BSpline2Box<dim>>;
-      /// the windows of this cell already checked (B-spline), as window_key gives them
-      static constexpr unsigned int max_windows = 8;
-      std::uint32_t                 checked_windows[max_windows];
-      unsigned int                  n_checked_windows = 0;
 
       inline void
       begin_cell(const unsigned int c)
@@ -376,55 +371,92 @@ namespace talus
         covered  = covered && recorded;
         if (recorded)
           cell = K::cell(grid, c);
-        n_checked_windows = 0;
       }
-      /// What decides the touched slots of a B-spline window: per direction the
-      /// first slot (1 bit) and which of its 3 values and 3 derivatives are 0.
-      static std::uint32_t
-      window_key(const typename K::Eval &e)
+
+      /// B-spline: what a window's zero factors imply, the same in every cell
+      /// and for either first slot (a pair's offset bit is a difference of
+      /// window digits): the touched window nodes and, per touched node, the
+      /// bits of its offsets to all touched nodes, which its recorded bits must
+      /// contain. A point then costs one word test per node instead of one bit
+      /// test per pair.
+      struct WindowMasks
       {
-        std::uint32_t key = 0;
+        std::uint32_t zeros; ///< window_zeros of the windows it describes
+        unsigned int  n;     ///< touched window nodes
+        unsigned int  offset[K::n_point_nodes]; ///< their patch slots from the first window slot
+        std::uint64_t mask[K::n_point_nodes][offset_words];
+      };
+      std::vector<WindowMasks> windows; ///< the kinds met in this walk (a handful)
+      unsigned int             last = 0;
+
+      /// Per direction which of the window's 3 values and 3 derivatives are 0:
+      /// all that decides its touched nodes (transfer::touched_window_slots).
+      template <class Eval>
+      static std::uint32_t
+      window_zeros(const Eval &e)
+      {
+        std::uint32_t z = 0;
         for (unsigned int d = 0; d < dim; ++d)
-          {
-            std::uint32_t k = e.first[d];
-            for (unsigned int a = 0; a < 3; ++a)
-              k |= (std::uint32_t(e.N[d][a] == 0.0) << (1 + a)) | (std::uint32_t(e.dN[d][a] == 0.0) << (4 + a));
-            key |= k << (7 * d);
-          }
-        return key;
+          for (unsigned int a = 0; a < 3; ++a)
+            z |= (std::uint32_t(e.N[d][a] == 0.0) << (6 * d + a)) | (std::uint32_t(e.dN[d][a] == 0.0) << (6 * d + 3 + a));
+        return z;
       }
+      template <class Eval>
+      const WindowMasks &
+      masks_of(const Eval &e)
+      {
+        const std::uint32_t zeros = window_zeros(e);
+        if (last < windows.size() && windows[last].zeros == zeros)
+          return windows[last];
+        for (last = 0; last < windows.size(); ++last)
+          if (windows[last].zeros == zeros)
+            return windows[last];
+        Eval at_corner = e; // the same window from the patch's first slot
+        for (unsigned int d = 0; d < dim; ++d)
+          at_corner.first[d] = 0;
+        WindowMasks m{};
+        m.zeros = zeros;
+        m.n     = transfer::touched_window_slots<dim>(at_corner, m.offset);
+        for (unsigned int a = 0; a < m.n; ++a)
+          for (unsigned int b = 0; b < m.n; ++b)
+            offsets.set(m.mask[a], m.offset[a], m.offset[b]);
+        windows.push_back(m);
+        return windows.back(); // last == windows.size() - 1
+      }
+
       inline bool
       point(const unsigned int, transfer::PointIterator<dim> &it)
       {
         if (!recorded || !covered)
           return true;
-        unsigned int t[K::n_point_nodes], n = 0;
         if constexpr (bspline)
           {
             typename K::Eval e;
             K::evaluate(cell, it->get_reference_location(), e);
-            const std::uint32_t key = window_key(e);
-            for (unsigned int k = 0; k < n_checked_windows; ++k)
-              if (checked_windows[k] == key)
-                return true; // its pairs were checked (and found) for an earlier point
-            if (n_checked_windows < max_windows)
-              checked_windows[n_checked_windows++] = key;
-            n = transfer::touched_window_slots<dim>(e, t);
+            const WindowMasks &m     = masks_of(e);
+            const unsigned int first = shape::Window3<dim>::first_slot(e);
+            for (unsigned int a = 0; a < m.n; ++a)
+              {
+                const std::uint64_t *bits =
+                  node_neighbours.data() + std::size_t(cell.dofs[(first + m.offset[a]) * dim]) * offset_words;
+                for (unsigned int w = 0; w < offset_words; ++w)
+                  covered = covered && (bits[w] & m.mask[a][w]) == m.mask[a][w];
+              }
           }
         else
           {
-            unsigned int slot[K::n_point_nodes];
+            unsigned int slot[K::n_point_nodes], t[K::n_point_nodes], n = 0;
             double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
             K::point_stencil(cell, it->get_reference_location(), slot, N, G);
             for (unsigned int w = 0; w < K::n_point_nodes; ++w)
               if (transfer::touches<dim>(N[w], G[w]))
                 t[n++] = slot[w];
-          }
-        for (unsigned int a = 0; a < n; ++a)
-          {
-            const std::uint64_t *bits = node_neighbours.data() + std::size_t(cell.dofs[t[a] * dim]) * offset_words;
-            for (unsigned int b = 0; b < n; ++b)
-              covered = covered && offsets.is_set(bits, t[a], t[b]);
+            for (unsigned int a = 0; a < n; ++a)
+              {
+                const std::uint64_t *bits = node_neighbours.data() + std::size_t(cell.dofs[t[a] * dim]) * offset_words;
+                for (unsigned int b = 0; b < n; ++b)
+                  covered = covered && offsets.is_set(bits, t[a], t[b]);
+              }
           }
         return true;
       }
