@@ -290,19 +290,20 @@ namespace
     };
     EXPECT_TRUE(all_covered());
 
-    // move the first point of rank 0 (if it holds one) within its cell
-    auto &set = *s.sets[0];
+    // move the first point of rank 0 (if it holds one) within its cell, to 0.3
+    // of the cell in direction 0 (its window takes in the node below)
+    auto &     set   = *s.sets[0];
     const bool moves = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0 && set.handler.n_locally_owned_particles() > 0;
+    const auto shift = [&](auto it) {
+      dealii::Point<dim> ref = it->get_reference_location();
+      ref[0]                 = 0.3;
+      it->set_reference_location(ref);
+      dealii::Point<dim> x = it->get_surrounding_cell()->center();
+      x[0] += (ref[0] - 0.5) / n_cells;
+      it->set_location(x);
+    };
     if (moves)
-      {
-        auto               it  = set.handler.begin();
-        dealii::Point<dim> ref = it->get_reference_location();
-        ref[0]                 = 0.3;
-        it->set_reference_location(ref);
-        dealii::Point<dim> x = it->get_surrounding_cell()->center();
-        x[0] += (ref[0] - 0.5) / n_cells;
-        it->set_location(x);
-      }
+      shift(set.handler.begin());
     const unsigned int n_moved = dealii::Utilities::MPI::sum(unsigned(moves), MPI_COMM_WORLD);
     ASSERT_EQ(n_moved, 1u);
     EXPECT_EQ(all_covered(), !is_bspline<K>) << "a shifted B-spline window must leave the kept pattern";
@@ -316,12 +317,7 @@ namespace
         for (unsigned int i = 1; i < set.handler.n_locally_owned_particles(); ++i)
           ++last;
         ASSERT_NE(last->get_surrounding_cell(), set.handler.begin()->get_surrounding_cell());
-        dealii::Point<dim> ref = last->get_reference_location();
-        ref[0]                 = 0.3;
-        last->set_reference_location(ref);
-        dealii::Point<dim> x = last->get_surrounding_cell()->center();
-        x[0] += (ref[0] - 0.5) / n_cells;
-        last->set_location(x);
+        shift(last);
       }
     EXPECT_EQ(all_covered(), !is_bspline<K>) << "a window met before in another cell must be checked again";
     active.template reinit<K>(s.set_pointers(), record);
