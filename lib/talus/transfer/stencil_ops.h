@@ -16,6 +16,7 @@
 #include <talus/transfer/matrix_ops.h>
 
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 namespace talus::transfer
@@ -257,7 +258,9 @@ namespace talus::transfer
     {
       auto &                    e  = cache.entries[index++];
       const dealii::Point<dim> &xi = it->get_reference_location();
-      if (e.cell != c || !(e.xi == xi))
+      // the same bits, not the same value: -0.0 == 0.0, but the stencil's
+      // derivatives keep the sign of a zero xi, and a restarted run evaluates
+      if (e.cell != c || std::memcmp(&e.xi, &xi, sizeof(xi)) != 0)
         {
           point_stencil<dim, K>(K::cell(grid, c), xi, e.stencil);
           e.cell = c;
