@@ -227,6 +227,12 @@ namespace talus::transfer
     {
       entries.resize(n_points);
     }
+    /// stencils evaluated (not reused) since the cache was made
+    unsigned long long
+    evaluations() const
+    {
+      return n_evaluated;
+    }
 
   private:
     template <int, class, class>
@@ -238,6 +244,7 @@ namespace talus::transfer
       PointStencil<dim, K> stencil;
     };
     std::vector<Entry> entries;
+    unsigned long long n_evaluated = 0;
   };
 
   /// VisitStencils through a StencilCache.
@@ -265,6 +272,7 @@ namespace talus::transfer
           point_stencil<dim, K>(K::cell(grid, c), xi, e.stencil);
           e.cell = c;
           e.xi   = xi;
+          ++cache.n_evaluated;
         }
       visit(c, it, static_cast<const PointStencil<dim, K> &>(e.stencil));
       return true;
