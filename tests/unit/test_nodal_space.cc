@@ -29,6 +29,7 @@
 #include <Epetra_CrsGraph.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <iostream>
@@ -289,24 +290,38 @@ namespace
     };
     EXPECT_TRUE(all_covered());
 
-    // move the first point of rank 0 (if it holds one) within its cell
-    auto &set = *s.sets[0];
+    // move the first point of rank 0 (if it holds one) within its cell, to 0.3
+    // of the cell in direction 0 (its window takes in the node below)
+    auto &     set   = *s.sets[0];
     const bool moves = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0 && set.handler.n_locally_owned_particles() > 0;
+    const auto shift = [&](auto it) {
+      dealii::Point<dim> ref = it->get_reference_location();
+      ref[0]                 = 0.3;
+      it->set_reference_location(ref);
+      dealii::Point<dim> x = it->get_surrounding_cell()->center();
+      x[0] += (ref[0] - 0.5) / n_cells;
+      it->set_location(x);
+    };
     if (moves)
-      {
-        auto               it  = set.handler.begin();
-        dealii::Point<dim> ref = it->get_reference_location();
-        ref[0]                 = 0.3;
-        it->set_reference_location(ref);
-        dealii::Point<dim> x = it->get_surrounding_cell()->center();
-        x[0] += (ref[0] - 0.5) / n_cells;
-        it->set_location(x);
-      }
+      shift(set.handler.begin());
     const unsigned int n_moved = dealii::Utilities::MPI::sum(unsigned(moves), MPI_COMM_WORLD);
     ASSERT_EQ(n_moved, 1u);
     EXPECT_EQ(all_covered(), !is_bspline<K>) << "a shifted B-spline window must leave the kept pattern";
     active.template reinit<K>(s.set_pointers(), record);
     EXPECT_TRUE(all_covered()) << "after a rebuild the pattern holds the points' couplings again";
+    // the same shift of a point in a later cell: the window of the first point
+    // (checked and found recorded) says nothing about this cell's nodes
+    if (moves)
+      {
+        auto last = set.handler.begin();
+        for (unsigned int i = 1; i < set.handler.n_locally_owned_particles(); ++i)
+          ++last;
+        ASSERT_NE(last->get_surrounding_cell(), set.handler.begin()->get_surrounding_cell());
+        shift(last);
+      }
+    EXPECT_EQ(all_covered(), !is_bspline<K>) << "a window met before in another cell must be checked again";
+    active.template reinit<K>(s.set_pointers(), record);
+    EXPECT_TRUE(all_covered());
     // a point of a second set in a cell the pattern was not built for
     Scene<dim> other(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
                      {{filled<dim>(0), filled<dim>(0.25), 1000, 1}}, is_bspline<K>);
@@ -324,6 +339,66 @@ namespace
   TEST(ActiveSet, KeptPatternWindowShiftQ1_3D) { kept_pattern_detects_window_shift<3, Q1_3>(); }
   TEST(ActiveSet, KeptPatternWindowShiftBSpline2D) { kept_pattern_detects_window_shift<2, BS_2>(); }
   TEST(ActiveSet, KeptPatternWindowShiftBSpline3D) { kept_pattern_detects_window_shift<3, BS_3>(); }
+
+  /// transfer::touched_window_slots (the kept-pattern check's touched nodes, no
+  /// products) against the filter of point_stencil (value or gradient non-zero)
+  /// at reference coordinates where window nodes vanish (0.5: the third node of
+  /// an interior window; 0 and 1: a wall hat) and next to them, in wall and
+  /// interior cells: the same slots in the same order (a superset where
+  /// products of 1e-300 factors underflow).
+  template <int dim>
+  void
+  touched_window_slots_match_point_stencil()
+  {
+    using K = shape::BSpline2Box<dim>;
+    const unsigned int n_cells = 5;
+    Scene<dim> s(MPI_COMM_SELF, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells), {}, true);
+    const std::vector<double> xis = {0.0, 1e-300, 1e-17, 0.25, std::nextafter(0.5, 0.0), 0.5,
+                                     std::nextafter(0.5, 1.0), 0.75, std::nextafter(1.0, 0.0), 1.0};
+    unsigned long long compared = 0, differ = 0;
+    for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
+      {
+        const auto cell = K::cell(s.grid, c);
+        std::array<unsigned int, dim> digit{};
+        for (bool more = true; more;)
+          {
+            dealii::Point<dim> xi;
+            for (unsigned int d = 0; d < dim; ++d)
+              xi[d] = xis[digit[d]];
+            unsigned int slot[K::n_point_nodes], from_products[K::n_point_nodes], n = 0;
+            double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+            K::point_stencil(cell, xi, slot, N, G);
+            for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+              if (transfer::touches<dim>(N[w], G[w]))
+                from_products[n++] = slot[w];
+            typename K::Eval e;
+            K::evaluate(cell, xi, e);
+            unsigned int from_factors[K::n_point_nodes];
+            const unsigned int m = transfer::touched_window_slots<dim>(e, from_factors);
+            bool same = m == n, superset = true;
+            for (unsigned int k = 0; same && k < n; ++k)
+              same = from_factors[k] == from_products[k];
+            for (unsigned int k = 0; k < n; ++k)
+              superset = superset && std::find(from_factors, from_factors + m, from_products[k]) != from_factors + m;
+            // products of several 1e-300 factors underflow: then more slots, never fewer
+            bool tiny = false;
+            for (unsigned int d = 0; d < dim; ++d)
+              tiny = tiny || (xi[d] > 0 && xi[d] < 1e-200);
+            differ += !superset || (!tiny && !same);
+            ++compared;
+            more = false;
+            for (unsigned int d = 0; d < dim && !more; ++d)
+              if (++digit[d] < xis.size())
+                more = true;
+              else
+                digit[d] = 0;
+          }
+      }
+    EXPECT_EQ(differ, 0u) << "of " << compared;
+    EXPECT_GT(compared, 0u);
+  }
+  TEST(ActiveSet, TouchedWindowSlotsMatchPointStencil2D) { touched_window_slots_match_point_stencil<2>(); }
+  TEST(ActiveSet, TouchedWindowSlotsMatchPointStencil3D) { touched_window_slots_match_point_stencil<3>(); }
 
   TEST(ActiveSet, SparsityActiveRegionOnlyQ1_2D) { sparsity_active_region_only<2, Q1_2>(); }
   TEST(ActiveSet, SparsityActiveRegionOnlyQ1_3D) { sparsity_active_region_only<3, Q1_3>(); }

@@ -20,39 +20,61 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
 
 using namespace talus;
 
 namespace
 {
+  /// A box grid of 4 x 5 (x 6) cells and one set of points (3 per direction)
+  /// over a box that touches the lower walls, not the upper ones, with two
+  /// extra properties.
+  template <int dim>
+  struct Scene
+  {
+    explicit Scene(const bool bspline)
+      : grid(MPI_COMM_WORLD)
+    {
+      std::vector<unsigned int> cells;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          lo[d] = 0;
+          hi[d] = 1.0 + 0.25 * d;
+          cells.push_back(4 + d);
+        }
+      grid.make_box(lo, hi, cells);
+      grid.setup();
+      if (bspline)
+        grid.setup_bspline_patches();
+      set         = std::make_unique<MaterialPointSet<dim>>(grid, "points");
+      coefficient = set->layout.add_extra("coefficient", 1);
+      source      = set->layout.add_extra("source", 1);
+      set->initialize();
+      BodyDescription<dim> body;
+      for (unsigned int d = 0; d < dim; ++d)
+        body.lower[d] = 0, body.upper[d] = 0.7 * hi[d];
+      body.particles_per_direction = 3;
+      seed_bodies(grid, {body}, {1500.0}, set->layout, set->handler);
+      set->collect_active_cells();
+    }
+    BackgroundGrid<dim>                    grid;
+    dealii::Point<dim>                     lo, hi;
+    std::unique_ptr<MaterialPointSet<dim>> set;
+    unsigned int                           coefficient = 0, source = 0;
+  };
+
   template <int dim, class K>
   void
   run_checks(const bool bspline)
   {
     using L = PropertyLayout<dim>;
-    BackgroundGrid<dim> grid(MPI_COMM_WORLD);
-    dealii::Point<dim>  lo, hi;
-    std::vector<unsigned int> cells;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        lo[d] = 0;
-        hi[d] = 1.0 + 0.25 * d;
-        cells.push_back(4 + d);
-      }
-    grid.make_box(lo, hi, cells);
-    grid.setup();
-    if (bspline)
-      grid.setup_bspline_patches();
-    MaterialPointSet<dim> set(grid, "points");
-    const unsigned int    coefficient = set.layout.add_extra("coefficient", 1);
-    const unsigned int    source      = set.layout.add_extra("source", 1);
-    set.initialize();
-    BodyDescription<dim> body; // touches the lower walls, not the upper ones
-    for (unsigned int d = 0; d < dim; ++d)
-      body.lower[d] = 0, body.upper[d] = 0.7 * hi[d];
-    body.particles_per_direction = 3;
-    seed_bodies(grid, {body}, {1500.0}, set.layout, set.handler);
-    set.collect_active_cells();
+    Scene<dim>                scene(bspline);
+    BackgroundGrid<dim> &     grid        = scene.grid;
+    MaterialPointSet<dim> &   set         = *scene.set;
+    const unsigned int        coefficient = scene.coefficient, source = scene.source;
 
     // a linear velocity field v = a + B x on the points, varying coefficients
     const double a[3] = {0.3, -0.2, 0.1}, B[3][3] = {{0.5, -1.0, 0.2}, {0.7, 0.25, -0.4}, {0.1, 0.3, -0.6}};
@@ -184,7 +206,93 @@ namespace
     A.vmult(Ay, y);
     EXPECT_NEAR(Ax * y, x * Ay, 1e-12 * A.linfty_norm() * x.l2_norm() * y.l2_norm());
   }
+
+  /// StencilCache: a cached walk hands every point the stencil a fresh
+  /// evaluation gives, bit for bit, after each change the points go through
+  /// between walks (a move inside the cell, a reference coordinate 0.0 turned
+  /// into -0.0, a move into another cell placed by deal.II's sort, a removed
+  /// point), and evaluates nothing when nothing changed.
+  template <int dim, class K>
+  void
+  stencil_cache_follows_the_points(const bool bspline)
+  {
+    using S = transfer::PointStencil<dim, K>;
+    Scene<dim>             scene(bspline);
+    MaterialPointSet<dim> &set = *scene.set;
+    const MPI_Comm         comm = MPI_COMM_WORLD;
+    transfer::StencilCache<dim, K> cache;
+    const auto same_bits = [](const S &a, const S &b) {
+      bool same = a.n == b.n;
+      for (unsigned int w = 0; same && w < a.n; ++w)
+        same = std::memcmp(a.dof[w], b.dof[w], sizeof(a.dof[w])) == 0 && std::memcmp(&a.N[w], &b.N[w], sizeof(double)) == 0 &&
+               std::memcmp(a.G[w], b.G[w], sizeof(a.G[w])) == 0;
+      return same;
+    };
+    // the number of stencils the cached walk evaluated; every one checked
+    const auto walk = [&](const std::string &after) {
+      std::vector<S> fresh;
+      transfer::for_each_point_stencil<dim, K>(scene.grid, set, [&](unsigned int, auto &, const S &s) { fresh.push_back(s); });
+      const unsigned long long before = cache.evaluations();
+      unsigned int             k = 0, differ = 0;
+      transfer::for_each_point_stencil<dim, K>(scene.grid, set, cache, [&](unsigned int, auto &, const S &s) {
+        differ += !same_bits(s, fresh[k++]);
+      });
+      EXPECT_EQ(dealii::Utilities::MPI::sum(differ, comm), 0u) << after;
+      EXPECT_EQ(k, fresh.size());
+      return dealii::Utilities::MPI::sum(cache.evaluations() - before, comm);
+    };
+    const unsigned long long n = set.handler.n_global_particles();
+    EXPECT_EQ(walk("the first walk"), n);
+    EXPECT_EQ(walk("an unchanged set"), 0u) << "nothing changed: every stencil reused";
+
+    // one point of an interior cell (direction 0; on the first rank that has
+    // one) to 0.3 of its cell, then to 0.0 and -0.0
+    auto moved = set.handler.begin();
+    while (moved != set.handler.end() && !(moved->get_location()[0] > 0.3 && moved->get_location()[0] < 0.45))
+      ++moved;
+    const unsigned int rank  = dealii::Utilities::MPI::this_mpi_process(comm);
+    const unsigned int first = dealii::Utilities::MPI::min(moved != set.handler.end() ? rank : ~0u, comm);
+    const bool         moves = rank == first;
+    EXPECT_EQ(dealii::Utilities::MPI::sum(unsigned(moves), comm), 1u);
+    const auto place = [&](const double xi0) {
+      if (!moves)
+        return;
+      dealii::Point<dim> ref = moved->get_reference_location();
+      ref[0]                 = xi0;
+      moved->set_reference_location(ref);
+    };
+    place(0.3);
+    EXPECT_EQ(walk("a move inside the cell"), 1u);
+    place(0.0);
+    EXPECT_EQ(walk("xi = 0"), 1u);
+    place(-0.0);
+    EXPECT_EQ(walk("xi = -0 (the same value, other bits)"), 1u);
+
+    // a point into the next cell (direction 0), placed by deal.II's sort
+    if (moves)
+      {
+        dealii::Point<dim> x = moved->get_location();
+        x[0] += 0.25;
+        moved->set_location(x);
+      }
+    set.handler.sort_particles_into_subdomains_and_cells();
+    set.collect_active_cells();
+    walk("a move into another cell and a sort");
+    EXPECT_EQ(walk("an unchanged set after the sort"), 0u);
+
+    // a removed point: the walk's places shift
+    if (rank == 0 && set.handler.n_locally_owned_particles() > 1)
+      set.handler.remove_particle(set.handler.begin());
+    set.collect_active_cells();
+    walk("a removed point");
+    EXPECT_EQ(walk("an unchanged set after the removal"), 0u);
+  }
 } // namespace
+
+TEST(StencilCache, FollowsThePointsQ1In2D) { stencil_cache_follows_the_points<2, shape::Q1Box<2>>(false); }
+TEST(StencilCache, FollowsThePointsQ1In3D) { stencil_cache_follows_the_points<3, shape::Q1Box<3>>(false); }
+TEST(StencilCache, FollowsThePointsBSplineIn2D) { stencil_cache_follows_the_points<2, shape::BSpline2Box<2>>(true); }
+TEST(StencilCache, FollowsThePointsBSplineIn3D) { stencil_cache_follows_the_points<3, shape::BSpline2Box<3>>(true); }
 
 TEST(StencilOps, Q1In2D) { run_checks<2, shape::Q1Box<2>>(false); }
 TEST(StencilOps, Q1In3D) { run_checks<3, shape::Q1Box<3>>(false); }

@@ -70,6 +70,20 @@ namespace talus::transfer
     // scratch per cell
     std::vector<unsigned int> local, free_rows, fixed_rows, inhomogeneous, order;
     std::vector<int>                                   column;
+    /// Epetra local row and column index of each partitioner-local DoF, looked
+    /// up at its first use in this assembly (-2: not yet, -1: not in the map):
+    /// a map's LID is a hash look-up, and a DoF comes up in every cell of its
+    /// support (up to 4^dim B-spline patches)
+    std::vector<int> row_lid, col_lid;
+    static inline int
+    cached_lid(std::vector<int> &cache, const Epetra_Map &map, const unsigned int l,
+               const dealii::types::global_dof_index g)
+    {
+      int &id = cache[l];
+      if (id == -2)
+        id = map.LID(static_cast<int>(g));
+      return id;
+    }
     std::vector<dealii::types::global_dof_index>       cols;
     std::vector<double>                                vals;
 
@@ -104,6 +118,8 @@ namespace talus::transfer
           value[l]             = line.inhomogeneity;
         }
       slot.assign(E->ColMap().NumMyElements(), 0);
+      row_lid.assign(n, -2);
+      col_lid.assign(n, -2);
       usable = true;
     }
 
@@ -177,20 +193,20 @@ namespace talus::transfer
           (state[local[i]] == 0 ? free_rows : fixed_rows).push_back(i);
         }
       const Epetra_Map &row_map = E->RowMap(), &col_map = E->ColMap();
-      const auto        to_int  = [](const dealii::types::global_dof_index g) { return static_cast<int>(g); };
+      const auto        row_of  = [&](const unsigned int i) { return cached_lid(row_lid, row_map, local[i], dofs[i]); };
 
       // Epetra column index of every local DoF (-1: not in the column map, in
       // no pattern row here)
       column.resize(m);
       for (unsigned int i = 0; i < m; ++i)
-        column[i] = col_map.LID(to_int(dofs[i]));
+        column[i] = cached_lid(col_lid, col_map, local[i], dofs[i]);
 
       // (1) matrix rows of the free DoFs, free columns only (deal.II:
       // resolve_matrix_row, zero entries elided)
       for (const unsigned int r : free_rows)
         {
           const double *row = Al + r * stride;
-          const int     lr  = row_map.LID(to_int(dofs[r]));
+          const int     lr  = row_of(r);
           if (lr >= 0)
             {
               open_row(lr);
@@ -268,7 +284,7 @@ namespace talus::transfer
           for (const unsigned int i : fixed_rows)
             {
               const double d  = Al[i * stride + i] != 0.0 ? std::abs(Al[i * stride + i]) : average;
-              const int    lr = row_map.LID(to_int(dofs[i]));
+              const int    lr = row_of(i);
               if (lr >= 0)
                 {
                   open_row(lr);

@@ -18,6 +18,7 @@
 
 #include <talus/grid/nodal_space.h>
 #include <talus/particles/material_points.h>
+#include <talus/shape/window3.h>
 #include <talus/transfer/cell_walk.h>
 
 #include <deal.II/base/numbers.h>
@@ -44,6 +45,42 @@ namespace talus::transfer
     for (unsigned int d = 0; d < dim; ++d)
       t = t || G[d] != 0.0;
     return t;
+  }
+
+  /// The patch slots a quadratic B-spline point touches (as `touches` on each
+  /// node of its point_stencil), found from its 1D factors alone (no products):
+  /// a window node's value and gradient components are products of one 1D
+  /// value or derivative per direction, so the node is touched iff every
+  /// direction's value is non-zero, or all but one are and that one's
+  /// derivative is. Exact unless a product of non-zero factors underflows
+  /// (inside a cell the 1D factors are 0 or above 2^-110, except a wall hat
+  /// of a point within ~1e-290 of its node); then it names more nodes than the
+  /// products do, never fewer. Slots in window order, as point_stencil's
+  /// filter gives them; returns their number.
+  template <int dim>
+  inline unsigned int
+  touched_window_slots(const typename shape::Window3<dim>::Eval &e, unsigned int (&slot)[shape::Window3<dim>::n_nodes])
+  {
+    using W                  = shape::Window3<dim>;
+    const unsigned int first = W::first_slot(e);
+    unsigned int       n     = 0;
+    for (unsigned int w = 0; w < W::n_nodes; ++w)
+      {
+        unsigned int zero_values = 0;
+        bool         dead        = false; // a direction with value and derivative 0
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const unsigned int a = W::digit(w, d);
+            if (e.N[d][a] == 0.0)
+              {
+                ++zero_values;
+                dead = dead || e.dN[d][a] == 0.0;
+              }
+          }
+        if (!dead && zero_values <= 1)
+          slot[n++] = first + W::window_offset(w);
+      }
+    return n;
   }
 
   /// The nodes of each cell that points touch and the node pairs that share a
@@ -342,7 +379,8 @@ namespace talus::transfer
     const BackgroundGrid<dim> &              grid;
     const NodalSpace<dim> &                  space;
     const dealii::AffineConstraints<double> &constraints;
-    const Integrand                          integrand;
+    /// (not const: a walk over several sets, for_each_cell_of_sets, switches it per set)
+    Integrand                                integrand;
     dealii::TrilinosWrappers::SparseMatrix * A;
     Vector *                                 b;
     const Vector *                           field;
@@ -442,6 +480,82 @@ namespace talus::transfer
                        Integrand::vector ? b : nullptr);
     }
   };
+
+  /// The walk of several point sets cell by cell: for every cell that holds
+  /// points of any set, op.begin_cell(c), then for each set k (in the order
+  /// given) with points in c select_set(k) and op.point(c, it) for those
+  /// points, then op.end_cell(c). An assembly then distributes one local
+  /// system per cell for all sets instead of one per set (the semi-implicit
+  /// Poisson matrix over soil and water: docs/semi-implicit.md). Cells in the
+  /// storage order of the first set, then the cells of the second that the
+  /// first has no points in, and so on: the order follows the storage only,
+  /// so a restart that restores the storage repeats it.
+  template <int dim, class Op, class SelectSet>
+  void
+  for_each_cell_of_sets(const BackgroundGrid<dim> &grid, const std::vector<MaterialPointSet<dim> *> &sets, Op &op,
+                        SelectSet &&select_set)
+  {
+    if (sets.empty())
+      return;
+    // every set but the first: its cell groups (first point, count) and the
+    // group of each cell
+    struct Group
+    {
+      unsigned int       cell, n;
+      PointIterator<dim> first;
+      bool               walked;
+    };
+    const unsigned int                     none = dealii::numbers::invalid_unsigned_int;
+    std::vector<std::vector<Group>>        groups(sets.size());
+    std::vector<std::vector<unsigned int>> group_of_cell(sets.size());
+    for (unsigned int k = 1; k < sets.size(); ++k)
+      {
+        group_of_cell[k].assign(grid.cells.size(), none);
+        groups[k].reserve(sets[k]->active_cells().size());
+        auto it = sets[k]->handler.begin();
+        for (const auto [c, n] : sets[k]->active_cells())
+          {
+            group_of_cell[k][c] = groups[k].size();
+            groups[k].push_back({c, n, it, false});
+            for (unsigned int i = 0; i < n; ++i)
+              ++it;
+          }
+      }
+    // the points of the sets from k on in cell c, except those of the driving set
+    const auto other_sets_in = [&](const unsigned int c, const unsigned int from) {
+      for (unsigned int k = from; k < sets.size(); ++k)
+        if (const unsigned int g = group_of_cell[k][c]; g != none && !groups[k][g].walked)
+          {
+            Group &group = groups[k][g];
+            group.walked = true;
+            select_set(k);
+            auto it = group.first;
+            for (unsigned int i = 0; i < group.n; ++i, ++it)
+              op.point(c, it);
+          }
+    };
+    {
+      auto            pt = sets[0]->handler.begin();
+      Prefetcher<dim> ahead(sets[0]->handler, prefetch_distance);
+      for (const auto [c, n] : sets[0]->active_cells())
+        {
+          op.begin_cell(c);
+          select_set(0);
+          for (unsigned int i = 0; i < n; ++i, ++pt, ahead.next(Op::prefetch_location))
+            op.point(c, pt);
+          other_sets_in(c, 1);
+          op.end_cell(c);
+        }
+    }
+    for (unsigned int k = 1; k < sets.size(); ++k)
+      for (const Group &group : groups[k])
+        if (!group.walked)
+          {
+            op.begin_cell(group.cell);
+            other_sets_in(group.cell, k);
+            op.end_cell(group.cell);
+          }
+  }
 
   /// A += and/or b += the integrand summed over the points of all `sets`, then
   /// finish_assembly. A (reinit by ActiveSet::reinit_matrix) and b (the space's

@@ -16,6 +16,8 @@
 #include <talus/transfer/matrix_ops.h>
 
 #include <algorithm>
+#include <cstring>
+#include <vector>
 
 namespace talus::transfer
 {
@@ -198,6 +200,99 @@ namespace talus::transfer
     for_each_active_cell(set, op);
   }
 
+  /// The stencils of a set's points as the last walk with this cache met
+  /// them, in walk order, each with the cell and reference location it was
+  /// evaluated at. A walk reuses the entry at a point's place in the walk when
+  /// the point has that cell and bitwise that reference location, and
+  /// evaluates (and stores) the stencil otherwise: the points themselves say
+  /// at every use whether an entry holds, so moves, relocations, sorts,
+  /// restarts and points that come or go need no notice, and a reused stencil
+  /// is bitwise the one the evaluation would give. Only a change of the grid
+  /// (its DoF numbering: a repartition) is not seen by the points: clear() then.
+  /// The semi-implicit step walks each set 5-7 times between two moves
+  /// (docs/semi-implicit.md).
+  template <int dim, class K>
+  class StencilCache
+  {
+  public:
+    void
+    clear()
+    {
+      entries.clear();
+    }
+    /// one entry per point of the coming walk (entries beyond a walk's points
+    /// hold for nobody; the checks sort out the rest)
+    void
+    fit(const std::size_t n_points)
+    {
+      entries.resize(n_points);
+    }
+    /// stencils evaluated (not reused) since the cache was made
+    unsigned long long
+    evaluations() const
+    {
+      return n_evaluated;
+    }
+
+  private:
+    template <int, class, class>
+    friend struct VisitCachedStencils;
+    struct Entry
+    {
+      unsigned int         cell = dealii::numbers::invalid_unsigned_int;
+      dealii::Point<dim>   xi;
+      PointStencil<dim, K> stencil;
+    };
+    std::vector<Entry> entries;
+    unsigned long long n_evaluated = 0;
+  };
+
+  /// VisitStencils through a StencilCache.
+  template <int dim, class K, class Visit>
+  struct VisitCachedStencils
+  {
+    const BackgroundGrid<dim> &grid;
+    Visit &                    visit;
+    StencilCache<dim, K> &     cache;
+    static constexpr bool      prefetch_location = false;
+    unsigned int               index = 0; ///< the point's place in the walk
+
+    inline void
+    begin_cell(const unsigned int)
+    {}
+    inline bool
+    point(const unsigned int c, PointIterator<dim> &it)
+    {
+      auto &                    e  = cache.entries[index++];
+      const dealii::Point<dim> &xi = it->get_reference_location();
+      // the same bits, not the same value: -0.0 == 0.0, but the stencil's
+      // derivatives keep the sign of a zero xi, and a restarted run evaluates
+      if (e.cell != c || std::memcmp(&e.xi, &xi, sizeof(xi)) != 0)
+        {
+          point_stencil<dim, K>(K::cell(grid, c), xi, e.stencil);
+          e.cell = c;
+          e.xi   = xi;
+          ++cache.n_evaluated;
+        }
+      visit(c, it, static_cast<const PointStencil<dim, K> &>(e.stencil));
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {}
+  };
+
+  /// for_each_point_stencil with the stencils kept in `cache` for the next walk.
+  template <int dim, class K, class Visit>
+  inline void
+  for_each_point_stencil(const BackgroundGrid<dim> &grid, MaterialPointSet<dim> &set, StencilCache<dim, K> &cache,
+                         Visit &&visit)
+  {
+    cache.fit(set.handler.n_locally_owned_particles());
+    VisitCachedStencils<dim, K, std::remove_reference_t<Visit>> op{grid, visit, cache};
+    for_each_active_cell(set, op);
+  }
+
   /// f[node][d] += V_p N (grad phi)(x_p) over every point of `set`: the weak
   /// gradient force of a nodal scalar phi (the pressure terms G p of the
   /// semi-implicit predictor and correction), V_p in the point's `volume_slot`.
@@ -207,27 +302,30 @@ namespace talus::transfer
   inline void
   scatter_weak_gradient(const BackgroundGrid<dim> &grid,
                         MaterialPointSet<dim> &    set,
+                        StencilCache<dim, K> &     cache,
                         const double *             phi,
                         const unsigned int         volume_slot,
                         double *                   f,
                         Also &&                    also)
   {
-    for_each_point_stencil<dim, K>(grid, set, [&](unsigned int, PointIterator<dim> &it, const PointStencil<dim, K> &s) {
-      also(it, s);
-      double g[dim];
-      s.gradient(phi, g);
-      s.scatter_vector(f, it->get_properties()[volume_slot], g);
-    });
+    for_each_point_stencil<dim, K>(grid, set, cache,
+                                   [&](unsigned int, PointIterator<dim> &it, const PointStencil<dim, K> &s) {
+                                     also(it, s);
+                                     double g[dim];
+                                     s.gradient(phi, g);
+                                     s.scatter_vector(f, it->get_properties()[volume_slot], g);
+                                   });
   }
   template <int dim, class K>
   inline void
   scatter_weak_gradient(const BackgroundGrid<dim> &grid,
                         MaterialPointSet<dim> &    set,
+                        StencilCache<dim, K> &     cache,
                         const double *             phi,
                         const unsigned int         volume_slot,
                         double *                   f)
   {
-    scatter_weak_gradient<dim, K>(grid, set, phi, volume_slot, f,
+    scatter_weak_gradient<dim, K>(grid, set, cache, phi, volume_slot, f,
                                   [](PointIterator<dim> &, const PointStencil<dim, K> &) {});
   }
 

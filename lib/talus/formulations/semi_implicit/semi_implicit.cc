@@ -44,6 +44,7 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 namespace talus::semi_implicit
 {
@@ -680,6 +681,29 @@ namespace talus::semi_implicit
     } phase;
     template <class K>
     double shape_walk_seconds(); // one stencil walk over both sets (summary)
+    /// Each set's point stencils, kept between the walks of a step (the
+    /// positions change only at the move): transfer::StencilCache checks every
+    /// entry against its point at each use; cleared when the grid changes.
+    struct StencilCaches
+    {
+      transfer::StencilCache<dim, shape::BSpline2Box<dim>> bspline;
+      transfer::StencilCache<dim, shape::Q1Box<dim>>        linear;
+      void clear()
+      {
+        bspline.clear();
+        linear.clear();
+      }
+    } soil_stencils, water_stencils;
+    template <class K>
+    transfer::StencilCache<dim, K> &
+    stencils(const MaterialPointSet<dim> &set)
+    {
+      StencilCaches &c = &set == &soil ? soil_stencils : water_stencils;
+      if constexpr (std::is_same_v<K, shape::BSpline2Box<dim>>)
+        return c.bspline;
+      else
+        return c.linear;
+    }
   };
 
   template <int dim>
@@ -697,6 +721,8 @@ namespace talus::semi_implicit
   Solver<dim>::grid_changed()
   {
     pspace.setup();
+    soil_stencils.clear(); // their DoF indices are of the old partition
+    water_stencils.clear();
     constrained = loads::wall_dof_flags(grid, prm.boundary_conditions);
 
     // node and component of every local grid DoF (from the cells' vertex DoFs)
@@ -1022,7 +1048,7 @@ namespace talus::semi_implicit
     {
       double *ms = at(Ms), *ps = at(Ps), *mn = at(Mn), *mk = at(Mk), *fsv = at(Fs);
       Stencil surface; // a loaded point's stencil at its share of the face
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int c, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int c, It &it, const Stencil &s) {
         const double *P = it->get_properties().data();
         const double  m = P[L::mass];
         s.scatter(ms, m);
@@ -1073,7 +1099,7 @@ namespace talus::semi_implicit
       const double *nn = at(n_node);
       double *      ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw), *mwg = at(Mwg);
       const bool    linear = prm.linear_smoothing;
-      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int c, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int c, It &it, const Stencil &s) {
         double *     P  = it->get_properties().data();
         const double n  = std::clamp(s.value(nn), 1e-6, 1.0);
         const double V0 = P[fw.initial_volume];
@@ -1132,11 +1158,11 @@ namespace talus::semi_implicit
     {
       const double *pn = at(p_node);
       double *      gpw = at(Gpw), *gps = at(Gps);
-      transfer::scatter_weak_gradient<dim, K>(grid, water, pn, L::volume, gpw, [&](It &it, const Stencil &s) {
+      transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), pn, L::volume, gpw, [&](It &it, const Stencil &s) {
         if (prm.pressure_smoothing)
           it->get_properties()[fw.pressure] = s.value(pn);
       });
-      transfer::scatter_weak_gradient<dim, K>(grid, soil, pn, L::volume, gps);
+      transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), pn, L::volume, gps);
     }
     exchange({&Gpw, &Gps});
     add_lap(phase.p2n);
@@ -1184,7 +1210,7 @@ namespace talus::semi_implicit
     // soil, n for the water; point porosity, see docs/semi-implicit.md)
     {
       const double *vss = at(vs_star), *vws = at(vw_star);
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
         double *     P   = it->get_properties().data();
         const double phi = 1 - P[fs.porosity];
         const double rs  = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
@@ -1194,7 +1220,7 @@ namespace talus::semi_implicit
         for (unsigned int d = 0; d < dim; ++d)
           P[fs.poisson_flux + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
       });
-      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
         double *     P   = it->get_properties().data();
         const double phi = P[fw.porosity];
         P[fw.poisson_coefficient] = h * phi / rw;
@@ -1301,13 +1327,15 @@ namespace talus::semi_implicit
     pspace.reinit_vector(rhs);
     pspace.reinit_vector(dp_solution);
     {
-      PoissonWithFlux soil_terms{fs.poisson_coefficient, fs.poisson_flux};
-      PoissonWithFlux water_terms{fw.poisson_coefficient, fw.poisson_flux};
-      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> as(active, constraints, soil_terms, &A, &rhs);
-      transfer::for_each_active_cell(soil, as);
-      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> aw(active, constraints, water_terms, &A, &rhs);
-      transfer::for_each_active_cell(water, aw);
-      transfer::finish_assembly(active, as.diag_sum + aw.diag_sum, as.diag_count + aw.diag_count, &A, &rhs);
+      // one local system per cell for the soil and the water points of the
+      // cell, distributed once (the distribution was the step's largest single
+      // cost when each set's cells were distributed on their own)
+      const PoissonWithFlux terms[2] = {{fs.poisson_coefficient, fs.poisson_flux},
+                                        {fw.poisson_coefficient, fw.poisson_flux}};
+      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> assembly(active, constraints, terms[0], &A, &rhs);
+      transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
+                                           [&](const unsigned int k) { assembly.integrand = terms[k]; });
+      transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, &A, &rhs);
     }
     add_lap(phase.poisson);
     {
@@ -1336,8 +1364,8 @@ namespace talus::semi_implicit
     {
       const double *dpn = at(dp_node);
       double *      gsv = at(gs), *gwv = at(gw);
-      transfer::scatter_weak_gradient<dim, K>(grid, soil, dpn, L::volume, gsv);
-      transfer::scatter_weak_gradient<dim, K>(grid, water, dpn, L::volume, gwv);
+      transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, gsv);
+      transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), dpn, L::volume, gwv);
     }
     exchange({&gs, &gw});
     add_lap(phase.p2n);
@@ -1363,7 +1391,7 @@ namespace talus::semi_implicit
       const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *dpn = at(dp_node), *pn = at(p_node);
       const double  flip = prm.flip_fraction;
       double *      ps = at(Ps);
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
         double *P = it->get_properties().data();
         double  a[dim], b[dim];
         s.vector_value(vsn, a);
@@ -1372,7 +1400,7 @@ namespace talus::semi_implicit
           P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
         s.scatter_vector(ps, P[L::mass], P + L::velocity);
       });
-      transfer::for_each_point_stencil<dim, K>(grid, water, [&](unsigned int, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
         double *P = it->get_properties().data();
         double  a[dim], b[dim];
         s.vector_value(vwn, a);
@@ -1605,7 +1633,7 @@ namespace talus::semi_implicit
     {
       const double *v  = vs_t.begin();
       double *      mj = Mdj.begin(), *mt = Mjt.begin();
-      transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
         double *P = it->get_properties().data();
         double  gv[dim][dim];
         s.vector_gradient(v, gv);
@@ -1646,7 +1674,7 @@ namespace talus::semi_implicit
           Mjt.local_element(i)   = m > ms_cut ? Mjt.local_element(i) / m : 0.0; // now J_I
         }
     const double *dj = Mdj.begin(), *jt = Mjt.begin();
-    transfer::for_each_point_stencil<dim, K>(grid, soil, [&](unsigned int, It &it, const Stencil &s) {
+    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
       double *P = it->get_properties().data();
       // the stencil's nodes all carry soil mass (this point's), so the
       // partition of unity holds: a uniform dJ is returned exactly
