@@ -29,9 +29,7 @@ T_newmark = T * w * dt / (2 * math.atan(w * dt / 2))
 tv.check(dt / (h / c) >= 10 - 1e-9, f"time step {dt} = {dt / (h / c):.1f} x the explicit critical step {h / c:.3e} s")
 s = tv.read_csv(f"{work}/out/series.csv")
 t, x = s["time"], [v - s["centre_of_mass_x"][0] for v in s["centre_of_mass_x"]]
-up = tv.zero_crossings(t[1:], x[1:], +1)
-down = tv.zero_crossings(t[1:], x[1:], -1)
-periods = [b - a for a, b in zip(up, up[1:])] + [b - a for a, b in zip(down, down[1:])]
+periods = tv.crossing_periods(t[1:], x[1:])
 tv.check(len(periods) >= 3, f"at least 3 periods between zero crossings ({len(periods)})")
 Tm = sum(periods) / len(periods)
 print(f"period {Tm:.5f} s; exact {T:.5f} s, stretched by the trapezoidal rule {T_newmark:.5f} s "

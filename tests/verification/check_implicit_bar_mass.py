@@ -116,9 +116,7 @@ def run(mass, n):
     t, e = s["time"], s["kinetic_energy"]
     mean = sum(e) / len(e)
     y = [v - mean for v in e]
-    up = tv.zero_crossings(t[1:], y[1:], +1)
-    down = tv.zero_crossings(t[1:], y[1:], -1)
-    spacings = [b - a for a, b in zip(up, up[1:])] + [b - a for a, b in zip(down, down[1:])]
+    spacings = tv.crossing_periods(t[1:], y[1:])
     tv.check(len(spacings) >= 6, f"{name}: at least 6 half-periods of the kinetic energy ({len(spacings)})")
     tv.check(abs(t[-1] - t_end) < 1e-9, f"{name}: the run reached its end time")
     steps = [i for i in range(len(t)) if s["step"][i] > 0]

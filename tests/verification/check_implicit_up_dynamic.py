@@ -48,8 +48,7 @@ w = 2 * math.pi / T
 T_newmark = T * w * dt / (2 * math.atan(w * dt / 2))
 s = run(bar_prm, "bar_up", {"implicit/formulation": "mixed up", "material 0/neo hookean/volumetric energy": "split"})
 t, x = s["time"], [v - s["centre_of_mass_x"][0] for v in s["centre_of_mass_x"]]
-up, down = tv.zero_crossings(t[1:], x[1:], +1), tv.zero_crossings(t[1:], x[1:], -1)
-periods = [b - a for a, b in zip(up, up[1:])] + [b - a for a, b in zip(down, down[1:])]
+periods = tv.crossing_periods(t[1:], x[1:])
 tv.check(len(periods) >= 3, f"bar: at least 3 periods between zero crossings ({len(periods)})")
 Tm = sum(periods) / len(periods)
 print(f"bar u-p: period {Tm:.5f} s; trapezoidal-rule period {T_newmark:.5f} s; "
@@ -107,8 +106,7 @@ def bending_period(name, formulation, nu):
                              "material 0/neo hookean/volumetric energy": "split"})
     t, y = s["time"], [v - s["centre_of_mass_y"][0] for v in s["centre_of_mass_y"]]
     tv.check(abs(t[-1] - 4.0) < 1e-9, f"{name}: the run reached its end time")
-    up, down = tv.zero_crossings(t[2:], y[2:], +1), tv.zero_crossings(t[2:], y[2:], -1)
-    periods = [b - a for a, b in zip(up, up[1:])] + [b - a for a, b in zip(down, down[1:])]
+    periods = tv.crossing_periods(t[2:], y[2:])
     if len(periods) < 2:
         tv.fail(f"{name}: fewer than 2 periods between zero crossings")
     Tm = sum(periods) / len(periods)

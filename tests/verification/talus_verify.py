@@ -167,6 +167,13 @@ def zero_crossings(t, y, direction=0):
     return out
 
 
+def crossing_periods(t, y):
+    """Spacings between successive upward zero crossings of y and between successive downward
+    ones (each a period of an oscillation about 0), upward ones first."""
+    up, down = zero_crossings(t, y, +1), zero_crossings(t, y, -1)
+    return [b - a for a, b in zip(up, up[1:])] + [b - a for a, b in zip(down, down[1:])]
+
+
 _failures = []
 
 
