@@ -10,7 +10,7 @@ Checks:
   * no numerical damping: the RMS of x_c - x_c(0) over the last period is within
     2 % of that over the first;
   * Newton converged in every step.
-Usage: check_implicit_bar.py TOOLS_DIR PRM WORKDIR
+Usage: check_implicit_bar.py TOOLS_DIR PRM WORKDIR [entry=value ...]
 """
 import math
 import sys
@@ -19,6 +19,9 @@ import talus_verify as tv
 
 tools, prm_path, work = sys.argv[1:4]
 text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+for kv in sys.argv[4:]:  # entry=value: e.g. the same bar in mixed u-p
+    k, v = kv.split("=", 1)
+    text = tv.prm_set(text, k, v)
 _, out, _ = tv.run_tool(f"{tools}/talus-implicit", text, work, "bar")
 print(out.strip().splitlines()[-2])
 E, rho, L, h, dt = 100.0, 1.0, 1.0, 1.25 / 40, 0.03125

@@ -58,12 +58,17 @@ add_test(NAME verification.implicit_ranks_cantilever_dynamic_consistent
 set_tests_properties(verification.implicit_ranks_cantilever_dynamic_consistent PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 
-# dynamic mixed u-p: the bar's period (trapezoidal rule) and the cantilever's bending
-# period against Timoshenko at nu = 0.3 and 0.4999 (u locks there, u-p does not)
+# dynamic mixed u-p: the bar's period (trapezoidal rule, the checks of implicit_bar_vibration)
+# and the cantilever's bending period against Timoshenko at nu = 0.3 and 0.4999 (u locks there,
+# u-p does not)
+add_test(NAME verification.implicit_bar_vibration_up
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_bar.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${_w}/implicit_bar_vibration_up
+                 "implicit/formulation=mixed up" "material 0/neo hookean/volumetric energy=split")
+set_tests_properties(verification.implicit_bar_vibration_up PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 add_test(NAME verification.implicit_up_dynamic
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_up_dynamic.py ${TALUS_TOOLS_DIR}
-                 ${TALUS_PRM_DIR}/implicit/bar_vibration.prm ${TALUS_PRM_DIR}/implicit/cantilever_vibration.prm
-                 ${_w}/implicit_up_dynamic)
+                 ${TALUS_PRM_DIR}/implicit/cantilever_vibration.prm ${_w}/implicit_up_dynamic)
 set_tests_properties(verification.implicit_up_dynamic PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
 # 1 vs 2 ranks, dynamic mixed u-p with the consistent mass and Rayleigh damping
 add_test(NAME verification.implicit_ranks_up_dynamic
