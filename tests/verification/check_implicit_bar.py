@@ -19,9 +19,7 @@ import talus_verify as tv
 
 tools, prm_path, work = sys.argv[1:4]
 text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
-for kv in sys.argv[4:]:  # entry=value: e.g. the same bar in mixed u-p
-    k, v = kv.split("=", 1)
-    text = tv.prm_set(text, k, v)
+text = tv.prm_set_args(text, sys.argv[4:])  # entry=value: e.g. the same bar in mixed u-p
 _, out, _ = tv.run_tool(f"{tools}/talus-implicit", text, work, "bar")
 print(out.strip().splitlines()[-2])
 E, rho, L, h, dt = 100.0, 1.0, 1.0, 1.25 / 40, 0.03125

@@ -9,10 +9,7 @@ import sys
 import talus_verify as tv
 
 tools, prm_path, work = sys.argv[1:4]
-text = open(prm_path).read()
-for kv in sys.argv[4:]:
-    k, v = kv.split("=", 1)
-    text = tv.prm_set(text, k, v)
+text = tv.prm_set_args(open(prm_path).read(), sys.argv[4:])
 text = tv.prm_set(text, "output/final particles csv", "true")
 for n in (1, 2):
     tv.run_tool(f"{tools}/talus-implicit", tv.prm_set(text, "output/directory", f"np{n}"), work, f"np{n}", np=n)

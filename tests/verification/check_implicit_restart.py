@@ -32,9 +32,7 @@ for k, v in {"grid/cells": "60, 20", "time/end time": "0.2", "output/vtu interva
              "output/series interval": "0", "output/final particles csv": "true", "output/progress": "false",
              "checkpoint/interval": "0.04", "checkpoint/keep": "2"}.items():
     base = tv.prm_set(base, k, v)
-for setting in sys.argv[4:]:
-    k, v = setting.split("=", 1)
-    base = tv.prm_set(base, k, v)
+base = tv.prm_set_args(base, sys.argv[4:])
 
 
 def run(name, np=1, expect_rc=0, **entries):

@@ -21,8 +21,8 @@ import talus_verify as tv
 tools, cant_prm, work = sys.argv[1:4]
 
 
-def run(prm_path, name, settings):
-    text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+def run(name, settings):
+    text = tv.prm_set(open(cant_prm).read(), "output/directory", "out")
     for k, v in settings.items():
         text = tv.prm_set(text, k, v)
     _, out, _ = tv.run_tool(f"{tools}/talus-implicit", text, f"{work}/{name}", name)
@@ -75,8 +75,8 @@ def timoshenko_period(nu, E=9e7, rho=1000.0, H=1.0, L=8.0, kappa=5.0 / 6.0):
 
 def bending_period(name, formulation, nu):
     # both formulations with the split Neo-Hookean (the one u-p accepts), so that they solve the same model
-    s = run(cant_prm, name, {"implicit/formulation": formulation, "material 0/neo hookean/poisson ratio": str(nu),
-                             "material 0/neo hookean/volumetric energy": "split"})
+    s = run(name, {"implicit/formulation": formulation, "material 0/neo hookean/poisson ratio": str(nu),
+                   "material 0/neo hookean/volumetric energy": "split"})
     t, y = s["time"], [v - s["centre_of_mass_y"][0] for v in s["centre_of_mass_y"]]
     tv.check(abs(t[-1] - 4.0) < 1e-9, f"{name}: the run reached its end time")
     periods = tv.crossing_periods(t[2:], y[2:])

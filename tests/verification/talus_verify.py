@@ -53,6 +53,14 @@ MPI_STARTUP_MARKERS = ("Local abort before MPI_INIT completed", "orte_init faile
                        "orte_ess_init failed", "An error occurred in MPI_Init", "MPI_INIT failed", "PMIx_Init failed")
 
 
+def prm_set_args(text, settings):
+    """prm_set for each "entry=value" string of `settings` (a script's trailing arguments)."""
+    for kv in settings:
+        k, v = kv.split("=", 1)
+        text = prm_set(text, k, v)
+    return text
+
+
 def child_env(extra=None):
     """os.environ without the variables of a parent mpirun, plus the settings every tool run needs."""
     env = {k: v for k, v in os.environ.items() if not (k.startswith(_LAUNCH_PREFIXES) or k in _LAUNCH_NAMES)}

@@ -47,12 +47,11 @@ namespace talus::materials
     // the rotated stress entry by entry and reading it back in pairs (as sigma = rotate;
     // sigma += ...) stalls each pair load on two 8-byte stores (no store-to-load
     // forwarding), about a fifth of the explicit bench's stress update (docs/scaling.md)
-    const double two_G_ = 2 * (0.5 * two_G); // == two_G; as before, bit for bit
-    const double tr     = trace(d_eps);
+    const double tr      = trace(d_eps);
     const Stress rotated = apply_jaumann_rotation(sigma, d_omega);
     double       out[6];
     for (unsigned int k = 0; k < 6; ++k)
-      out[k] = rotated.access_raw_entry(k) + two_G_ * d_eps.access_raw_entry(k);
+      out[k] = rotated.access_raw_entry(k) + two_G * d_eps.access_raw_entry(k);
     for (unsigned int k = 0; k < 3; ++k)
       out[k] += lame_lambda * tr;
     for (unsigned int k = 0; k < 6; ++k)

@@ -256,6 +256,8 @@ namespace talus::transfer
     StencilCache<dim, K> &     cache;
     static constexpr bool      prefetch_location = false;
     unsigned int               index = 0; ///< the point's place in the walk
+    typename K::Cell           cell;      ///< of cell `cell_of`, made at its first miss
+    unsigned int               cell_of = dealii::numbers::invalid_unsigned_int;
 
     inline void
     begin_cell(const unsigned int)
@@ -269,7 +271,12 @@ namespace talus::transfer
       // derivatives keep the sign of a zero xi, and a restarted run evaluates
       if (e.cell != c || std::memcmp(&e.xi, &xi, sizeof(xi)) != 0)
         {
-          point_stencil<dim, K>(K::cell(grid, c), xi, e.stencil);
+          if (cell_of != c) // once per cell (after a move every point misses)
+            {
+              cell    = K::cell(grid, c);
+              cell_of = c;
+            }
+          point_stencil<dim, K>(cell, xi, e.stencil);
           e.cell = c;
           e.xi   = xi;
           ++cache.n_evaluated;
