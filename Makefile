@@ -11,7 +11,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export OMP_NUM_THREADS=1
 
-.PHONY: all deps configure build demo test verify campaign sanitize bench clean
+.PHONY: all deps configure build demo test verify verify-paper campaign sanitize bench clean
 
 all: build
 
@@ -35,11 +35,16 @@ demo: build
 	  else echo "demo: no PNG of the final deposit was drawn (see the warning above)"; fi
 
 test: build
-	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE "verify|bench"
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE "verify|bench|paper"
 
 verify: build sanitize
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L "fast|verify"
 	$(MAKE) campaign
+
+# Checks at a paper's full resolution that take hours (label "paper"); each run
+# checkpoints and resumes, so the target can be stopped and started again.
+verify-paper: build
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L paper
 
 # The verification campaign (issue 6, `make verify` only): convergence families,
 # Courant sweeps, large-deformation and near-incompressible stress tests; regenerates

@@ -203,6 +203,35 @@ namespace
   }
   TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
 
+  // F-bar ('volumetric stabilisation = f-bar'): each point's model sees dFbar with
+  // the volume-weighted mean det dF of its cell, so the tangent couples all points
+  // of a cell (the rank-one cell term); 2 x 2 points per cell, a random iterate
+  // gives the points of a cell different det dF.
+  const std::string fbar = " set volumetric stabilisation = f-bar\n";
+  TEST(ImplicitTangent, FbarNeoHookeanStatic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, fbar), 1e-6);
+  }
+  TEST(ImplicitTangent, FbarNeoHookeanStatic3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2, 0, 9.81, fbar), 1e-6);
+  }
+  TEST(ImplicitTangent, FbarNeoHookeanDynamicAfterLoadSteps2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 2, 9.81, fbar), 1e-6);
+  }
+  TEST(ImplicitTangent, FbarNeoHookeanSplitQuasiIncompressible2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean_split_incompressible, "static", 1e-4, 0, 9.81, fbar), 1e-6);
+  }
+  TEST(ImplicitTangent, FbarJ2Plastic2D) { EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, fbar), 1e-5); }
+  TEST(ImplicitTangent, FbarJ2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2, 0, 9.81, fbar), 1e-5); }
+  TEST(ImplicitTangent, FbarHenckyMohrCoulomb2D)
+  {
+    EXPECT_LT(tangent_error<2>(hencky_mc, "static", 1e-2, 0, 9.81, fbar), 1e-5);
+  }
+
+
   // 'mass matrix = consistent': M_ij = sum_p m_p N_i N_j in the residual (M a,
   // alpha_R M v) and in the tangent (coef M) on the free DoFs. With h = 0.01 s
   // the inertia (1/(beta h^2) m_p ~ 6e5 N/m per point) is as large as the

@@ -161,6 +161,15 @@ add_test(NAME verification.implicit_ranks_cooks
                  ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_ranks_cooks)
 set_tests_properties(verification.implicit_ranks_cooks PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+# the same with F-bar (its cell means need no communication: a cell's points live on its owner)
+add_test(NAME verification.implicit_ranks_cooks_fbar
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_ranks_cooks_fbar
+                 "implicit/formulation=irreducible" "implicit/volumetric stabilisation=f-bar"
+                 "newton/increment relative=1e-7"
+                 "material 0/neo hookean/poisson ratio=0.4999")
+set_tests_properties(verification.implicit_ranks_cooks_fbar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)
 
 # axisymmetry (seed 001 App. C): thick-walled cylinder under internal pressure vs the
 # linear Lame solution (u_r, hoop stress), 3 grids (fast) / 4 grids (verify)

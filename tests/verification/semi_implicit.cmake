@@ -204,6 +204,17 @@ add_test(NAME verification.semi_implicit_landslide_loose
                  --only=loose)
 set_tests_properties(verification.semi_implicit_landslide_loose PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
                      TIMEOUT 7200)
+# The paper's resolution (0.025 m grid, 3 x 3 points per cell per phase, about 18k points per
+# set; the paper's step 1.2e-4 s, 0.89 of the skeleton's critical step): the four runs take
+# hours each, so they checkpoint every 15 min of wall time and resume from there when the test
+# is run again (`make verify-paper`, label "paper": neither in `make test` nor in `make verify`).
+add_test(NAME verification.semi_implicit_landslide_paper
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_landslide.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_landslide.prm ${_w}/semi_implicit_landslide_paper
+                 "--set=grid/cells=160, 40" "--set=body 0/particles per direction=3"
+                 "--set=time/time step=1.2e-4" --resume=900)
+set_tests_properties(verification.semi_implicit_landslide_paper PROPERTIES LABELS "paper" ENVIRONMENT "${_env}"
+                     TIMEOUT 86400)
 add_test(NAME verification.semi_implicit_landslide_coarse
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_landslide.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_landslide.prm ${_w}/semi_implicit_landslide_coarse

@@ -246,7 +246,7 @@ namespace talus::transfer
 
   /// Whether an integrand has terms over the points of a whole cell (static
   /// constexpr bool cell_terms = true): AssembleSystem then calls
-  /// begin_cell_terms() at each cell and end_cell_terms<dim, nc>(local system,
+  /// begin_cell_terms(c) at each cell c and end_cell_terms<dim, nc>(local system,
   /// number of local nodes) before distributing it (e.g. the pressure
   /// projection onto cell means of the mixed u-p stabilisation).
   template <class T, class = void>
@@ -406,7 +406,7 @@ namespace talus::transfer
         local_of_slot[slot_of_local[a]] = dealii::numbers::invalid_unsigned_int;
       n_local = 0;
       if constexpr (has_cell_terms<Integrand>::value)
-        integrand.begin_cell_terms();
+        integrand.begin_cell_terms(c);
     }
     /// local node of slot s; a new one gets zero rows and columns
     inline unsigned int

@@ -69,6 +69,34 @@ namespace talus::transfer
     return F;
   }
 
+  /// F-bar (de Souza Neto et al. 1996; docs/implicit.md, "F-bar"): the
+  /// determinant of the in-plane (2D: plane strain, dF_zz = 1) or full (3D)
+  /// block of a step's dF.
+  template <int dim>
+  inline double
+  fbar_det(const dealii::Tensor<2, 3> &dF)
+  {
+    if constexpr (dim == 2)
+      return dF[0][0] * dF[1][1] - dF[0][1] * dF[1][0];
+    else
+      return determinant(dF);
+  }
+
+  /// dF scaled in its in-plane block so that its determinant becomes jbar (the
+  /// cell's mean): dFbar = (jbar / j)^(1/dim) dF, dFbar_zz = 1 in plane strain.
+  /// Returns the factor s = (jbar / j)^(1/dim).
+  template <int dim>
+  inline double
+  fbar_scale(dealii::Tensor<2, 3> &dF, const double jbar)
+  {
+    const double j = fbar_det<dim>(dF);
+    const double s = dim == 2 ? std::sqrt(jbar / j) : std::cbrt(jbar / j);
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int k = 0; k < dim; ++k)
+        dF[i][k] *= s;
+    return s;
+  }
+
   /// Axisymmetric (x = radius, y = axis; seed 001 App. C): the step's hoop
   /// stretch dF_zz = r_{n+1} / r_n = 1 + Du_r(x_p) / r_n, Du_r = sum_a N_a Du_a,x
   /// (r_n > 0: points never sit on the axis).
@@ -258,8 +286,43 @@ namespace talus::transfer
     PointFailure *                                                 failure = nullptr;
     /// axisymmetric (2D): the property holding the point's radius r_n; invalid: plane strain / 3D
     unsigned int radius_offset = dealii::numbers::invalid_unsigned_int;
+    /// F-bar: the mean det dF of each active cell (CellMeanJacobian, indexed by
+    /// the walk's cell index) at the field being assembled; null: no F-bar
+    const std::vector<double> *jbar = nullptr;
 
-    static constexpr bool matrix = true, vector = true;
+    static constexpr bool         matrix = true, vector = true, cell_terms = true;
+    static constexpr unsigned int max_local = 8 * dim;
+    // F-bar, per cell: jbar, sum V_n, and the two factors of the coupling term
+    // d r / d ln jbar (x) d ln jbar / d Du (one column and one row over the cell's DoFs)
+    mutable double cell_jbar = 1, cell_v = 0, row_factor[max_local], column_factor[max_local];
+
+    void
+    begin_cell_terms(const unsigned int c) const
+    {
+      if (!jbar)
+        return;
+      cell_jbar = (*jbar)[c];
+      cell_v    = 0;
+      std::fill(std::begin(row_factor), std::end(row_factor), 0.0);
+      std::fill(std::begin(column_factor), std::end(column_factor), 0.0);
+    }
+
+    /// F-bar's coupling of all points of a cell through jbar:
+    /// K_(a i)(b k) += row_a,i column_b,k / (sum V_n jbar), with
+    /// row_a,i = sum_p (d Pk_p / d ln jbar)_ij G_a,j(p) and
+    /// column_b,k = sum_q V_n,q j_q Finv_q,dk G_b,d(q) (= sum_q V_n d j_q / d Du_b,k).
+    template <int d_, unsigned int nc>
+    void
+    end_cell_terms(LocalSystem &ls, const unsigned int n_local) const
+    {
+      if (!jbar || !tangent || cell_v <= 0)
+        return;
+      const unsigned int m     = n_local * nc;
+      const double       scale = 1.0 / (cell_v * cell_jbar);
+      for (unsigned int r = 0; r < m; ++r)
+        for (unsigned int q = 0; q < m; ++q)
+          ls.a(r, q) += row_factor[r] * column_factor[q] * scale;
+    }
 
     template <int d_, unsigned int nc, class PN>
     inline void
@@ -274,11 +337,25 @@ namespace talus::transfer
       const bool           axisymmetric = dim == 2 && radius_offset != dealii::numbers::invalid_unsigned_int;
       if (axisymmetric)
         dF[2][2] = hoop_stretch<PN, dim>(ls.u, p, P[radius_offset]);
+      // F-bar: the model sees dFbar (det = the cell's jbar); the spatial
+      // gradients below keep the point's own dF
+      dealii::Tensor<2, 3> dF_bar = dF;
+      double               fbar_s = 1, fbar_j = 1;
+      if (jbar)
+        {
+          fbar_j = fbar_det<dim>(dF);
+          if (!(fbar_j > 0))
+            {
+              failure->set("a material point's det dF is not positive (F-bar)");
+              return;
+            }
+          fbar_s = fbar_scale<dim>(dF_bar, cell_jbar);
+        }
       materials::Stress    tau;
       dealii::Tensor<4, 3> dtau;
       try
         {
-          m.finite_strain_update(dF,
+          m.finite_strain_update(dF_bar,
                                  dealii::ArrayView<const double>(P + history_offset, nh),
                                  dealii::ArrayView<double>(history_new, nh),
                                  tau,
@@ -312,7 +389,56 @@ namespace talus::transfer
       if (!tangent)
         return;
       double A[dim][dim][dim][dim];
-      scaled_piola_tangent<dim>(c, tau, dtau, Finv, A);
+      if (jbar)
+        {
+          // tau = tau(dFbar), dFbar = s dF (in-plane), s = (jbar / j)^(1/dim):
+          // d dFbar_mn / d dF_kd = s (delta_mk delta_nd - Finv_dk dF_mn / dim) at fixed jbar, and
+          // d dFbar / d ln jbar = dFbar / dim. T = d tau / d ln jbar = dtau : dFbar / dim.
+          const double s = fbar_s;
+          double       T[3][3];
+          for (unsigned int i = 0; i < 3; ++i)
+            for (unsigned int e = 0; e < 3; ++e)
+              {
+                double t = 0;
+                for (unsigned int mm = 0; mm < dim; ++mm)
+                  for (unsigned int n = 0; n < dim; ++n)
+                    t += dtau[i][e][mm][n] * dF_bar[mm][n];
+                T[i][e] = t / dim;
+              }
+          dealii::Tensor<4, 3> dtau_local;
+          for (unsigned int i = 0; i < 3; ++i)
+            for (unsigned int e = 0; e < 3; ++e)
+              for (unsigned int k = 0; k < dim; ++k)
+                for (unsigned int d = 0; d < dim; ++d)
+                  dtau_local[i][e][k][d] = s * dtau[i][e][k][d] - T[i][e] * Finv[d][k];
+          scaled_piola_tangent<dim>(c, tau, dtau_local, Finv, A);
+          // the cell coupling's factors of this point
+          double Q[dim][dim]; // d Pk / d ln jbar = c T Finv^T
+          for (unsigned int i = 0; i < dim; ++i)
+            for (unsigned int b = 0; b < dim; ++b)
+              {
+                double q = 0;
+                for (unsigned int e = 0; e < 3; ++e)
+                  q += T[i][e] * Finv[b][e];
+                Q[i][b] = c * q;
+              }
+          const double vj = P[PropertyLayout<dim>::volume] * fbar_j;
+          for (unsigned int a = 0; a < p.n; ++a)
+            for (unsigned int i = 0; i < dim; ++i)
+              {
+                double r = 0, q = 0;
+                for (unsigned int b = 0; b < dim; ++b)
+                  {
+                    r += Q[i][b] * p.G[a][b];
+                    q += Finv[b][i] * p.G[a][b];
+                  }
+                row_factor[p.local[a] * dim + i] += r;
+                column_factor[p.local[a] * dim + i] += vj * q;
+              }
+          cell_v += P[PropertyLayout<dim>::volume];
+        }
+      else
+        scaled_piola_tangent<dim>(c, tau, dtau, Finv, A);
       add_displacement_stiffness<dim, dim>(A, p, ls);
     }
   };
@@ -355,7 +481,7 @@ namespace talus::transfer
     mutable double cell_vn[max_local], cell_wn[max_local], cell_w = 0, cell_v = 0;
 
     void
-    begin_cell_terms() const
+    begin_cell_terms(const unsigned int) const
     {
       std::fill(std::begin(cell_vn), std::end(cell_vn), 0.0);
       std::fill(std::begin(cell_wn), std::end(cell_wn), 0.0);
@@ -506,6 +632,81 @@ namespace talus::transfer
     }
   };
 
+  /// The dim components of a space vector with ghost values at the K::n_nodes
+  /// nodes of a cell (0 where the cell's slot has no node).
+  template <int dim, class K>
+  inline void
+  gather_cell_vector(const typename K::Cell &cell, const NodalSpace<dim> &space, const Vector &v,
+                     double (&out)[K::n_nodes][dim])
+  {
+    for (unsigned int s = 0; s < K::n_nodes; ++s)
+      for (unsigned int k = 0; k < dim; ++k)
+        {
+          const unsigned int i = cell.dofs[s * dim];
+          out[s][k]            = i != dealii::numbers::invalid_unsigned_int ? v(space.node_dof(i, k)) : 0.0;
+        }
+  }
+
+  /// A point's step dF = I + grad Du from the cell's nodal Du (gather_cell_vector)
+  /// and its stencil (slots, gradients).
+  template <int dim, unsigned int n>
+  inline dealii::Tensor<2, 3>
+  stencil_deformation_gradient(const double (*un)[dim], const unsigned int (&slot)[n], const double (&G)[n][dim])
+  {
+    dealii::Tensor<2, 3> dF;
+    for (unsigned int i = 0; i < 3; ++i)
+      dF[i][i] = 1.0;
+    for (unsigned int w = 0; w < n; ++w)
+      for (unsigned int i = 0; i < dim; ++i)
+        for (unsigned int j = 0; j < dim; ++j)
+          dF[i][j] += un[slot[w]][i] * G[w][j];
+    return dF;
+  }
+
+  /// F-bar's cell means: for every active cell c of the walk, jbar[c] = sum_p
+  /// V_n,p j_p / sum_p V_n,p over its points, j_p = det dF_p (in-plane in 2D) of
+  /// the field Du (a vector of `space` with ghost values). sum V_n jbar = sum
+  /// V_n j: the cell's volume is that of its points' own dF. jbar has one entry
+  /// per active cell of the grid (1 where a cell has no point).
+  template <int dim, class K>
+  struct CellMeanJacobian
+  {
+    const BackgroundGrid<dim> &grid;
+    const NodalSpace<dim> &    space;
+    const Vector &             du;
+    std::vector<double> &      jbar;
+
+    static constexpr bool prefetch_location = false;
+    typename K::Cell      cell;
+    double                un[K::n_nodes][dim];
+    double                sum_vj = 0, sum_v = 0;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      gather_cell_vector<dim, K>(cell, space, du, un);
+      sum_vj = sum_v = 0;
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      unsigned int slot[K::n_point_nodes];
+      double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+      K::point_stencil(cell, it->get_reference_location(), slot, N, G);
+      const dealii::Tensor<2, 3> dF = stencil_deformation_gradient<dim>(un, slot, G);
+      const double V = it->get_properties()[PropertyLayout<dim>::volume];
+      sum_vj += V * fbar_det<dim>(dF);
+      sum_v += V;
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int c)
+    {
+      jbar[c] = sum_v > 0 ? sum_vj / sum_v : 1.0;
+    }
+  };
+
   /// The convective phase (Algorithm 1 step 3, Eqs. 2.14-2.17): per point
   /// Du_p = N Du, the constitutive update at dF committed (stress = tau / J,
   /// history), V *= det dF; with accelerations (dynamic), a_p^{n+1} = N a^{n+1}
@@ -548,6 +749,9 @@ namespace talus::transfer
     PointFailure &                                                 failure;
     const unsigned int                                             pressure;
     const unsigned int radius; ///< axisymmetric: the property with r_n (invalid: plane / 3D)
+    /// F-bar: each active cell's mean det dF of the converged Du (CellMeanJacobian); null: none.
+    /// The model is updated with dFbar and V *= det dFbar = jbar (the cell keeps its volume).
+    const std::vector<double> *jbar = nullptr;
 
     static constexpr bool prefetch_location = true;
     typename K::Cell      cell;
@@ -557,16 +761,18 @@ namespace talus::transfer
     begin_cell(const unsigned int c)
     {
       cell = K::cell(grid, c);
+      gather_cell_vector<dim, K>(cell, space, du, un);
+      if (a_new)
+        gather_cell_vector<dim, K>(cell, space, *a_new, an);
+      else
+        std::fill(&an[0][0], &an[0][0] + K::n_nodes * dim, 0.0);
       for (unsigned int s = 0; s < K::n_nodes; ++s)
-        for (unsigned int k = 0; k < dim; ++k)
-          {
-            const unsigned int i = cell.dofs[s * dim];
-            const bool         valid = i != dealii::numbers::invalid_unsigned_int;
-            un[s][k] = valid ? du(space.node_dof(i, k)) : 0.0;
-            an[s][k] = valid && a_new ? (*a_new)(space.node_dof(i, k)) : 0.0;
-            if (k == 0)
-              pn[s] = valid && pressure != dealii::numbers::invalid_unsigned_int ? du(space.node_dof(i, dim)) : 0.0;
-          }
+        {
+          const unsigned int i = cell.dofs[s * dim];
+          pn[s] = i != dealii::numbers::invalid_unsigned_int && pressure != dealii::numbers::invalid_unsigned_int
+                    ? du(space.node_dof(i, dim))
+                    : 0.0;
+        }
     }
     inline bool
     point(const unsigned int c, PointIterator<dim> &it)
@@ -576,23 +782,27 @@ namespace talus::transfer
       unsigned int slot[K::n_point_nodes];
       double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
       K::point_stencil(cell, it->get_reference_location(), slot, N, G);
-      double               dx[dim] = {}, ap[dim] = {}, pp = 0;
-      dealii::Tensor<2, 3> dF;
-      for (unsigned int i = 0; i < 3; ++i)
-        dF[i][i] = 1.0;
+      double dx[dim] = {}, ap[dim] = {}, pp = 0;
       for (unsigned int w = 0; w < K::n_point_nodes; ++w)
         for (unsigned int i = 0; i < dim; ++i)
           {
-            const double u = un[slot[w]][i];
-            dx[i] += N[w] * u;
+            dx[i] += N[w] * un[slot[w]][i];
             ap[i] += N[w] * an[slot[w]][i];
             if (i == 0)
               pp += N[w] * pn[slot[w]];
-            for (unsigned int j = 0; j < dim; ++j)
-              dF[i][j] += u * G[w][j];
           }
+      dealii::Tensor<2, 3> dF = stencil_deformation_gradient<dim>(un, slot, G);
       if (dim == 2 && radius != dealii::numbers::invalid_unsigned_int)
         dF[2][2] = 1.0 + dx[0] / P[radius]; // the hoop stretch r_{n+1} / r_n
+      if (jbar)
+        {
+          if (!(fbar_det<dim>(dF) > 0))
+            {
+              failure.set("a material point's det dF is not positive (F-bar)");
+              return true;
+            }
+          fbar_scale<dim>(dF, (*jbar)[c]);
+        }
       const auto &       m  = *materials[static_cast<unsigned int>(P[L::material])];
       const unsigned int nh = m.n_history();
       double             old[64];

@@ -143,6 +143,14 @@ namespace talus::implicit_mpm
                         "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
                         "pressure projection (seed 001 ch. 5; static analysis, neo hookean with 'volumetric energy "
                         "= split' or j2 plasticity, direct linear solver).");
+      prm.declare_entry("volumetric stabilisation", "none", Selection("none|f-bar"),
+                        "irreducible formulation: none, or f-bar: each point's constitutive update sees "
+                        "dFbar = (jbar / j)^(1/dim) dF (in-plane in 2D), jbar the volume-weighted mean of "
+                        "det dF over the points of its grid cell, and its volume follows jbar (de Souza Neto "
+                        "et al. 1996, with the cell as the patch; the exact tangent couples the points of a "
+                        "cell). Removes the volumetric locking of Q1 cells with several points (near "
+                        "incompressible elasticity, isochoric plastic flow). Not with 'mixed up' or "
+                        "'axisymmetric'.");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
@@ -242,12 +250,19 @@ namespace talus::implicit_mpm
     p.ramp_loads     = prm.get_bool("ramp loads");
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
+    p.fbar           = prm.get("volumetric stabilisation") == "f-bar";
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
+    require(!p.fbar || !p.mixed_up, "implicit/volumetric stabilisation",
+            "'f-bar' is for 'formulation = irreducible' (the mixed u-p form treats the volume through its pressure "
+            "field); allowed with 'mixed up': none");
+    require(!p.fbar || !p.axisymmetric, "implicit/volumetric stabilisation",
+            "'f-bar' is not available with 'geometry = axisymmetric' (the hoop stretch is not in the cell mean); "
+            "allowed there: none");
     prm.enter_subsection("rigid footing");
     {
       auto &f   = p.footing;
@@ -1183,6 +1198,15 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
+  void
+  Solver<dim>::compute_cell_jbar()
+  {
+    cell_jbar.assign(grid.tria.n_active_cells(), 1.0);
+    transfer::CellMeanJacobian<dim, shape::Q1Box<dim>> mean{grid, space, du, cell_jbar};
+    transfer::for_each_active_cell(points, mean);
+  }
+
+  template <int dim>
   double
   Solver<dim>::assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g)
   {
@@ -1197,6 +1221,11 @@ namespace talus::implicit_mpm
     force.tangent        = with_tangent;
     force.failure        = &failure;
     force.radius_offset  = radius_offset;
+    if (prm.fbar)
+      {
+        compute_cell_jbar();
+        force.jbar = &cell_jbar;
+      }
     residual             = 0;
     if (with_tangent)
       tangent = 0;
@@ -1530,6 +1559,11 @@ namespace talus::implicit_mpm
                                                                      prm.materials, acceleration_offset, h,
                                                                      newmark.gamma(), failure, pressure_offset,
                                                                      radius_offset);
+    if (prm.fbar)
+      {
+        compute_cell_jbar(); // of the converged du
+        commit.jbar = &cell_jbar;
+      }
     transfer::for_each_active_cell(points, commit);
     if (dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0)
       throw InstabilityError("the constitutive update of the converged step failed: " +

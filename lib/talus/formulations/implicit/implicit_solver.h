@@ -52,6 +52,10 @@ namespace talus::implicit_mpm
     /// V_p and m_p of a point are those of its ring (2 pi r x the seeded area),
     /// dF_zz = r_{n+1} / r_n is the hoop stretch (docs/implicit.md)
     bool axisymmetric = false;
+    /// 'implicit/volumetric stabilisation = f-bar' (irreducible form): each point's model sees
+    /// dFbar = (jbar / j)^(1/dim) dF, jbar the volume-weighted mean det dF of its grid cell,
+    /// with the exact tangent (docs/implicit.md, "F-bar")
+    bool fbar = false;
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
@@ -324,6 +328,9 @@ namespace talus::implicit_mpm
     LinearSolveInfo solve_for_delta();
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
+    /// F-bar: the mean det dF of each active cell at the current du (transfer::CellMeanJacobian)
+    std::vector<double> cell_jbar;
+    void                compute_cell_jbar();
     /// consistent mass: a^{n+1} + alpha_R v^{n+1} at the free DoFs (0 at constrained
     /// ones), ghosts updated, the field the inertia integrand reads
     Vector inertia_field;
