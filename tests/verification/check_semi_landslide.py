@@ -32,7 +32,6 @@ Usage: check_semi_landslide.py TOOL PRM WORKDIR [--set=entry=value ...]
 """
 import math
 import os
-import subprocess
 import sys
 
 import talus_verify as tv
@@ -108,15 +107,8 @@ def run_resumable(text, name, end, d):
         text = tv.prm_set(text, "checkpoint/keep", "1")
         print(f"{name}: running (or resuming) to t = {end} s; checkpoints every {resume_seconds:g} s of wall time", flush=True)
         os.makedirs(run_dir, exist_ok=True)
-        prm = os.path.join(run_dir, name + ".prm")
-        with open(prm, "w") as f:
-            f.write(text)
         # the output goes straight to the log, so that a segment that is stopped keeps its lines
-        with open(log, "a") as f:
-            rc = subprocess.run([os.path.abspath(tool), os.path.abspath(prm)], cwd=run_dir, stdout=f,
-                                stderr=subprocess.STDOUT, env=tv.child_env(None)).returncode
-        if rc != 0:
-            tv.fail(f"{name}: exit code {rc} (log: {log})")
+        tv.run_tool(tool, text, run_dir, name, timeout=48 * 3600, log=log)
     else:
         print(f"{name}: already at t = {end} s; reading its output", flush=True)
     return open(log).read() if os.path.exists(log) else ""

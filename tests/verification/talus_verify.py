@@ -88,12 +88,14 @@ def startup_failure(returncode, text):
     return returncode not in (0, 2) and any(m in text for m in MPI_STARTUP_MARKERS)
 
 
-def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None, timeout=3000):
+def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None, timeout=3000, log=None):
     """Write <workdir>/<name>.prm, run the tool (under mpirun if np > 1).
 
     Returns (returncode, stdout, stderr). Fails the test if the return code is
     not expect_rc (None: accept anything), and always if the tool could not
-    start (MPI start-up failure), with a message saying so.
+    start (MPI start-up failure), with a message saying so. With `log` (a file
+    path) stdout and stderr are appended to that file as the tool writes them
+    (a run that is stopped keeps its lines) and returned as stdout of this run.
     """
     os.makedirs(workdir, exist_ok=True)
     prm = os.path.join(workdir, name + ".prm")
@@ -104,7 +106,16 @@ def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None, t
         cmd = ["mpirun", "--oversubscribe", "-np", str(np)] + cmd
     env = child_env(extra_env)
     with (mpirun_session(env) if np > 1 else contextlib.nullcontext()):
-        p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=timeout)
+        if log is None:
+            p = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, env=env, timeout=timeout)
+        else:
+            with open(log, "a") as f:
+                start = f.tell()
+                rc = subprocess.run(cmd, cwd=workdir, stdout=f, stderr=subprocess.STDOUT, env=env,
+                                    timeout=timeout).returncode
+            with open(log) as f:
+                f.seek(start)
+                p = subprocess.CompletedProcess(cmd, rc, f.read(), "")
     if startup_failure(p.returncode, p.stdout + p.stderr):
         sys.stderr.write(p.stderr[-3000:])
         fail(f"{name}: {os.path.basename(tool)} could not start (MPI start-up failure, exit {p.returncode}); "

@@ -83,13 +83,13 @@ namespace talus::transfer
   }
 
   /// dF scaled in its in-plane block so that its determinant becomes jbar (the
-  /// cell's mean): dFbar = (jbar / j)^(1/dim) dF, dFbar_zz = 1 in plane strain.
-  /// Returns the factor s = (jbar / j)^(1/dim).
+  /// cell's mean): dFbar = (jbar / j)^(1/dim) dF, dFbar_zz = 1 in plane strain;
+  /// j = fbar_det(dF) (the caller has checked it is positive). Returns the factor
+  /// s = (jbar / j)^(1/dim).
   template <int dim>
   inline double
-  fbar_scale(dealii::Tensor<2, 3> &dF, const double jbar)
+  fbar_scale(dealii::Tensor<2, 3> &dF, const double j, const double jbar)
   {
-    const double j = fbar_det<dim>(dF);
     const double s = dim == 2 ? std::sqrt(jbar / j) : std::cbrt(jbar / j);
     for (unsigned int i = 0; i < dim; ++i)
       for (unsigned int k = 0; k < dim; ++k)
@@ -349,7 +349,7 @@ namespace talus::transfer
               failure->set("a material point's det dF is not positive (F-bar)");
               return;
             }
-          fbar_s = fbar_scale<dim>(dF_bar, cell_jbar);
+          fbar_s = fbar_scale<dim>(dF_bar, fbar_j, cell_jbar);
         }
       materials::Stress    tau;
       dealii::Tensor<4, 3> dtau;
@@ -796,12 +796,13 @@ namespace talus::transfer
         dF[2][2] = 1.0 + dx[0] / P[radius]; // the hoop stretch r_{n+1} / r_n
       if (jbar)
         {
-          if (!(fbar_det<dim>(dF) > 0))
+          const double j = fbar_det<dim>(dF);
+          if (!(j > 0))
             {
               failure.set("a material point's det dF is not positive (F-bar)");
               return true;
             }
-          fbar_scale<dim>(dF, (*jbar)[c]);
+          fbar_scale<dim>(dF, j, (*jbar)[c]);
         }
       const auto &       m  = *materials[static_cast<unsigned int>(P[L::material])];
       const unsigned int nh = m.n_history();
