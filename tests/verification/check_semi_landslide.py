@@ -20,7 +20,12 @@ Checks (the paper's findings, §5.4):
   2. dense double: the gap opens, gap > GAP_MIN = h / 4 (half the point spacing at
      2 x 2 points per cell), and exceeds the loose double-point gap;
   3. loose: |run-out(double) - run-out(single)| <= 10 % of their mean;
-  4. every run reaches its end time with no point lost and finite fields.
+  4. every run reaches its end time with no point lost and finite fields;
+  5. every run ends with bounded effective stresses: no soil point's mean effective
+     stress exceeds STRESS_FACTOR = 2 x the largest geostatic one of the initial slope,
+     (1 - n0)(rho_s - rho_w) g H0, H0 the height of the highest soil point at t = 0
+     (the deposit is lower than the slope and near rest at the end; a point whose
+     stress is not its volume's, the 2026-12-04 modified F-bar bug, had 17 x).
 With --resume (the runs at the paper's resolution, hours each): every run writes a
 checkpoint every RESUME wall-clock seconds (default 900) and starts from its newest
 checkpoint if there is one, so an interrupted campaign goes on where it stopped; a run
@@ -69,6 +74,7 @@ def grid_h(text):
 
 h = grid_h(base)
 gap_min = h / 4
+STRESS_FACTOR = 2.0
 
 
 def tops(t, width):
@@ -140,6 +146,16 @@ for density, v0, end in cases:
         lost = [l for l in out.splitlines() if "lost points" in l]
         tv.check(bool(lost) and all("lost points 0" in l for l in lost),
                  f"{name}: no point lost ({len(lost)} run segment(s); last: {lost[-1].strip() if lost else 'no summary line'})")
+        # check 5: (1 - n0) rho_s = m / V0 of a soil point; rho_w g H0 from the .prm
+        rho_w = float(tv.prm_get(text, "semi implicit/water density"))
+        g = abs(float(tv.prm_get(text, "gravity/acceleration").split(",")[-1]))
+        H0 = max(y - v for y, v in zip(soil["pos_y"], soil["displacement_y"]))
+        geostatic = max((m / V0 - (1 - n0) * rho_w) * g * H0
+                        for m, V0, n0 in zip(soil["mass"], soil["initial_volume"], soil["initial_porosity"]))
+        mean_stress = [-(a + b + c) / 3 for a, b, c in zip(soil["stress_xx"], soil["stress_yy"], soil["stress_zz"])]
+        tv.check(max(mean_stress) <= STRESS_FACTOR * geostatic,
+                 f"{name}: largest mean effective stress {max(mean_stress):.0f} Pa <= {STRESS_FACTOR} x the geostatic "
+                 f"{geostatic:.0f} Pa (H0 = {H0:.3f} m)")
         runout = max(soil["pos_x"]) - max(x - u for x, u in zip(soil["pos_x"], soil["displacement_x"]))
         st, wt = tops(soil, h), tops(water, h)
         gaps = [st[b] - wt[b] for b in st if b in wt]

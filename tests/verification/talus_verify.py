@@ -12,15 +12,8 @@ import sys
 import tempfile
 
 
-def prm_set(text, path, value):
-    """Set entry `path` ("sub/sub/entry" or "entry") in a .prm text.
-
-    Replaces the entry where it is; otherwise adds it to the (innermost existing)
-    subsection, creating the missing subsections at the end of the text.
-    """
-    parts = path.split("/")
-    subs, key = parts[:-1], parts[-1]
-    lines = text.splitlines()
+def _prm_entries(lines):
+    """(line index, subsection stack, entry, value) of every `set` line of a .prm."""
     stack = []
     for i, line in enumerate(lines):
         s = line.split("#", 1)[0].strip()
@@ -32,13 +25,38 @@ def prm_set(text, path, value):
             stack.pop()
             continue
         m = re.match(r"set\s+(.*?)\s*=\s*(.*)$", s)
-        if m and m.group(1) == key and stack == subs:
+        if m:
+            yield i, stack, m.group(1), m.group(2).strip()
+
+
+def prm_set(text, path, value):
+    """Set entry `path` ("sub/sub/entry" or "entry") in a .prm text.
+
+    Replaces the entry where it is; otherwise adds it to the (innermost existing)
+    subsection, creating the missing subsections at the end of the text.
+    """
+    parts = path.split("/")
+    subs, key = parts[:-1], parts[-1]
+    lines = text.splitlines()
+    for i, stack, k, _ in _prm_entries(lines):
+        if k == key and stack == subs:
+            line = lines[i]
             indent = line[: len(line) - len(line.lstrip())]
             lines[i] = f"{indent}set {key} = {value}"
             return "\n".join(lines) + "\n"
     # not found: append a block (deal.II accepts a subsection opened twice)
     block = [f"subsection {x}" for x in subs] + [f"set {key} = {value}"] + ["end"] * len(subs)
     return "\n".join(lines + block) + "\n"
+
+
+def prm_get(text, path):
+    """The value of entry `path` ("sub/sub/entry") in a .prm text (the last one set);
+    an error naming the entry if the text does not set it."""
+    parts = path.split("/")
+    found = [v for _, stack, k, v in _prm_entries(text.splitlines()) if k == parts[-1] and stack == parts[:-1]]
+    if not found:
+        raise KeyError(f"the .prm does not set '{path}'")
+    return found[-1]
 
 
 # Variables an mpirun (or PMIx launcher) sets for the processes it starts; a

@@ -15,22 +15,31 @@
 namespace talus::semi_implicit
 {
   /// dF-bar = (dJbar / dJ)^(1/dim) dF (Eq. 79; in 2D the in-plane block, the
-  /// paper's dof = 2), times (Jebar / J^e)^(1/3) for the modified F-bar: pushing
-  /// b_e-bar = (Jebar / J^e)^(2/3) b_e (Eq. 82) by dF-bar (Eq. 81) is pushing b_e
-  /// by this isotropically scaled increment, so any model that keeps b_e gets
-  /// the modified F-bar through its ordinary update. elastic_ratio = 1: F-bar.
+  /// paper's dof = 2): the increment a soil point's model sees with either F-bar.
   template <int dim>
   inline dealii::Tensor<2, 3>
-  stabilised_increment(const dealii::Tensor<2, 3> &dF, const double dJ_bar, const double elastic_ratio)
+  stabilised_increment(const dealii::Tensor<2, 3> &dF, const double dJ_bar)
   {
     const double         a = std::pow(dJ_bar / dealii::determinant(dF), 1.0 / dim);
     dealii::Tensor<2, 3> f = dF;
     for (unsigned int i = 0; i < dim; ++i)
       for (unsigned int j = 0; j < dim; ++j)
         f[i][j] *= a;
-    if (elastic_ratio != 1.0)
-      f *= std::cbrt(elastic_ratio);
     return f;
+  }
+
+  /// The modified F-bar's b_e-bar = (Jebar / J^e)^(2/3) b_e (Eq. 82), on the six
+  /// stored components of a symmetric b_e (xx, yy, zz, xy, yz, xz): afterwards
+  /// sqrt(det b_e) = Jebar. It goes into the history, not into the increment:
+  /// folding it into the increment would also multiply the model's own total J
+  /// by the ratio every step, and those factors pile up (docs/semi-implicit.md,
+  /// 'The modified F-bar and the point's J').
+  inline void
+  scale_elastic_b(double *b_sym, const double elastic_ratio)
+  {
+    const double c = std::cbrt(elastic_ratio * elastic_ratio);
+    for (unsigned int k = 0; k < 6; ++k)
+      b_sym[k] *= c;
   }
 
   /// The modified F-bar patches: a fixed tiling of the grid box by squares

@@ -1463,8 +1463,8 @@ namespace talus::semi_implicit
         const unsigned int mid = static_cast<unsigned int>(P[L::material]);
         const materials::Material &m = *models[mid];
         double *const history = P + s.soil.layout.history;
-        // the increment the model sees: ΔF, or ΔF-bar (79), or for the modified
-        // F-bar ΔF-bar scaled so that it pushes b_e-bar (81)-(82) (fbar.h)
+        // the increment the model sees: ΔF, or ΔF-bar (79); the modified F-bar
+        // also replaces the model's b_e by b_e-bar (82) before the push (81)
         dealii::Tensor<2, 3> dF_model = dF;
         if (s.prm.stabilisation != VolumetricStabilisation::none)
           {
@@ -1472,10 +1472,9 @@ namespace talus::semi_implicit
             if (!(dJ_bar > 0))
               throw InstabilityError("a soil point's smoothed volume increment (F-bar) " + std::to_string(dJ_bar) +
                                      " is not positive");
-            const double ratio = s.prm.stabilisation == VolumetricStabilisation::modified_f_bar
-                                   ? P[s.fs.patch_elastic_jacobian] / elastic_jacobian(m, history)
-                                   : 1.0;
-            dF_model = stabilised_increment<dim>(dF, dJ_bar, ratio);
+            if (s.prm.stabilisation == VolumetricStabilisation::modified_f_bar)
+              scale_elastic_b(history, P[s.fs.patch_elastic_jacobian] / elastic_jacobian(m, history));
+            dF_model = stabilised_increment<dim>(dF, dJ_bar);
           }
         P[L::volume] *= dJ;                                     // (8d)
         if (P[s.fs.surface_force] != 0) // the loaded face moves with the material: d <- dF d
@@ -1520,6 +1519,12 @@ namespace talus::semi_implicit
               ns->parameters().v0 * P[s.fs.smoothed_jacobian] / dealii::determinant(dF_model);
         auto sigma = L::get_stress(P);
         m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(history, m.n_history()));
+        // sigma' = tau / J with the point's own J = V / V0 (Alg. step 10(d)), so
+        // that V sigma' = V0 tau: the model's J follows the stabilised
+        // increments, which may wander from the point's volume (a gas-like
+        // point of a landslide: 4e-6 against 1.0, its stress 2e5 x too large)
+        if (m.has_finite_strain_form())
+          sigma *= m.kirchhoff_jacobian(dealii::ArrayView<const double>(history, m.n_history())) / J;
         L::set_stress(sigma, P);
       }
       inline void
