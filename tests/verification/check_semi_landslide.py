@@ -25,7 +25,12 @@ Checks (the paper's findings, §5.4):
      stress exceeds STRESS_FACTOR = 2 x the largest geostatic one of the initial slope,
      (1 - n0)(rho_s - rho_w) g H0, H0 the height of the highest soil point at t = 0
      (the deposit is lower than the slope and near rest at the end; a point whose
-     stress is not its volume's, the 2026-12-04 modified F-bar bug, had 17 x).
+     stress is not its volume's, the 2026-12-04 modified F-bar bug, had 17 x);
+  6. every Nor-Sand soil point carries its model's Kirchhoff stress over its own J:
+     mean(sigma') V/V0 = p_ref exp(-(eps_v^e - eps_v,ref) / kappa) with eps_v^e =
+     ln det(b_e) / 2 from the stored b_e (history 0-5, 11, 12), to TAU_TOL relative
+     (the points above the gas-like cut-off, tau = 0, are left out). The modified
+     F-bar bug broke it by up to 16 x on the 0.1 m grid (docs/semi-implicit.md).
 With --resume (the runs at the paper's resolution, hours each): every run writes a
 checkpoint every RESUME wall-clock seconds (default 900) and starts from its newest
 checkpoint if there is one, so an interrupted campaign goes on where it stopped; a run
@@ -75,6 +80,7 @@ def grid_h(text):
 h = grid_h(base)
 gap_min = h / 4
 STRESS_FACTOR = 2.0
+TAU_TOL = 1e-6
 
 
 def tops(t, width):
@@ -156,6 +162,28 @@ for density, v0, end in cases:
         tv.check(max(mean_stress) <= STRESS_FACTOR * geostatic,
                  f"{name}: largest mean effective stress {max(mean_stress):.0f} Pa <= {STRESS_FACTOR} x the geostatic "
                  f"{geostatic:.0f} Pa (H0 = {H0:.3f} m)")
+        # check 6: sigma' J = tau of the model, from b_e
+        kappa = float(tv.prm_get(text, "material 0/nor sand/swelling index"))
+        try:
+            gas = float(tv.prm_get(text, "material 0/nor sand/gas cutoff factor"))
+        except KeyError:
+            gas = 1.6  # the tool's default
+        worst, counted = 0.0, 0
+        for i in range(len(soil["pos_x"])):
+            if soil["history_7"][i] > 0.999 * gas * v0:
+                continue
+            b = [[soil[f"history_{k}"][i] for k in row] for row in ((0, 3, 5), (3, 1, 4), (5, 4, 2))]
+            det = (b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1]) - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+                   + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]))
+            tau = soil["history_11"][i] * math.exp(-(0.5 * math.log(det) - soil["history_12"][i]) / kappa)
+            if abs(tau) < 1e-3:
+                continue
+            sigma = (soil["stress_xx"][i] + soil["stress_yy"][i] + soil["stress_zz"][i]) / 3
+            worst = max(worst, abs(sigma * soil["volume"][i] / soil["initial_volume"][i] - tau) / abs(tau))
+            counted += 1
+        tv.check(counted > 0 and worst < TAU_TOL,
+                 f"{name}: mean(sigma') V/V0 = the model's tau from b_e at {counted} points, worst {worst:.2e} relative "
+                 f"(< {TAU_TOL:g})")
         runout = max(soil["pos_x"]) - max(x - u for x, u in zip(soil["pos_x"], soil["displacement_x"]))
         st, wt = tops(soil, h), tops(water, h)
         gaps = [st[b] - wt[b] for b in st if b in wt]
