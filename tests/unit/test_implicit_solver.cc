@@ -27,13 +27,15 @@ namespace
                 const std::string &implicit_extra = "", const double pressure_scale = 1.0,
                 const std::string &boundary = " set fixed = 0\n")
   {
+    // the B-spline needs 3 cells per direction
+    const std::string ny = implicit_extra.find("bspline") != std::string::npos ? "3" : "2";
     std::ostringstream prm_text;
     prm_text << "set dimension = " << dim << "\n"
              << "subsection time\n set end time = 1\n set time step = 0.5\nend\n"
              << "subsection implicit\n set analysis = " << analysis << "\n" << implicit_extra << "end\n"
              << "subsection grid\n set lower corner = 0, 0" << (dim == 3 ? ", 0" : "")
-             << "\n set upper corner = 2, 1" << (dim == 3 ? ", 1" : "") << "\n set cells = 4, 2"
-             << (dim == 3 ? ", 2" : "") << "\nend\n"
+             << "\n set upper corner = 2, 1" << (dim == 3 ? ", 1" : "") << "\n set cells = 4, " << ny
+             << (dim == 3 ? ", " + ny : std::string()) << "\nend\n"
              << "subsection boundary conditions\n" << boundary << "end\n"
              << "subsection gravity\n set acceleration = 0, " << (dim == 3 ? "0, " : "") << -gravity << "\nend\n"
              << "subsection output\n set directory = test_implicit_out\n set progress = false\nend\n"
@@ -259,5 +261,41 @@ namespace
   TEST(ImplicitTangent, ConsistentMassPointContact2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent, 1.0, point_floor), 1e-6);
+  }
+
+  // 'shape function = quadratic bspline': every transfer on the B-spline basis
+  // (a point couples the 3^dim nodes of its window, the walls' modified
+  // splines at x = 0 and at the grid's faces). Mixed u-p couples the 4^dim
+  // patch of a cell through the PPP cell means (ActiveSet::Reach::cell: with
+  // the point pattern the assembly throws on an entry outside the sparsity).
+  const std::string bspline = " set shape function = quadratic bspline\n";
+  TEST(ImplicitTangent, BSplineNeoHookeanStatic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, bspline), 1e-6);
+  }
+  TEST(ImplicitTangent, BSplineNeoHookeanDynamicAfterSteps2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 2, 9.81, bspline), 1e-6);
+  }
+  TEST(ImplicitTangent, BSplineNeoHookeanStatic3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2, 0, 9.81, bspline), 1e-6);
+  }
+  TEST(ImplicitTangent, BSplineJ2Plastic2D) { EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, bspline), 1e-5); }
+  TEST(ImplicitTangent, BSplineConsistentMassDynamic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, bspline + consistent_damped), 1e-6);
+  }
+  TEST(ImplicitTangent, BSplineMixedUpStatic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean_split, "static", 1e-2, 0, 9.81, bspline + mixed, 1e6), 1e-8);
+  }
+  TEST(ImplicitTangent, BSplineMixedUpJ2Plastic3D)
+  {
+    EXPECT_LT(tangent_error<3>(j2, "static", 1e-2, 0, 9.81, bspline + mixed, 1e6), 1e-6);
+  }
+  TEST(ImplicitTangent, BSplineRigidFootingRough2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, bspline, 1.0, footing(2, "rough")), 1e-6);
   }
 } // namespace

@@ -41,7 +41,8 @@ per cell in [0, 1] x [1, 2]), --negligible=F (implicit/negligible nodal mass).
 Usage: check_strip_footing_prandtl.py TOOLS_DIR PRM WORKDIR [--h=H] [--ppd=N] [--du=D] [--settlement=S]
        [--window=A,B] [--no-window] [--peak=S] [--tol=T] [--rise=S1,...] [--max-its=N] [--u-settlement=S]
        [--zig-u=Z] [--zig-up=Z] [--ranks=N] [--ranks-klu] [--yield=Y] [--fixed-nodes] [--line-search] [--width-b2]
-       [--edge=X] [--alpha=A] [--smooth] [--fine-ppd=N] [--negligible=F] [--points]
+       [--edge=X] [--alpha=A] [--smooth] [--fine-ppd=N] [--negligible=F] [--points] [--set=entry=value ...]
+(--set: any other .prm entry, e.g. --set=implicit/shape function=quadratic bspline)
 """
 import math
 import sys
@@ -133,7 +134,7 @@ def scene(settlement):
         text = tv.prm_set(text, "newton/line search", "true")
     if fixed_nodes:
         text = tv.prm_set(text, "implicit/velocity regions follow", "false")
-    return text
+    return tv.prm_set_args(text, [a[len("--set="):] for a in sys.argv if a.startswith("--set=")])
 
 
 def run(text, name, np=1):

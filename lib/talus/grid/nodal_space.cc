@@ -234,7 +234,8 @@ namespace talus
   template <int dim>
   template <class K>
   void
-  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings)
+  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings,
+                         const Reach reach)
   {
     const auto &       grid = space.grid;
     const unsigned int nc   = space.n_components();
@@ -264,7 +265,7 @@ namespace talus
           std::uint64_t *    bits = record ? node_neighbours.data() + std::size_t(ga) * offset_words : nullptr;
           cols.clear();
           for (unsigned int b = 0; b < K::n_nodes; ++b)
-            if (pairs[a * K::n_nodes + b])
+            if (reach == Reach::cell ? touched[b] : pairs[a * K::n_nodes + b])
               {
                 if (record)
                   offsets.set(bits, a, b);
@@ -515,13 +516,13 @@ namespace talus
   template class ActiveSet<2>;
   template class ActiveSet<3>;
   template void ActiveSet<2>::reinit<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &,
-                                                            ActiveSet<2>::Couplings);
+                                                            ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
   template void ActiveSet<3>::reinit<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &,
-                                                            ActiveSet<3>::Couplings);
+                                                            ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
   template void ActiveSet<2>::reinit<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &,
-                                                            ActiveSet<2>::Couplings);
+                                                            ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
   template void ActiveSet<3>::reinit<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &,
-                                                            ActiveSet<3>::Couplings);
+                                                            ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
   template bool ActiveSet<2>::couplings_covered<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
   template bool ActiveSet<3>::couplings_covered<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
   template bool ActiveSet<2>::couplings_covered<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;

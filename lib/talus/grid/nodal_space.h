@@ -113,8 +113,20 @@ namespace talus
     /// The active region of the points of `sets` (one pass over each) with the
     /// stencil of kernel K (shape::Q1Box<dim> or shape::BSpline2Box<dim>; the
     /// latter needs grid.setup_bspline_patches()). Collective.
+    /// Which node pairs the assembly couples: those that share a point, or
+    /// (cell) every pair of nodes that the points of one cell touch, for
+    /// assemblies with cell terms (the PPP cell means of mixed u-p, the cell
+    /// mean of F-bar): with the B-spline, two points of a cell touch different
+    /// 3^dim windows of its 4^dim patch.
+    enum class Reach
+    {
+      point,
+      cell
+    };
+
     template <class K>
-    void reinit(const std::vector<MaterialPointSet<dim> *> &sets, Couplings couplings = Couplings::skip);
+    void reinit(const std::vector<MaterialPointSet<dim> *> &sets, Couplings couplings = Couplings::skip,
+                Reach reach = Reach::point);
 
     /// Whether every point of `sets` on this rank couples only node pairs that
     /// the points (of any rank) coupled at the last reinit<K> (with

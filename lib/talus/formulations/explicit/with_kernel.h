@@ -5,8 +5,7 @@
 #pragma once
 
 #include <talus/formulations/explicit/explicit_solver.h>
-#include <talus/shape/bspline2_box.h>
-#include <talus/shape/q1_box.h>
+#include <talus/shape/with_kernel.h>
 
 namespace talus::explicit_mpm
 {
@@ -15,9 +14,6 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::with_kernel(F &&f)
   {
-    if (prm.numerics.bspline())
-      f(shape::BSpline2Box<dim>());
-    else
-      f(shape::Q1Box<dim>());
+    shape::with_kernel<dim>(prm.numerics.bspline(), std::forward<F>(f));
   }
 } // namespace talus::explicit_mpm

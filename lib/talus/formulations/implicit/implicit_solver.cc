@@ -8,7 +8,7 @@
 #include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/io/output.h>
 #include <talus/loads/kinematics.h>
-#include <talus/shape/q1_box.h>
+#include <talus/shape/with_kernel.h>
 #include <talus/transfer/updated_lagrangian_ops.h>
 
 #include <deal.II/base/mpi.h>
@@ -151,6 +151,11 @@ namespace talus::implicit_mpm
                         "cell). Removes the volumetric locking of Q1 cells with several points (near "
                         "incompressible elasticity, isochoric plastic flow). Not with 'mixed up' or "
                         "'axisymmetric'.");
+      prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
+                        "The grid basis of every transfer (mass, forces, tangent, convective phase): linear Q1, or "
+                        "quadratic B-splines with the wall treatment of docs/shape-functions.md (C1 across cell "
+                        "faces: no force jump when a point crosses a cell face; a point couples the 3^dim nodes "
+                        "around it). Not with 'volumetric stabilisation = f-bar' or 'geometry = axisymmetric'.");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
@@ -251,6 +256,7 @@ namespace talus::implicit_mpm
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
     p.fbar           = prm.get("volumetric stabilisation") == "f-bar";
+    p.bspline        = prm.get("shape function") == "quadratic bspline";
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
@@ -260,6 +266,12 @@ namespace talus::implicit_mpm
     require(!p.fbar || !p.mixed_up, "implicit/volumetric stabilisation",
             "'f-bar' is for 'formulation = irreducible' (the mixed u-p form treats the volume through its pressure "
             "field); allowed with 'mixed up': none");
+    require(!p.fbar || !p.bspline, "implicit/volumetric stabilisation",
+            "'f-bar' (a mean over the points of a cell) is for 'shape function = linear': a B-spline point "
+            "reaches beyond its cell; allowed with 'quadratic bspline': none");
+    require(!p.bspline || !p.axisymmetric, "implicit/shape function",
+            "'quadratic bspline' is not available with 'geometry = axisymmetric' (the axis is no wall of the "
+            "B-spline basis); allowed there: linear");
     require(!p.fbar || !p.axisymmetric, "implicit/volumetric stabilisation",
             "'f-bar' is not available with 'geometry = axisymmetric' (the hoop stretch is not in the cell mean); "
             "allowed there: none");
@@ -540,6 +552,14 @@ namespace talus::implicit_mpm
 
   // ================================================================ solver
   template <int dim>
+  template <class F>
+  void
+  Solver<dim>::with_kernel(F &&f) const
+  {
+    shape::with_kernel<dim>(prm.bspline, std::forward<F>(f));
+  }
+
+  template <int dim>
   Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
     : prm(p)
     , comm(c)
@@ -560,6 +580,8 @@ namespace talus::implicit_mpm
   {
     grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
+    if (prm.bspline)
+      grid.setup_bspline_patches(); // the 4^dim node patch of every owned cell
     space.setup();
 
     unsigned int n_history = 0;
@@ -608,7 +630,7 @@ namespace talus::implicit_mpm
               }
             planes.push_back(c);
           }
-        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric);
+        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric, prm.bspline);
         point_contact->extend_layout(points.layout);
       }
     if (prm.mixed_up)
@@ -822,7 +844,9 @@ namespace talus::implicit_mpm
             }
         prescribed_dofs = loads::prescribed_node_dofs(grid, velocities, false);
       }
-    active.template reinit<shape::Q1Box<dim>>({&points});
+    // the cell terms (PPP cell means, F-bar's cell mean) couple all the nodes a cell's points touch
+    const auto reach = prm.mixed_up || prm.fbar ? ActiveSet<dim>::Reach::cell : ActiveSet<dim>::Reach::point;
+    with_kernel([&](auto k) { active.template reinit<decltype(k)>({&points}, ActiveSet<dim>::Couplings::skip, reach); });
     active.reinit_matrix(tangent);
     project_to_grid();
     find_negligible_nodes();
@@ -1171,9 +1195,11 @@ namespace talus::implicit_mpm
     std::vector<MaterialPointSet<dim> *> sets = {&points};
     const auto &pins = active.constraints(); // inactive DoFs only: walls keep their mass
     mass = 0;
-    with_components([&](auto nc) {
-      transfer::assemble<dim, shape::Q1Box<dim>, decltype(nc)::value>(sets, active, pins,
-                                                                      transfer::NodalProjection<dim>{}, nullptr, &mass);
+    with_kernel([&](auto k) {
+      with_components([&](auto nc) {
+        transfer::assemble<dim, decltype(k), decltype(nc)::value>(sets, active, pins, transfer::NodalProjection<dim>{},
+                                                                  nullptr, &mass);
+      });
     });
     if (!dynamic())
       return;
@@ -1181,13 +1207,14 @@ namespace talus::implicit_mpm
     a_n = 0;
     // mixed u-p: onto the displacement components of the u-p space (the
     // pressure components get no mass, hence no inertia)
-    with_components([&](auto nc) {
-      constexpr unsigned int n = decltype(nc)::value;
-      transfer::assemble<dim, shape::Q1Box<dim>, n>(sets, active, pins, transfer::NodalProjection<dim>{L::velocity},
-                                                    nullptr, &v_n);
-      transfer::assemble<dim, shape::Q1Box<dim>, n>(sets, active, pins,
-                                                    transfer::NodalProjection<dim>{acceleration_offset}, nullptr,
-                                                    &a_n);
+    with_kernel([&](auto k) {
+      using K = decltype(k);
+      with_components([&](auto nc) {
+        constexpr unsigned int n = decltype(nc)::value;
+        transfer::assemble<dim, K, n>(sets, active, pins, transfer::NodalProjection<dim>{L::velocity}, nullptr, &v_n);
+        transfer::assemble<dim, K, n>(sets, active, pins, transfer::NodalProjection<dim>{acceleration_offset}, nullptr,
+                                      &a_n);
+      });
     });
     for (unsigned int i = 0; i < mass.locally_owned_size(); ++i)
       {
@@ -1240,12 +1267,16 @@ namespace talus::implicit_mpm
         up.alpha          = prm.stabilisation;
         up.tangent        = with_tangent;
         up.failure        = &failure;
-        transfer::assemble<dim, shape::Q1Box<dim>, dim + 1>({&points}, active, constraints, up,
-                                                            with_tangent ? &tangent : nullptr, &residual, &du);
+        with_kernel([&](auto k) {
+          transfer::assemble<dim, decltype(k), dim + 1>({&points}, active, constraints, up,
+                                                        with_tangent ? &tangent : nullptr, &residual, &du);
+        });
       }
     else
-      transfer::assemble<dim, shape::Q1Box<dim>, dim>({&points}, active, constraints, force,
-                                                      with_tangent ? &tangent : nullptr, &residual, &du);
+      with_kernel([&](auto k) {
+        transfer::assemble<dim, decltype(k), dim>({&points}, active, constraints, force,
+                                                  with_tangent ? &tangent : nullptr, &residual, &du);
+      });
     const bool any_failed = dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0;
     if (any_failed)
       throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
@@ -1307,21 +1338,22 @@ namespace talus::implicit_mpm
     // the constraints are inhomogeneous (the lifted predictor of prescribed
     // nodes): there the combined call would move -coef M_ij g_j to the residual,
     // an inertia of the prescribed nodes that the residual (w = 0 there) does not have.
-    with_components([&](auto nc) {
-      constexpr unsigned int n = decltype(nc)::value;
-      if (with_tangent && !constraints.has_inhomogeneities())
-        transfer::assemble<dim, shape::Q1Box<dim>, n>({&points}, active, constraints,
-                                                      ConsistentInertia<dim, true, true>{coef}, &tangent, &residual,
-                                                      &inertia_field);
-      else
-        {
-          if (with_tangent)
-            transfer::assemble<dim, shape::Q1Box<dim>, n>({&points}, active, constraints,
-                                                          ConsistentInertia<dim, true, false>{coef}, &tangent, nullptr);
-          transfer::assemble<dim, shape::Q1Box<dim>, n>({&points}, active, constraints,
-                                                        ConsistentInertia<dim, false, true>{coef}, nullptr, &residual,
-                                                        &inertia_field);
-        }
+    with_kernel([&](auto k) {
+      using K = decltype(k);
+      with_components([&](auto nc) {
+        constexpr unsigned int n = decltype(nc)::value;
+        if (with_tangent && !constraints.has_inhomogeneities())
+          transfer::assemble<dim, K, n>({&points}, active, constraints, ConsistentInertia<dim, true, true>{coef},
+                                        &tangent, &residual, &inertia_field);
+        else
+          {
+            if (with_tangent)
+              transfer::assemble<dim, K, n>({&points}, active, constraints, ConsistentInertia<dim, true, false>{coef},
+                                            &tangent, nullptr);
+            transfer::assemble<dim, K, n>({&points}, active, constraints, ConsistentInertia<dim, false, true>{coef},
+                                          nullptr, &residual, &inertia_field);
+          }
+      });
     });
   }
 
@@ -1333,12 +1365,13 @@ namespace talus::implicit_mpm
     const auto &pins = active.constraints();
     residual         = 0;
     delta            = 0;
-    transfer::assemble<dim, shape::Q1Box<dim>, dim + 1>({&points}, active, pins,
-                                                        transfer::PressureProjection<dim>{pressure_offset, true},
-                                                        nullptr, &residual);
-    transfer::assemble<dim, shape::Q1Box<dim>, dim + 1>({&points}, active, pins,
-                                                        transfer::PressureProjection<dim>{pressure_offset, false},
-                                                        nullptr, &delta);
+    with_kernel([&](auto k) {
+      using K = decltype(k);
+      transfer::assemble<dim, K, dim + 1>({&points}, active, pins, transfer::PressureProjection<dim>{pressure_offset, true},
+                                          nullptr, &residual);
+      transfer::assemble<dim, K, dim + 1>({&points}, active, pins, transfer::PressureProjection<dim>{pressure_offset, false},
+                                          nullptr, &delta);
+    });
     for (unsigned int k = 0; k < du.locally_owned_size(); ++k)
       if (space.component(k) == dim && delta.local_element(k) > 0)
         du.local_element(k) = residual.local_element(k) / delta.local_element(k);
@@ -1380,9 +1413,11 @@ namespace talus::implicit_mpm
         // the scale of gravity plus tractions: |sum_p N_i (m_p g + lambda f_p)|
         transfer::ExternalForce<dim> load{g, &point_forces, point_force_scale};
         residual = 0;
-        with_components([&](auto nc) {
-          transfer::assemble<dim, shape::Q1Box<dim>, decltype(nc)::value>({&points}, active, active.constraints(),
-                                                                          load, nullptr, &residual);
+        with_kernel([&](auto k) {
+          with_components([&](auto nc) {
+            transfer::assemble<dim, decltype(k), decltype(nc)::value>({&points}, active, active.constraints(), load,
+                                                                      nullptr, &residual);
+          });
         });
         f_ext = residual.l2_norm();
       }
@@ -1555,16 +1590,17 @@ namespace talus::implicit_mpm
     if (dynamic())
       nodal_acceleration(a_new);
     transfer::PointFailure failure;
-    transfer::CommitUpdatedLagrangian<dim, shape::Q1Box<dim>> commit(points, space, du, dynamic() ? &a_new : nullptr,
-                                                                     prm.materials, acceleration_offset, h,
-                                                                     newmark.gamma(), failure, pressure_offset,
-                                                                     radius_offset);
     if (prm.fbar)
-      {
-        compute_cell_jbar(); // of the converged du
+      compute_cell_jbar(); // of the converged du
+    with_kernel([&](auto k) {
+      transfer::CommitUpdatedLagrangian<dim, decltype(k)> commit(points, space, du, dynamic() ? &a_new : nullptr,
+                                                                 prm.materials, acceleration_offset, h,
+                                                                 newmark.gamma(), failure, pressure_offset,
+                                                                 radius_offset);
+      if (prm.fbar)
         commit.jbar = &cell_jbar;
-      }
-    transfer::for_each_active_cell(points, commit);
+      transfer::for_each_active_cell(points, commit);
+    });
     if (dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0)
       throw InstabilityError("the constitutive update of the converged step failed: " +
                              (failure.failed ? failure.what : std::string("on another rank")));
@@ -1693,8 +1729,10 @@ namespace talus::implicit_mpm
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
         << "), time step " << dt << std::endl;
     out << "  formulation: "
-        << (prm.mixed_up ? "mixed u-p (Q1-Q1, PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
+        << (prm.mixed_up ? std::string(prm.bspline ? "mixed u-p (equal-order B-splines" : "mixed u-p (Q1-Q1") +
+                             ", PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
                          : std::string("irreducible (displacement)"))
+        << (prm.bspline ? ", quadratic B-splines" : ", linear shape functions")
         << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
         << (prm.velocities.empty() ? "" :
                                      ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")

@@ -56,6 +56,9 @@ namespace talus::implicit_mpm
     /// dFbar = (jbar / j)^(1/dim) dF, jbar the volume-weighted mean det dF of its grid cell,
     /// with the exact tangent (docs/implicit.md, "F-bar")
     bool fbar = false;
+    /// 'implicit/shape function = quadratic bspline': the kernel of every grid
+    /// transfer (else linear Q1; docs/implicit.md 'Quadratic B-splines')
+    bool bspline = false;
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
@@ -286,6 +289,10 @@ namespace talus::implicit_mpm
       else
         f(std::integral_constant<unsigned int, dim>());
     }
+    /// f(K()) with K the shape kernel of 'implicit/shape function'
+    /// (defined in implicit_solver.cc, its only user)
+    template <class F>
+    void with_kernel(F &&f) const;
     /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
     void nodal_acceleration(Vector &a) const;
     /// The newest valid checkpoint into the state (false: none). Collective.

@@ -1,6 +1,6 @@
 // talus — contact walls on the points' side (point_contact.h).
 #include <talus/formulations/implicit/point_contact.h>
-#include <talus/shape/q1_box.h>
+#include <talus/shape/with_kernel.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/matrix_ops.h>
 
@@ -13,9 +13,10 @@ namespace talus::implicit_mpm
   template <int dim>
   PointContact<dim>::PointContact(std::vector<ContactPlane> planes_,
                                   const std::vector<std::shared_ptr<const materials::Material>> &materials,
-                                  const bool axisymmetric_)
+                                  const bool axisymmetric_, const bool bspline_)
     : planes(std::move(planes_))
     , axisymmetric(axisymmetric_)
+    , bspline(bspline_)
   {
     for (const auto &m : materials)
       modulus.push_back(m->constrained_modulus());
@@ -260,9 +261,11 @@ namespace talus::implicit_mpm
     PointContactStats          stats;
     const ContactIntegrand<dim> integrand{this, &stats};
     const auto                  run = [&](auto nc) {
-      transfer::AssembleSystem<dim, shape::Q1Box<dim>, decltype(nc)::value, ContactIntegrand<dim>> op(
-        active, constraints, integrand, A, &b, &du);
-      transfer::for_each_active_cell(points, op);
+      shape::with_kernel<dim>(bspline, [&](auto k) {
+        transfer::AssembleSystem<dim, decltype(k), decltype(nc)::value, ContactIntegrand<dim>> op(
+          active, constraints, integrand, A, &b, &du);
+        transfer::for_each_active_cell(points, op);
+      });
     };
     if (active.space.n_components() == dim)
       run(std::integral_constant<unsigned int, dim>());
@@ -329,8 +332,10 @@ namespace talus::implicit_mpm
     const auto run = [&](auto nc) {
       constexpr unsigned int n = decltype(nc)::value;
       auto cb = [&](transfer::PointIterator<dim> &it, const double *val, const auto &grad) { update(it, val, grad); };
-      transfer::InterpolateField<dim, shape::Q1Box<dim>, n, decltype(cb)> op(space, du, cb);
-      transfer::for_each_active_cell(points, op);
+      shape::with_kernel<dim>(bspline, [&](auto k) {
+        transfer::InterpolateField<dim, decltype(k), n, decltype(cb)> op(space, du, cb);
+        transfer::for_each_active_cell(points, op);
+      });
     };
     if (space.n_components() == dim)
       run(std::integral_constant<unsigned int, dim>());

@@ -86,8 +86,10 @@ namespace talus::implicit_mpm
   class PointContact
   {
   public:
+    /// bspline: the grid basis of the solver (quadratic B-splines, else linear Q1)
     PointContact(std::vector<ContactPlane> planes,
-                 const std::vector<std::shared_ptr<const materials::Material>> &materials, const bool axisymmetric);
+                 const std::vector<std::shared_ptr<const materials::Material>> &materials, const bool axisymmetric,
+                 const bool bspline);
 
     /// Adds the block 'contact' (x_n, then per wall: anchor (dim) and flag) to
     /// the layout; call before the points are initialised.
@@ -135,6 +137,7 @@ namespace talus::implicit_mpm
     std::vector<ContactPlane> planes;
     std::vector<double>       modulus; ///< per material: constrained modulus M
     bool                      axisymmetric;
+    bool                      bspline;
     unsigned int              offset_ = 0;
   };
 } // namespace talus::implicit_mpm
