@@ -317,6 +317,15 @@ add_test(NAME verification.implicit_checkpoint_restart_footing
                  "linear solver/direct package=klu" "implicit/ramp loads=false")
 set_tests_properties(verification.implicit_checkpoint_restart_footing PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+# the same on quadratic B-splines (verify: 6.6 min on the shared machine, KLU on the 3^2 couplings)
+add_test(NAME verification.implicit_checkpoint_restart_footing_bspline
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_checkpoint_restart_footing_bspline
+                 "grid/cells=30, 22" "time/time step=0.01" "rigid footing/velocity=-0.2"
+                 "linear solver/direct package=klu" "implicit/ramp loads=false"
+                 "implicit/shape function=quadratic bspline")
+set_tests_properties(verification.implicit_checkpoint_restart_footing_bspline PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1800 PROCESSORS 2)
 
 # issue 15: load balancing by material points (formulations/common/load_balance.h):
 # a column collapsing in the left fifth of the box on 2 ranks, imbalance before/after
