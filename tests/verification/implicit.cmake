@@ -416,6 +416,26 @@ add_test(NAME verification.implicit_strip_footing_points_bspline
                  "--set=implicit/shape function=quadratic bspline")
 set_tests_properties(verification.implicit_strip_footing_points_bspline PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
+# the rising curve of thesis Fig. 6.8 (docs/implicit.md "Quadratic B-splines"): B-splines and the
+# PPP factor alpha = 8 (Kratos's effective 2D value): plateau s/B in [0.03, 0.06] +0.77 %, then the
+# means over +-0.01 B rise: 5.4306 (0.1 B), 5.6021 (0.2 B); alpha = 1 falls there (fails)
+add_test(NAME verification.implicit_strip_footing_bspline_rise
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_bspline_rise
+                 --points --settlement=0.21 --window=0.03,0.06 --tol=0.03 --rise=0.1,0.2 --max-its=25 --alpha=8
+                 "--set=implicit/shape function=quadratic bspline")
+set_tests_properties(verification.implicit_strip_footing_bspline_rise PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900)
+# the same to s = 0.5 B in a grid 0.6 m taller than the body: 5.43, 5.60, 5.73, 5.78, 5.94 at
+# s/B = 0.1 .. 0.49 (verify)
+add_test(NAME verification.implicit_strip_footing_bspline_rise_large
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_bspline_rise_large
+                 --points --settlement=0.5 --window=0.03,0.06 --tol=0.03 --rise=0.1,0.2,0.3,0.4,0.49 --max-its=25
+                 --alpha=8 "--set=implicit/shape function=quadratic bspline" "--set=grid/upper corner=3, 2.6"
+                 "--set=grid/cells=30, 26")
+set_tests_properties(verification.implicit_strip_footing_bspline_rise_large PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1800)
 add_test(NAME verification.implicit_strip_footing_points_full
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points_full
