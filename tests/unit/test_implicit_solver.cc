@@ -263,6 +263,24 @@ namespace
     EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent, 1.0, point_floor), 1e-6);
   }
 
+  // 'rayleigh beta': C = beta_R K_n, K_n the force tangent at the step's start (du = 0),
+  // held for the step: r += beta_R K_n v^{n+1}(du), tangent += beta_R gamma/(beta h) K_n.
+  // With h = 0.01 s, gamma/(beta h) = 200, so beta_R = 0.01 doubles the stiffness part of
+  // the tangent: a missing or wrong damping term shows at order 1.
+  const std::string rayleigh_beta = " set rayleigh beta = 0.01\n";
+  TEST(ImplicitTangent, RayleighBetaDynamic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, rayleigh_beta), 1e-6);
+  }
+  TEST(ImplicitTangent, RayleighBetaJ2AfterSteps2D)
+  {
+    EXPECT_LT(tangent_error<2>(j2, "dynamic", 1e-2, 2, 9.81, rayleigh_beta + " set rayleigh alpha = 1.5\n"), 1e-5);
+  }
+  TEST(ImplicitTangent, RayleighBetaDynamic3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "dynamic", 1e-2, 0, 9.81, rayleigh_beta), 1e-6);
+  }
+
   // 'shape function = quadratic bspline': every transfer on the B-spline basis
   // (a point couples the 3^dim nodes of its window, the walls' modified
   // splines at x = 0 and at the grid's faces). Mixed u-p couples the 4^dim

@@ -50,6 +50,13 @@ cases = {
     "mass matrix misspelt": (tv.prm_set(base, "implicit/mass matrix", "consistant"),
                              ["mass matrix", "consistant", "lumped|consistent"]),
     "damping in a static run": (tv.prm_set(base, "implicit/rayleigh alpha", "1"), ["rayleigh alpha", "dynamic"]),
+    "stiffness damping in a static run": (tv.prm_set(base, "implicit/rayleigh beta", "0.01"),
+                                          ["rayleigh beta", "dynamic"]),
+    "stiffness damping with mixed up": (
+        tv.prm_set_args(base, ["implicit/analysis=dynamic", "implicit/formulation=mixed up",
+                               "material 0/neo hookean/volumetric energy=split", "implicit/rayleigh beta=0.01"]),
+        ["implicit/rayleigh beta", "irreducible", "mixed up"]),
+    "negative stiffness damping": (tv.prm_set(base, "implicit/rayleigh beta", "-1"), ["rayleigh beta", "-1"]),
     "static without supports": (tv.prm_set(base, "boundary conditions/fixed", ""), ["boundary conditions", "static",
                                                                                    "singular"]),
     "mixed up without the split energy": (tv.prm_set(base, "implicit/formulation", "mixed up"),

@@ -128,6 +128,11 @@ namespace talus::implicit_mpm
       prm.declare_entry("rayleigh alpha", "0", Double(0),
                         "Mass-proportional Rayleigh damping C = alpha M [1/s] (dynamic only; the column "
                         "collapse of thesis §6.1 uses 1.5).");
+      prm.declare_entry("rayleigh beta", "0", Double(0),
+                        "Stiffness-proportional Rayleigh damping C += beta K [s] (dynamic, irreducible form): K the "
+                        "material + geometric tangent at the start of each step, held for the step so that Newton's "
+                        "tangent stays exact; a mode of frequency omega gets the damping ratio beta omega / 2. "
+                        "Rows and columns of constrained DoFs carry no damping force.");
       prm.declare_entry("mass matrix", "lumped", Selection("lumped|consistent"),
                         "dynamic: the mass matrix of the inertia M a and of the damping alpha M v. lumped: "
                         "M_ii = sum_p m_p N_i(x_p) (the default: Kratos MPM's choice, positive for every node "
@@ -251,6 +256,7 @@ namespace talus::implicit_mpm
     p.gamma          = prm.get_double("newmark gamma");
     p.beta           = prm.get_double("newmark beta");
     p.rayleigh_alpha = prm.get_double("rayleigh alpha");
+    p.rayleigh_beta  = prm.get_double("rayleigh beta");
     p.consistent_mass = prm.get("mass matrix") == "consistent";
     p.ramp_loads     = prm.get_bool("ramp loads");
     p.mixed_up       = prm.get("formulation") == "mixed up";
@@ -526,6 +532,11 @@ namespace talus::implicit_mpm
       }
     require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_alpha == 0, "implicit/rayleigh alpha",
             "damping needs 'analysis = dynamic'");
+    require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_beta == 0, "implicit/rayleigh beta",
+            "damping needs 'analysis = dynamic'");
+    require(!p.mixed_up || p.rayleigh_beta == 0, "implicit/rayleigh beta",
+            "stiffness-proportional damping is for 'formulation = irreducible' (the u-p tangent's pressure blocks are "
+            "not a stiffness); allowed with 'mixed up': 0 (use 'rayleigh alpha')");
     for (unsigned int k = 0; k < p.stages.size(); ++k)
       require(p.analysis == Parameters<dim>::Analysis::dynamic || !p.stages[k].boundary_conditions.empty(),
               p.staged ? "stage " + std::to_string(k) + "/boundary conditions" : std::string("boundary conditions"),
@@ -1280,6 +1291,27 @@ namespace talus::implicit_mpm
     const bool any_failed = dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0;
     if (any_failed)
       throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
+    if (assembling_damping)
+      return 0.0;
+    if (dynamic() && prm.rayleigh_beta > 0)
+      {
+        // stiffness-proportional damping: r += beta_R K_n v^{n+1}(du) on the free DoFs and
+        // tangent += beta_R gamma/(beta h) K_n (K_n held for the step: the tangent is exact)
+        Vector v, Kv;
+        space.reinit_vector(v);
+        space.reinit_vector(Kv);
+        const auto &owned = space.locally_owned_dofs();
+        for (unsigned int k = 0; k < v.locally_owned_size(); ++k)
+          v.local_element(k) = constraints.is_constrained(owned.nth_index_in_set(k))
+                                 ? 0.0
+                                 : newmark.velocity(du.local_element(k), v_n.local_element(k), a_n.local_element(k));
+        damping_stiffness.vmult(Kv, v);
+        for (unsigned int k = 0; k < v.locally_owned_size(); ++k)
+          if (!constraints.is_constrained(owned.nth_index_in_set(k)))
+            residual.local_element(k) += prm.rayleigh_beta * Kv.local_element(k);
+        if (with_tangent)
+          tangent.add(prm.rayleigh_beta * newmark.damping_coefficient(), damping_stiffness);
+      }
     if (point_contact) // the penalty walls on the points (point_contact.h)
       point_contact->assemble(points, active, constraints, du, with_tangent ? &tangent : nullptr, residual);
     if (dynamic() && prm.consistent_mass)
@@ -1391,6 +1423,29 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
+  void
+  Solver<dim>::assemble_damping_stiffness(const dealii::Tensor<1, dim> &g)
+  {
+    const Vector saved(du);
+    du = 0;
+    du.update_ghost_values();
+    assembling_damping = true;
+    try
+      {
+        assemble(true, g);
+      }
+    catch (...)
+      {
+        assembling_damping = false;
+        throw;
+      }
+    assembling_damping = false;
+    damping_stiffness.copy_from(tangent);
+    du = saved;
+    du.update_ghost_values();
+  }
+
+  template <int dim>
   StepOutcome
   Solver<dim>::advance_by(const double h)
   {
@@ -1399,6 +1454,8 @@ namespace talus::implicit_mpm
       point_contact->set_time(time, time + h);
     prepare_step();
     const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
+    if (dynamic() && prm.rayleigh_beta > 0)
+      assemble_damping_stiffness(g);
     // the external force scale |f_ext| (lumped nodal masses times g)
     double f2 = 0;
     for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
@@ -1631,6 +1688,8 @@ namespace talus::implicit_mpm
     newmark.set_time_step(h);
     prepare_step();
     const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
+    if (dynamic() && prm.rayleigh_beta > 0)
+      assemble_damping_stiffness(g);
     const auto &                 owned = space.locally_owned_dofs();
     Vector                       v;
     space.reinit_vector(v);
@@ -1725,7 +1784,8 @@ namespace talus::implicit_mpm
     out << "  grid: " << grid.tria.n_global_active_cells() << " cells; " << n_points() << " material points" << std::endl;
     out << "  analysis: " << (dynamic() ? "dynamic (Newmark gamma = " : "static (")
         << (dynamic() ? std::to_string(prm.gamma) + ", beta = " + std::to_string(prm.beta) + (prm.consistent_mass ? ", consistent mass" : ", lumped mass") +
-                          (prm.rayleigh_alpha > 0 ? ", Rayleigh alpha = " + std::to_string(prm.rayleigh_alpha) : "")
+                          (prm.rayleigh_alpha > 0 ? ", Rayleigh alpha = " + std::to_string(prm.rayleigh_alpha) : "") +
+                          (prm.rayleigh_beta > 0 ? ", Rayleigh beta = " + std::to_string(prm.rayleigh_beta) : "")
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
         << "), time step " << dt << std::endl;
     out << "  formulation: "

@@ -62,6 +62,9 @@ namespace talus::implicit_mpm
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
+    /// C += beta K: stiffness-proportional Rayleigh damping [s], K the material + geometric
+    /// tangent at the start of the step (frozen within it)
+    double   rayleigh_beta = 0;
     /// 'implicit/mass matrix = consistent': the inertia and damping with
     /// M_ij = sum_p m_p N_i N_j (per component) instead of its row sums; the
     /// projection of v_p and a_p to the nodes stays lumped (docs/implicit.md)
@@ -293,6 +296,8 @@ namespace talus::implicit_mpm
     /// (defined in implicit_solver.cc, its only user)
     template <class F>
     void with_kernel(F &&f) const;
+    /// 'rayleigh beta' > 0: damping_stiffness = the force tangent at du = 0 (the step's start)
+    void assemble_damping_stiffness(const dealii::Tensor<1, dim> &g);
     /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
     void nodal_acceleration(Vector &a) const;
     /// The newest valid checkpoint into the state (false: none). Collective.
@@ -334,6 +339,10 @@ namespace talus::implicit_mpm
     /// counted); a failed or singular solve throws NewtonFailure.
     LinearSolveInfo solve_for_delta();
     dealii::TrilinosWrappers::SparseMatrix  tangent;
+    /// 'rayleigh beta' > 0: the stiffness K_n of the step's start (du = 0), whose beta K_n v^{n+1}
+    /// is the damping force of the step (assemble_damping_stiffness)
+    dealii::TrilinosWrappers::SparseMatrix  damping_stiffness;
+    bool assembling_damping = false; ///< assemble() stops after the points' force (K_n for the damping)
     Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
     /// F-bar: the mean det dF of each active cell at the current du (transfer::CellMeanJacobian)
     std::vector<double> cell_jbar;
