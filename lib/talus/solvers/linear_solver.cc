@@ -99,6 +99,18 @@ namespace talus
             rn = rn_new;
           }
       }
+    else if (options.method == LinearSolverOptions::Method::gmres_amg)
+      {
+        info.method = "GMRES + AMG (ML)";
+        dealii::TrilinosWrappers::PreconditionAMG amg_preconditioner;
+        amg_preconditioner.initialize(A, amg_data(options, constant_modes));
+        // AztecOO's criterion is absolute (|r| <= tol, unscaled), as for CG
+        dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b_norm);
+        dealii::TrilinosWrappers::SolverGMRES solver(control,
+                                                     dealii::TrilinosWrappers::SolverGMRES::AdditionalData(false, 100));
+        solver.solve(A, x, b, amg_preconditioner);
+        info.iterations = control.last_step();
+      }
     else
       {
         info.method = "CG + AMG (ML)";

@@ -24,7 +24,8 @@ namespace talus
     enum class Method
     {
       direct, ///< TrilinosWrappers::SolverDirect (Amesos_Klu)
-      cg_amg  ///< TrilinosWrappers::SolverCG + PreconditionAMG (ML)
+      cg_amg,   ///< TrilinosWrappers::SolverCG + PreconditionAMG (ML): symmetric matrices
+      gmres_amg ///< TrilinosWrappers::SolverGMRES (restart 100) + PreconditionAMG (ML): non-symmetric ones
     };
     Method method = Method::direct;
     /// direct: the Amesos package ("Amesos_Klu" or "Amesos_Mumps"). KLU's
@@ -45,7 +46,7 @@ namespace talus
   struct LinearSolveInfo
   {
     std::string  method;
-    unsigned int iterations = 0; ///< CG iterations; 1 for the direct solve
+    unsigned int iterations = 0; ///< CG or GMRES iterations; 1 for the direct solve
     double       relative_residual = 0; ///< |b - A x| / |b| after the solve
   };
 

@@ -228,14 +228,16 @@ namespace talus::implicit_mpm
     prm.leave_subsection();
     prm.enter_subsection("linear solver");
     {
-      prm.declare_entry("method", "direct", Selection("direct|cg amg"),
-                        "direct: Amesos KLU; cg amg: conjugate gradients with ML algebraic multigrid "
+      prm.declare_entry("method", "direct", Selection("direct|cg amg|gmres amg"),
+                        "direct: Amesos KLU; gmres amg: GMRES (restart 100) with ML algebraic multigrid (any tangent "
+                        "of the irreducible form: plastic models, F-bar, Coulomb friction); cg amg: conjugate "
+                        "gradients with ML algebraic multigrid "
                         "(symmetric tangents only: elastic models).");
       prm.declare_entry("direct package", "klu", Selection("klu|mumps"),
                         "direct: the Amesos package, KLU or MUMPS (MUMPS is much faster on the indefinite mixed "
                         "u-p tangent, whose pivoting fills KLU's factors).");
-      prm.declare_entry("relative tolerance", "1e-10", Double(0, 1), "cg amg: |b - A x| <= tol |b|.");
-      prm.declare_entry("max iterations", "1000", Integer(1), "cg amg: iteration limit.");
+      prm.declare_entry("relative tolerance", "1e-10", Double(0, 1), "cg amg, gmres amg: |b - A x| <= tol |b|.");
+      prm.declare_entry("max iterations", "1000", Integer(1), "cg amg, gmres amg: iteration limit.");
     }
     prm.leave_subsection();
   }
@@ -456,8 +458,9 @@ namespace talus::implicit_mpm
                   "the grid's solution; allowed: boundary | region (prescribed grid nodes)");
       }
     prm.enter_subsection("linear solver");
-    p.linear.method = prm.get("method") == "direct" ? LinearSolverOptions::Method::direct
-                                                    : LinearSolverOptions::Method::cg_amg;
+    p.linear.method = prm.get("method") == "direct"  ? LinearSolverOptions::Method::direct :
+                      prm.get("method") == "cg amg" ? LinearSolverOptions::Method::cg_amg :
+                                                      LinearSolverOptions::Method::gmres_amg;
     p.linear.direct_package     = prm.get("direct package") == "mumps" ? "Amesos_Mumps" : "Amesos_Klu";
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
@@ -466,10 +469,10 @@ namespace talus::implicit_mpm
             "a rigid footing acts on the material points; with contact walls set 'boundary conditions/contact "
             "method = points'");
     require(!p.contact_on_points || p.contact_mu == 0 || std::isinf(p.contact_mu) ||
-              p.linear.method == LinearSolverOptions::Method::direct,
+              p.linear.method != LinearSolverOptions::Method::cg_amg,
             "linear solver/method",
-            "Coulomb friction on the contact walls gives a non-symmetric tangent: use 'direct' (or contact friction "
-            "= no slip | frictionless with cg amg)");
+            "Coulomb friction on the contact walls gives a non-symmetric tangent: use 'direct' or 'gmres amg' (or "
+            "contact friction = no slip | frictionless with cg amg)");
 
     for (unsigned int k = 0; k < p.materials.size(); ++k)
       {
@@ -1827,7 +1830,10 @@ namespace talus::implicit_mpm
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
         << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
         << " iterations; linear solver "
-        << (prm.linear.method == LinearSolverOptions::Method::direct ? "direct (" + prm.linear.direct_package + ")" : std::string("CG + ML AMG")) << std::endl;
+        << (prm.linear.method == LinearSolverOptions::Method::direct   ? "direct (" + prm.linear.direct_package + ")" :
+            prm.linear.method == LinearSolverOptions::Method::cg_amg ? std::string("CG + ML AMG") :
+                                                                       std::string("GMRES + ML AMG"))
+        << std::endl;
   }
 
   template <int dim>
