@@ -110,9 +110,6 @@ namespace talus
       record
     };
 
-    /// The active region of the points of `sets` (one pass over each) with the
-    /// stencil of kernel K (shape::Q1Box<dim> or shape::BSpline2Box<dim>; the
-    /// latter needs grid.setup_bspline_patches()). Collective.
     /// Which node pairs the assembly couples: those that share a point, or
     /// (cell) every pair of nodes that the points of one cell touch, for
     /// assemblies with cell terms (the PPP cell means of mixed u-p, the cell
@@ -124,6 +121,10 @@ namespace talus
       cell
     };
 
+    /// The active region of the points of `sets` (one pass over each) with the
+    /// stencil of kernel K (shape::Q1Box<dim> or shape::BSpline2Box<dim>; the
+    /// latter needs grid.setup_bspline_patches()), its sparsity with `reach`.
+    /// Collective.
     template <class K>
     void reinit(const std::vector<MaterialPointSet<dim> *> &sets, Couplings couplings = Couplings::skip,
                 Reach reach = Reach::point);

@@ -24,7 +24,24 @@ namespace talus
       return amg;
     }
 
-    /// CG to |b - A x| <= tol |b|; returns the iterations
+    /// A Krylov solve (TrilinosWrappers::SolverCG or SolverGMRES) to |b - A x| <=
+    /// tol |b|; returns the iterations
+    template <class KrylovSolver>
+    unsigned int
+    krylov(const dealii::TrilinosWrappers::SparseMatrix &        A,
+           Vector &                                              x,
+           const Vector &                                        b,
+           const LinearSolverOptions &                           options,
+           const dealii::TrilinosWrappers::PreconditionAMG &     preconditioner,
+           const typename KrylovSolver::AdditionalData &         data = {})
+    {
+      // AztecOO's criterion is absolute (|r| <= tol, unscaled)
+      dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b.l2_norm());
+      KrylovSolver          solver(control, data);
+      solver.solve(A, x, b, preconditioner);
+      return control.last_step();
+    }
+
     unsigned int
     cg(const dealii::TrilinosWrappers::SparseMatrix &   A,
        Vector &                                         x,
@@ -32,11 +49,7 @@ namespace talus
        const LinearSolverOptions &                      options,
        const dealii::TrilinosWrappers::PreconditionAMG &preconditioner)
     {
-      // AztecOO's criterion is absolute (|r| <= tol, unscaled)
-      dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b.l2_norm());
-      dealii::TrilinosWrappers::SolverCG solver(control);
-      solver.solve(A, x, b, preconditioner);
-      return control.last_step();
+      return krylov<dealii::TrilinosWrappers::SolverCG>(A, x, b, options, preconditioner);
     }
 
     double
@@ -99,24 +112,21 @@ namespace talus
             rn = rn_new;
           }
       }
-    else if (options.method == LinearSolverOptions::Method::gmres_amg)
-      {
-        info.method = "GMRES + AMG (ML)";
-        dealii::TrilinosWrappers::PreconditionAMG amg_preconditioner;
-        amg_preconditioner.initialize(A, amg_data(options, constant_modes));
-        // AztecOO's criterion is absolute (|r| <= tol, unscaled), as for CG
-        dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b_norm);
-        dealii::TrilinosWrappers::SolverGMRES solver(control,
-                                                     dealii::TrilinosWrappers::SolverGMRES::AdditionalData(false, 100));
-        solver.solve(A, x, b, amg_preconditioner);
-        info.iterations = control.last_step();
-      }
     else
       {
-        info.method = "CG + AMG (ML)";
         dealii::TrilinosWrappers::PreconditionAMG amg_preconditioner;
         amg_preconditioner.initialize(A, amg_data(options, constant_modes));
-        info.iterations = cg(A, x, b, options, amg_preconditioner);
+        if (options.method == LinearSolverOptions::Method::gmres_amg)
+          {
+            using GMRES     = dealii::TrilinosWrappers::SolverGMRES;
+            info.method     = "GMRES + AMG (ML)";
+            info.iterations = krylov<GMRES>(A, x, b, options, amg_preconditioner, GMRES::AdditionalData(false, 100));
+          }
+        else
+          {
+            info.method     = "CG + AMG (ML)";
+            info.iterations = cg(A, x, b, options, amg_preconditioner);
+          }
       }
     info.relative_residual = relative_residual(A, x, b);
     return info;
