@@ -62,13 +62,8 @@ def corner_displacement(path):
     rows = [(1.0, x - 48, y - 60) for x, y, _ in near]
     A = [[sum(r[i] * r[j] for r in rows) for j in range(3)] for i in range(3)]
     b = [sum(r[i] * p[2] for r, p in zip(rows, near)) for i in range(3)]
-
-    def det(m):
-        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
-
     Ab = [[b[i] if j == 0 else A[i][j] for j in range(3)] for i in range(3)]
-    return det(Ab) / det(A), len(pts)
+    return tv.det3(Ab) / tv.det3(A), len(pts)
 
 
 FORMS = ("irreducible", "mixed up") if bspline else ("irreducible", "mixed up", "f-bar")

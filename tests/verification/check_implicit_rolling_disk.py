@@ -132,13 +132,8 @@ def quadratic_fit(ts, ys):
     S = [sum(x ** k for x in ts) for k in range(5)]
     b = [sum(y * x ** k for x, y in zip(ts, ys)) for k in range(3)]
     A = [[S[i + j] for j in range(3)] for i in range(3)]
-
-    def det(M):
-        return (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0])
-                + M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]))
-
-    D = det(A)
-    return [det([[b[i] if j == k else A[i][j] for j in range(3)] for i in range(3)]) / D for k in range(3)]
+    D = tv.det3(A)
+    return [tv.det3([[b[i] if j == k else A[i][j] for j in range(3)] for i in range(3)]) / D for k in range(3)]
 
 
 c = quadratic_fit(t, xc)

@@ -173,9 +173,7 @@ for density, v0, end in cases:
             if soil["history_7"][i] > 0.999 * gas * v0:
                 continue
             b = [[soil[f"history_{k}"][i] for k in row] for row in ((0, 3, 5), (3, 1, 4), (5, 4, 2))]
-            det = (b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1]) - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
-                   + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]))
-            tau = soil["history_11"][i] * math.exp(-(0.5 * math.log(det) - soil["history_12"][i]) / kappa)
+            tau = soil["history_11"][i] * math.exp(-(0.5 * math.log(tv.det3(b)) - soil["history_12"][i]) / kappa)
             if abs(tau) < 1e-3:
                 continue
             sigma = (soil["stress_xx"][i] + soil["stress_yy"][i] + soil["stress_zz"][i]) / 3

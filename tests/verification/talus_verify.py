@@ -29,6 +29,12 @@ def _prm_entries(lines):
             yield i, stack, m.group(1), m.group(2).strip()
 
 
+def det3(m):
+    """Determinant of a 3 x 3 matrix (nested lists)."""
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
 def prm_set(text, path, value):
     """Set entry `path` ("sub/sub/entry" or "entry") in a .prm text.
 
