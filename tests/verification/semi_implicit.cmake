@@ -221,3 +221,10 @@ add_test(NAME verification.semi_implicit_landslide_coarse
                  "--set=grid/cells=40, 10" --only=dense)
 set_tests_properties(verification.semi_implicit_landslide_coarse PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 1800)
+
+# a body read from a talus-mesh particle file equals the box body (1 and 2 ranks,
+# double and single point, materials from the file's rows), bad files refused
+add_test(NAME verification.semi_implicit_file_body
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_file_body.py ${TALUS_TOOLS_DIR} ${CMAKE_SOURCE_DIR}
+                 ${_w}/semi_implicit_file_body)
+set_tests_properties(verification.semi_implicit_file_body PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

@@ -160,30 +160,7 @@ namespace talus
         const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
         if (b.shape == BodyDescription<dim>::Shape::file)
           {
-            const std::string entry = "body " + std::to_string(k);
-            const auto info = io::particle_file_info(b.particle_file, dim, MPI_COMM_WORLD, entry + "/particle file");
-            const std::uint64_t rows = b.file_body_id < info.rows_per_body.size() ? info.rows_per_body[b.file_body_id] : 0;
-            if (rows == 0)
-              {
-                std::string present;
-                for (unsigned int i = 0; i < info.rows_per_body.size(); ++i)
-                  if (info.rows_per_body[i])
-                    present += (present.empty() ? "" : ", ") + std::to_string(i);
-                throw InputError(entry + "/file body id: particle file '" + b.particle_file +
-                                 "' has no material point with body id " + std::to_string(b.file_body_id) +
-                                 " (body ids present: " + (present.empty() ? "none" : present) + ")");
-              }
-            require(info.max_material < p.materials.size(), entry + "/particle file",
-                    "'" + b.particle_file + "' uses material id " + std::to_string(info.max_material) +
-                      ", but number of materials = " + std::to_string(p.materials.size()) + " (allowed 0.." +
-                      std::to_string(p.materials.size() - 1) + ")");
-            for (unsigned int j = 0; j < k; ++j)
-              require(p.bodies[j].shape != BodyDescription<dim>::Shape::file ||
-                        p.bodies[j].particle_file != b.particle_file || p.bodies[j].file_body_id != b.file_body_id,
-                      entry + "/file body id",
-                      "body " + std::to_string(j) + " already takes the points of body id " +
-                        std::to_string(b.file_body_id) + " of '" + b.particle_file + "' (each point once)");
-            n_points += rows;
+            n_points += check_file_body(p, k);
             continue;
           }
         // bounding box of the body
@@ -275,6 +252,37 @@ namespace talus
   }
 
   template <int dim>
+  std::uint64_t
+  check_file_body(const SceneParameters<dim> &p, const unsigned int k)
+  {
+    const auto &        b     = p.bodies[k];
+    const std::string   entry = "body " + std::to_string(k);
+    const auto          info  = io::particle_file_info(b.particle_file, dim, MPI_COMM_WORLD, entry + "/particle file");
+    const std::uint64_t rows  = b.file_body_id < info.rows_per_body.size() ? info.rows_per_body[b.file_body_id] : 0;
+    if (rows == 0)
+      {
+        std::string present;
+        for (unsigned int i = 0; i < info.rows_per_body.size(); ++i)
+          if (info.rows_per_body[i])
+            present += (present.empty() ? "" : ", ") + std::to_string(i);
+        throw InputError(entry + "/file body id: particle file '" + b.particle_file +
+                         "' has no material point with body id " + std::to_string(b.file_body_id) +
+                         " (body ids present: " + (present.empty() ? "none" : present) + ")");
+      }
+    require(info.max_material < p.materials.size(), entry + "/particle file",
+            "'" + b.particle_file + "' uses material id " + std::to_string(info.max_material) +
+              ", but number of materials = " + std::to_string(p.materials.size()) + " (allowed 0.." +
+              std::to_string(p.materials.size() - 1) + ")");
+    for (unsigned int j = 0; j < k; ++j)
+      require(p.bodies[j].shape != BodyDescription<dim>::Shape::file || p.bodies[j].particle_file != b.particle_file ||
+                p.bodies[j].file_body_id != b.file_body_id,
+              entry + "/file body id",
+              "body " + std::to_string(j) + " already takes the points of body id " + std::to_string(b.file_body_id) +
+                " of '" + b.particle_file + "' (each point once)");
+    return rows;
+  }
+
+  template <int dim>
   double
   smallest_cell_edge(const SceneParameters<dim> &p)
   {
@@ -286,6 +294,8 @@ namespace talus
     return h;
   }
 
+  template std::uint64_t check_file_body(const SceneParameters<2> &, unsigned int);
+  template std::uint64_t check_file_body(const SceneParameters<3> &, unsigned int);
   template double smallest_cell_edge(const SceneParameters<2> &);
   template double smallest_cell_edge(const SceneParameters<3> &);
   template void check_run_files(const RunParameters<2> &);

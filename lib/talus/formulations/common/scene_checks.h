@@ -6,6 +6,7 @@
 
 #include <talus/formulations/common/scene_parameters.h>
 
+#include <cstdint>
 #include <string>
 
 namespace talus
@@ -19,6 +20,12 @@ namespace talus
 
   template <int dim>
   void check_scene_consistency(const SceneParameters<dim> &p);
+
+  /// Body k has shape = file: its particle file holds rows of its body id, their
+  /// material ids exist, and no earlier body takes the same rows. Returns the
+  /// number of rows (its material points). InputError naming the entry. Collective.
+  template <int dim>
+  std::uint64_t check_file_body(const SceneParameters<dim> &p, unsigned int k);
 
   /// Smallest cell edge of the scene's grid (grid file or box) [m]: the L of
   /// the critical time step (seed 000 Eq. 4.120), known before any setup.

@@ -10,12 +10,14 @@
 #include <talus/formulations/common/load_balance.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/run_formulation.h>
+#include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/semi_implicit/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
 #include <talus/io/output.h>
+#include <talus/io/particle_file.h>
 #include <talus/io/vtu.h>
 #include <talus/loads/k0.h>
 #include <talus/loads/kinematics.h>
@@ -43,6 +45,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <type_traits>
 
@@ -261,6 +264,11 @@ namespace talus::semi_implicit
         {
           const auto &       b     = p.bodies[k];
           const std::string  where = "body " + std::to_string(k) + " ('" + b.name + "')";
+          if (b.shape == BodyDescription<dim>::Shape::file) // its rows; the seeding checks their positions
+            {
+              n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * double(check_file_body(p, k));
+              continue;
+            }
           dealii::Point<dim> lo, hi;
           b.bounding_box(lo, hi);
           double overlap = 1;
@@ -436,8 +444,19 @@ namespace talus::semi_implicit
                 "body " + std::to_string(k) + "/surface load", "needs a box body with soil points (phase saturated or soil)");
         any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
         any_water = any_water || p.phase_of_body.back() != Phase::soil;
-        require(p.bodies[k].shape != BodyDescription<dim>::Shape::file, "body " + std::to_string(k) + "/shape",
-                "file bodies are not available in talus-semi-implicit yet; allowed: box, ball, polygon");
+        // the material ids of the body's points: its entry, or those of its rows
+        std::set<unsigned int> ids{p.bodies[k].material_id};
+        if (p.bodies[k].shape == BodyDescription<dim>::Shape::file)
+          {
+            check_file_body(p, k); // rows of its body id exist, their material ids too
+            const auto t = io::read_particle_file(p.bodies[k].particle_file, dim, MPI_COMM_WORLD,
+                                                  "body " + std::to_string(k) + "/particle file");
+            ids.clear();
+            for (std::size_t i = 0; i < t.size(); ++i)
+              if (t.body[i] == p.bodies[k].file_body_id)
+                ids.insert(static_cast<unsigned int>(t.material[i]));
+          }
+        p.materials_of_body.emplace_back(ids.begin(), ids.end());
       }
     std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
@@ -456,11 +475,12 @@ namespace talus::semi_implicit
     if (p.stabilisation == VolumetricStabilisation::modified_f_bar)
       for (unsigned int b = 0; b < p.bodies.size(); ++b)
         if (p.phase_of_body[b] != Phase::water)
+          for (const unsigned int mid : p.materials_of_body[b])
           {
-            const auto &m = *p.materials[p.bodies[b].material_id];
+            const auto &m = *p.materials[mid];
             require(keeps_elastic_b(m), "semi implicit/volumetric stabilisation",
                     "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
-                      std::to_string(p.bodies[b].material_id) + " is '" + m.model_name() +
+                      std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
                       "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
           }
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
@@ -475,11 +495,11 @@ namespace talus::semi_implicit
     double dt = std::numeric_limits<double>::max();
     for (unsigned int b = 0; b < p.bodies.size(); ++b)
       if (p.phase_of_body[b] != Phase::water)
-        {
-          const unsigned int m   = p.bodies[b].material_id;
-          const double       rho = (1 - p.soil_of_material[m].porosity) * p.materials[m]->density();
-          dt = std::min(dt, h_min / std::sqrt(p.materials[m]->constrained_modulus() / rho));
-        }
+        for (const unsigned int m : p.materials_of_body[b])
+          {
+            const double rho = (1 - p.soil_of_material[m].porosity) * p.materials[m]->density();
+            dt = std::min(dt, h_min / std::sqrt(p.materials[m]->constrained_modulus() / rho));
+          }
     return dt;
   }
 
@@ -926,7 +946,12 @@ namespace talus::semi_implicit
               body_index.push_back(b);
             }
         std::vector<double> unit_density(prm.materials.size(), 1.0); // masses set below
-        const auto seeded = seed_bodies(grid, bodies, unit_density, set.layout, set.handler);
+        auto       seeded = seed_bodies(grid, bodies, unit_density, set.layout, set.handler);
+        // file bodies: the rows of their particle files, the same rows for both
+        // sets of a saturated body (the single-point variant relies on it)
+        const auto filed = insert_file_bodies(grid, bodies, unit_density, set.layout, set.handler, seeded.n_particles);
+        for (unsigned int k = 0; k < bodies.size(); ++k)
+          seeded.volume_per_body[k] += filed.volume_per_body[k];
         for (unsigned int k = 0; k < bodies.size(); ++k)
           require(seeded.volume_per_body[k] > 0, "body " + std::to_string(body_index[k]) + " ('" + bodies[k].name + "')",
                   "contains no " + std::string(is_soil ? "soil" : "water") +
@@ -937,7 +962,7 @@ namespace talus::semi_implicit
             auto               P = pt.get_properties();
             const unsigned int b = body_index[static_cast<unsigned int>(P[L::body])];
             P[L::body]           = b;
-            const unsigned int m = prm.bodies[b].material_id;
+            const unsigned int m = static_cast<unsigned int>(P[L::material]); // a file body's: its row's
             // a water body's points take the porosity 1 (free water)
             const double n0          = prm.phase_of_body[b] == Phase::water ? 1.0 : prm.soil_of_material[m].porosity;
             const double V0          = P[L::volume];
@@ -963,6 +988,7 @@ namespace talus::semi_implicit
             else
               {
                 P[L::mass]     = n0 * prm.water_density * V0; // Eq. 37
+                L::set_stress(materials::Stress(), P.data());       // a particle file's stress is the soil's
                 P[f.pressure]  = 0;
                 for (unsigned int d = 0; d < dim; ++d)
                   P[f.pressure_gradient + d] = 0;

@@ -64,6 +64,8 @@ namespace talus::semi_implicit
   {
     std::vector<Phase>    phase_of_body;
     std::vector<SoilData> soil_of_material;
+    /// per body: the material ids of its points (a file body: those of its rows)
+    std::vector<std::vector<unsigned int>> materials_of_body;
     std::vector<SurfaceLoad> surface_load; ///< per body: q [Pa] on its upper face
     // time step: fixed, or courant x the soil skeleton's critical step
     double time_step = 0, courant = 0.5;
