@@ -1526,31 +1526,47 @@ namespace talus::semi_implicit
             const double C1 = k0 * (1 - n0) * (1 - n0) / (n0 * n0 * n0);
             P[s.fs.conductivity] = C1 * n * n * n / ((1 - n) * (1 - n));
           }
-        // effective stress: the model's update with the strain and spin
-        // increments of ΔF (rate form, as the explicit family)
-        materials::Strain d_eps;
-        materials::Spin   d_omega;
-        double            gu_model[dim][dim];
-        for (unsigned int i = 0; i < dim; ++i)
-          for (unsigned int j = 0; j < dim; ++j)
-            gu_model[i][j] = dF_model[i][j] - (i == j ? 1.0 : 0.0);
-        materials::strain_and_spin_increments<dim>(gu_model, d_eps, d_omega);
-        if (dim == 2) // the out-of-plane stretch of the modified F-bar's isotropic factor
-          d_eps[2][2] = dF_model[2][2] - 1;
         // Nor-Sand (96): v^{t+1} = v0 Jbar^{t+1}; the model multiplies its v by
         // det of the increment it is given, so it gets v0 Jbar / det(dF_model)
         if (s.smooth_jacobian)
           if (const auto *ns = dynamic_cast<const materials::NorSand *>(&m))
             history[materials::NorSand::specific_volume_slot] =
               ns->parameters().v0 * P[s.fs.smoothed_jacobian] / dealii::determinant(dF_model);
-        auto sigma = L::get_stress(P);
-        m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(history, m.n_history()));
-        // sigma' = tau / J with the point's own J = V / V0 (Alg. step 10(d)), so
-        // that V sigma' = V0 tau: the model's J follows the stabilised
-        // increments, which may wander from the point's volume (a gas-like
-        // point of a landslide: 4e-6 against 1.0, its stress 2e5 x too large)
+        auto                            sigma = L::get_stress(P);
+        const dealii::ArrayView<double> hist(history, m.n_history());
         if (m.has_finite_strain_form())
-          sigma *= m.kirchhoff_jacobian(dealii::ArrayView<const double>(history, m.n_history())) / J;
+          {
+            // the finite-strain return with the increment itself (Hencky
+            // Mohr-Coulomb, Nor-Sand, Neo-Hookean): b_e^tr = ΔF b_e ΔF^T, the
+            // return in principal logarithmic strains, Kirchhoff tau; then
+            // sigma' = tau / J with the point's own J = V / V0 (Alg. step
+            // 10(d)), so that V sigma' = V0 tau: the model's J follows the
+            // stabilised increments, which may wander from the point's volume
+            // (a gas-like point of a landslide: 4e-6 against 1.0)
+            constexpr unsigned int          max_history = 64; // as Material::finite_strain_rate_update
+            std::array<double, max_history> old;
+            AssertThrow(hist.size() <= old.size(), dealii::ExcMessage("history too long"));
+            std::copy(hist.begin(), hist.end(), old.begin());
+            materials::Stress tau;
+            m.finite_strain_update(dF_model, dealii::ArrayView<const double>(old.data(), hist.size()), hist, tau,
+                                   nullptr);
+            sigma = tau / J;
+          }
+        else
+          {
+            // small-strain models: the rate form with the strain and spin
+            // increments of ΔF (as the explicit family)
+            materials::Strain d_eps;
+            materials::Spin   d_omega;
+            double            gu_model[dim][dim];
+            for (unsigned int i = 0; i < dim; ++i)
+              for (unsigned int j = 0; j < dim; ++j)
+                gu_model[i][j] = dF_model[i][j] - (i == j ? 1.0 : 0.0);
+            materials::strain_and_spin_increments<dim>(gu_model, d_eps, d_omega);
+            if (dim == 2) // the out-of-plane stretch of the F-bar's isotropic factor
+              d_eps[2][2] = dF_model[2][2] - 1;
+            m.update_stress(d_eps, d_omega, h, sigma, hist);
+          }
         L::set_stress(sigma, P);
       }
       inline void
