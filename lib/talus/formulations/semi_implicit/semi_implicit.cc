@@ -476,13 +476,13 @@ namespace talus::semi_implicit
       for (unsigned int b = 0; b < p.bodies.size(); ++b)
         if (p.phase_of_body[b] != Phase::water)
           for (const unsigned int mid : p.materials_of_body[b])
-          {
-            const auto &m = *p.materials[mid];
-            require(keeps_elastic_b(m), "semi implicit/volumetric stabilisation",
-                    "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
-                      std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
-                      "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
-          }
+            {
+              const auto &m = *p.materials[mid];
+              require(keeps_elastic_b(m), "semi implicit/volumetric stabilisation",
+                      "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
+                        std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
+                        "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
+            }
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
     check_scene(p);
     return p;
@@ -988,7 +988,7 @@ namespace talus::semi_implicit
             else
               {
                 P[L::mass]     = n0 * prm.water_density * V0; // Eq. 37
-                L::set_stress(materials::Stress(), P.data());       // a particle file's stress is the soil's
+                L::set_stress(materials::Stress(), P.data()); // a particle file's stress is the soil's
                 P[f.pressure]  = 0;
                 for (unsigned int d = 0; d < dim; ++d)
                   P[f.pressure_gradient + d] = 0;
