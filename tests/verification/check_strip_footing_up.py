@@ -38,8 +38,12 @@ Checks:
 Reported: S(semi-implicit, none) / S(u-p) and S(implicit u) / S(u-p).
 --young=E: E of the implicit runs only (a mutant: 1.1e7
 must fail the comparison).
-Usage: check_strip_footing_up.py TOOLS_DIR SEMI_PRM IMPLICIT_PRM WORKDIR [--h=H] [--tol=T] [--dyn=D] [--long=T] [--young=E]
+--jobs=N: make the six runs N at a time (default 1; h = 0.05 m: 2, the runs
+are about an hour each); --timeout=S: the limit per run in seconds (default 3000).
+Usage: check_strip_footing_up.py TOOLS_DIR SEMI_PRM IMPLICIT_PRM WORKDIR [--h=H] [--tol=T] [--dyn=D] [--long=T]
+       [--young=E] [--jobs=N] [--timeout=S]
 """
+import concurrent.futures
 import sys
 
 import talus_verify as tv
@@ -55,6 +59,8 @@ tol = float(option("tol", 0.05))
 dyn = float(option("dyn", 0.05))
 young = option("young", None)
 t_long = float(option("long", 3.0))
+jobs = int(option("jobs", 1))
+timeout = float(option("timeout", 3000))
 n = round(10 / h)
 q, width = 2e4, 3.0
 
@@ -91,23 +97,7 @@ def loaded(X, Y, f):
     return sorted((round(x, 9), round(y, 9)) for x, y, g in zip(X, Y, f) if g != 0), sum(f)
 
 
-# semi-implicit: modified f-bar and none
-res, zig = {}, {}
-for st in ("modified f-bar", "none"):
-    name = "semi_" + st.replace(" ", "_")
-    tv.run_tool(f"{tools}/talus-semi-implicit", tv.prm_set(semi, "semi implicit/volumetric stabilisation", st),
-                f"{work}/{name}", name)
-    s = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
-    X = [x - u for x, u in zip(s["pos_x"], s["displacement_x"])]
-    Y = [y - u for y, u in zip(s["pos_y"], s["displacement_y"])]
-    res[st] = settlement(top_points(X, Y, s["displacement_y"]))
-    zig[st] = zigzag(X, Y, s)
-    if st == "modified f-bar":
-        semi_loaded = loaded(X, Y, [-f for f in s["surface_force"]])
-        series = tv.read_csv(f"{work}/{name}/out/series.csv")
-    print(f"h = {h} m, semi-implicit {st}: settlement {res[st] * 1000:.4f} mm, zigzag index {zig[st]:.2e}")
-
-# implicit: u-p (Neo-Hookean, split), u (Neo-Hookean, split), u (Hencky, never yields)
+# the implicit runs: u-p (Neo-Hookean, split), u (Neo-Hookean, split), u (Hencky, never yields)
 hencky = """subsection material 0
   set model   = hencky mohr coulomb
   set density = 2000
@@ -123,9 +113,35 @@ end
 runs = {"u-p": impl, "u": tv.prm_set(impl, "implicit/formulation", "irreducible")}
 start, end = runs["u"].index("subsection material 0"), runs["u"].index("set number of bodies")
 runs["u hencky"] = runs["u"][:start] + hencky + "\n" + runs["u"][end:]
+# every run, longest first (--jobs at a time); the results are read below
+semi_runs = {"semi_long": tv.prm_set(semi, "time/end time", str(t_long))}
+for st in ("modified f-bar", "none"):
+    semi_runs["semi_" + st.replace(" ", "_")] = tv.prm_set(semi, "semi implicit/volumetric stabilisation", st)
+all_runs = [(f"{tools}/talus-semi-implicit", name, text) for name, text in semi_runs.items()]
+all_runs += [(f"{tools}/talus-implicit", "implicit_" + key.replace(" ", "_").replace("-", ""), text)
+             for key, text in runs.items()]
+with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+    for future in [pool.submit(tv.run_tool, tool, text, f"{work}/{name}", name, timeout=timeout)
+                   for tool, name, text in all_runs]:
+        future.result()
+
+# semi-implicit: modified f-bar and none
+res, zig = {}, {}
+for st in ("modified f-bar", "none"):
+    name = "semi_" + st.replace(" ", "_")
+    s = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
+    X = [x - u for x, u in zip(s["pos_x"], s["displacement_x"])]
+    Y = [y - u for y, u in zip(s["pos_y"], s["displacement_y"])]
+    res[st] = settlement(top_points(X, Y, s["displacement_y"]))
+    zig[st] = zigzag(X, Y, s)
+    if st == "modified f-bar":
+        semi_loaded = loaded(X, Y, [-f for f in s["surface_force"]])
+        series = tv.read_csv(f"{work}/{name}/out/series.csv")
+    print(f"h = {h} m, semi-implicit {st}: settlement {res[st] * 1000:.4f} mm, zigzag index {zig[st]:.2e}")
+
+# implicit: u-p (Neo-Hookean, split), u (Neo-Hookean, split), u (Hencky, never yields)
 for key, text in runs.items():
     name = "implicit_" + key.replace(" ", "_").replace("-", "")
-    tv.run_tool(f"{tools}/talus-implicit", text, f"{work}/{name}", name)
     s = tv.read_csv(f"{work}/{name}/out/particles_final.csv")
     X = [x - u for x, u in zip(s["pos_x"], s["u_x"])]
     Y = [y - u for y, u in zip(s["pos_y"], s["u_y"])]
@@ -157,7 +173,6 @@ tv.check(ek[-1] < 0.02 * work_done, f"semi-implicit near quasi-static: E_k {ek[-
 # the long run: the modified f-bar to --long s, the time mean of its settlement
 # after the ramp (t >= 1 s): the static value the undamped run oscillates about
 name = "semi_long"
-tv.run_tool(f"{tools}/talus-semi-implicit", tv.prm_set(semi, "time/end time", str(t_long)), f"{work}/{name}", name)
 ls = tv.read_csv(f"{work}/{name}/out/series.csv")
 lt, lu = ls["time"], ls["load_settlement"]
 num = den = 0.0
