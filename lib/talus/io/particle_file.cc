@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 namespace talus::io
 {
@@ -72,7 +73,9 @@ namespace talus::io
     info.dim        = dim;
     info.n          = f.shape("volume").first;
     info.has_stress = f.exists("stress");
-    for (const auto b : f.read_rows_u64("body_id", 0, info.n))
+    const auto body     = f.read_rows_u64("body_id", 0, info.n);
+    const auto material = f.read_rows_u64("material_id", 0, info.n);
+    for (const auto b : body)
       {
         if (b >= 65536)
           throw InputError(where + ": particle file '" + path + "': body id " + std::to_string(b) + " out of range");
@@ -80,8 +83,14 @@ namespace talus::io
           info.rows_per_body.resize(b + 1, 0);
         ++info.rows_per_body[b];
       }
-    for (const auto m : f.read_rows_u64("material_id", 0, info.n))
-      info.max_material = std::max(info.max_material, m);
+    std::vector<std::set<std::uint64_t>> materials(info.rows_per_body.size());
+    for (std::uint64_t i = 0; i < info.n; ++i)
+      {
+        info.max_material = std::max(info.max_material, material[i]);
+        materials[body[i]].insert(material[i]);
+      }
+    for (const auto &m : materials)
+      info.materials_per_body.emplace_back(m.begin(), m.end());
     return info;
   }
 

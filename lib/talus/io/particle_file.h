@@ -43,6 +43,8 @@ namespace talus::io
     bool                       has_stress = false;
     std::vector<std::uint64_t> rows_per_body;
     std::uint64_t              max_material = 0;
+    /// per body id: the distinct material ids of its rows, ascending
+    std::vector<std::vector<std::uint64_t>> materials_per_body;
   };
   /// InputError naming the file (and `where`, the .prm entry) if it is not a
   /// talus particle file of dimension dim.

@@ -92,16 +92,21 @@ namespace talus::materials
   }
 
   Stress
-  Material::finite_strain_rate_update(const Strain &d_eps, const Spin &d_omega, ArrayView<double> history) const
+  Material::finite_strain_step(const dealii::Tensor<2, 3> &dF, ArrayView<double> history) const
   {
     constexpr unsigned int max_history = 64;
-    AssertThrow(history.size() <= max_history, dealii::ExcMessage("history too long for the rate form"));
+    AssertThrow(history.size() <= max_history, dealii::ExcMessage("history too long for a finite-strain step"));
     double old[max_history];
     std::copy(history.begin(), history.end(), old);
     Stress tau;
-    finite_strain_update(fs::incremental_deformation_gradient(d_eps, d_omega),
-                         ArrayView<const double>(old, history.size()), history, tau, nullptr);
+    finite_strain_update(dF, ArrayView<const double>(old, history.size()), history, tau, nullptr);
     return tau;
+  }
+
+  Stress
+  Material::finite_strain_rate_update(const Strain &d_eps, const Spin &d_omega, ArrayView<double> history) const
+  {
+    return finite_strain_step(fs::incremental_deformation_gradient(d_eps, d_omega), history);
   }
 
   void

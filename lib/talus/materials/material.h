@@ -111,6 +111,12 @@ namespace talus::materials
                                       Stress &                    tau,
                                       dealii::Tensor<4, 3> *      dtau_ddF) const;
 
+    /// One step of finite_strain_update() with the history updated in place
+    /// (from a copy of the old one; no tangent). Returns the Kirchhoff stress;
+    /// the caller divides by its J. Used by the rate form below and by the
+    /// semi-implicit driver, which passes its (stabilised) increment dF itself.
+    Stress finite_strain_step(const dealii::Tensor<2, 3> &dF, ArrayView<double> history) const;
+
     /// det F of the total deformation that the Kirchhoff stress of
     /// finite_strain_update() refers to, read from the history: sigma = tau / J.
     /// (Initial stresses make it differ from the driver's volume ratio.)

@@ -52,13 +52,17 @@ namespace talus
       }
     auto &count   = count_in_cell;
     cells_changed = false;
-    for (const unsigned int c : r.removed_from)
-      if (--count[c] == 0)
-        cell_erased[c] = 1;
+    // in the order the relocator applied them: a cell emptied and filled again
+    // in one finish() has lost its entry and got a new one at the end
     const std::size_t n_old = cells.size();
-    for (const unsigned int c : r.inserted_into)
-      if (count[c]++ == 0)
-        cells.push_back({c, 0});
+    for (const auto &change : r.cell_changes)
+      if (!change.inserted)
+        {
+          if (--count[change.cell] == 0)
+            cell_erased[change.cell] = 1;
+        }
+      else if (count[change.cell]++ == 0)
+        cells.push_back({change.cell, 0});
     std::size_t out = 0;
     for (std::size_t i = 0; i < cells.size(); ++i)
       {
@@ -72,8 +76,8 @@ namespace talus
       }
     cells_changed = cells_changed || cells.size() > n_old;
     cells.resize(out);
-    for (const unsigned int c : r.removed_from)
-      cell_erased[c] = 0;
+    for (const auto &change : r.cell_changes)
+      cell_erased[change.cell] = 0;
   }
 
   template <int dim>

@@ -521,9 +521,7 @@ namespace talus
     const auto t0 = std::chrono::steady_clock::now();
     moves.clear();
     props.clear();
-    to_remove.clear();
-    removed_from.clear();
-    inserted_into.clear();
+    cell_changes.clear();
     sorted_last = false;
     const unsigned int n_props = particles.n_properties_per_particle();
     bool               need_sort = false;
@@ -531,8 +529,12 @@ namespace talus
     // per destination rank: the points that entered one of its cells (CellId
     // words, id, x, xi, properties per point); only ranks that get points have an entry
     std::map<unsigned int, std::vector<double>> outgoing;
-    unsigned long long n_sent = 0;
-    for (std::size_t k = 0; k < pending.size(); ++k)
+    unsigned long long n_sent = 0, n_local_moves = 0;
+    props.resize(n_props);
+    // backwards: pending is in ascending order within each cell, and deal.II
+    // removes by moving the cell's last particle into the hole (an insertion
+    // appends to its cell, so the iterators still pending stay valid)
+    for (std::size_t k = pending.size(); k-- > 0;)
       {
         const auto &       it = pending[k].it;
         dealii::Point<dim> xi;
@@ -546,37 +548,37 @@ namespace talus
         const auto p = it->get_properties();
         if (grid.cells[n].locally_owned)
           {
-            moves.push_back({x, xi, it->get_id(), n, static_cast<unsigned int>(props.size())});
-            props.insert(props.end(), p.begin(), p.end());
+            // remove, then insert at once: the pool gives the freed slot back
+            const auto id = it->get_id();
+            std::copy(p.begin(), p.end(), props.begin());
+            particles.remove_particle(it);
+            cell_changes.push_back({pending[k].cell, false});
+            if (moved)
+              moved(n, xi, props.data());
+            particles.insert_particle(x, xi, id, grid.cell_iterators[n],
+                                      dealii::ArrayView<const double>(props.data(), n_props));
+            cell_changes.push_back({n, true});
+            ++n_local_moves;
+            continue;
           }
-        else
-          {
-            // a neighbour cell of another rank: send the point to its owner
-            // (point to point, no collective sort)
-            const auto &cell = grid.cell_iterators[n];
-            auto &      buf  = outgoing[cell->subdomain_id()];
-            for (const unsigned int w : cell->id().template to_binary<dim>())
-              buf.push_back(w);
-            buf.push_back(static_cast<double>(it->get_id()));
-            for (unsigned int d = 0; d < dim; ++d)
-              buf.push_back(x[d]);
-            for (unsigned int d = 0; d < dim; ++d)
-              buf.push_back(xi[d]);
-            buf.insert(buf.end(), p.begin(), p.end());
-            ++n_sent;
-          }
-        to_remove.push_back(k);
+        // a neighbour cell of another rank: send the point to its owner
+        // (point to point, no collective sort)
+        const auto &cell = grid.cell_iterators[n];
+        auto &      buf  = outgoing[cell->subdomain_id()];
+        for (const unsigned int w : cell->id().template to_binary<dim>())
+          buf.push_back(w);
+        buf.push_back(static_cast<double>(it->get_id()));
+        for (unsigned int d = 0; d < dim; ++d)
+          buf.push_back(x[d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          buf.push_back(xi[d]);
+        buf.insert(buf.end(), p.begin(), p.end());
+        ++n_sent;
+        particles.remove_particle(it);
+        cell_changes.push_back({pending[k].cell, false});
       }
-    // remove backwards: pending is in ascending order within each cell, and
-    // deal.II removes by moving the cell's last particle into the hole
-    for (auto k = to_remove.rbegin(); k != to_remove.rend(); ++k)
-      {
-        removed_from.push_back(pending[*k].cell);
-        particles.remove_particle(pending[*k].it);
-      }
-    // the points other ranks sent into my cells, in rank order (deterministic),
-    // join the local moves
-    const std::size_t n_local_moves = moves.size();
+    // the points other ranks sent into my cells, in rank order (deterministic)
+    props.clear();
     if (parallel)
       {
         const auto         received = dealii::Utilities::MPI::some_to_some(grid.comm, outgoing);
@@ -606,7 +608,7 @@ namespace talus
       {
         if (moved)
           moved(m.cell, m.xi, props.data() + m.prop_offset);
-        inserted_into.push_back(m.cell);
+        cell_changes.push_back({m.cell, true});
         particles.insert_particle(m.x,
                                 m.xi,
                                 m.id,
@@ -615,7 +617,7 @@ namespace talus
       }
     stats.moved_locally += n_local_moves + n_sent;
     stats.sent_to_ranks += n_sent;
-    moved_since_sort += moves.size(); // local and received: both sit in recycled slots
+    moved_since_sort += n_local_moves + moves.size(); // local and received
     pending.clear();
 
     // one reduction decides both: a needed sort and a memory-order sort

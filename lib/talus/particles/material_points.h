@@ -253,8 +253,12 @@ namespace talus
       pending.push_back({it, c});
     }
 
-    /// Apply all moves. Collective. Moved particles get new storage slots
-    /// scattered in memory; once the particles moved since the last full sort
+    /// Apply all moves. Collective. Each point that stays on this rank is
+    /// removed and at once inserted again: deal.II's pool hands the slot just
+    /// freed to the next insertion, so the point keeps its storage slot and the
+    /// insertion writes the cache lines the removal has just read. Moved points
+    /// are still walked with their new cell while their slot sits with the old
+    /// one; once the particles moved since the last full sort
     /// exceed `resort_fraction` of all particles (1.0: measured best
     /// on the 3D bench, with the loops prefetching), a full deal.II sort restores
     /// the cell-by-cell memory order (it calls PropertyPool::sort_memory_slots).
@@ -265,12 +269,17 @@ namespace talus
 
     double resort_fraction = 1.0;
 
-    /// What the last finish() did, for callers that keep per-cell bookkeeping:
-    /// source cells of removed particles, target cells of inserted ones (in
-    /// insertion order), and whether a full deal.II sort ran (then everything
-    /// may have changed).
-    std::vector<unsigned int> removed_from, inserted_into;
-    bool                      sorted_last = false;
+    /// What the last finish() did to the handler's storage, for callers that
+    /// keep per-cell bookkeeping: every removal (from its source cell) and every
+    /// insertion (into its target cell) in the order they were applied, and
+    /// whether a full deal.II sort ran (then everything may have changed).
+    struct CellChange
+    {
+      unsigned int cell;
+      bool         inserted; ///< false: a point was removed from `cell`
+    };
+    std::vector<CellChange> cell_changes;
+    bool                    sorted_last = false;
 
     /// Particles moved (locally) since the last full sort: part of the state a
     /// checkpoint saves, since it decides when the next memory-order sort runs.
@@ -296,8 +305,7 @@ namespace talus
       unsigned int                  cell;
       unsigned int                  prop_offset;
     };
-    std::vector<Move>        moves;
-    std::vector<double>      props;
-    std::vector<std::size_t> to_remove;
+    std::vector<Move>   moves;
+    std::vector<double> props;
   };
 } // namespace talus

@@ -160,7 +160,7 @@ namespace talus
         const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
         if (b.shape == BodyDescription<dim>::Shape::file)
           {
-            n_points += check_file_body(p, k);
+            n_points += check_file_body(p, k).rows;
             continue;
           }
         // bounding box of the body
@@ -252,7 +252,7 @@ namespace talus
   }
 
   template <int dim>
-  std::uint64_t
+  FileBodyRows
   check_file_body(const SceneParameters<dim> &p, const unsigned int k)
   {
     const auto &        b     = p.bodies[k];
@@ -279,7 +279,11 @@ namespace talus
               entry + "/file body id",
               "body " + std::to_string(j) + " already takes the points of body id " + std::to_string(b.file_body_id) +
                 " of '" + b.particle_file + "' (each point once)");
-    return rows;
+    FileBodyRows r;
+    r.rows = rows;
+    for (const auto m : info.materials_per_body[b.file_body_id])
+      r.materials.push_back(static_cast<unsigned int>(m));
+    return r;
   }
 
   template <int dim>
@@ -294,8 +298,8 @@ namespace talus
     return h;
   }
 
-  template std::uint64_t check_file_body(const SceneParameters<2> &, unsigned int);
-  template std::uint64_t check_file_body(const SceneParameters<3> &, unsigned int);
+  template FileBodyRows check_file_body(const SceneParameters<2> &, unsigned int);
+  template FileBodyRows check_file_body(const SceneParameters<3> &, unsigned int);
   template double smallest_cell_edge(const SceneParameters<2> &);
   template double smallest_cell_edge(const SceneParameters<3> &);
   template void check_run_files(const RunParameters<2> &);

@@ -21,11 +21,18 @@ namespace talus
   template <int dim>
   void check_scene_consistency(const SceneParameters<dim> &p);
 
+  /// What a file body takes from its particle file (known before seeding).
+  struct FileBodyRows
+  {
+    std::uint64_t             rows = 0;  ///< its material points
+    std::vector<unsigned int> materials; ///< the distinct material ids of its rows, ascending
+  };
+
   /// Body k has shape = file: its particle file holds rows of its body id, their
-  /// material ids exist, and no earlier body takes the same rows. Returns the
-  /// number of rows (its material points). InputError naming the entry. Collective.
+  /// material ids exist, and no earlier body takes the same rows. Reads only the
+  /// file's body and material id columns. InputError naming the entry. Collective.
   template <int dim>
-  std::uint64_t check_file_body(const SceneParameters<dim> &p, unsigned int k);
+  FileBodyRows check_file_body(const SceneParameters<dim> &p, unsigned int k);
 
   /// Smallest cell edge of the scene's grid (grid file or box) [m]: the L of
   /// the critical time step (seed 000 Eq. 4.120), known before any setup.

@@ -266,7 +266,7 @@ namespace talus::semi_implicit
           const std::string  where = "body " + std::to_string(k) + " ('" + b.name + "')";
           if (b.shape == BodyDescription<dim>::Shape::file) // its rows; the seeding checks their positions
             {
-              n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * double(check_file_body(p, k));
+              n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * double(check_file_body(p, k).rows);
               continue;
             }
           dealii::Point<dim> lo, hi;
@@ -445,18 +445,11 @@ namespace talus::semi_implicit
         any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
         any_water = any_water || p.phase_of_body.back() != Phase::soil;
         // the material ids of the body's points: its entry, or those of its rows
-        std::set<unsigned int> ids{p.bodies[k].material_id};
+        // (checked: rows of its body id exist, their material ids too)
         if (p.bodies[k].shape == BodyDescription<dim>::Shape::file)
-          {
-            check_file_body(p, k); // rows of its body id exist, their material ids too
-            const auto t = io::read_particle_file(p.bodies[k].particle_file, dim, MPI_COMM_WORLD,
-                                                  "body " + std::to_string(k) + "/particle file");
-            ids.clear();
-            for (std::size_t i = 0; i < t.size(); ++i)
-              if (t.body[i] == p.bodies[k].file_body_id)
-                ids.insert(static_cast<unsigned int>(t.material[i]));
-          }
-        p.materials_of_body.emplace_back(ids.begin(), ids.end());
+          p.materials_of_body.push_back(check_file_body(p, k).materials);
+        else
+          p.materials_of_body.push_back({p.bodies[k].material_id});
       }
     std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
@@ -1543,14 +1536,7 @@ namespace talus::semi_implicit
             // 10(d)), so that V sigma' = V0 tau: the model's J follows the
             // stabilised increments, which may wander from the point's volume
             // (a gas-like point of a landslide: 4e-6 against 1.0)
-            constexpr unsigned int          max_history = 64; // as Material::finite_strain_rate_update
-            std::array<double, max_history> old;
-            AssertThrow(hist.size() <= old.size(), dealii::ExcMessage("history too long"));
-            std::copy(hist.begin(), hist.end(), old.begin());
-            materials::Stress tau;
-            m.finite_strain_update(dF_model, dealii::ArrayView<const double>(old.data(), hist.size()), hist, tau,
-                                   nullptr);
-            sigma = tau / J;
+            sigma = m.finite_strain_step(dF_model, hist) / J;
           }
         else
           {
