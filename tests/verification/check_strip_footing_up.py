@@ -42,9 +42,11 @@ must fail the comparison).
 are about an hour each); --timeout=S: the limit per run in seconds (default 3000);
 --reuse: a run whose final particle file is already in WORKDIR is not made again
 (a long campaign finished in parts); --skip-none: no semi-implicit run without
-stabilisation (the locking figure is then not reported).
+stabilisation (the locking figure is then not reported); --mumps: the implicit runs
+solve with MUMPS instead of KLU (KLU's pivoting fills the indefinite u-p factors:
+docs/implicit.md; needed at h = 0.05 m).
 Usage: check_strip_footing_up.py TOOLS_DIR SEMI_PRM IMPLICIT_PRM WORKDIR [--h=H] [--tol=T] [--dyn=D] [--long=T]
-       [--young=E] [--jobs=N] [--timeout=S] [--reuse] [--skip-none]
+       [--young=E] [--jobs=N] [--timeout=S] [--reuse] [--skip-none] [--mumps]
 """
 import concurrent.futures
 import os
@@ -82,6 +84,8 @@ impl = grid(tv.prm_set(open(impl_prm).read(), "output/directory", "out"))
 impl = tv.prm_set(impl, "loads/traction 0/region lower corner", f"0, {10 - h / 2}")
 if young:
     impl = tv.prm_set(impl, "material 0/neo hookean/young modulus", young)
+if "--mumps" in sys.argv:
+    impl = tv.prm_set(impl, "linear solver/direct package", "mumps")
 
 
 def top_points(X, Y, u):
