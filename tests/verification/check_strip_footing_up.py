@@ -103,6 +103,14 @@ def zigzag(X, Y, s):
     return tv.zigzag_index(X, Y, [(a + b + c) / 3 for a, b, c in zip(s["stress_xx"], s["stress_yy"], s["stress_zz"])], h)
 
 
+def final_points(name, csv, ux, uy):
+    """a run's final points: the table, initial X and Y, the settlement and the zigzag index"""
+    s = tv.read_csv(f"{work}/{name}/out/{csv}")
+    X = [x - u for x, u in zip(s["pos_x"], s[ux])]
+    Y = [y - u for y, u in zip(s["pos_y"], s[uy])]
+    return s, X, Y, settlement(top_points(X, Y, s[uy])), zigzag(X, Y, s)
+
+
 def loaded(X, Y, f):
     return sorted((round(x, 9), round(y, 9)) for x, y, g in zip(X, Y, f) if g != 0), sum(f)
 
@@ -143,11 +151,7 @@ with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
 res, zig = {}, {}
 for st in stabilisations:
     name = "semi_" + st.replace(" ", "_")
-    s = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
-    X = [x - u for x, u in zip(s["pos_x"], s["displacement_x"])]
-    Y = [y - u for y, u in zip(s["pos_y"], s["displacement_y"])]
-    res[st] = settlement(top_points(X, Y, s["displacement_y"]))
-    zig[st] = zigzag(X, Y, s)
+    s, X, Y, res[st], zig[st] = final_points(name, "soil_final.csv", "displacement_x", "displacement_y")
     if st == "modified f-bar":
         semi_loaded = loaded(X, Y, [-f for f in s["surface_force"]])
         series = tv.read_csv(f"{work}/{name}/out/series.csv")
@@ -156,11 +160,7 @@ for st in stabilisations:
 # implicit: u-p (Neo-Hookean, split), u (Neo-Hookean, split), u (Hencky, never yields)
 for key, text in runs.items():
     name = "implicit_" + key.replace(" ", "_").replace("-", "")
-    s = tv.read_csv(f"{work}/{name}/out/particles_final.csv")
-    X = [x - u for x, u in zip(s["pos_x"], s["u_x"])]
-    Y = [y - u for y, u in zip(s["pos_y"], s["u_y"])]
-    res[key] = settlement(top_points(X, Y, s["u_y"]))
-    zig[key] = zigzag(X, Y, s)
+    s, X, Y, res[key], zig[key] = final_points(name, "particles_final.csv", "u_x", "u_y")
     if key == "u-p":
         impl_loaded = loaded(X, Y, s["point_force_0_y"])
     print(f"h = {h} m, implicit {key}: settlement {res[key] * 1000:.4f} mm, zigzag index {zig[key]:.2e}")
