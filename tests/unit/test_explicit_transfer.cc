@@ -74,9 +74,12 @@ TEST(ExplicitTransfer, P2GConservesMassAndMomentum3D) { conservation<3>(); }
 TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum2D) { conservation<2>(Shape::quadratic_bspline); }
 TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum3D) { conservation<3>(Shape::quadratic_bspline); }
 
+/// The ball of scene() plus two small bodies sliding along the bottom, one
+/// behind the other: cells become active for the first time, are vacated, and
+/// are re-entered (stale nodal entries); no gravity.
 template <int dim>
-void
-relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = false)
+explicit_mpm::Parameters<dim>
+sliding_scene(const Shape shape, const bool apic)
 {
   auto p = scene<dim>(shape);
   if (apic)
@@ -98,6 +101,14 @@ relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = fal
   auto b3      = b2; // follows b2 into the cells it vacates
   b3.center[0] = 0.94;
   p.bodies.push_back(b3);
+  return p;
+}
+
+template <int dim>
+void
+relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = false)
+{
+  const auto                p = sliding_scene<dim>(shape, apic);
   explicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
   s.setup();
   const auto         n0  = s.n_particles();
@@ -121,8 +132,10 @@ relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = fal
       EXPECT_TRUE(same_cells) << "step " << i;
       // a point moved to a neighbour cell on this rank keeps its storage slot
       // (the relocator removes and at once re-inserts it; deal.II's pool hands
-      // the freed slot to the next insertion), unless a full sort ran
-      if (!s.points.relocator().sorted_last && dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
+      // the freed slot to the next insertion), unless a full sort or a
+      // memory-order rebuild ran
+      if (!s.points.relocator().sorted_last && !s.points.relocator().reordered_last &&
+          dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
         {
           for (const auto &pt : s.points.handler)
             EXPECT_EQ(pt.get_local_index(), slot_of_id.at(pt.get_id())) << "step " << i << ", point " << pt.get_id();
@@ -169,6 +182,81 @@ relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = fal
   for (std::size_t i = 0; i < merged.size(); ++i)
     EXPECT_EQ(merged[i], i);
 }
+
+/// The relocator's memory-order rebuild (Relocator::restore_memory_order):
+/// run A rebuilds after every step in which a point changed cell, run B never.
+/// After a rebuild the walk reads the storage slots in increasing order, the
+/// kept cell list and the fused P2G equal fresh ones (so every point kept its
+/// cell and data), no deal.II sort ran, and A's points equal B's to round-off
+/// (only the order of the sums differs).
+template <int dim>
+void
+memory_order(const Shape shape = Shape::linear)
+{
+  const auto                p = sliding_scene<dim>(shape, false);
+  explicit_mpm::Solver<dim> a(p, MPI_COMM_WORLD), b(p, MPI_COMM_WORLD);
+  a.setup();
+  b.setup();
+  a.points.relocator().resort_fraction = 0.0;  // rebuild whenever a point moved
+  b.points.relocator().resort_fraction = 1e30; // never
+  unsigned int rebuilds = 0;
+  for (int i = 0; i < 40; ++i)
+    {
+      const double h = a.time_step();
+      a.step(h);
+      b.step(h);
+      const auto [err, same_cells] = a.check_incremental_state();
+      EXPECT_LT(err, 1e-12) << "step " << i << ": fused P2G differs from a fresh P2G after a rebuild";
+      EXPECT_TRUE(same_cells) << "step " << i;
+      if (!a.points.relocator().reordered_last)
+        continue;
+      ++rebuilds;
+      EXPECT_FALSE(a.points.relocator().sorted_last);
+      bool         ascending = true;
+      unsigned int last      = 0, k = 0;
+      for (const auto &pt : a.points.handler)
+        {
+          ascending = ascending && (k++ == 0 || pt.get_local_index() > last);
+          last      = pt.get_local_index();
+        }
+      EXPECT_TRUE(ascending) << "step " << i << ": the walk must read the slots in increasing order";
+    }
+  EXPECT_GT(dealii::Utilities::MPI::max(rebuilds, MPI_COMM_WORLD), 5u) << "the test must rebuild";
+  EXPECT_EQ(a.points.relocation_stats.global_sorts, 0u);
+  EXPECT_EQ(b.points.relocation_stats.storage_sorts, 0u);
+  // the points of A and B, by id: all properties and the position
+  auto by_id = [](explicit_mpm::Solver<dim> &s) {
+    std::map<dealii::types::particle_index, std::vector<double>> m;
+    for (const auto &pt : s.points.handler)
+      {
+        std::vector<double> r(pt.get_properties().begin(), pt.get_properties().end());
+        for (unsigned int d = 0; d < dim; ++d)
+          r.push_back(pt.get_location()[d]);
+        m[pt.get_id()] = r;
+      }
+    return m;
+  };
+  const auto ma = by_id(a), mb = by_id(b);
+  ASSERT_EQ(ma.size(), mb.size());
+  ASSERT_FALSE(ma.empty());
+  // per column (property or coordinate): largest difference over its scale
+  const std::size_t   n_columns = ma.begin()->second.size();
+  std::vector<double> worst(n_columns, 0.0), scale(n_columns, 0.0);
+  for (const auto &[id, ra] : ma)
+    {
+      const auto &rb = mb.at(id);
+      for (std::size_t j = 0; j < n_columns; ++j)
+        {
+          worst[j] = std::max(worst[j], std::abs(ra[j] - rb[j]));
+          scale[j] = std::max(scale[j], std::abs(rb[j]));
+        }
+    }
+  for (std::size_t j = 0; j < n_columns; ++j)
+    EXPECT_LE(worst[j], 1e-12 * scale[j]) << "column " << j << ": the rebuild changed the points beyond round-off";
+}
+TEST(ExplicitTransfer, MemoryOrderRebuild2D) { memory_order<2>(); }
+TEST(ExplicitTransfer, MemoryOrderRebuild3D) { memory_order<3>(); }
+TEST(ExplicitTransfer, BSplineMemoryOrderRebuild3D) { memory_order<3>(Shape::quadratic_bspline); }
 
 TEST(ExplicitTransfer, RelocationKeepsParticles2D) { relocation_and_momentum<2>(); }
 TEST(ExplicitTransfer, RelocationKeepsParticles3D) { relocation_and_momentum<3>(); }

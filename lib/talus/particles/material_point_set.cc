@@ -45,7 +45,7 @@ namespace talus
     // removal loses its list entry, a cell that receives its first particle is
     // appended at the end of the owned cells, in insertion order.
     const auto &r = *relocator_ptr;
-    if (r.sorted_last)
+    if (r.sorted_last || r.reordered_last)
       {
         collect_active_cells();
         return;
@@ -85,10 +85,9 @@ namespace talus
   MaterialPointSet<dim>::relocate(
     const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved)
   {
-    const auto sorts_before = relocation_stats.global_sorts + relocation_stats.storage_sorts;
     relocator_ptr->finish(relocation_stats, moved);
     update_active_cells();
-    return relocation_stats.global_sorts + relocation_stats.storage_sorts != sorts_before;
+    return relocator_ptr->sorted_last;
   }
 
   template <int dim>

@@ -54,16 +54,23 @@ namespace talus
     /// a restart).
     void collect_active_cells();
 
-    /// From inside a walk: the point at `it` left cell `c` (location updated).
+    /// From inside a walk: the point at `it` left cell `c` (location updated)
+    /// for the vertex neighbour `entered` (xi: its reference location there) or
+    /// for none (invalid_unsigned_int); Relocator::leaving.
     void
-    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it, const unsigned int c)
+    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
+            const unsigned int                                                          c,
+            const unsigned int                                                          entered,
+            const dealii::Point<dim> &                                                  xi,
+            const bool                                                                  added)
     {
-      relocator_ptr->leaving(it, c);
+      relocator_ptr->leaving(it, c, entered, xi, added);
     }
 
     /// Move the points handed to leaving() and update the cell list. Collective.
     /// `moved(c, xi, properties)` is called for every point moved to a
-    /// neighbour cell c (not for those placed by a full deal.II sort). Returns
+    /// neighbour cell c (not for those placed by a full deal.II sort, nor for
+    /// those the walk already added: `added` of leaving()). Returns
     /// true if a full deal.II sort ran (reference locations recomputed, points
     /// possibly sent to other ranks).
     bool relocate(const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved = {});

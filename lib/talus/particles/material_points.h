@@ -244,13 +244,20 @@ namespace talus
   public:
     Relocator(const BackgroundGrid<dim> &grid, dealii::Particles::ParticleHandler<dim> &particles);
 
-    /// Called from the particle loop for a particle whose new position x left
-    /// cell c (its location is already updated).
+    /// Called from the particle loop for a particle whose new position left
+    /// cell c (its location is already updated): `entered` is the vertex
+    /// neighbour of c it is in (BackgroundGrid::find_cell_near, with xi its
+    /// reference location there), or invalid_unsigned_int if none is (then a
+    /// full sort places it). `added`: the caller has already added the point to
+    /// what finish()'s `moved` callback would add it to.
     void
     leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
-            const unsigned int c)
+            const unsigned int                                                          c,
+            const unsigned int                                                          entered,
+            const dealii::Point<dim> &                                                  xi,
+            const bool                                                                  added)
     {
-      pending.push_back({it, c});
+      pending.push_back({it, xi, c, entered, added});
     }
 
     /// Apply all moves. Collective. Each point that stays on this rank is
@@ -260,10 +267,11 @@ namespace talus
     /// are still walked with their new cell while their slot sits with the old
     /// one; once the particles moved since the last full sort
     /// exceed `resort_fraction` of all particles (1.0: measured best
-    /// on the 3D bench, with the loops prefetching), a full deal.II sort restores
-    /// the cell-by-cell memory order (it calls PropertyPool::sort_memory_slots).
+    /// on the 3D bench, with the loops prefetching), restore_memory_order()
+    /// puts the storage back in cell-by-cell memory order.
     /// `moved(c, xi, properties)` is called for every particle moved to a
-    /// neighbour cell c (not for those handled by a full sort).
+    /// neighbour cell c (not for those handled by a full sort, nor for those
+    /// handed to leaving() with `added`).
     void finish(RelocationStats &stats,
                 const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved = {});
 
@@ -272,14 +280,20 @@ namespace talus
     /// What the last finish() did to the handler's storage, for callers that
     /// keep per-cell bookkeeping: every removal (from its source cell) and every
     /// insertion (into its target cell) in the order they were applied, and
-    /// whether a full deal.II sort ran (then everything may have changed).
+    /// whether a full deal.II sort ran (then everything may have changed:
+    /// points sent to other ranks or lost, reference locations recomputed, so
+    /// nodal sums and per-point sums of the step are stale), or whether only the
+    /// storage was rebuilt in memory order (`reordered_last`: the same points in
+    /// the same cells with the same data, so those sums stay valid; only the
+    /// order of the cell groups changed).
     struct CellChange
     {
       unsigned int cell;
       bool         inserted; ///< false: a point was removed from `cell`
     };
     std::vector<CellChange> cell_changes;
-    bool                    sorted_last = false;
+    bool                    sorted_last    = false;
+    bool                    reordered_last = false;
 
     /// Particles moved (locally) since the last full sort: part of the state a
     /// checkpoint saves, since it decides when the next memory-order sort runs.
@@ -287,10 +301,22 @@ namespace talus
     unsigned long long  moves_since_sort() const { return moved_since_sort; }
 
   private:
+    /// Rebuild the handler's storage in memory order: every point is copied out
+    /// with its cell groups taken in active-cell order, the handler is cleared
+    /// (deal.II 9.4's pool then hands out slots 0, 1, 2, ... again) and the
+    /// points are inserted back into their cells in that order. Each point keeps
+    /// its cell, location, reference location, id and properties bit for bit:
+    /// unlike deal.II's sort_particles_into_subdomains_and_cells() there is no
+    /// point location, no mapping and no communication except one collective
+    /// update of the handler's counts. Collective.
+    void restore_memory_order();
+
     struct Pending
     {
       typename dealii::Particles::ParticleHandler<dim>::particle_iterator it;
-      unsigned int                                                        cell;
+      dealii::Point<dim>                                                  xi; ///< in `entered`
+      unsigned int                                                        cell, entered;
+      bool                                                                added;
     };
     const BackgroundGrid<dim> &              grid;
     dealii::Particles::ParticleHandler<dim> &particles;

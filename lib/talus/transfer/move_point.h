@@ -9,12 +9,19 @@ namespace talus::transfer
   /// Put the point at `it` (in cell c of the box grid) at its new location x.
   /// Returns true if it stays in cell c (reference location xi set and
   /// returned), false if it left (the set's relocation will place it; the walk
-  /// must not touch it again).
+  /// must not touch it again). A point that left is looked up among the vertex
+  /// neighbours of c at once, while their data are in cache from the walk
+  /// (the relocation used to do it later, cold): `entered` is the cell it
+  /// entered, with xi its reference location there, or invalid_unsigned_int
+  /// (then a full sort will place it). `caller_adds`: the caller adds a point
+  /// that entered a locally owned cell to the nodal sums itself, so the
+  /// relocation's `moved` callback skips it.
   template <int dim>
   inline bool
   place_moved_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
                     typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
-                    const dealii::Point<dim> &x, dealii::Point<dim> &xi)
+                    const dealii::Point<dim> &x, dealii::Point<dim> &xi, unsigned int &entered,
+                    const bool caller_adds)
   {
     const auto &cc     = grid.cells[c];
     bool        inside = true;
@@ -29,8 +36,22 @@ namespace talus::transfer
         it->set_reference_location(xi);
         return true;
       }
-    set.leaving(it, c);
+    entered          = grid.find_cell_near(c, x, xi);
+    const bool added = caller_adds && entered != dealii::numbers::invalid_unsigned_int &&
+                       grid.cells[entered].locally_owned;
+    set.leaving(it, c, entered, xi, added);
     return false;
+  }
+
+  /// The same for a caller that does not add entered points itself.
+  template <int dim>
+  inline bool
+  place_moved_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
+                    typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
+                    const dealii::Point<dim> &x, dealii::Point<dim> &xi)
+  {
+    unsigned int entered;
+    return place_moved_point(set, grid, c, it, x, xi, entered, false);
   }
 
   /// Move the point at `it` (in cell c) by dx; place_moved_point.

@@ -87,6 +87,13 @@ namespace talus::transfer
     {
       sums.scatter(cell, g, M, F);
     }
+    /// a point of the walk that entered cell c (a fused op after a move; the
+    /// walk hands it to the relocation with `added`)
+    inline void
+    point_entered(const unsigned int c, const dealii::Point<dim> &xi, const double *P)
+    {
+      scatter_one(c, xi, P);
+    }
     /// the same for one point outside a walk (a point moved to cell c)
     inline void
     scatter_one(const unsigned int c, const dealii::Point<dim> &xi, const double *P)
@@ -351,6 +358,21 @@ namespace talus::transfer
     }
     static constexpr bool whole_cells = has_update_cell<Physics>(0);
 
+    /// Whether a fused second op adds points that entered a neighbour cell
+    /// (point_entered(c, xi, P)).
+    template <class Op>
+    static constexpr auto
+    adds_entered(int) -> decltype(&Op::point_entered, bool())
+    {
+      return true;
+    }
+    template <class Op>
+    static constexpr bool
+    adds_entered(long)
+    {
+      return false;
+    }
+
     /// One point of whole_cell() between its loops.
     struct CellPoint
     {
@@ -393,8 +415,14 @@ namespace talus::transfer
               q.P[L::displacement + d] += q.dx[d];
             }
           physics.moved(p, q.P, x, q.state);
-          if (place_moved_point(set, grid, c, p, x, xi_new))
+          // a second op with point_entered() adds a point that entered an owned
+          // neighbour cell at once (its nodal entries are in cache now)
+          unsigned int entered;
+          if (place_moved_point(set, grid, c, p, x, xi_new, entered, adds_entered<Second>(0)))
             second.point_at(c, p, xi_new);
+          else if constexpr (adds_entered<Second>(0))
+            if (entered != dealii::numbers::invalid_unsigned_int && grid.cells[entered].locally_owned)
+              second.point_entered(entered, xi_new, q.P);
         }
       second.end_cell(c);
       end_cell(c);

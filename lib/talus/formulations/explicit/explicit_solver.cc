@@ -817,8 +817,10 @@ namespace talus::explicit_mpm
                                         probe_ids, probe_values, probe_stress};
     // the mass and force of the next step are accumulated here, at the updated
     // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
-    // the next cycle fused into this pass); moved particles are added by the
-    // relocation, and any deal.II sort falls back to a full P2G pass.
+    // the next cycle fused into this pass) and for every particle that entered
+    // an owned neighbour cell (into that cell); particles received from other
+    // ranks are added by the relocation, and any deal.II sort falls back to a
+    // full P2G pass.
     // Every non-zero entry of the mass/force vectors belongs to a cell that
     // holds particles now (writes go only to cells that hold particles after
     // the relocation), so clearing the active DoFs clears everything, and the
@@ -866,9 +868,10 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::relocate()
   {
-    // moved points add their mass and force to the next step's sums; a deal.II
-    // sort recomputes reference locations and may move points to other ranks:
-    // the fused P2G is then redone from scratch
+    // points received from other ranks add their mass and force to the next
+    // step's sums (points that entered an owned neighbour cell were added by the
+    // fused update pass already); a deal.II sort recomputes reference locations
+    // and may move points to other ranks: the fused P2G is then redone from scratch
     bool sorted = false;
     with_kernel([&](auto kernel) {
       transfer::ScatterMassForce<dim, decltype(kernel)> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
