@@ -265,17 +265,19 @@ namespace talus
     /// freed to the next insertion, so the point keeps its storage slot and the
     /// insertion writes the cache lines the removal has just read. Moved points
     /// are still walked with their new cell while their slot sits with the old
-    /// one; once the particles moved since the last full sort
-    /// exceed `resort_fraction` of all particles (1.0: measured best
-    /// on the 3D bench, with the loops prefetching), restore_memory_order()
-    /// puts the storage back in cell-by-cell memory order.
+    /// one; once the particles moved since the last memory-order rebuild
+    /// exceed `resort_fraction` of all particles, restore_memory_order()
+    /// puts the storage back in cell-by-cell memory order. 2.0 measured best
+    /// on the 3D bench with the rebuild (docs/scaling.md): 1.0 spent 3 ns per
+    /// point-step more on rebuilds, 4.0 was no faster than 2.0, and the update
+    /// pass did not get slower with the rarer rebuilds (the loops prefetch).
     /// `moved(c, xi, properties)` is called for every particle moved to a
     /// neighbour cell c (not for those handled by a full sort, nor for those
     /// handed to leaving() with `added`).
     void finish(RelocationStats &stats,
                 const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved = {});
 
-    double resort_fraction = 1.0;
+    double resort_fraction = 2.0;
 
     /// What the last finish() did to the handler's storage, for callers that
     /// keep per-cell bookkeeping: every removal (from its source cell) and every
