@@ -635,17 +635,18 @@ namespace talus
         const unsigned long long lost_before = lost_counter;
         particles.sort_particles_into_subdomains_and_cells();
         ++stats.global_sorts;
-        moved_since_sort = 0;
-        sorted_last      = true;
+        sorted_last = true;
         stats.lost += dealii::Utilities::MPI::sum(lost_counter - lost_before, grid.comm);
-        stats.seconds_sorts += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       }
     else if (reorder)
       {
         restore_memory_order();
         ++stats.storage_sorts;
+        reordered_last = true;
+      }
+    if (sorted_last || reordered_last)
+      {
         moved_since_sort = 0;
-        reordered_last   = true;
         stats.seconds_sorts += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
       }
   }

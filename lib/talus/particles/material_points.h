@@ -227,9 +227,9 @@ namespace talus
     unsigned long long sent_to_ranks = 0; ///< of those: entered a neighbour owned by another rank (sent there)
     unsigned long long global_sorts  = 0; ///< full deal.II sorts needed
     unsigned long long lost          = 0; ///< left the grid (removed)
-    unsigned long long storage_sorts = 0; ///< sorts done to restore memory order
+    unsigned long long storage_sorts = 0; ///< memory-order rebuilds (Relocator::restore_memory_order)
     double             seconds_moves = 0; ///< wall time of local moves
-    double             seconds_sorts = 0; ///< wall time of deal.II sorts
+    double             seconds_sorts = 0; ///< wall time of deal.II sorts and memory-order rebuilds
   };
 
   /// Relocator: after positions were updated, each particle still inside its
@@ -297,8 +297,9 @@ namespace talus
     bool                    sorted_last    = false;
     bool                    reordered_last = false;
 
-    /// Particles moved (locally) since the last full sort: part of the state a
-    /// checkpoint saves, since it decides when the next memory-order sort runs.
+    /// Particles moved (locally) since the last full sort or memory-order
+    /// rebuild: part of the state a checkpoint saves, since it decides when the
+    /// next rebuild runs.
     unsigned long long &moves_since_sort() { return moved_since_sort; }
     unsigned long long  moves_since_sort() const { return moved_since_sort; }
 

@@ -11,16 +11,16 @@ namespace talus::transfer
   /// returned), false if it left (the set's relocation will place it; the walk
   /// must not touch it again). A point that left is looked up among the vertex
   /// neighbours of c at once, while their data are in cache from the walk
-  /// (the relocation used to do it later, cold): `entered` is the cell it
-  /// entered, with xi its reference location there, or invalid_unsigned_int
-  /// (then a full sort will place it). `caller_adds`: the caller adds a point
-  /// that entered a locally owned cell to the nodal sums itself, so the
-  /// relocation's `moved` callback skips it.
+  /// (the relocation used to do it later, cold; xi: its reference location
+  /// in the cell it entered). `caller_adds`: the caller adds a point that
+  /// entered a locally owned cell to the nodal sums itself, so the
+  /// relocation's `moved` callback skips it; `add_to` is then that cell, else
+  /// invalid_unsigned_int.
   template <int dim>
   inline bool
   place_moved_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
                     typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
-                    const dealii::Point<dim> &x, dealii::Point<dim> &xi, unsigned int &entered,
+                    const dealii::Point<dim> &x, dealii::Point<dim> &xi, unsigned int &add_to,
                     const bool caller_adds)
   {
     const auto &cc     = grid.cells[c];
@@ -36,9 +36,10 @@ namespace talus::transfer
         it->set_reference_location(xi);
         return true;
       }
-    entered          = grid.find_cell_near(c, x, xi);
-    const bool added = caller_adds && entered != dealii::numbers::invalid_unsigned_int &&
+    const unsigned int entered = grid.find_cell_near(c, x, xi);
+    const bool         added   = caller_adds && entered != dealii::numbers::invalid_unsigned_int &&
                        grid.cells[entered].locally_owned;
+    add_to = added ? entered : dealii::numbers::invalid_unsigned_int;
     set.leaving(it, c, entered, xi, added);
     return false;
   }
@@ -50,8 +51,8 @@ namespace talus::transfer
                     typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
                     const dealii::Point<dim> &x, dealii::Point<dim> &xi)
   {
-    unsigned int entered;
-    return place_moved_point(set, grid, c, it, x, xi, entered, false);
+    unsigned int add_to;
+    return place_moved_point(set, grid, c, it, x, xi, add_to, false);
   }
 
   /// Move the point at `it` (in cell c) by dx; place_moved_point.

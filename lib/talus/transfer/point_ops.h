@@ -417,12 +417,12 @@ namespace talus::transfer
           physics.moved(p, q.P, x, q.state);
           // a second op with point_entered() adds a point that entered an owned
           // neighbour cell at once (its nodal entries are in cache now)
-          unsigned int entered;
-          if (place_moved_point(set, grid, c, p, x, xi_new, entered, adds_entered<Second>(0)))
+          unsigned int add_to;
+          if (place_moved_point(set, grid, c, p, x, xi_new, add_to, adds_entered<Second>(0)))
             second.point_at(c, p, xi_new);
           else if constexpr (adds_entered<Second>(0))
-            if (entered != dealii::numbers::invalid_unsigned_int && grid.cells[entered].locally_owned)
-              second.point_entered(entered, xi_new, q.P);
+            if (add_to != dealii::numbers::invalid_unsigned_int)
+              second.point_entered(add_to, xi_new, q.P);
         }
       second.end_cell(c);
       end_cell(c);
