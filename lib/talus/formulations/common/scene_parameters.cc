@@ -67,6 +67,7 @@ namespace talus
     c.n_materials =
       dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of materials", "1", Integer(1, 64)));
     c.n_bodies = dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of bodies", "1", Integer(1, 64)));
+    c.n_rigid_plates = loads::peek_rigid_plates(prm_file);
     return c;
   }
 
@@ -101,6 +102,7 @@ namespace talus
                         "Boundary ids (comma-separated) on which every velocity component is zero.");
       prm.declare_entry("roller", "", Anything(),
                         "Boundary ids on which the velocity component normal to the boundary is zero.");
+      loads::declare_rigid_plate_parameters(prm, dim, counts.n_rigid_plates);
     }
     prm.leave_subsection();
 
@@ -277,6 +279,7 @@ namespace talus
       p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::fixed});
     for (const auto id : parse_ids(prm.get("roller"), "boundary conditions/roller"))
       p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::roller});
+    p.rigid_plates = loads::parse_rigid_plate_parameters<dim>(prm, !p.grid_mesh);
     prm.leave_subsection();
 
     prm.enter_subsection("gravity");

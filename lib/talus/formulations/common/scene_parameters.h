@@ -9,6 +9,7 @@
 #include <talus/formulations/common/formulation.h>
 #include <talus/grid/background_grid.h>
 #include <talus/io/grid_mesh.h>
+#include <talus/loads/rigid_plate.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
 
@@ -33,6 +34,8 @@ namespace talus
     std::string                         grid_file;
     std::shared_ptr<const io::GridMesh> grid_mesh;
     std::vector<BoundaryCondition>      boundary_conditions;
+    /// 'boundary conditions/rigid plate k' (loads/rigid_plate.h)
+    std::vector<loads::RigidPlate<dim>> rigid_plates;
     dealii::Tensor<1, dim>              gravity;
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                        bodies;
@@ -81,9 +84,10 @@ namespace talus
   /// The counts a .prm declares before its numbered subsections.
   struct SceneCounts
   {
-    unsigned int dim = 2, n_materials = 1, n_bodies = 1;
+    unsigned int dim = 2, n_materials = 1, n_bodies = 1, n_rigid_plates = 0;
   };
-  /// 'dimension', 'number of materials', 'number of bodies' read from the
+  /// 'dimension', 'number of materials', 'number of bodies', 'boundary
+  /// conditions/number of rigid plates' read from the
   /// file before the declaration (the declaration depends on them).
   SceneCounts peek_scene_counts(const std::string &prm_file);
 

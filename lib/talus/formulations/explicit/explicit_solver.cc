@@ -101,6 +101,7 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     parse_scene_parameters<dim>(prm, p);
+    loads::refuse_rigid_plates(p.rigid_plates, "talus-explicit", "not built in this family yet");
     parse_liquid_output(prm, p.liquid);
     for (unsigned int k = 0; k < p.materials.size(); ++k)
       {

@@ -249,6 +249,7 @@ namespace talus::implicit_mpm
     Parameters<dim> p;
     parse_run_parameters<dim>(prm, p);
     parse_scene_parameters<dim>(prm, p);
+    loads::refuse_rigid_plates(p.rigid_plates, "talus-implicit", "not built in this family yet");
     prm.enter_subsection("time");
     p.time_step = prm.get_double("time step");
     prm.leave_subsection();

@@ -312,6 +312,7 @@ namespace talus::semi_implicit
     Parameters<dim> p;
     parse_run_parameters<dim>(prm, p);
     parse_scene_parameters<dim>(prm, p);
+    loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit", "not built in this family yet");
     prm.enter_subsection("time");
     p.time_step = prm.get_double("time step");
     p.courant   = prm.get_double("courant number");
