@@ -106,6 +106,16 @@ namespace talus
     }
     prm.leave_subsection();
 
+    prm.enter_subsection("numerics");
+    prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
+                      "Shape functions of every particle-grid transfer, in every family: 'linear' (Q1 on the grid "
+                      "cells) or 'quadratic bspline' (uniform quadratic B-splines on the grid nodes, 3 nodes per "
+                      "direction per point: no cell-crossing noise; at the grid walls the outside node is a ghost "
+                      "carrying the linear extrapolation, so fixed and roller walls hold exactly at the wall; "
+                      "needs a uniform box grid with at least 3 cells per direction; docs/shape-functions.md). A "
+                      "family refuses the combinations with its own options that it cannot honour, naming them.");
+    prm.leave_subsection();
+
     prm.enter_subsection("gravity");
     prm.declare_entry("acceleration", zeros_text(dim, "-9.81"), Anything(), "Gravitational acceleration vector [m/s^2].");
     prm.leave_subsection();
@@ -284,6 +294,11 @@ namespace talus
 
     prm.enter_subsection("gravity");
     p.gravity = parse_point<dim>(prm.get("acceleration"), "gravity/acceleration");
+    prm.leave_subsection();
+
+    prm.enter_subsection("numerics");
+    p.shape_function =
+      prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline : ShapeFunction::linear;
     prm.leave_subsection();
 
     const unsigned int n_materials = prm.get_integer("number of materials");

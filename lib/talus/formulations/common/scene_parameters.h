@@ -12,6 +12,7 @@
 #include <talus/loads/rigid_plate.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
+#include <talus/shape/shape_function.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
@@ -22,7 +23,7 @@
 
 namespace talus
 {
-  /// Grid, boundary conditions, gravity, materials and bodies.
+  /// Grid, boundary conditions, gravity, materials, bodies and the shape functions.
   template <int dim>
   struct SceneParameters
   {
@@ -39,6 +40,8 @@ namespace talus
     dealii::Tensor<1, dim>              gravity;
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                        bodies;
+    ShapeFunction shape_function = ShapeFunction::linear;
+    bool          bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
   };
 
   /// End time, step limit, lost points, output and checkpoint settings.

@@ -3,6 +3,7 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/formulations/explicit/with_kernel.h>
+#include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/run_formulation.h>
@@ -325,31 +326,18 @@ namespace talus::explicit_mpm
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
-      std::vector<double> density;
-      for (const auto &m : prm.materials)
-        density.push_back(m->density());
-      auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
-      const auto filed  = insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
-      for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-        seeded.volume_per_body[b] += filed.volume_per_body[b];
-      log_clipping(prm, seeded, filed); // what 'clip to grid' left out (input_checks.h)
-      if (fem) // the cells these points occupy get Gauss points instead (fem.h)
-        seeded = fem->seed(density);
-      for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-        require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
-                "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+      const std::vector<double> density = material_densities(prm);
+      // FEM: the cells these points occupy get Gauss points instead (fem.h)
+      auto seeded = seed_scene_bodies(grid, prm.bodies, density, points, "material point", &prm, {}, fem != nullptr);
+      if (fem)
+        {
+          seeded = fem->seed(density);
+          require_seeded(prm.bodies, seeded.volume_per_body, "material point");
+        }
       if (control)
         control->initial_state(*this); // K0 stresses, stage 0 (gravity, boundaries, mass scaling)
-
-      // history initialisation
-      for (auto &pt : points.handler)
-        {
-          auto        P = pt.get_properties();
-          const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
-          if (points.layout.n_history)
-            m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
-                                 dealii::ArrayView<double>(P.data() + points.layout.history, m.n_history()));
-        }
+      if (points.layout.n_history)
+        initialize_point_histories(prm.materials, points, points.layout.history);
       if (two_phase)
         two_phase->initialize_particles(); // restored points carry their 2-phase state
       }

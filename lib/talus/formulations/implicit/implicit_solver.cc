@@ -1,5 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/scene_checks.h>
@@ -156,11 +157,6 @@ namespace talus::implicit_mpm
                         "cell). Removes the volumetric locking of Q1 cells with several points (near "
                         "incompressible elasticity, isochoric plastic flow). Not with 'mixed up' or "
                         "'axisymmetric'.");
-      prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
-                        "The grid basis of every transfer (mass, forces, tangent, convective phase): linear Q1, or "
-                        "quadratic B-splines with the wall treatment of docs/shape-functions.md (C1 across cell "
-                        "faces: no force jump when a point crosses a cell face; a point couples the 3^dim nodes "
-                        "around it). Not with 'volumetric stabilisation = f-bar' or 'geometry = axisymmetric'.");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
@@ -265,7 +261,6 @@ namespace talus::implicit_mpm
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
     p.fbar           = prm.get("volumetric stabilisation") == "f-bar";
-    p.bspline        = prm.get("shape function") == "quadratic bspline";
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
@@ -275,10 +270,10 @@ namespace talus::implicit_mpm
     require(!p.fbar || !p.mixed_up, "implicit/volumetric stabilisation",
             "'f-bar' is for 'formulation = irreducible' (the mixed u-p form treats the volume through its pressure "
             "field); allowed with 'mixed up': none");
-    require(!p.fbar || !p.bspline, "implicit/volumetric stabilisation",
+    require(!p.fbar || !p.bspline(), "implicit/volumetric stabilisation",
             "'f-bar' (a mean over the points of a cell) is for 'shape function = linear': a B-spline point "
             "reaches beyond its cell; allowed with 'quadratic bspline': none");
-    require(!p.bspline || !p.axisymmetric, "implicit/shape function",
+    require(!p.bspline() || !p.axisymmetric, "numerics/shape function",
             "'quadratic bspline' is not available with 'geometry = axisymmetric' (the axis is no wall of the "
             "B-spline basis); allowed there: linear");
     require(!p.fbar || !p.axisymmetric, "implicit/volumetric stabilisation",
@@ -571,7 +566,7 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::with_kernel(F &&f) const
   {
-    shape::with_kernel<dim>(prm.bspline, std::forward<F>(f));
+    shape::with_kernel<dim>(prm.bspline(), std::forward<F>(f));
   }
 
   template <int dim>
@@ -595,7 +590,7 @@ namespace talus::implicit_mpm
   {
     grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
-    if (prm.bspline)
+    if (prm.bspline())
       grid.setup_bspline_patches(); // the 4^dim node patch of every owned cell
     space.setup();
 
@@ -645,7 +640,7 @@ namespace talus::implicit_mpm
               }
             planes.push_back(c);
           }
-        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric, prm.bspline);
+        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric, prm.bspline());
         point_contact->extend_layout(points.layout);
       }
     if (prm.mixed_up)
@@ -659,23 +654,12 @@ namespace talus::implicit_mpm
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
-        std::vector<double> density;
-        for (const auto &m : prm.materials)
-          density.push_back(m->density());
-        auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
-        const auto filed =
-          insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
-        for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-          require(seeded.volume_per_body[b] + filed.volume_per_body[b] > 0,
-                  "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
-                  "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+        seed_scene_bodies(grid, prm.bodies, material_densities(prm), points, "material point", &prm);
         using L = PropertyLayout<dim>;
+        initialize_point_histories(prm.materials, points, L::history);
         for (auto &pt : points.handler)
           {
-            auto        P = pt.get_properties();
-            const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
-            m.initialize_history(L::get_stress(P.data()),
-                                 dealii::ArrayView<double>(P.data() + L::history, m.n_history()));
+            auto P = pt.get_properties();
             for (unsigned int d = 0; d < dim; ++d)
               P[acceleration_offset + d] = 0.0;
             if (prm.mixed_up) // the mean of the initial stress
@@ -1793,10 +1777,10 @@ namespace talus::implicit_mpm
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
         << "), time step " << dt << std::endl;
     out << "  formulation: "
-        << (prm.mixed_up ? std::string(prm.bspline ? "mixed u-p (equal-order B-splines" : "mixed u-p (Q1-Q1") +
+        << (prm.mixed_up ? std::string(prm.bspline() ? "mixed u-p (equal-order B-splines" : "mixed u-p (Q1-Q1") +
                              ", PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
                          : std::string("irreducible (displacement)"))
-        << (prm.bspline ? ", quadratic B-splines" : ", linear shape functions")
+        << (prm.bspline() ? ", quadratic B-splines" : ", linear shape functions")
         << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
         << (prm.velocities.empty() ? "" :
                                      ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")

@@ -56,9 +56,7 @@ namespace talus::implicit_mpm
     /// dFbar = (jbar / j)^(1/dim) dF, jbar the volume-weighted mean det dF of its grid cell,
     /// with the exact tangent (docs/implicit.md, "F-bar")
     bool fbar = false;
-    /// 'implicit/shape function = quadratic bspline': the kernel of every grid
-    /// transfer (else linear Q1; docs/implicit.md 'Quadratic B-splines')
-    bool bspline = false;
+    // 'numerics/shape function' (SceneParameters::bspline()): the kernel of every grid transfer
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
@@ -292,7 +290,7 @@ namespace talus::implicit_mpm
       else
         f(std::integral_constant<unsigned int, dim>());
     }
-    /// f(K()) with K the shape kernel of 'implicit/shape function'
+    /// f(K()) with K the shape kernel of 'numerics/shape function'
     /// (defined in implicit_solver.cc, its only user)
     template <class F>
     void with_kernel(F &&f) const;
