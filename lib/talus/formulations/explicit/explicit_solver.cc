@@ -101,7 +101,6 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     parse_scene_parameters<dim>(prm, p);
-    loads::refuse_rigid_plates(p.rigid_plates, "talus-explicit", "not built in this family yet");
     parse_liquid_output(prm, p.liquid);
     for (unsigned int k = 0; k < p.materials.size(); ++k)
       {
@@ -117,6 +116,14 @@ namespace talus::explicit_mpm
         p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
         prm.leave_subsection();
       }
+    // rigid plates (loads/rigid_plate.h; LoadControl): not with pore liquid
+    if (p.liquid.any_coupled())
+      loads::refuse_rigid_plates(
+        p.rigid_plates, "talus-explicit",
+        "a material has coupled pore liquid (material k/pore liquid): the single-point 2-phase step keeps the pore "
+        "pressure at the material points, so a permeable plate (p = 0 at its nodes) has no nodal pressure to hold, "
+        "and the impermeable plate (the liquid moving with the plate) is not built in the 2-phase nodal solve yet "
+        "(docs/explicit.md, Rigid plate); allowed: pore liquid/drainage = drained or undrained with a plate");
     const unsigned int n_bodies = p.bodies.size();
     p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
     if (p.loads.staged)
@@ -289,10 +296,11 @@ namespace talus::explicit_mpm
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
     points.layout.n_history = n_history;
-    if (prm.loads.active())
+    if (prm.loads.active() || !prm.rigid_plates.empty())
       {
         control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
         control->extend_layout(points.layout);
+        control->setup_rigid_plates(*this); // node checks (exit 2) and log lines, before any output
       }
     // 2-phase / traction properties and the free-surface flag: only when used
     if (prm.liquid.any_coupled() || prm.liquid.any_traction())
@@ -1263,6 +1271,8 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < probe_ids.size(); ++k)
       for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
         c.push_back("probe" + std::to_string(k) + "_" + names[PropertyLayout<dim>::stress + q]);
+    for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
+      c.push_back(name);
     return c;
   }
 
@@ -1321,6 +1331,11 @@ namespace talus::explicit_mpm
       }
     r.insert(r.end(), probes.begin(), probes.end());
     r.insert(r.end(), probe_sigma.begin(), probe_sigma.end());
+    if (!prm.rigid_plates.empty())
+      {
+        const auto v = control->rigid_plate_series();
+        r.insert(r.end(), v.begin(), v.end());
+      }
     return r;
   }
 
