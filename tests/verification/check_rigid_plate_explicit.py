@@ -8,7 +8,9 @@ CASE:
       the shared layer (1 m x 1 m, E = 1 MPa, nu = 0.3, fixed base, roller
       sides) under a frictionless plate loaded by -1 kN/m, to quasi-static
       rest: plate settlement vs q H / E_oed = 7.4286e-4 m within 1 %; with
-      Q1, quadratic B-splines, numerics/integration = fem.
+      Q1, quadratic B-splines, numerics/integration = fem. With Q1 also the
+      separate-pass step (a zero body traction selects it): within 1e-8 of the
+      fused step.
   displacement
       the same layer with the plate driven by a displacement of -1 mm:
       reaction vs E_oed (d / H) W = 1346.2 N within 1 %, and the plate at -1 mm.
@@ -21,6 +23,10 @@ CASE:
       nodes move as one: their u_y agree to 1e-10 (relative). The same layer
       under a uniform traction instead of the plate must show a spread > 5 %
       (the check can fail). A frictionless plate has no tangential column.
+      Zero horizontal reaction: the layer (1 m x 1 m) between a roller base and
+      the frictionless plate, x held at x = 0 only, is in uniaxial stress in
+      the plane (plane strain): settlement (1 - nu^2) q H / E and
+      u_x = nu (1 + nu) q X / E at every point, within 1 %.
   rough
       the one-cell layer (uniform, free sides, fixed base) under a rough plate:
       every node of the cell holds u_x = 0, so every point has |u_x| <= 1e-12
@@ -136,6 +142,15 @@ if case in ("layer", "layer_bspline", "layer_fem"):
     err = abs(u - ua) / abs(ua)
     tv.check(err < 0.01, f"{case}: plate settlement {u:.6e} m vs -q H / E_oed = {ua:.6e} m (error {err:.2e} < 1e-2)")
     tv.check(abs(s["plate_0_force"][-1] + q * W) < 1e-9, f"plate_0_force = the given force {s['plate_0_force'][-1]}")
+    if case == "layer":
+        # a body traction (zero, on a roller side) sends the run through the separate-pass
+        # step of explicit_two_phase.cc (the plate's balance in nodal_forces_two_phase)
+        t2 = tv.prm_set(tv.prm_set(t, "body 0/traction face", "x+"), "body 0/traction", "0, 0")
+        s2, _ = run("separate_passes", t2)
+        u2 = s2["plate_0_displacement"][-1]
+        d = abs(u2 - u) / abs(u)
+        tv.check(d < 1e-8, f"separate-pass step (body traction): settlement {u2:.10e} m, {d:.1e} from the fused "
+                           "step (< 1e-8)")
 elif case == "displacement":
     t = tv.prm_set(base, "boundary conditions/rigid plate 0/total force", "")
     t = tv.prm_set(t, "boundary conditions/rigid plate 0/displacement", "-1e-3")
@@ -162,6 +177,22 @@ elif case == "frictionless":
         if plate:
             tv.check("plate_0_tangential_force" not in s, "a frictionless plate has no tangential reaction column")
             tv.check(abs(s["plate_0_force"][-1] + q * W) < 1e-9, "plate_0_force = the given force")
+    # zero horizontal reaction: the layer between a frictionless base (roller) and the
+    # frictionless plate, free right side, x held at x = 0 only, is in uniaxial stress
+    # in the plane (plane strain: sigma_zz = nu sigma_yy): settlement (1 - nu^2) q H / E,
+    # u_x = nu (1 + nu) q X / E (a plate that held u_x would give 0)
+    t = tv.prm_set(tv.prm_set(base, "boundary conditions/fixed", ""), "boundary conditions/roller", "0, 2")
+    t = tv.prm_set(t, "output/final particles csv", "true")
+    s, _ = run("uniaxial", t)
+    u, ua = s["plate_0_displacement"][-1], -(1 - nu * nu) * q * H / E
+    err = abs(u - ua) / abs(ua)
+    tv.check(err < 0.01, f"uniaxial stress: plate settlement {u:.6e} m vs -(1 - nu^2) q H / E = {ua:.6e} m "
+                         f"(error {err:.2e} < 1e-2)")
+    p = points("uniaxial")
+    c = nu * (1 + nu) * q / E
+    ex = max(abs(ux - c * (x - ux)) for x, ux in zip(p["pos_x"], p["u_x"])) / (c * W)
+    tv.check(ex < 0.01, f"uniaxial stress: u_x = nu (1 + nu) q X / E at every point within {ex:.2e} of its value "
+                        "at X = W (< 1e-2): the frictionless plate exerts no horizontal force")
     tv.check(spreads["plate"] < 1e-10,
              f"frictionless plate: the points of the top row settle alike (spread {spreads['plate']:.2e} < 1e-10): "
              "the plate nodes move as one")
