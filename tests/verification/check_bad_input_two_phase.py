@@ -28,10 +28,6 @@ cases = [
     ("mass scaling below 1", [("mass scaling/factor", "0.5")], "mass scaling/factor"),
     # issue 12: with B-splines the point pore pressures carry a spurious mode
     ("B-splines", [("numerics/shape function", "quadratic bspline")], "numerics/shape function"),
-    # issue 37: a rigid plate with coupled pore liquid (docs/explicit.md, Rigid plate)
-    ("rigid plate", [("boundary conditions/number of rigid plates", "1"),
-                     ("boundary conditions/rigid plate 0/boundary id", "3"),
-                     ("boundary conditions/rigid plate 0/total force", "-1")], "boundary conditions/rigid plate 0"),
 ]
 for name, edits, needle in cases:
     text = base

@@ -32,17 +32,27 @@ CASE:
       every node of the cell holds u_x = 0, so every point has |u_x| <= 1e-12
       of the settlement; with a frictionless plate the top expands sideways
       (|u_x| > 1 % of the settlement), so the check can fail.
+  two_phase
+      Terzaghi's column (terzaghi_consolidation.prm, one cell wide) loaded by a
+      plate with a step force q = 10 kPa instead of the traction: permeable
+      plate, T_v = 0.5: settlement U(T_v) q H / E_c within 1 %, pore pressures
+      within 3 % (L2, of q) of Terzaghi's series; impermeable plate (and base):
+      undrained, settlement q H / (E_c + K_L / n) and mean pore pressure
+      (K_L / n) / (E_c + K_L / n) q within 1 %.
   ranks
       the layer to t = 0.5 s (mid-ramp: every field still moves; near rest the
       velocities are round-off themselves) on 1 and 2 ranks: every series.csv
       column and every final point field within 1e-10, relative to the largest
       value of its group (a vector's components, the energies, a plate's
-      forces); the same for a displacement-driven rough plate with free sides.
+      forces); the same for a displacement-driven rough plate with free sides,
+      and for a rough permeable plate on Terzaghi's column to t = 0.05 s.
   restart
       the layer stopped at t = 0.6 s (checkpoints every 0.2 s) and restarted
       to 1.2 s: series.csv and particles_final.csv byte for byte equal to the
-      uninterrupted run, on 1 rank and on 2 ranks.
+      uninterrupted run, on 1 rank and on 2 ranks; Terzaghi's column under a
+      permeable plate stopped at 0.03 s and restarted to 0.06 s, on 1 rank.
 """
+import math
 import os
 import shutil
 import sys
@@ -122,6 +132,26 @@ def group(col):
     if col[-2:] in ("_x", "_y", "_z"):
         return col[:-2]
     return col
+
+
+# Terzaghi's column (terzaghi_consolidation.prm, one cell wide as its fast check):
+# the top traction replaced by a region plate on the nodes at y = 1 m, a step force
+Et, KL, n0, qt = 1e7, 2.2e9, 0.3, 1e4
+
+
+def terzaghi_plate(drainage):
+    t = open(os.path.join(os.path.dirname(prm_path), "..", "terzaghi_consolidation.prm")).read()
+    for key, value in [("grid/upper corner", "0.025, 1.025"), ("grid/cells", "1, 41"),
+                       ("body 0/upper corner", "0.025, 1"), ("body 0/traction face", "none"),
+                       ("output/progress", "false"),
+                       ("boundary conditions/number of rigid plates", "1"),
+                       ("boundary conditions/rigid plate 0/apply to", "region"),
+                       ("boundary conditions/rigid plate 0/region lower corner", "0, 1"),
+                       ("boundary conditions/rigid plate 0/region upper corner", "0.025, 1"),
+                       ("boundary conditions/rigid plate 0/total force", str(-qt * 0.025)),
+                       ("boundary conditions/rigid plate 0/drainage", drainage)]:
+        t = tv.prm_set(t, key, value)
+    return t
 
 
 def points(name):
@@ -215,6 +245,33 @@ elif case == "rough":
     tv.check(ux["rough"] <= 1e-12, f"rough plate: no horizontal displacement (max |u_x| / |u_y| = {ux['rough']:.2e})")
     tv.check(ux["frictionless"] > 0.01,
              f"frictionless plate: the top expands sideways (max |u_x| / |u_y| = {ux['frictionless']:.2e} > 1e-2)")
+elif case == "two_phase":
+    # Terzaghi's column under the plate (coupled 2-phase single point)
+    t = terzaghi_plate("permeable")
+    s, out = run("permeable", t)
+    Tv = 0.5
+    U = 1 - sum(8 / (m * m * math.pi ** 2) * math.exp(-m * m * math.pi ** 2 * Tv / 4) for m in range(1, 400, 2))
+    u, ua = s["plate_0_displacement"][-1], -U * qt * H / Et
+    err = abs(u - ua) / abs(ua)
+    tv.check(err < 0.01, f"permeable plate, T_v = 0.5: settlement {u:.6e} m vs Terzaghi U q H / E_c = {ua:.6e} m "
+                         f"(U = {U:.4f}; error {err:.2e} < 1e-2)")
+    p = points("permeable")
+    z = [H - (y - uy) for y, uy in zip(p["pos_y"], p["u_y"])]
+    ref = [sum(4 / (m * math.pi) * math.sin(m * math.pi * zz / (2 * H)) * math.exp(-m * m * math.pi ** 2 * Tv / 4)
+               for m in range(1, 400, 2)) for zz in z]
+    l2 = math.sqrt(sum((x / qt - r) ** 2 for x, r in zip(p["pore_pressure"], ref)) / len(ref))
+    tv.check(l2 < 0.03, f"permeable plate: pore pressures vs Terzaghi's series, L2 error {l2:.2e} q < 3e-2 "
+                        "(the water drains through the plate)")
+    mean_perm = sum(p["pore_pressure"]) / len(ref) / qt
+    s, out = run("impermeable", terzaghi_plate("impermeable"))
+    u, ua = s["plate_0_displacement"][-1], -qt * H / (Et + KL / n0)
+    err = abs(u - ua) / abs(ua)
+    tv.check(err < 0.01, f"impermeable plate (and base): undrained settlement {u:.6e} m vs q H / (E_c + K_L / n) = "
+                         f"{ua:.6e} m (error {err:.2e} < 1e-2)")
+    p = points("impermeable")
+    mean, ma = sum(p["pore_pressure"]) / len(ref) / qt, (KL / n0) / (Et + KL / n0)
+    tv.check(abs(mean - ma) < 0.01, f"impermeable plate: mean pore pressure {mean:.5f} q vs (K_L / n) / (E_c + K_L / n) "
+                                    f"= {ma:.5f} q (within 1e-2; the permeable plate left {mean_perm:.3f} q)")
 elif case == "ranks":
     fixed = tv.prm_set(tv.prm_set(base, "convergence/enabled", "false"), "time/end time", "0.5")
     fixed = tv.prm_set(fixed, "output/final particles csv", "true")
@@ -222,7 +279,9 @@ elif case == "ranks":
     rough = tv.prm_set(rough, "boundary conditions/rigid plate 0/displacement", "-1e-3")
     rough = tv.prm_set(rough, "boundary conditions/rigid plate 0/surface", "rough")
     rough = tv.prm_set(rough, "boundary conditions/roller", "")
-    for label, t in (("force", fixed), ("rough_displacement", rough)):
+    two = tv.prm_set(terzaghi_plate("permeable"), "time/end time", "0.05")
+    two = tv.prm_set(two, "boundary conditions/rigid plate 0/surface", "rough")
+    for label, t in (("force", fixed), ("rough_displacement", rough), ("two_phase", two)):
         worst = {}
         for np in (1, 2):
             run(f"{label}_np{np}", t, np)
@@ -255,19 +314,21 @@ elif case == "restart":
     t = tv.prm_set(tv.prm_set(base, "convergence/enabled", "false"), "time/end time", "1.2")
     t = tv.prm_set(t, "output/final particles csv", "true")
     t = tv.prm_set(t, "checkpoint/interval", "0.2")
-    for np in (1, 2):
-        ref, part = f"reference_np{np}", f"part_np{np}"
+    # and Terzaghi's column under a permeable plate (coupled 2-phase), stopped at 0.03 s of 0.06 s
+    two = tv.prm_set(tv.prm_set(terzaghi_plate("permeable"), "time/end time", "0.06"), "checkpoint/interval", "0.01")
+    for np, label, t, t_stop in ((1, "", t, "0.6"), (2, "", t, "0.6"), (1, "two_phase_", two, "0.03")):
+        ref, part = f"{label}reference_np{np}", f"{label}part_np{np}"
         run(ref, t, np)
         tp = tv.prm_set(t, "output/directory", part)
-        tv.run_tool(tool, tv.prm_set(tp, "time/end time", "0.6"), work, part + "_early", np=np)
+        tv.run_tool(tool, tv.prm_set(tp, "time/end time", t_stop), work, part + "_early", np=np)
         os.remove(os.path.join(work, part, "particles_final.csv"))
         rc, out, err = tv.run_tool(tool, tv.prm_set(tp, "checkpoint/restart", "true"), work, part, np=np)
         tv.check("restarting from" in out, f"{np} rank(s): the run restarted from a checkpoint")
         for f in ("series.csv", "particles_final.csv"):
             a = open(os.path.join(work, ref, f)).read()
             b = open(os.path.join(work, part, f)).read()
-            tv.check(a == b, f"{np} rank(s): {f} after the restart at t = 0.6 s byte for byte equal to the "
-                             f"uninterrupted run ({len(a.splitlines())} lines)")
+            tv.check(a == b, f"{label}{np} rank(s): {f} after the restart at t = {t_stop} s byte for byte equal to "
+                             f"the uninterrupted run ({len(a.splitlines())} lines)")
         s = tv.read_csv(os.path.join(work, part, "series.csv"))
         print(f"{np} rank(s): plate displacement at t = {s['time'][-1]}: {s['plate_0_displacement'][-1]:.10e} m")
 else:

@@ -520,11 +520,8 @@ namespace talus::loads
         for (const unsigned int i : s.active_dofs)
           F[i] += T[i];
       }
-    if (any_plate) // the 2-phase step without pore liquid only (coupled: refused by parse_parameters)
-      {
-        AssertThrow(!s.two_phase->coupled, dealii::ExcInternalError());
-        rigid_plate_balance(s, F, MS);
-      }
+    if (any_plate) // the plates' sums before the damping (coupled: V after the liquid's a_L)
+      rigid_plate_balance(s, F, MS);
     if (!check_step(s))
       return;
     // Static equilibrium of both phases: the mixture force and the liquid's
@@ -687,11 +684,28 @@ namespace talus::loads
     // wins there): a = (V - v_i^t) / h along the axis, (0 - v_i^t) / h for the
     // tangential components of a rough plate; the plate's work was counted by
     // rigid_plate_balance
+    if (any_plate && cp)
+      {
+        // the liquid's share of the plate nodes' balance, sum beta Mbar_L a_L per
+        // plate and component (a_L of the 2-phase nodal solve), then V
+        std::vector<double> liquid(s.prm.rigid_plates.size() * dim, 0.0);
+        for (const auto &p : plate_dofs)
+          if (plate_active[p.dof] && M[p.dof] > 0 && mLn[p.dof] > 0)
+            liquid[p.condition * dim + p.component] += beta * mLn[p.dof] * AL[p.dof];
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(liquid), s.comm,
+                                    dealii::ArrayView<double>(liquid));
+        rigid_plate_velocities(s, liquid.data());
+      }
     for (const auto &p : plate_dofs)
       if (plate_active[p.dof] && M[p.dof] > 0)
         {
-          const double V = p.component == s.prm.rigid_plates[p.condition].axis ? plate_run[p.condition].velocity : 0.0;
-          A[p.dof]       = (V - Pm[p.dof] / M[p.dof]) / h;
+          const auto & pl = s.prm.rigid_plates[p.condition];
+          const bool   on_axis = p.component == pl.axis;
+          const double V       = on_axis ? plate_run[p.condition].velocity : 0.0;
+          A[p.dof]             = (V - Pm[p.dof] / M[p.dof]) / h;
+          // impermeable: the pore liquid moves with the plate along its axis
+          if (cp && on_axis && !pl.permeable && mLn[p.dof] > 0)
+            AL[p.dof] = (V - PL[p.dof] / mLn[p.dof]) / h;
         }
   }
 
@@ -786,7 +800,13 @@ namespace talus::loads
       }
     for (const auto &p : plate_dofs)
       if (plate_active[p.dof] && s.nodal_mass.local_element(p.dof) > 0)
-        V[p.dof] = p.component == s.prm.rigid_plates[p.condition].axis ? plate_run[p.condition].velocity : 0.0;
+        {
+          const auto &pl      = s.prm.rigid_plates[p.condition];
+          const bool  on_axis = p.component == pl.axis;
+          V[p.dof]            = on_axis ? plate_run[p.condition].velocity : 0.0;
+          if (VL && on_axis && !pl.permeable && s.two_phase->m_liquid_n.local_element(p.dof) > 0)
+            VL[p.dof] = V[p.dof];
+        }
   }
 
   // ---------------------------------------------------------------- rigid plates
@@ -873,43 +893,74 @@ namespace talus::loads
     plate_active.assign(n_owned, 0);
     for (const unsigned int i : s.active_dofs)
       plate_active[i] = 1;
-    // per plate: M_P, F_P, P_P along the axis, then F_d, P_d per component (rough)
-    constexpr unsigned int nk = 3 + 2 * dim;
-    std::vector<double>    sum(plates.size() * nk, 0.0);
-    const double *const    Pm = vt.begin();
+    // per plate (plate_sum_size values): M_P, F_P, P_P along the axis, the
+    // pore liquid's Mbar_L and momentum along the axis (coupled 2-phase), then
+    // F_d, P_d per component (the tangential reaction of a rough plate)
+    const bool    cp  = s.two_phase && s.two_phase->coupled;
+    const double *mLn = cp ? s.two_phase->m_liquid_n.begin() : nullptr;
+    const double *PL  = cp ? s.two_phase->p_liquid.begin() : nullptr;
+    plate_sum.assign(plates.size() * plate_sum_size, 0.0);
+    const double *const Pm = vt.begin();
     for (const auto &p : plate_dofs)
       if (plate_active[p.dof] && M[p.dof] > 0)
         {
-          double *q = &sum[p.condition * nk];
+          double *q = &plate_sum[p.condition * plate_sum_size];
           if (p.component == plates[p.condition].axis)
             {
               q[0] += M[p.dof];
               q[1] += F[p.dof];
               q[2] += Pm[p.dof];
+              if (cp && mLn[p.dof] > 0)
+                {
+                  q[3] += mLn[p.dof];
+                  q[4] += PL[p.dof];
+                }
             }
           else
             {
-              q[3 + p.component] += F[p.dof];
-              q[3 + dim + p.component] += Pm[p.dof];
+              q[5 + p.component] += F[p.dof];
+              q[5 + dim + p.component] += Pm[p.dof];
             }
         }
-    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sum), s.comm, dealii::ArrayView<double>(sum));
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(plate_sum), s.comm,
+                                dealii::ArrayView<double>(plate_sum));
+    if (!cp) // else after the liquid's accelerations (nodal_accelerations)
+      rigid_plate_velocities(s, nullptr);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::rigid_plate_velocities(Solver &s, const double *liquid)
+  {
+    const auto & plates = s.prm.rigid_plates;
     const double beta = current->mass_scaling, alpha = current->damping, av = current->viscous_damping;
     for (unsigned int k = 0; k < plates.size(); ++k)
       {
         const auto &  pl = plates[k];
-        const double *q  = &sum[k * nk];
-        const double  Mp = q[0], Fp = q[1], Pp = q[2];
-        PlateRun &    r  = plate_run[k];
-        double        V  = 0;
+        const double *q  = &plate_sum[k * plate_sum_size];
+        // the plate's inertia and its force: the solid alone (1-phase; a
+        // permeable plate, through which the liquid flows with its own
+        // acceleration a_L, carried by the solid's equation as -beta Mbar_L a_L),
+        // or solid and liquid moving together (impermeable)
+        const double *lq = liquid ? &liquid[k * dim] : nullptr; // sum beta Mbar_L a_L per component
+        double        Mp = q[0], Fp = q[1], Pp = q[2];
+        if (lq && pl.permeable)
+          Fp -= lq[pl.axis];
+        else if (lq)
+          {
+            Mp += q[3];
+            Pp += q[4];
+          }
+        PlateRun &r = plate_run[k];
+        double    V = 0;
         if (pl.control == RigidPlate<dim>::Control::force)
           {
             // M_P dV/dt = F_P + F_plate (+ local and viscous damping of the
             // plate's own unbalanced force and momentum); a plate without
             // material under it (M_P = 0) waits at rest
-            r.force       = pl.force_at(s.time);
-            double R      = Fp + r.force;
-            r.unbalanced  = R;
+            r.force      = pl.force_at(s.time);
+            double R     = Fp + r.force;
+            r.unbalanced = R;
             if (alpha > 0)
               R += local_damping_force(alpha, R, Pp);
             R -= av * Pp;
@@ -920,13 +971,13 @@ namespace talus::loads
             V       = (pl.displacement_at(s.time + h) - r.displacement) / h;
             r.force = beta * (Mp * V - Pp) / h - Fp; // sum (beta m a - f) over the nodes
           }
-        if (pl.rough)
+        if (pl.rough) // the liquid slides along the plate: its a_L enters as in the solid's equation
           {
             double t2 = 0;
             for (unsigned int d = 0; d < dim; ++d)
               if (d != pl.axis)
                 {
-                  const double Rd = beta * (0.0 - q[3 + dim + d]) / h - q[3 + d];
+                  const double Rd = beta * (0.0 - q[5 + dim + d]) / h - q[5 + d] + (lq ? lq[d] : 0.0);
                   t2 += Rd * Rd;
                 }
             r.tangential = std::sqrt(t2);

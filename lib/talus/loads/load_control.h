@@ -30,7 +30,10 @@
 // control V = (u(t+h) - u_P) / h, reaction beta (M_P V - P_P) / h - F_P.
 // nodal_accelerations gives every plate node a = (V - v_i^t) / h along the
 // axis (0 - v_i^t for the tangential components of a rough plate),
-// nodal_velocities sets V. Wall-held components keep their wall.
+// nodal_velocities sets V. Wall-held components keep their wall. Coupled
+// 2-phase: the sums in nodal_forces_two_phase, V in nodal_accelerations after
+// the liquid's a_L (permeable: the solid alone, the liquid flows through with
+// its own a_L; impermeable: both phases move with the plate along its axis).
 //
 // The 2-phase single-point step (explicit_two_phase.cc, seed 000 §4.5.7) calls
 // the same hooks at the same places, and they act on both phases there:
@@ -213,6 +216,14 @@ namespace talus::loads
     /// each plate's velocity V^{t+h}, force/reaction and displacement; F: the
     /// nodal force before damping, M: the nodal mass (solid).
     void rigid_plate_balance(Solver &s, const double *F, const double *M);
+    /// From the sums: each plate's V^{t+h}, force/reaction, displacement and
+    /// work. `liquid` (coupled 2-phase, after the liquid's accelerations): per
+    /// plate and component sum beta Mbar_L a_L over its nodes; a permeable
+    /// plate moves the solid only (the liquid flows through with its own a_L),
+    /// an impermeable one the solid and the liquid together along its axis.
+    void rigid_plate_velocities(Solver &s, const double *liquid);
+    static constexpr unsigned int plate_sum_size = 5 + 2 * dim;
+    std::vector<double>           plate_sum; ///< per plate, summed over the ranks
 
     void assign_tractions(Solver &s);
     void update_factors(const Solver &s);

@@ -116,14 +116,6 @@ namespace talus::explicit_mpm
         p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
         prm.leave_subsection();
       }
-    // rigid plates (loads/rigid_plate.h; LoadControl): not with pore liquid
-    if (p.liquid.any_coupled())
-      loads::refuse_rigid_plates(
-        p.rigid_plates, "talus-explicit",
-        "a material has coupled pore liquid (material k/pore liquid): the single-point 2-phase step keeps the pore "
-        "pressure at the material points, so a permeable plate (p = 0 at its nodes) has no nodal pressure to hold, "
-        "and the impermeable plate (the liquid moving with the plate) is not built in the 2-phase nodal solve yet "
-        "(docs/explicit.md, Rigid plate); allowed: pore liquid/drainage = drained or undrained with a plate");
     const unsigned int n_bodies = p.bodies.size();
     p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
     if (p.loads.staged)
