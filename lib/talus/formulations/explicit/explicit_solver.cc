@@ -102,7 +102,6 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
 
     parse_scene_parameters<dim>(prm, p);
-    loads::refuse_rigid_plates(p.rigid_plates, "talus-explicit", "not built in this family yet");
     parse_liquid_output(prm, p.liquid);
     for (unsigned int k = 0; k < p.materials.size(); ++k)
       {
@@ -290,10 +289,11 @@ namespace talus::explicit_mpm
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
     points.layout.n_history = n_history;
-    if (prm.loads.active())
+    if (prm.loads.active() || !prm.rigid_plates.empty())
       {
         control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
         control->extend_layout(points.layout);
+        control->setup_rigid_plates(*this); // node checks (exit 2) and log lines, before any output
       }
     // 2-phase / traction properties and the free-surface flag: only when used
     if (prm.liquid.any_coupled() || prm.liquid.any_traction())
@@ -1251,6 +1251,8 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < probe_ids.size(); ++k)
       for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
         c.push_back("probe" + std::to_string(k) + "_" + names[PropertyLayout<dim>::stress + q]);
+    for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
+      c.push_back(name);
     return c;
   }
 
@@ -1309,6 +1311,11 @@ namespace talus::explicit_mpm
       }
     r.insert(r.end(), probes.begin(), probes.end());
     r.insert(r.end(), probe_sigma.begin(), probe_sigma.end());
+    if (!prm.rigid_plates.empty())
+      {
+        const auto v = control->rigid_plate_series();
+        r.insert(r.end(), v.begin(), v.end());
+      }
     return r;
   }
 
