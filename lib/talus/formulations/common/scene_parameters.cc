@@ -164,11 +164,11 @@ namespace talus
 
   SceneCounts
   declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
-                            const std::string &time_step_doc)
+                            const std::string &time_step_doc, const std::vector<std::string> &png_fields_not_written)
   {
     const SceneCounts counts = peek_scene_counts(prm_file);
     declare_scene_parameters(prm, counts);
-    declare_run_parameters(prm);
+    declare_run_parameters(prm, counts.dim, png_fields_not_written);
     prm.enter_subsection("time");
     prm.declare_entry("time step", "0", Double(0), time_step_doc);
     prm.leave_subsection();
@@ -176,7 +176,8 @@ namespace talus
   }
 
   void
-  declare_run_parameters(dealii::ParameterHandler &prm)
+  declare_run_parameters(dealii::ParameterHandler &prm, const unsigned int dim,
+                         const std::vector<std::string> &png_fields_not_written)
   {
     prm.enter_subsection("time");
     {
@@ -213,7 +214,7 @@ namespace talus
                         "series.csv (energies, momentum, probes over time), the probe displacements, velocities "
                         "and stresses over time, the final material point fields and the final fields mapped to "
                         "the grid nodes (lumped projection). Layout in docs/fem.md.");
-      io::declare_png_snapshot_parameters(prm);
+      io::declare_png_snapshot_parameters(prm, dim, png_fields_not_written);
     }
     prm.leave_subsection();
 

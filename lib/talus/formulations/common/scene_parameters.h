@@ -99,13 +99,19 @@ namespace talus
   /// points per direction, clipping, initial velocity).
   void declare_scene_parameters(dealii::ParameterHandler &prm, const SceneCounts &counts);
   /// Declare time (end time, maximum steps), stability (lost particles), output
-  /// (with io/png_snapshots' entries), checkpoint and load balancing.
-  void declare_run_parameters(dealii::ParameterHandler &prm);
+  /// (with io/png_snapshots' entries: 'png field' offers the fields of a run of
+  /// dimension `dim` but those the family never writes), checkpoint and load
+  /// balancing.
+  void declare_run_parameters(dealii::ParameterHandler &prm, unsigned int dim = 3,
+                              const std::vector<std::string> &png_fields_not_written = {});
   /// The head of every family's declaration: the counts peeked from `prm_file`,
   /// the scene and run entries, and 'time/time step' (default 0) with the
-  /// family's own meaning in `time_step_doc`. Returns the counts.
+  /// family's own meaning in `time_step_doc`; `png_fields_not_written`: the
+  /// talus-plot fields the family's VTU files never hold (e.g. {"pore pressure"}),
+  /// refused in 'output/png field'. Returns the counts.
   SceneCounts declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
-                                        const std::string &time_step_doc);
+                                        const std::string &time_step_doc,
+                                        const std::vector<std::string> &png_fields_not_written = {});
 
   template <int dim>
   void parse_scene_parameters(dealii::ParameterHandler &prm, SceneParameters<dim> &p);

@@ -1367,7 +1367,7 @@ namespace talus::explicit_mpm
   int
   run(dealii::ParameterHandler &prm, const std::string &)
   {
-    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>, /*png_snapshots=*/true);
+    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
   TALUS_INSTANTIATE_FORMULATION(class);

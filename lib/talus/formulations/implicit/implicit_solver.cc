@@ -77,7 +77,8 @@ namespace talus::implicit_mpm
       declare_common_parameters(prm, prm_file,
                                 "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
                                 "> 0, required. Not limited by the explicit critical step; a step whose Newton "
-                                "iteration fails is halved and retried (at most 6 times in a row).");
+                                "iteration fails is halved and retried (at most 6 times in a row).",
+                                /*png fields not written:*/ {"pore pressure", "free surface"});
     loads::declare_traction_parameters(prm, prm_file, counts.dim, true);
     prm.enter_subsection("boundary conditions");
     {

@@ -64,7 +64,7 @@ namespace talus::semi_implicit
       declare_common_parameters(prm, prm_file,
                                 "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
                                 "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
-                                "conductivity (seed 002 §5.3).");
+                                "conductivity (seed 002 §5.3).", /*png fields not written:*/ {"free surface"});
     prm.enter_subsection("time");
     {
       prm.declare_entry("courant number", "0.5", Double(0, 1),
