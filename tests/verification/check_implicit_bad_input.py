@@ -9,6 +9,8 @@ the right exit code, no NaN written.
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
+  * rigid plates: a force and a displacement, a boundary id the grid lacks, a
+    region holding no grid node, the axis held by a wall at every node;
   * the rigid footing: its span reversed, with two values in 2D, not a number; normal z in 2D;
     penalty 0; with contact walls on the nodes;
   * contact walls on the points: a misspelt 'contact method', 'points' without
@@ -40,6 +42,14 @@ for entry, value in (("rigid footing/enabled", "true"), ("rigid footing/level", 
                      ("rigid footing/lower corner", "0"), ("rigid footing/upper corner", "0.5"),
                      ("rigid footing/velocity", "-0.001")):
     footing_base = tv.prm_set(footing_base, entry, value)
+
+
+def plate(entries):
+    """base with one rigid plate whose entries are `entries` ("entry=value")"""
+    t = tv.prm_set(base, "boundary conditions/number of rigid plates", "1")
+    return tv.prm_set_args(t, ["boundary conditions/rigid plate 0/" + e for e in entries])
+
+
 cases = {
     "no finite-strain form": (tv.prm_set(base, "material 0/model", "linear elastic"),
                               ["material 0/model", "linear elastic", "finite-strain", "neo hookean"]),
@@ -144,6 +154,18 @@ cases = {
                                   ["rigid footing/upper corner", "half"]),
     "footing with contact walls on the nodes": (tv.prm_set(footing_base, "boundary conditions/contact", "3"),
                                                 ["rigid footing/enabled", "contact method = points"]),
+    # rigid plates (issue 37): both controls, a boundary id the grid lacks, a region
+    # between grid nodes, a plate whose axis a wall holds at every node
+    "plate with a force and a displacement": (plate(["total force=-1", "displacement=-0.01"]),
+                                              ["boundary conditions/rigid plate 0", "not both"]),
+    "plate on a missing boundary": (plate(["boundary id=7", "total force=-1"]),
+                                    ["boundary conditions/rigid plate 0/boundary id", "does not exist"]),
+    "plate holding no node": (plate(["apply to=region", "region lower corner=1.1, 1", "region upper corner=1.2, 1",
+                                     "total force=-1"]),
+                              ["boundary conditions/rigid plate 0", "holds no grid node"]),
+    "plate held by a wall everywhere": (plate(["boundary id=0", "direction=x", "total force=-1"]),
+                                        ["boundary conditions/rigid plate 0", "held by a fixed/roller wall",
+                                         "every one of its nodes"]),
     "velocity on a missing boundary": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
                                                   "loads/velocity 0/boundary id", "7"),
                                        ["loads/velocity 0/boundary id", "does not exist"]),

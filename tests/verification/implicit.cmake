@@ -462,3 +462,23 @@ add_test(NAME verification.implicit_strip_footing_points_large
                  --points --settlement=0.19 --window=0.02,0.06 --tol=0.03 --max-its=25)
 set_tests_properties(verification.implicit_strip_footing_points_large PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1200)
+
+# rigid plates (issue 37; docs/implicit.md "Rigid plate"): the shared layer scene's settlement
+# within 1 % (Q1, quadratic B-splines, mixed u-p); a displacement-driven plate's reaction within
+# 1 %; a footing-like region plate whose nodes move as one (recovered from the points), frictionless
+# vs rough sideways, its force balance at convergence; 1 vs 2 ranks to 1e-10; checkpoint/restart
+foreach(_case layer displacement footing ranks)
+  add_test(NAME verification.implicit_rigid_plate_${_case}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rigid_plate.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                   ${_w}/implicit_rigid_plate_${_case} ${_case})
+  set_tests_properties(verification.implicit_rigid_plate_${_case} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 600)
+endforeach()
+set_tests_properties(verification.implicit_rigid_plate_ranks PROPERTIES PROCESSORS 2)
+add_test(NAME verification.implicit_rigid_plate_restart
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rigid_plate_footing.prm ${_w}/implicit_rigid_plate_restart
+                 "grid/cells=16, 16" "time/time step=0.02" "boundary conditions/rigid plate 0/surface=rough"
+                 "implicit/ramp loads=false")
+set_tests_properties(verification.implicit_rigid_plate_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)

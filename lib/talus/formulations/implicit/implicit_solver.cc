@@ -15,6 +15,9 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
 
+#include <Epetra_CrsMatrix.h>
+#include <Epetra_Map.h>
+
 #include <cmath>
 #include <limits>
 #include <iomanip>
@@ -246,7 +249,6 @@ namespace talus::implicit_mpm
     Parameters<dim> p;
     parse_run_parameters<dim>(prm, p);
     parse_scene_parameters<dim>(prm, p);
-    loads::refuse_rigid_plates(p.rigid_plates, "talus-implicit", "not built in this family yet");
     prm.enter_subsection("time");
     p.time_step = prm.get_double("time step");
     prm.leave_subsection();
@@ -652,6 +654,15 @@ namespace talus::implicit_mpm
       }
     points.initialize();
 
+    const unsigned int n_plates = prm.rigid_plates.size();
+    plate_displacement.assign(n_plates, 0.0);
+    plate_step.assign(n_plates, 0.0);
+    plate_c.assign(n_plates, 0.0);
+    plate_target.assign(n_plates, 0.0);
+    plate_sum.assign(n_plates, 0.0);
+    plate_reaction.assign(n_plates, dealii::Tensor<1, dim>());
+    plate_owned.assign(n_plates, {});
+    idle_plates.assign(n_plates, 0);
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
@@ -674,6 +685,7 @@ namespace talus::implicit_mpm
             "the checkpoint is in stage " + std::to_string(current_stage) + " but the .prm has " +
               std::to_string(prm.stages.size()) + " stage(s)");
     enter_stage(current_stage);
+    check_plates();
     points.collect_active_cells();
     if (!prm.tractions.empty())
       point_forces.assign(prm.tractions, points, grid, prm.bodies, comm);
@@ -805,7 +817,7 @@ namespace talus::implicit_mpm
   Solver<dim>::enter_stage(const unsigned int k)
   {
     stage_nodes(k);
-    idle_conditions.assign(prm.stages[k].velocities.size(), 0);
+    idle_conditions.assign(prm.stages[k].velocities.size() + prm.rigid_plates.size(), 0);
     region_shift.assign(prm.stages[k].velocities.size(), dealii::Tensor<1, dim>());
   }
 
@@ -823,6 +835,95 @@ namespace talus::implicit_mpm
     // the grid nodes of the stage's 'velocity k' (owned and ghost: constraints
     // of a distributed assembly must be known where a rank assembles)
     prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
+    // the plates' nodes (their walls are those of the stage)
+    plate_nodes = loads::rigid_plate_node_dofs(grid, prm.rigid_plates, false);
+    append_plate_dofs();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::append_plate_dofs()
+  {
+    // a component a fixed/roller wall holds stays the wall's (wall_constraints
+    // would let a prescribed line win); the axis component of a force plate is
+    // no prescribed DoF but the plate's unknown
+    const unsigned int n_vel = n_velocities();
+    for (const auto &p : plate_nodes)
+      {
+        const auto &plate = prm.rigid_plates[p.condition];
+        if (boundary_flags[p.dof] || (force_plate(p.condition) && p.component == plate.axis))
+          continue;
+        prescribed_dofs.push_back({p.dof, p.node, n_vel + p.condition, p.component});
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::check_plates()
+  {
+    // per plate: owned nodes, and those whose axis component no wall holds
+    const unsigned int  n = prm.rigid_plates.size();
+    std::vector<double> count(2 * n, 0.0);
+    const unsigned int  n_owned = grid.partitioner->locally_owned_size();
+    for (const auto &p : plate_nodes)
+      if (p.node < n_owned && p.component == prm.rigid_plates[p.condition].axis)
+        {
+          count[2 * p.condition] += 1;
+          if (!boundary_flags[p.dof])
+            count[2 * p.condition + 1] += 1;
+        }
+    dealii::Utilities::MPI::sum(count, comm, count);
+    const char *ax[] = {"x", "y", "z"};
+    for (unsigned int k = 0; k < n; ++k)
+      {
+        const auto &plate = prm.rigid_plates[k];
+        require(count[2 * k] > 0, plate.where,
+                plate.target == loads::RigidPlate<dim>::Target::boundary
+                  ? "holds no grid node (no face of the grid has boundary id " + std::to_string(plate.boundary) + ")"
+                  : std::string("holds no grid node: no node of the grid lies inside its region (widen the region "
+                                "to reach a row of grid nodes)"));
+        require(count[2 * k + 1] > 0, plate.where,
+                std::string("its axis component (") + ax[plate.axis] +
+                  ") is held by a fixed/roller wall at every one of its nodes: the plate cannot move; allowed: a "
+                  "direction no wall holds at its nodes, or remove the wall");
+        std::ostringstream os;
+        os << "  rigid plate " << k << " (" << plate.where << "): " << count[2 * k] << " grid nodes ("
+           << count[2 * k + 1] << " free along " << ax[plate.axis] << "), "
+           << (plate.rough ? "rough" : "frictionless") << ", "
+           << (force_plate(k) ? "force control: total force " + std::to_string(plate.force)
+                              : "displacement control: displacement " + std::to_string(plate.displacement))
+           << " x f(t) along " << ax[plate.axis] << " (its own time function, absolute time)";
+        log() << os.str() << std::endl;
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::find_plate_dofs()
+  {
+    // the axis DoFs of each force plate that the step leaves free (not held by
+    // a wall, a prescribed line, contact, the inactive pins or the negligible
+    // mass rule); a DoF of two plates belongs to the first
+    const auto &owned = space.locally_owned_dofs();
+    std::vector<dealii::types::global_dof_index> mine;
+    for (auto &v : plate_owned)
+      v.clear();
+    for (const auto &p : plate_nodes)
+      {
+        const auto &plate = prm.rigid_plates[p.condition];
+        if (!force_plate(p.condition) || p.component != plate.axis)
+          continue;
+        const auto i = space.node_dof(p.node, p.component);
+        if (!owned.is_element(i) || constraints.is_constrained(i) ||
+            std::find(mine.begin(), mine.end(), i) != mine.end())
+          continue;
+        plate_owned[p.condition].push_back(i);
+        mine.push_back(i);
+      }
+    plate_all.clear();
+    for (const auto &v : dealii::Utilities::MPI::all_gather(comm, mine))
+      plate_all.insert(plate_all.end(), v.begin(), v.end());
+    std::sort(plate_all.begin(), plate_all.end());
   }
 
   template <int dim>
@@ -843,6 +944,7 @@ namespace talus::implicit_mpm
               velocities[k].upper += region_shift[k];
             }
         prescribed_dofs = loads::prescribed_node_dofs(grid, velocities, false);
+        append_plate_dofs();
       }
     // the cell terms (PPP cell means, F-bar's cell mean) couple all the nodes a cell's points touch
     const auto reach = prm.mixed_up || prm.fbar ? ActiveSet<dim>::Reach::cell : ActiveSet<dim>::Reach::point;
@@ -858,6 +960,8 @@ namespace talus::implicit_mpm
     if (point_contact) // x_n of the points, read by the contact terms of the step
       point_contact->start_step(points);
     constraints = step_constraints();
+    if (any_force_plate())
+      find_plate_dofs();
   }
 
   template <int dim>
@@ -910,7 +1014,7 @@ namespace talus::implicit_mpm
   template <int dim>
   dealii::AffineConstraints<double>
   Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact,
-                                const bool with_prescribed) const
+                                const bool with_prescribed, const bool hold_plates) const
   {
     // the contact nodes now in contact: their normal DoF, with no slip all
     std::vector<dealii::types::global_dof_index> held;
@@ -925,6 +1029,10 @@ namespace talus::implicit_mpm
               held.push_back(space.node_dof(c.node, d));
         }
     held.insert(held.end(), negligible_dofs.begin(), negligible_dofs.end());
+    if (hold_plates) // the force plates' axis DoFs at zero increment (the predictor)
+      for (const auto &p : plate_nodes)
+        if (force_plate(p.condition) && p.component == prm.rigid_plates[p.condition].axis)
+          held.push_back(space.node_dof(p.node, p.component));
     return active.constraints_with(
       loads::wall_constraints(grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values,
                               &held));
@@ -1048,7 +1156,15 @@ namespace talus::implicit_mpm
   double
   Solver<dim>::prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const
   {
-    return condition_increment(p.condition, h)[p.component];
+    const unsigned int n_vel = n_velocities();
+    if (p.condition < n_vel)
+      return condition_increment(p.condition, h)[p.component];
+    // a plate: its displacement history along its axis (absolute time; the
+    // static ramp does not scale it), zero tangential increments (rough)
+    const auto &plate = prm.rigid_plates[p.condition - n_vel];
+    if (plate.control != loads::RigidPlate<dim>::Control::displacement || p.component != plate.axis)
+      return 0.0;
+    return plate.displacement_at(time + h) - plate.displacement_at(time);
   }
 
   template <int dim>
@@ -1074,7 +1190,9 @@ namespace talus::implicit_mpm
     std::swap(constraints, free_prescribed);
     const auto &owned = space.locally_owned_dofs();
     const auto &pins  = active.constraints();
-    std::vector<double>                          f(dim, 0.0);
+    // the velocity conditions' sum per component, then each plate's per component
+    const unsigned int                           n_vel = n_velocities();
+    std::vector<double>                          f(dim * (1 + prm.rigid_plates.size()), 0.0);
     std::vector<dealii::types::global_dof_index> seen; // a node of two conditions counts once
     for (const auto &p : prescribed_dofs)
       {
@@ -1083,11 +1201,15 @@ namespace talus::implicit_mpm
             std::find(seen.begin(), seen.end(), i) != seen.end())
           continue;
         seen.push_back(i);
-        f[p.component] += residual(i);
+        const unsigned int slot = p.condition < n_vel ? 0 : 1 + p.condition - n_vel;
+        f[slot * dim + p.component] += residual(i);
       }
     dealii::Utilities::MPI::sum(f, comm, f);
     for (unsigned int d = 0; d < dim; ++d)
       last.prescribed_force[d] = f[d];
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      for (unsigned int d = 0; d < dim; ++d)
+        plate_reaction[k][d] = f[(1 + k) * dim + d];
     residual = kept;
   }
 
@@ -1095,8 +1217,15 @@ namespace talus::implicit_mpm
   LinearSolveInfo
   Solver<dim>::solve_for_delta()
   {
+    return solve_for_delta(residual);
+  }
+
+  template <int dim>
+  LinearSolveInfo
+  Solver<dim>::solve_for_delta(const Vector &r)
+  {
     const auto start = Clock::now();
-    Vector     rhs(residual);
+    Vector     rhs(r);
     rhs *= -1.0;
     delta = 0;
     LinearSolveInfo info;
@@ -1138,8 +1267,10 @@ namespace talus::implicit_mpm
     std::vector<double> minus_increment(prescribed_dofs.size());
     for (std::size_t k = 0; k < prescribed_dofs.size(); ++k)
       minus_increment[k] = -prescribed_increment(prescribed_dofs[k], h);
-    auto lifted = step_constraints(&minus_increment);
+    // a force plate's DoFs are held here (Newton moves them as one from this iterate on)
+    auto lifted = step_constraints(&minus_increment, true, true, true);
     std::swap(constraints, lifted);
+    plates_held = true;
     try
       {
         // the out-of-balance force the prescribed increment creates: the scale
@@ -1151,9 +1282,14 @@ namespace talus::implicit_mpm
     catch (...)
       {
         std::swap(constraints, lifted);
+        plates_held = false;
         throw;
       }
     std::swap(constraints, lifted);
+    plates_held = false;
+    for (const auto &dofs : plate_owned)
+      for (const auto i : dofs)
+        delta[i] = 0.0;
 
     // Du: the solve's free values, the prescribed increments at the prescribed
     // DoFs of active nodes, 0 at the other constrained DoFs
@@ -1161,7 +1297,7 @@ namespace talus::implicit_mpm
     const auto &        pins  = active.constraints(); // inactive nodes: no mass, pinned to 0
     const auto &        owned = space.locally_owned_dofs();
     const auto &        velocities = prm.stages[current_stage].velocities;
-    std::vector<double> n_active(velocities.size(), 0.0);
+    std::vector<double> n_active(velocities.size() + prm.rigid_plates.size(), 0.0);
     for (const auto &p : prescribed_dofs)
       {
         const auto i = space.node_dof(p.node, p.component);
@@ -1178,10 +1314,12 @@ namespace talus::implicit_mpm
     // (once per condition) instead of letting a displacement control go slack
     dealii::Utilities::MPI::sum(n_active, comm, n_active);
     for (unsigned int k = 0; k < n_active.size(); ++k)
-      if (n_active[k] == 0 && !idle_conditions[k])
+      if (n_active[k] == 0 && !idle_conditions[k] && (k < velocities.size() || !force_plate(k - velocities.size())))
         {
           idle_conditions[k] = 1;
-          log() << "  WARNING: " << velocities[k].where << " reaches no grid node next to material at t = "
+          log() << "  WARNING: "
+                << (k < velocities.size() ? velocities[k].where : prm.rigid_plates[k - velocities.size()].where)
+                << " reaches no grid node next to material at t = "
                 << time << " s (the prescribed nodes are fixed in space and the material has left their cells): "
                 << "the condition has no effect from here on" << std::endl;
         }
@@ -1328,7 +1466,187 @@ namespace talus::implicit_mpm
       }
     seconds_assembly += seconds_since(start);
     ++n_assemblies;
-    return residual.l2_norm();
+    if (!any_force_plate() || plates_held)
+      return residual.l2_norm();
+    // force plates: their DoFs' equations are the plates' balances, one per
+    // plate: sum_{i in P_k} r_i = F_k (the force the plate exerts on the
+    // material). The sums are kept and the rows zeroed (the solve's right-hand
+    // side there is 0); the norm Newton tests is that of the free rows and the
+    // plates' out-of-balance forces.
+    const unsigned int  n = prm.rigid_plates.size();
+    std::vector<double> sums(n, 0.0);
+    for (unsigned int k = 0; k < n; ++k)
+      for (const auto i : plate_owned[k])
+        {
+          sums[k] += residual(i);
+          residual(i) = 0.0;
+        }
+    dealii::Utilities::MPI::sum(sums, comm, sums);
+    double norm2 = residual.norm_sqr();
+    for (unsigned int k = 0; k < n; ++k)
+      if (force_plate(k))
+        {
+          plate_sum[k] = sums[k];
+          norm2 += (sums[k] - plate_target[k]) * (sums[k] - plate_target[k]);
+        }
+    return std::sqrt(norm2);
+  }
+
+  namespace
+  {
+    /// Zero the rows and columns of the global DoFs `dofs` (sorted, the same
+    /// list on every rank) of a filled Trilinos matrix, keeping each row's
+    /// diagonal: the matrix of the system with those DoFs prescribed
+    /// (symmetric if A is). In place on Epetra's values (the pattern is kept).
+    void
+    zero_rows_and_columns(dealii::TrilinosWrappers::SparseMatrix &            A,
+                          const std::vector<dealii::types::global_dof_index> &dofs)
+    {
+      auto &            E    = const_cast<Epetra_CrsMatrix &>(A.trilinos_matrix());
+      const Epetra_Map &rows = E.RowMap(), &cols = E.ColMap();
+      std::vector<unsigned char> col_hit(E.NumMyCols(), 0);
+      for (const auto g : dofs)
+        {
+          const int l = cols.LID(static_cast<int>(g));
+          if (l >= 0)
+            col_hit[l] = 1;
+        }
+      for (int r = 0; r < E.NumMyRows(); ++r)
+        {
+          int     n = 0;
+          double *values = nullptr;
+          int *   indices = nullptr;
+          E.ExtractMyRowView(r, n, values, indices);
+          const int  gid  = rows.GID(r);
+          const bool hit  = std::binary_search(dofs.begin(), dofs.end(), dealii::types::global_dof_index(gid));
+          for (int j = 0; j < n; ++j)
+            if ((hit && cols.GID(indices[j]) != gid) || (!hit && col_hit[indices[j]]))
+              values[j] = 0.0;
+        }
+      // values changed behind Epetra's back: drop its cached norms
+      E.SumIntoMyValues(0, 0, nullptr, nullptr);
+    }
+
+    /// Solve the small dense system M c = b (n x n, row-major) by Gaussian
+    /// elimination with partial pivoting; the same arithmetic on every rank.
+    std::vector<double>
+    solve_dense(std::vector<double> M, std::vector<double> b)
+    {
+      const unsigned int n = b.size();
+      for (unsigned int k = 0; k < n; ++k)
+        {
+          unsigned int p = k;
+          for (unsigned int i = k + 1; i < n; ++i)
+            if (std::abs(M[i * n + k]) > std::abs(M[p * n + k]))
+              p = i;
+          for (unsigned int j = 0; j < n; ++j)
+            std::swap(M[k * n + j], M[p * n + j]);
+          std::swap(b[k], b[p]);
+          for (unsigned int i = k + 1; i < n; ++i)
+            {
+              const double f = M[i * n + k] / M[k * n + k];
+              for (unsigned int j = k; j < n; ++j)
+                M[i * n + j] -= f * M[k * n + j];
+              b[i] -= f * b[k];
+            }
+        }
+      std::vector<double> c(n, 0.0);
+      for (unsigned int k = n; k-- > 0;)
+        {
+          double s = b[k];
+          for (unsigned int j = k + 1; j < n; ++j)
+            s -= M[k * n + j] * c[j];
+          c[k] = s / M[k * n + k];
+        }
+      return c;
+    }
+  } // namespace
+
+  template <int dim>
+  LinearSolveInfo
+  Solver<dim>::solve_with_plates()
+  {
+    // The plates' DoFs condensed by superposition (docs/implicit.md, "Rigid
+    // plate"): exact, the same solution as a master-slave line u_i = u_m per
+    // plate node, without couplings of the master in the sparsity or the
+    // master as a ghost on every rank.
+    const auto         start = Clock::now();
+    const unsigned int n_all = prm.rigid_plates.size();
+    std::vector<unsigned int> ks; // the force plates
+    for (unsigned int k = 0; k < n_all; ++k)
+      if (force_plate(k))
+        ks.push_back(k);
+    const unsigned int  n = ks.size();
+    std::vector<Vector> e(n), v(n), w(n), z(n);
+    std::vector<double> size(n, 0.0);
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        for (Vector *x : {&e[a], &v[a], &w[a], &z[a]})
+          space.reinit_vector(*x);
+        for (const auto i : plate_owned[ks[a]])
+          e[a][i] = 1.0;
+        size[a] = plate_owned[ks[a]].size();
+        tangent.vmult(v[a], e[a]);  // K e: the plate's column sum (K_FP 1 in the free rows)
+        tangent.Tvmult(w[a], e[a]); // K^T e: its row sum, sum_{i in P} K_ij
+      }
+    dealii::Utilities::MPI::sum(size, comm, size);
+    zero_rows_and_columns(tangent, plate_all);
+    const auto zero_plate_entries = [&](Vector &x) {
+      for (const auto &dofs : plate_owned)
+        for (const auto i : dofs)
+          x[i] = 0.0;
+    };
+    seconds_plates += seconds_since(start);
+    LinearSolveInfo info = solve_for_delta(); // z_0: the plates held
+    const auto      start2 = Clock::now();
+    Vector          z0(delta);
+    zero_plate_entries(z0);
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        Vector rhs(v[a]);
+        zero_plate_entries(rhs);
+        const auto more = solve_for_delta(rhs); // z_a: the response to a unit plate displacement
+        info.iterations += more.iterations;
+        info.relative_residual = std::max(info.relative_residual, more.relative_residual);
+        z[a] = delta;
+        zero_plate_entries(z[a]);
+      }
+    // the linearised balance of plate a: sum_{i in P_a} (r + K delta)_i = F_a,
+    // delta = z_0 + sum_b c_b (z_b + e_b): sum_b (w_a . z_b + e_a . v_b) c_b = F_a - R_a - w_a . z_0
+    std::vector<double> M(n * n), b(n);
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        const auto k = ks[a];
+        if (size[a] == 0)
+          {
+            // the plate acts on no free node next to material: its force has
+            // nothing to act on (said once), its increment is 0
+            for (unsigned int c = 0; c < n; ++c)
+              M[a * n + c] = c == a ? 1.0 : 0.0;
+            b[a] = 0;
+            if (!idle_plates[k])
+              {
+                idle_plates[k] = 1;
+                log() << "  WARNING: " << prm.rigid_plates[k].where << " reaches no free grid node next to material at t = "
+                      << time << " s: its force acts on nothing from here on" << std::endl;
+              }
+            continue;
+          }
+        for (unsigned int c = 0; c < n; ++c)
+          M[a * n + c] = (w[a] * z[c]) + (e[a] * v[c]);
+        b[a] = plate_target[k] - plate_sum[k] - (w[a] * z0);
+      }
+    const std::vector<double> c = solve_dense(M, b);
+    delta = z0;
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        delta.add(c[a], z[a]);
+        plate_c[ks[a]] = c[a];
+        for (const auto i : plate_owned[ks[a]])
+          delta[i] = c[a]; // exactly c: the plate's nodes move as one
+      }
+    seconds_plates += seconds_since(start2);
+    return info;
   }
 
   template <int dim>
@@ -1467,6 +1785,14 @@ namespace talus::implicit_mpm
         });
         f_ext = residual.l2_norm();
       }
+    // the plates' forces at t + h (their own time functions) join the scale
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        plate_target[k] = force_plate(k) ? prm.rigid_plates[k].force_at(time + h) : 0.0;
+        plate_step[k]   = 0.0;
+        plate_c[k]      = 0.0;
+        f_ext           = std::sqrt(f_ext * f_ext + plate_target[k] * plate_target[k]);
+      }
 
     du = 0;
     du.update_ghost_values();
@@ -1494,7 +1820,7 @@ namespace talus::implicit_mpm
     NewtonProblem problem;
     problem.assemble = [&](const bool with_tangent) { return assemble(with_tangent, g); };
     problem.solve    = [&]() {
-      const LinearSolveInfo info = solve_for_delta();
+      const LinearSolveInfo info = any_force_plate() ? solve_with_plates() : solve_for_delta();
       linear_iterations += info.iterations;
       worst_linear_residual = std::max(worst_linear_residual, info.relative_residual);
       constraints.set_zero(delta);
@@ -1504,6 +1830,8 @@ namespace talus::implicit_mpm
     problem.apply = [&](const double alpha) {
       du.add(alpha, delta);
       du.update_ghost_values();
+      for (unsigned int k = 0; k < plate_step.size(); ++k)
+        plate_step[k] += alpha * plate_c[k];
     };
     problem.step_increment_norm = [&]() { return du.l2_norm(); };
     problem.residual_reference  = [&]() { return std::max(f_ext, lifted_residual); };
@@ -1545,6 +1873,8 @@ namespace talus::implicit_mpm
             break;
           }
         constraints = step_constraints();
+        if (any_force_plate())
+          find_plate_dofs();
         constraints.set_zero(du);
         du.update_ghost_values();
       }
@@ -1606,7 +1936,7 @@ namespace talus::implicit_mpm
         return StepOutcome::cut_back;
       }
 
-    if (any_velocity_condition()) // collective: the same on every rank
+    if (any_velocity_condition() || any_plate_reaction()) // collective: the same on every rank
       {
         try
           {
@@ -1621,6 +1951,12 @@ namespace talus::implicit_mpm
       }
     for (unsigned int k = 0; k < region_shift.size(); ++k)
       region_shift[k] += condition_increment(k, h);
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        const auto &plate = prm.rigid_plates[k];
+        plate_displacement[k] +=
+          force_plate(k) ? plate_step[k] : plate.displacement_at(time + h) - plate.displacement_at(time);
+      }
 
     if (point_contact)
       {
@@ -1663,6 +1999,9 @@ namespace talus::implicit_mpm
             << last.point_contact.max_penetration_ratio;
     if (prm.footing.enabled)
       log() << "; footing force " << last.point_contact.footing_force;
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      log() << "; plate " << k << " displacement " << std::setprecision(8) << plate_displacement[k] << ", force "
+            << (force_plate(k) ? plate_sum[k] : plate_reaction[k][prm.rigid_plates[k].axis]) << std::setprecision(6);
     if (any_contact)
       log() << "; contact: " << passes << " pass(es), " << released << " released, " << added << " in contact again, "
             << last.contact_nodes << " nodes in contact" << pass_log.str();
@@ -1868,6 +2207,8 @@ namespace talus::implicit_mpm
     if (any_velocity_condition())
       for (unsigned int d = 0; d < dim; ++d)
         c.push_back(std::string("prescribed_force_") + ax[d]);
+    for (const auto &n : loads::rigid_plate_series_columns(prm.rigid_plates))
+      c.push_back(n);
     balance.add_series_column(c);
     return c;
   }
@@ -1909,6 +2250,23 @@ namespace talus::implicit_mpm
     if (any_velocity_condition())
       for (unsigned int d = 0; d < dim; ++d)
         v.push_back(after_step ? last.prescribed_force[d] : 0.0);
+    // the plates (rigid_plate_series_columns): displacement, the force on the
+    // material along the axis (force control: F(t); displacement control: the
+    // reaction), the tangential reaction's magnitude (rough)
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        const auto &plate = prm.rigid_plates[k];
+        v.push_back(plate_displacement[k]);
+        v.push_back((force_plate(k) ? plate.force_at(time) : after_step ? plate_reaction[k][plate.axis] : 0.0) + 0.0); // no -0
+        if (plate.rough)
+          {
+            double t2 = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              if (d != plate.axis)
+                t2 += plate_reaction[k][d] * plate_reaction[k][d];
+            v.push_back(after_step ? std::sqrt(t2) : 0.0);
+          }
+      }
     balance.add_series_value(v);
     return v;
   }
@@ -1939,6 +2297,16 @@ namespace talus::implicit_mpm
                                    f.set_attribute("newton iterations", std::int64_t(total_iterations));
                                    f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
                                    f.set_attribute("cut-backs", std::int64_t(cut_backs));
+                                   for (unsigned int k = 0; k < plate_displacement.size(); ++k)
+                                     {
+                                       // the plate's state, and its last reaction for the series
+                                       f.set_attribute("plate " + std::to_string(k) + " displacement",
+                                                       plate_displacement[k]);
+                                       for (unsigned int d = 0; d < dim; ++d)
+                                         f.set_attribute("plate " + std::to_string(k) + " reaction " +
+                                                           std::to_string(d),
+                                                         plate_reaction[k][d]);
+                                     }
                                    write_points(f, points);
                                    write_pvd_times(f, "output/pvd", pvd_records);
                                    balance.write(f); // the partition of the last rebalance
@@ -1964,6 +2332,12 @@ namespace talus::implicit_mpm
     total_iterations        = fp->get_int("newton iterations");
     total_linear_iterations = fp->get_int("linear iterations");
     cut_backs               = fp->get_int("cut-backs");
+    for (unsigned int k = 0; k < plate_displacement.size(); ++k)
+      {
+        plate_displacement[k] = fp->get_double("plate " + std::to_string(k) + " displacement");
+        for (unsigned int d = 0; d < dim; ++d)
+          plate_reaction[k][d] = fp->get_double("plate " + std::to_string(k) + " reaction " + std::to_string(d));
+      }
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, points, grid, "checkpoint " + fp->path());
     pvd_records = read_pvd_records(*fp, "output/pvd", "particles");
@@ -1996,6 +2370,11 @@ namespace talus::implicit_mpm
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;
+    if (any_force_plate())
+      log() << "  rigid plates: " << seconds_plates
+            << " s of the products K e, K^T e, the row and column zeroing and the second solves (within the "
+               "linear solve time above)"
+            << std::endl;
   }
 
   int
