@@ -5,7 +5,8 @@ Cases (the last argument):
                 (layer.inc: 1 m x 1 m elastic layer, E = 1 MPa, nu = 0.3, fixed base, roller
                 sides, a frictionless plate on the top face loaded by -1 kN/m): the plate's
                 settlement q H / E_oed = 7.4286e-4 m within 1 %, on the default Q1 basis, on
-                quadratic B-splines and with mixed u-p; the reported force is the given one;
+                quadratic B-splines, with mixed u-p, with CG + AMG and in 3D (the layer as a
+                1 m cube under a plate on z+); the reported force is the given one;
   displacement  the same layer with the plate driven by a displacement d = -1 mm instead: its
                 reaction F = E_oed d / H x W = -1346.15 N within 1 %, frictionless and rough;
   footing       parameter_files/implicit/rigid_plate_footing.prm (a region plate on the top's
@@ -98,13 +99,18 @@ def by_origin(t):
 
 if case == "layer":
     s_exact = 1e3 * 1.0 / E_oed
-    for label, settings in (("Q1", []), ("quadratic B-splines", ["implicit/shape function=quadratic bspline"]),
-                            ("mixed u-p", ["implicit/formulation=mixed up",
-                                           "material 0/neo hookean/volumetric energy=split"])):
+    box3d = ["dimension=3", "grid/lower corner=0, 0, 0", "grid/upper corner=1, 1, 1", "grid/cells=4, 4, 4",
+             "boundary conditions/fixed=4", "boundary conditions/roller=0, 1, 2, 3",
+             "boundary conditions/rigid plate 0/boundary id=5", "boundary conditions/rigid plate 0/direction=z",
+             "gravity/acceleration=0, 0, 0", "body 0/lower corner=0, 0, 0", "body 0/upper corner=1, 1, 1"]
+    for label, nodes, settings in (
+            ("Q1", 9, []), ("quadratic B-splines", 9, ["implicit/shape function=quadratic bspline"]),
+            ("mixed u-p", 9, ["implicit/formulation=mixed up", "material 0/neo hookean/volumetric energy=split"]),
+            ("CG + AMG", 9, ["linear solver/method=cg amg"]), ("3D (4 x 4 x 4 cells, plate on z+)", 25, box3d)):
         name = label.split()[0].replace("-", "")
         out, ser, _ = run(layer, name, settings=settings)
-        tv.check("rigid plate 0 (boundary conditions/rigid plate 0): 9 grid nodes" in out,
-                 f"{label}: the log names the plate and its 9 nodes")
+        tv.check(f"rigid plate 0 (boundary conditions/rigid plate 0): {nodes} grid nodes" in out,
+                 f"{label}: the log names the plate and its {nodes} nodes")
         s = -ser["plate_0_displacement"][-1]
         err = abs(s - s_exact) / s_exact
         print(f"{label}: settlement {s:.6e} m, analytic {s_exact:.6e} m, error {100 * err:.3f} %")

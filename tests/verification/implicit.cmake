@@ -478,7 +478,7 @@ set_tests_properties(verification.implicit_rigid_plate_ranks PROPERTIES PROCESSO
 add_test(NAME verification.implicit_rigid_plate_restart
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/rigid_plate_footing.prm ${_w}/implicit_rigid_plate_restart
-                 "grid/cells=16, 16" "time/time step=0.02" "boundary conditions/rigid plate 0/surface=rough"
+                 "grid/cells=8, 8" "time/time step=0.02" "boundary conditions/rigid plate 0/surface=rough"
                  "implicit/ramp loads=false")
 set_tests_properties(verification.implicit_rigid_plate_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)

@@ -390,7 +390,8 @@ namespace talus::implicit_mpm
     std::vector<dealii::types::global_dof_index>              plate_all; ///< every rank's, sorted
     std::vector<unsigned char> idle_plates; ///< per plate: reported as acting on nothing
     bool plates_held = false; ///< the predictor holds the force plates' DoFs (their increment 0)
-    double seconds_plates = 0; ///< the plates' extra linear algebra (products, second solves)
+    double seconds_plates = 0; ///< the plates' extra linear algebra (products, zeroing, combination)
+    double seconds_plates_solve = 0; ///< the plates' Newton solves (all right-hand sides)
     /// The displacement of a prescribed DoF over the step [t, t + h].
     double prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const;
     /// du before Newton: one linear solve with the prescribed increments lifted
@@ -402,6 +403,8 @@ namespace talus::implicit_mpm
     LinearSolveInfo solve_for_delta();
     /// delta from tangent delta = -r
     LinearSolveInfo solve_for_delta(const Vector &r);
+    /// each r[k] replaced by x solving tangent x = -r[k] (direct: one factorisation)
+    LinearSolveInfo solve_several(std::vector<Vector> &r);
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     /// 'rayleigh beta' > 0: the stiffness K_n of the step's start (du = 0), whose beta K_n v^{n+1}
     /// is the damping force of the step (assemble_damping_stiffness)
