@@ -24,6 +24,7 @@
 #include <limits>
 #include <iomanip>
 #include <sstream>
+#include <unordered_set>
 
 namespace talus::implicit_mpm
 {
@@ -908,6 +909,7 @@ namespace talus::implicit_mpm
     // mass rule); a DoF of two plates belongs to the first
     const auto &owned = space.locally_owned_dofs();
     std::vector<dealii::types::global_dof_index> mine;
+    std::unordered_set<dealii::types::global_dof_index> taken;
     for (auto &v : plate_owned)
       v.clear();
     for (const auto &p : plate_nodes)
@@ -916,8 +918,7 @@ namespace talus::implicit_mpm
         if (!force_plate(p.condition) || p.component != plate.axis)
           continue;
         const auto i = space.node_dof(p.node, p.component);
-        if (!owned.is_element(i) || constraints.is_constrained(i) ||
-            std::find(mine.begin(), mine.end(), i) != mine.end())
+        if (!owned.is_element(i) || constraints.is_constrained(i) || !taken.insert(i).second)
           continue;
         plate_owned[p.condition].push_back(i);
         mine.push_back(i);
