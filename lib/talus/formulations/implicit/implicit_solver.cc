@@ -906,7 +906,8 @@ namespace talus::implicit_mpm
   {
     // the axis DoFs of each force plate that the step leaves free (not held by
     // a wall, a prescribed line, contact, the inactive pins or the negligible
-    // mass rule); a DoF of two plates belongs to the first
+    // mass rule, which includes the prescribed lines of displacement plates);
+    // a DoF of two force plates belongs to the first
     const auto &owned = space.locally_owned_dofs();
     std::vector<dealii::types::global_dof_index> mine;
     std::unordered_set<dealii::types::global_dof_index> taken;
