@@ -9,6 +9,10 @@ Cases (the last argument):
                 1 m cube under a plate on z+); the reported force is the given one;
   displacement  the same layer with the plate driven by a displacement d = -1 mm instead: its
                 reaction F = E_oed d / H x W = -1346.15 N within 1 %, frictionless and rough;
+  dynamic       the layer under a step force (constant time function), dynamic (Newmark 1/2,
+                1/4, 1 ms, 4 x 32 cells): the massless plate's settlement peaks at twice the
+                static one at t = 2 H / c, c = sqrt(E_oed / rho) (the wave reflected at the
+                fixed base), both within 5 % (the grid's and the trapezoidal rule's dispersion);
   footing       parameter_files/implicit/rigid_plate_footing.prm (a region plate on the top's
                 half x <= 0.5 beside the roller wall x = 0, -1 kN/m, one load step): the top nodes of the plate, recovered
                 from the points of the top cell row (one step: u_p is the bilinear interpolation
@@ -133,6 +137,24 @@ elif case == "displacement":
             T = ser["plate_0_tangential_force"][-1]
             print(f"rough: tangential reaction {T:.3e} N (oedometric: none)")
             tv.check(T < 1e-6 * abs(F), f"rough, oedometric: no tangential reaction ({T:.2e} N)")
+
+elif case == "dynamic":
+    # a step force on the layer (4 x 32 cells, dynamic, Newmark 1/2, 1/4, dt = 1 ms): the
+    # compression wave from the massless plate reflects at the fixed base; the plate's
+    # settlement peaks at twice the static one at t = 2 H / c (c = sqrt(E_oed / rho))
+    s_static = 1e3 * 1.0 / E_oed
+    c = (E_oed / 2000.0) ** 0.5
+    text = tv.prm_set_args(layer, ["implicit/analysis=dynamic", "boundary conditions/rigid plate 0/time function=constant",
+                                   "time/end time=0.12", "time/time step=0.001", "output/series interval=0",
+                                   "grid/cells=4, 32"])
+    out, ser, _ = run(text, "step")
+    d, t = ser["plate_0_displacement"], ser["time"]
+    i = min(range(len(d)), key=lambda k: d[k])
+    peak, t_peak = -d[i] / (2 * s_static), t[i] / (2 * 1.0 / c)
+    print(f"dynamic step load: peak settlement {-d[i]:.6e} m = {peak:.4f} x 2 s_static at t = {t[i]:.4f} s = "
+          f"{t_peak:.4f} x 2 H / c")
+    tv.check(abs(peak - 1) < 0.05, f"dynamic: the peak settlement within 5 % of twice the static one ({peak:.4f})")
+    tv.check(abs(t_peak - 1) < 0.05, f"dynamic: at t = 2 H / c within 5 % ({t_peak:.4f})")
 
 elif case == "footing":
     F = -1e3

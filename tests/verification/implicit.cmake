@@ -467,7 +467,7 @@ set_tests_properties(verification.implicit_strip_footing_points_large PROPERTIES
 # within 1 % (Q1, quadratic B-splines, mixed u-p); a displacement-driven plate's reaction within
 # 1 %; a footing-like region plate whose nodes move as one (recovered from the points), frictionless
 # vs rough sideways, its force balance at convergence; 1 vs 2 ranks to 1e-10; checkpoint/restart
-foreach(_case layer displacement footing ranks)
+foreach(_case layer displacement dynamic footing ranks)
   add_test(NAME verification.implicit_rigid_plate_${_case}
            COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rigid_plate.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
                    ${_w}/implicit_rigid_plate_${_case} ${_case})
