@@ -23,7 +23,9 @@ Cases (the last argument):
                 holds the layer back (a tangential reaction); the plate's force
                 balance holds at convergence, not as a penalty: sum_p sigma_yy V_p = F (1 + s)
                 (the discrete identity sum_i y_i r_i = sum_p V_p sigma_yy: only the plate's
-                nodes carry a vertical reaction at a height other than 0) to 1e-8 of F;
+                nodes carry a vertical reaction at a height other than 0) to 1e-8 of F; with
+                the side x = 0 fixed instead of a roller the wall keeps the plate's corner
+                node (u = 0) and the plate moves the other four as one;
   ranks         the footing (rough, 4 load steps) and the displacement-driven layer, both
                 turned on their side so that the plate's nodes lie on both ranks, on 1 and
                 2 ranks: point fields and the plate columns of series.csv agree to 1e-10
@@ -186,6 +188,19 @@ elif case == "footing":
             T = ser["plate_0_tangential_force"][-1]
             print(f"rough: tangential reaction {T:.4e} N")
             tv.check(T > 1e-3 * abs(F), f"rough: the plate holds the layer back (tangential reaction {T:.3e} N)")
+    # walls win: with the side x = 0 fixed (not a roller) the plate's corner node (0, 1)
+    # keeps both components held; the other four move as one
+    text = tv.prm_set_args(footing, ["boundary conditions/fixed=0, 2", "boundary conditions/roller=1"])
+    out, ser, p = run(text, "fixed_side")
+    s = ser["plate_0_displacement"][-1]
+    nodes = top_nodes(p)
+    corner = max(abs(v) for v in nodes[0.0][0] + nodes[0.0][1])
+    spread = max(abs(v - s) for x in nodes if 0.1 < x <= 0.5 + 1e-9 for v in nodes[x][1]) / abs(s)
+    print(f"fixed side: the log says '{[l.strip() for l in out.splitlines() if 'rigid plate 0' in l][0]}'; "
+          f"corner node |u| {corner:.2e} m, the other plate nodes' u_y within {spread:.2e} of s = {s:.6e} m")
+    tv.check("5 grid nodes (4 free along y)" in out, "fixed side: the log counts 5 plate nodes, 4 free along y")
+    tv.check(corner < 1e-9 * abs(s) and spread < 1e-9,
+             "fixed side: the wall keeps the corner node (u = 0), the plate moves the other four as one")
     ux_f, s_f = res["frictionless"]
     ux_r, s_r = res["rough"]
     tv.check(ux_f > 1e-2 * s_f, f"frictionless: the plate's nodes move sideways (|u_x| up to {ux_f / s_f:.3f} s)")
