@@ -10,7 +10,8 @@ the right exit code, no NaN written.
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
   * rigid plates: a force and a displacement, a boundary id the grid lacks, a
-    region holding no grid node, the axis held by a wall at every node;
+    region holding no grid node, the axis held by a wall at every node, two
+    plates sharing a node;
   * the rigid footing: its span reversed, with two values in 2D, not a number; normal z in 2D;
     penalty 0; with contact walls on the nodes;
   * contact walls on the points: a misspelt 'contact method', 'points' without
@@ -166,6 +167,13 @@ cases = {
     "plate held by a wall everywhere": (plate(["boundary id=0", "direction=x", "total force=-1"]),
                                         ["boundary conditions/rigid plate 0", "held by a fixed/roller wall",
                                          "every one of its nodes"]),
+    "plates sharing a node": (
+        tv.prm_set_args(plate(["apply to=region", "region lower corner=1, 1", "region upper corner=2, 1",
+                               "total force=-1"]),
+                        ["boundary conditions/number of rigid plates=2"] +
+                        ["boundary conditions/rigid plate 1/" + e for e in
+                         ["apply to=region", "region lower corner=2, 1", "region upper corner=3, 1", "total force=-1"]]),
+        ["boundary conditions/rigid plate 1", "shares 1 node(s) with another rigid plate"]),
     "velocity on a missing boundary": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
                                                   "loads/velocity 0/boundary id", "7"),
                                        ["loads/velocity 0/boundary id", "does not exist"]),

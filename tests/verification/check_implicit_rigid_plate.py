@@ -110,7 +110,7 @@ if case == "layer":
              "boundary conditions/rigid plate 0/boundary id=5", "boundary conditions/rigid plate 0/direction=z",
              "gravity/acceleration=0, 0, 0", "body 0/lower corner=0, 0, 0", "body 0/upper corner=1, 1, 1"]
     for label, nodes, settings in (
-            ("Q1", 9, []), ("quadratic B-splines", 9, ["implicit/shape function=quadratic bspline"]),
+            ("Q1", 9, []), ("quadratic B-splines", 9, ["numerics/shape function=quadratic bspline"]),
             ("mixed u-p", 9, ["implicit/formulation=mixed up", "material 0/neo hookean/volumetric energy=split"]),
             ("CG + AMG", 9, ["linear solver/method=cg amg"]), ("3D (4 x 4 x 4 cells, plate on z+)", 25, box3d)):
         name = label.split()[0].replace("-", "")

@@ -24,7 +24,6 @@
 #include <limits>
 #include <iomanip>
 #include <sstream>
-#include <unordered_set>
 
 namespace talus::implicit_mpm
 {
@@ -864,34 +863,50 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::check_plates()
   {
-    // per plate: owned nodes, and those whose axis component no wall holds
-    const unsigned int  n = prm.rigid_plates.size();
-    std::vector<double> count(2 * n, 0.0);
+    // per plate: owned nodes, nodes shared with another plate, and per stage
+    // the nodes whose axis component that stage's walls hold
+    const unsigned int  n = prm.rigid_plates.size(), n_stages = prm.stages.size(), nc = 2 + n_stages;
+    std::vector<double> count(n * nc, 0.0);
     const unsigned int  n_owned = grid.partitioner->locally_owned_size();
+    std::vector<std::vector<unsigned char>> flags;
+    for (const auto &st : prm.stages)
+      flags.push_back(loads::wall_dof_flags(grid, st.boundary_conditions));
+    std::vector<int> owner(n_owned, -1);
     for (const auto &p : plate_nodes)
       if (p.node < n_owned && p.component == prm.rigid_plates[p.condition].axis)
         {
-          count[2 * p.condition] += 1;
-          if (!boundary_flags[p.dof])
-            count[2 * p.condition + 1] += 1;
+          double *c = &count[p.condition * nc];
+          c[0] += 1;
+          if (owner[p.node] >= 0 && owner[p.node] != static_cast<int>(p.condition))
+            c[1] += 1;
+          owner[p.node] = static_cast<int>(p.condition);
+          for (unsigned int j = 0; j < n_stages; ++j)
+            if (flags[j][p.dof])
+              c[2 + j] += 1;
         }
     dealii::Utilities::MPI::sum(count, comm, count);
     const char *ax[] = {"x", "y", "z"};
     for (unsigned int k = 0; k < n; ++k)
       {
-        const auto &plate = prm.rigid_plates[k];
-        require(count[2 * k] > 0, plate.where,
+        const auto &  plate = prm.rigid_plates[k];
+        const double *c     = &count[k * nc];
+        require(c[0] > 0, plate.where,
                 plate.target == loads::RigidPlate<dim>::Target::boundary
                   ? "holds no grid node (no face of the grid has boundary id " + std::to_string(plate.boundary) + ")"
                   : std::string("holds no grid node: no node of the grid lies inside its region (widen the region "
                                 "to reach a row of grid nodes)"));
-        require(count[2 * k + 1] > 0, plate.where,
-                std::string("its axis component (") + ax[plate.axis] +
-                  ") is held by a fixed/roller wall at every one of its nodes: the plate cannot move; allowed: a "
-                  "direction no wall holds at its nodes, or remove the wall");
+        require(c[1] == 0, plate.where,
+                "shares " + std::to_string(static_cast<long>(c[1])) +
+                  " node(s) with another rigid plate; a grid node can belong to one plate only");
+        for (unsigned int j = 0; j < n_stages; ++j)
+          require(c[2 + j] < c[0], plate.where,
+                  std::string("its axis component (") + ax[plate.axis] +
+                    ") is held by a fixed/roller wall at every one of its nodes" +
+                    (prm.staged ? " in stage " + std::to_string(j) : std::string()) +
+                    ": the plate cannot move; allowed: a direction no wall holds at its nodes, or remove the wall");
         std::ostringstream os;
-        os << "  rigid plate " << k << " (" << plate.where << "): " << count[2 * k] << " grid nodes ("
-           << count[2 * k + 1] << " free along " << ax[plate.axis] << "), "
+        os << "  rigid plate " << k << " (" << plate.where << "): " << c[0] << " grid nodes ("
+           << c[0] - c[2 + current_stage] << " free along " << ax[plate.axis] << "), "
            << (plate.rough ? "rough" : "frictionless") << ", "
            << (force_plate(k) ? "force control: total force " + std::to_string(plate.force)
                               : "displacement control: displacement " + std::to_string(plate.displacement))
@@ -906,11 +921,10 @@ namespace talus::implicit_mpm
   {
     // the axis DoFs of each force plate that the step leaves free (not held by
     // a wall, a prescribed line, contact, the inactive pins or the negligible
-    // mass rule, which includes the prescribed lines of displacement plates);
-    // a DoF of two force plates belongs to the first
+    // mass rule, which includes the prescribed lines of displacement plates;
+    // plates share no node: check_plates)
     const auto &owned = space.locally_owned_dofs();
     std::vector<dealii::types::global_dof_index> mine;
-    std::unordered_set<dealii::types::global_dof_index> taken;
     for (auto &v : plate_owned)
       v.clear();
     for (const auto &p : plate_nodes)
@@ -919,7 +933,7 @@ namespace talus::implicit_mpm
         if (!force_plate(p.condition) || p.component != plate.axis)
           continue;
         const auto i = space.node_dof(p.node, p.component);
-        if (!owned.is_element(i) || constraints.is_constrained(i) || !taken.insert(i).second)
+        if (!owned.is_element(i) || constraints.is_constrained(i))
           continue;
         plate_owned[p.condition].push_back(i);
         mine.push_back(i);

@@ -361,8 +361,9 @@ namespace talus::implicit_mpm
     /// The plates' prescribed DoFs appended to prescribed_dofs (a component a
     /// fixed/roller wall holds stays the wall's).
     void append_plate_dofs();
-    /// Setup: every plate holds a grid node, and one whose axis component no
-    /// wall holds (InputError naming the plate); the log line per plate.
+    /// Setup: every plate holds a grid node, shares none with another plate
+    /// and has one whose axis component no wall of any stage holds
+    /// (InputError naming the plate); the log line per plate.
     void check_plates();
     /// After the step's constraints: the owned axis DoFs of each force plate
     /// that are free this step, and all of them (every rank) for the matrix.
