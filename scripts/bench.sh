@@ -181,7 +181,7 @@ echo "bench: $SLOPE (single rank; point sets single | double, 2x2 ... 6x6 points
 for rep in 1 2; do
   for ppd in 2 3 4 5 6; do
     for sets in single double; do
-      "$BUILD/tools/talus-semi-implicit" "$(prm_set "$SLOPE" "$TMPD/out_semi_${sets}_$ppd" \
+      "$BUILD/tools/talus-semi-implicit" --time-shape-walk "$(prm_set "$SLOPE" "$TMPD/out_semi_${sets}_$ppd" \
         "particles per direction=$ppd" "point sets=$sets")" > "$TMPD/semi_${sets}_${ppd}_$rep.log"
       tail -n 2 "$TMPD/semi_${sets}_${ppd}_$rep.log"
     done

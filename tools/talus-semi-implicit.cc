@@ -19,5 +19,7 @@ main(int argc, char **argv)
   tool.check   = &talus::semi_implicit::check_parameters;
   tool.run     = &talus::semi_implicit::run;
   tool.options = talus::formulation_tool_options();
+  tool.options.push_back({"--time-shape-walk", "time one stencil walk over both point sets after the run and print "
+                                               "it with the breakdown (make bench)"});
   return talus::run_tool(argc, argv, tool);
 }

@@ -1862,13 +1862,19 @@ namespace talus::semi_implicit
           << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
-    const double walk = prm.bspline() ? shape_walk_seconds<shape::BSpline2Box<dim>>() : shape_walk_seconds<shape::Q1Box<dim>>();
+    // the timing walk only when asked (make bench passes --time-shape-walk): it is work of its own
+    const bool   time_walk = tool_option_given("--time-shape-walk");
+    const double walk      = !time_walk      ? 0.0
+                             : prm.bspline() ? shape_walk_seconds<shape::BSpline2Box<dim>>()
+                                             : shape_walk_seconds<shape::Q1Box<dim>>();
     log() << std::setprecision(4) << "  breakdown [s]: P2N " << phase.p2n << ", grid " << phase.grid << ", Poisson assembly "
           << phase.poisson << ", pressure solve " << seconds_solve << " (AMG set-up "
           << pressure_solver.setup_seconds() << "), N2P " << phase.n2p << ", update+stress "
           << phase.stress << ", relocation " << phase.relocation << "; points soil "
-          << soil.handler.n_global_particles() << " water " << water.handler.n_global_particles()
-          << "; shape functions: one stencil walk over both sets " << walk << " s" << std::endl;
+          << soil.handler.n_global_particles() << " water " << water.handler.n_global_particles();
+    if (time_walk)
+      log() << "; shape functions: one stencil walk over both sets " << walk << " s";
+    log() << std::endl;
   }
 
   // ================================================================ tool entry points
