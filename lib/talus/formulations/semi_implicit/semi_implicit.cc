@@ -330,6 +330,8 @@ namespace talus::semi_implicit
     p.rigid_skeleton        = prm.get_bool("rigid skeleton");
     // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
     // plate can move it (a physical impossibility, not a missing feature)
+    if (p.grid_mesh == nullptr) // (a grid file is refused below)
+      loads::check_rigid_plates_on_box(p.rigid_plates, p.grid_lower, p.grid_upper, p.grid_cells, p.boundary_conditions);
     if (p.rigid_skeleton)
       loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit",
                                  "'semi implicit/rigid skeleton = true' holds every soil node at rest, so no plate "
@@ -706,6 +708,11 @@ namespace talus::semi_implicit
     // tangential DoF (held at zero like a wall; its reaction is summed)
     static constexpr unsigned int no_plate = static_cast<unsigned int>(-1);
     std::vector<unsigned int> plate_of, plate_tangential_of;
+    /// per node (component-0 DoF): a node of an impermeable plate, which covers
+    /// the surface there: no free-surface p = 0 at it (the pressure is solved)
+    std::vector<unsigned char> plate_sealed;
+    /// per node (component-0 DoF): the plate that holds it, or no_plate
+    std::vector<unsigned int> plate_node_of;
     /// per plate: the state between steps (checkpointed) and the last step's answer
     struct PlateState
     {
@@ -718,6 +725,9 @@ namespace talus::semi_implicit
       /// and a rough plate's tangential ones against 0), in v^{t+1} and in the
       /// remapped velocity: a bound on how far the plate's nodes moved apart [m]
       double node_spread = 0;
+      /// sum over the steps of h x the largest tangential velocity of a plate
+      /// node in v^{t+1} (components no wall holds): 0 for a rough plate [m]
+      double node_slip = 0;
     };
     std::vector<PlateState> plate_state;
     std::vector<unsigned int> force_plates; ///< indices of the force-controlled plates
@@ -826,11 +836,16 @@ namespace talus::semi_implicit
     plate_of.assign(nl, no_plate);
     plate_tangential_of.assign(nl, no_plate);
     std::vector<unsigned char> plate_drained(nl, 0);
+    plate_sealed.assign(nl, 0);
+    plate_node_of.assign(nl, no_plate);
     for (const auto &e : loads::rigid_plate_node_dofs(grid, prm.rigid_plates, false))
       {
         const auto &pl = prm.rigid_plates[e.condition];
+        plate_node_of[e.node] = e.condition;
         if (pl.permeable)
           plate_drained[e.node] = 1;
+        else
+          plate_sealed[e.node] = 1;
         if (constrained[e.dof] && plate_tangential_of[e.dof] == no_plate)
           continue; // a fixed/roller wall holds this component: it keeps it
         if (e.component == pl.axis)
@@ -1037,6 +1052,7 @@ namespace talus::semi_implicit
                                        f.set_attribute(a + "force", plate_state[k].force);
                                        f.set_attribute(a + "tangential force", plate_state[k].tangential);
                                        f.set_attribute(a + "node spread", plate_state[k].node_spread);
+                                       f.set_attribute(a + "node slip", plate_state[k].node_slip);
                                      }
                                    write_points(f, soil, "soil");
                                    write_points(f, water, "water");
@@ -1071,6 +1087,7 @@ namespace talus::semi_implicit
         plate_state[k].force        = fp->get_double(a + "force");
         plate_state[k].tangential   = fp->get_double(a + "tangential force");
         plate_state[k].node_spread  = fp->get_double(a + "node spread");
+        plate_state[k].node_slip    = fp->get_double(a + "node slip");
       }
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, soil, grid, where, "soil");
@@ -1526,7 +1543,7 @@ namespace talus::semi_implicit
           if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
             continue;
           const bool has_water = Mw.local_element(i) > mw_cut;
-          const bool surface   = dry.local_element(i) > 0;
+          const bool surface   = dry.local_element(i) > 0 && !plate_sealed[i];
           if (has_water && drained[i]) // a drained face: p^{t+1} = 0
             {
               dirichlet.add_line(gdof);
@@ -1851,18 +1868,26 @@ namespace talus::semi_implicit
       }
     if (!prm.rigid_plates.empty()) // what the nodes moved the soil with: node_spread
       {
-        std::vector<double> spread(prm.rigid_plates.size(), 0.0);
+        // [0, n): axis spread; [n, 2n): tangential slip of the nodes
+        const unsigned int  np = prm.rigid_plates.size();
+        std::vector<double> spread(2 * np, 0.0);
         for (unsigned int i = 0; i < grid.partitioner->locally_owned_size(); ++i)
           {
-            const unsigned int k = plate_of[i] != no_plate ? plate_of[i] : plate_tangential_of[i];
+            const unsigned int k = plate_node_of[node_of[i]];
             if (k == no_plate)
               continue;
-            const double V = plate_of[i] != no_plate ? plate_v[k] : 0.0;
-            spread[k]      = std::max({spread[k], std::abs(vs_new.local_element(i) - V), std::abs(vs_t.local_element(i) - V)});
+            if (plate_of[i] != no_plate)
+              spread[k] = std::max({spread[k], std::abs(vs_new.local_element(i) - plate_v[k]),
+                                    std::abs(vs_t.local_element(i) - plate_v[k])});
+            else if (component[i] != prm.rigid_plates[k].axis && (!constrained[i] || plate_tangential_of[i] != no_plate))
+              spread[np + k] = std::max({spread[np + k], std::abs(vs_new.local_element(i)), std::abs(vs_t.local_element(i))});
           }
         MPI_Allreduce(MPI_IN_PLACE, spread.data(), static_cast<int>(spread.size()), MPI_DOUBLE, MPI_MAX, comm);
-        for (unsigned int k = 0; k < spread.size(); ++k)
-          plate_state[k].node_spread += 2 * h * spread[k];
+        for (unsigned int k = 0; k < np; ++k)
+          {
+            plate_state[k].node_spread += 2 * h * spread[k];
+            plate_state[k].node_slip += h * spread[np + k];
+          }
       }
     add_lap(phase.n2p);
 
@@ -2169,7 +2194,10 @@ namespace talus::semi_implicit
     for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
       c.push_back(name);
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k) // this family's check that the nodes move as one
-      c.push_back("plate_" + std::to_string(k) + "_node_spread");
+      {
+        c.push_back("plate_" + std::to_string(k) + "_node_spread");
+        c.push_back("plate_" + std::to_string(k) + "_node_slip");
+      }
     balance.add_series_column(c);
     return c;
   }
@@ -2219,7 +2247,10 @@ namespace talus::semi_implicit
           v.push_back(plate_state[k].tangential);
       }
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
-      v.push_back(plate_state[k].node_spread);
+      {
+        v.push_back(plate_state[k].node_spread);
+        v.push_back(plate_state[k].node_slip);
+      }
     balance.add_series_value(v);
     return v;
   }
