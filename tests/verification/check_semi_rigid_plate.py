@@ -13,7 +13,8 @@ Modes (one ctest each):
                 the given -1 kN x f(t) at every row (1e-9 relative: force control
                 balances the plate at the end of each step); the plate nodes'
                 displacement spread 0 (1e-15 m); the same with 'point sets =
-                single' (1 %); and 1 vs 2 ranks over the first 0.4 s: every series
+                single' (1 %); the 3D column (3 x 3 x 8 cells, plate along z): 1 %
+                and the 2D settlement to 1e-9 (the problem is 1D); and 1 vs 2 ranks over the first 0.4 s: every series
                 column and every final point field within 1e-10 relative (per
                 quantity, of its largest component).
   displacement  the layer driven by the displacement -7.4286e-4 m (ramp 1 s): the
@@ -127,6 +128,23 @@ if mode == "layer":
         tv.check(ferr < 1e-9, f"{name}: plate force = -1 kN x f(t) at every row (largest difference {ferr:.1e} of 1 kN)")
         tv.check(s["plate_0_node_spread"][-1] < 1e-15,
                  f"{name}: the plate nodes moved as one (spread {s['plate_0_node_spread'][-1]:.1e} m)")
+    # 3D: the same layer as a 0.375 x 0.375 x 1 m column (3 x 3 x 8 cells), rollers on the four
+    # sides, fixed base, the plate on the top face (id 5) along z with q x 0.375^2
+    text3 = layer.replace("include layer.inc", open(inc).read())
+    for key, v in {"dimension": "3", "grid/lower corner": "0, 0, 0", "grid/upper corner": "0.375, 0.375, 1",
+                   "grid/cells": "3, 3, 8", "boundary conditions/fixed": "4",
+                   "boundary conditions/roller": "0, 1, 2, 3", "boundary conditions/rigid plate 0/boundary id": "5",
+                   "boundary conditions/rigid plate 0/direction": "z",
+                   "boundary conditions/rigid plate 0/total force": f"{-q * 0.375 ** 2}",
+                   "gravity/acceleration": "0, 0, 0", "body 0/lower corner": "0, 0, 0",
+                   "body 0/upper corner": "0.375, 0.375, 1"}.items():
+        text3 = tv.prm_set(text3, key, v)
+    run("three_d", text3)
+    u3 = -series("three_d")["plate_0_displacement"][-1]
+    u2 = -series("double")["plate_0_displacement"][-1]
+    tv.check(abs(u3 - s_inf) / s_inf < 0.01 and abs(u3 - u2) / u2 < 1e-9,
+             f"3D column: plate settlement {u3:.6e} m ({100 * (u3 - s_inf) / s_inf:+.3f} %; 2D {u2:.6e} m, "
+             f"relative difference {abs(u3 - u2) / u2:.1e}, tolerances 1 % and 1e-9)")
     # 1 vs 2 ranks on the first 0.4 s (200 steps: through the ramp, mid-consolidation)
     run("short", layer, **{"time/end time": "0.4"})
     run("short_np2", layer, np=2, **{"time/end time": "0.4"})

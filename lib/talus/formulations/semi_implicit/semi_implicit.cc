@@ -1220,8 +1220,12 @@ namespace talus::semi_implicit
         out << "  " << pl.where << ": "
             << (pl.target == loads::RigidPlate<dim>::Target::boundary ? "boundary id " + std::to_string(pl.boundary)
                                                                         : std::string("region"))
-            << ", " << plate_nodes[k] << " nodes (" << plate_axis_dofs[k] << " moved along " << "xyz"[pl.axis]
-            << ", the others' axis component held by a wall), " << (pl.rough ? "rough" : "frictionless") << ", "
+            << ", " << plate_nodes[k] << " nodes"
+            << (plate_axis_dofs[k] < plate_nodes[k]
+                  ? " (" + std::to_string(plate_axis_dofs[k]) + " move along " + "xyz"[pl.axis] +
+                      ", the others' " + "xyz"[pl.axis] + " is held by a wall)"
+                  : std::string(" moving along ") + "xyz"[pl.axis])
+            << ", " << (pl.rough ? "rough" : "frictionless") << ", "
             << (pl.permeable ? "permeable" : "impermeable") << ", "
             << (pl.control == loads::RigidPlate<dim>::Control::force
                   ? "force control: " + number_text(pl.force) + " N x f(t), displacement unknown"
