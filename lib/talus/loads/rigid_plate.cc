@@ -187,6 +187,10 @@ namespace talus::loads
               i0[d] = 0, i1[d] = n;
             else
               {
+                // (the wording of check_scene_consistency, which not every family calls)
+                require(p.lower[d] <= upper[d] && p.upper[d] >= lower[d], p.where + "/region lower corner",
+                        "the region lies outside the grid (grid extent " + std::to_string(lower[d]) + " .. " +
+                          std::to_string(upper[d]) + " along " + std::string(1, char('x' + d)) + ")");
                 i0[d] = std::max(0, static_cast<int>(std::ceil((p.lower[d] - tol - lower[d]) / h)));
                 i1[d] = std::min(n, static_cast<int>(std::floor((p.upper[d] + tol - lower[d]) / h)));
               }
