@@ -228,3 +228,23 @@ add_test(NAME verification.semi_implicit_file_body
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_file_body.py ${TALUS_TOOLS_DIR} ${CMAKE_SOURCE_DIR}
                  ${_w}/semi_implicit_file_body)
 set_tests_properties(verification.semi_implicit_file_body PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# the rigid plate (issue 37; docs/semi-implicit.md 'Rigid plate'), on the shared
+# layer parameter_files/verification/rigid_plate/layer_semi_implicit.prm:
+# layer: drained settlement within 1 % of q H / E_oed (double and single point
+# sets), force = the given force, nodes move as one, 1 vs 2 ranks to 1e-10;
+# displacement: reaction within 1 % of E_oed (d / H) W; terzaghi: sudden load,
+# settlement within 0.01 s_inf of U(T_v) at T_v = 0.1, 0.2, 0.5; footing:
+# frictionless / rough / impermeable region plates (tangential node motion 0
+# only when rough), 1 vs 2 ranks; restart: bitwise on 1 and 2 ranks
+foreach(_mode layer displacement terzaghi footing restart)
+  add_test(NAME verification.semi_implicit_rigid_plate_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_rigid_plate.py ${_mode}
+                   ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                   ${TALUS_PRM_DIR}/verification/rigid_plate/layer_semi_implicit.prm
+                   ${_w}/semi_implicit_rigid_plate_${_mode})
+  set_tests_properties(verification.semi_implicit_rigid_plate_${_mode} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 600)
+endforeach()
+set_tests_properties(verification.semi_implicit_rigid_plate_layer verification.semi_implicit_rigid_plate_footing
+                     verification.semi_implicit_rigid_plate_restart PROPERTIES PROCESSORS 2)

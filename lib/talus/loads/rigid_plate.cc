@@ -5,6 +5,7 @@
 
 #include <deal.II/base/utilities.h>
 
+#include <array>
 #include <cmath>
 
 namespace talus::loads
@@ -166,6 +167,74 @@ namespace talus::loads
 
   template <int dim>
   void
+  check_rigid_plates_on_box(const std::vector<RigidPlate<dim>> &plates, const dealii::Point<dim> &lower,
+                            const dealii::Point<dim> &upper, const std::vector<unsigned int> &cells,
+                            const std::vector<BoundaryCondition> &walls)
+  {
+    std::vector<std::array<int, 2 * dim>> ranges; // per plate: i0, i1 per axis
+    for (const auto &p : plates)
+      {
+        // per axis the range of node indices the plate holds
+        int  i0[dim], i1[dim];
+        bool any = true;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const int    n = static_cast<int>(cells[d]);
+            const double h = (upper[d] - lower[d]) / n, tol = 1e-9 * h; // as prescribed_node_dofs
+            if (p.target == RigidPlate<dim>::Target::boundary && p.boundary / 2 == d)
+              i0[d] = i1[d] = p.boundary % 2 ? n : 0;
+            else if (p.target == RigidPlate<dim>::Target::boundary)
+              i0[d] = 0, i1[d] = n;
+            else
+              {
+                // (the wording of check_scene_consistency, which not every family calls)
+                require(p.lower[d] <= upper[d] && p.upper[d] >= lower[d], p.where + "/region lower corner",
+                        "the region lies outside the grid (grid extent " + std::to_string(lower[d]) + " .. " +
+                          std::to_string(upper[d]) + " along " + std::string(1, char('x' + d)) + ")");
+                i0[d] = std::max(0, static_cast<int>(std::ceil((p.lower[d] - tol - lower[d]) / h)));
+                i1[d] = std::min(n, static_cast<int>(std::floor((p.upper[d] + tol - lower[d]) / h)));
+              }
+            any = any && i0[d] <= i1[d];
+          }
+        require(any, p.where, "holds no grid node: its region contains no node of the grid (node spacing per axis: "
+                              "the grid's cell size); allowed: a region that contains at least one grid node");
+        // a node is free along the axis unless it lies on a face whose wall
+        // holds that component: some node is free iff every axis has an index
+        // in the range on no such face
+        bool free = true;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const int n     = static_cast<int>(cells[d]);
+            bool      holds[2] = {false, false}; // the lower / upper face of axis d
+            for (const auto &w : walls)
+              if (w.id / 2 == d && w.id < 2 * dim)
+                holds[w.id % 2] = holds[w.id % 2] || w.kind == BoundaryCondition::Kind::fixed || d == p.axis;
+            const int held = (holds[0] && i0[d] == 0) + (holds[1] && i1[d] == n && n != 0);
+            free           = free && i1[d] - i0[d] + 1 > held;
+          }
+        const char *axes = "xyz";
+        require(free, p.where,
+                std::string("moves along ") + axes[p.axis] +
+                  ", but a fixed or roller wall holds that component at every node of the plate (a wall keeps the "
+                  "components it holds); allowed: a direction or nodes that no wall holds");
+        std::array<int, 2 * dim> r;
+        for (unsigned int d = 0; d < dim; ++d)
+          r[2 * d] = i0[d], r[2 * d + 1] = i1[d];
+        for (unsigned int j = 0; j < ranges.size(); ++j)
+          {
+            bool overlap = true;
+            for (unsigned int d = 0; d < dim; ++d)
+              overlap = overlap && std::max(r[2 * d], ranges[j][2 * d]) <= std::min(r[2 * d + 1], ranges[j][2 * d + 1]);
+            require(!overlap, p.where,
+                    "shares grid nodes with 'boundary conditions/rigid plate " + std::to_string(j) +
+                      "'; allowed: plates whose node sets are disjoint");
+          }
+        ranges.push_back(r);
+      }
+  }
+
+  template <int dim>
+  void
   refuse_rigid_plates(const std::vector<RigidPlate<dim>> &plates, const std::string &tool, const std::string &reason)
   {
     require(plates.empty(), plates.empty() ? std::string() : plates.front().where,
@@ -182,6 +251,12 @@ namespace talus::loads
                                                                 const std::vector<RigidPlate<3>> &, bool);
   template std::vector<std::string> rigid_plate_series_columns(const std::vector<RigidPlate<2>> &);
   template std::vector<std::string> rigid_plate_series_columns(const std::vector<RigidPlate<3>> &);
+  template void check_rigid_plates_on_box(const std::vector<RigidPlate<2>> &, const dealii::Point<2> &,
+                                          const dealii::Point<2> &, const std::vector<unsigned int> &,
+                                          const std::vector<BoundaryCondition> &);
+  template void check_rigid_plates_on_box(const std::vector<RigidPlate<3>> &, const dealii::Point<3> &,
+                                          const dealii::Point<3> &, const std::vector<unsigned int> &,
+                                          const std::vector<BoundaryCondition> &);
   template void refuse_rigid_plates(const std::vector<RigidPlate<2>> &, const std::string &, const std::string &);
   template void refuse_rigid_plates(const std::vector<RigidPlate<3>> &, const std::string &, const std::string &);
 } // namespace talus::loads

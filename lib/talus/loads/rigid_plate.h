@@ -93,6 +93,19 @@ namespace talus::loads
   template <int dim>
   std::vector<std::string> rigid_plate_series_columns(const std::vector<RigidPlate<dim>> &plates);
 
+  /// The checks of a box grid (grid/source = box: lower, upper, cells; face
+  /// ids 2 d and 2 d + 1 the lower and upper faces normal to axis d) that need
+  /// no grid, so that --check finds them: InputError naming the plate when a
+  /// region plate contains no grid node, or when the fixed/roller walls hold
+  /// the plate's axis component at every node it holds (a wall keeps the
+  /// components it holds). A family checks the same on its grid at setup.
+  template <int dim>
+  void check_rigid_plates_on_box(const std::vector<RigidPlate<dim>> &       plates,
+                                 const dealii::Point<dim> &                 lower,
+                                 const dealii::Point<dim> &                 upper,
+                                 const std::vector<unsigned int> &          cells,
+                                 const std::vector<BoundaryCondition> &     walls);
+
   /// InputError naming the first plate unless `plates` is empty: for a family
   /// (`tool`) that cannot honour a rigid plate, with `reason`.
   template <int dim>

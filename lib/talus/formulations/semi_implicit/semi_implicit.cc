@@ -22,6 +22,7 @@
 #include <talus/io/vtu.h>
 #include <talus/loads/k0.h>
 #include <talus/loads/kinematics.h>
+#include <talus/loads/rigid_plate.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
@@ -311,7 +312,6 @@ namespace talus::semi_implicit
     Parameters<dim> p;
     parse_run_parameters<dim>(prm, p);
     parse_scene_parameters<dim>(prm, p);
-    loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit", "not built in this family yet");
     prm.enter_subsection("time");
     p.time_step = prm.get_double("time step");
     p.courant   = prm.get_double("courant number");
@@ -328,6 +328,14 @@ namespace talus::semi_implicit
     p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
     p.flip_fraction         = prm.get_double("flip fraction");
     p.rigid_skeleton        = prm.get_bool("rigid skeleton");
+    // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
+    // plate can move it (a physical impossibility, not a missing feature)
+    if (p.grid_mesh == nullptr) // (a grid file is refused below)
+      loads::check_rigid_plates_on_box(p.rigid_plates, p.grid_lower, p.grid_upper, p.grid_cells, p.boundary_conditions);
+    if (p.rigid_skeleton)
+      loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit",
+                                 "'semi implicit/rigid skeleton = true' holds every soil node at rest, so no plate "
+                                 "can move the soil (allowed: rigid skeleton = false, or no plate)");
     {
       const std::string text = prm.get("drained boundaries");
       for (const auto &item : dealii::Utilities::split_string_list(text, ','))
@@ -507,6 +515,7 @@ namespace talus::semi_implicit
       unsigned int poisson_coefficient = 0, poisson_flux = 0; // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
       unsigned int smoothed_jacobian = 0; // Nor-Sand (96)-(97): Jbar^{t+1}
+      unsigned int plate_flux = 0; // rigid plates with force control: dim values, phi v* of a unit plate velocity
     };
 
     /// The pressure-increment Poisson terms of one point: K += V c grad N grad N,
@@ -544,6 +553,28 @@ namespace talus::semi_implicit
                 ls.a(p.local[i], p.local[j]) += v;
                 ls.a(p.local[j], p.local[i]) += v;
               }
+            for (unsigned int d = 0; d < dim; ++d)
+              fg += P[flux + d] * p.G[i][d];
+            ls.b[p.local[i]] -= V * fg;
+          }
+      }
+    };
+
+    /// The source part of PoissonWithFlux alone (f -= V flux . grad N): the
+    /// right-hand side of a force-controlled rigid plate's unit velocity, on
+    /// the matrix already assembled (rigid plates, docs/semi-implicit.md)
+    struct PoissonFluxSource
+    {
+      unsigned int          flux = 0;
+      static constexpr bool matrix = false, vector = true;
+      template <int dim, unsigned int nc, class PN>
+      inline void
+      add(const double *P, const PN &p, transfer::LocalSystem &ls) const
+      {
+        const double V = P[PropertyLayout<dim>::volume];
+        for (unsigned int i = 0; i < p.n; ++i)
+          {
+            double fg = 0;
             for (unsigned int d = 0; d < dim; ++d)
               fg += P[flux + d] * p.G[i][d];
             ls.b[p.local[i]] -= V * fg;
@@ -670,6 +701,48 @@ namespace talus::semi_implicit
     PatchTiling<dim>    patches;
     std::vector<double> patch_mass, patch_mass_Je;
     std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
+
+    // rigid plates (issue 37; docs/semi-implicit.md 'Rigid plate'): per local
+    // grid DoF the plate whose axis component it is (none: not a plate DoF or
+    // held by a wall, which keeps it), and the plate of a rough plate's
+    // tangential DoF (held at zero like a wall; its reaction is summed)
+    static constexpr unsigned int no_plate = static_cast<unsigned int>(-1);
+    std::vector<unsigned int> plate_of, plate_tangential_of;
+    /// per node (component-0 DoF): a node of an impermeable plate, which covers
+    /// the surface there: no free-surface p = 0 at it (the pressure is solved)
+    std::vector<unsigned char> plate_sealed;
+    /// per node (component-0 DoF): the plate that holds it, or no_plate
+    std::vector<unsigned int> plate_node_of;
+    /// per plate: the state between steps (checkpointed) and the last step's answer
+    struct PlateState
+    {
+      double displacement = 0; ///< along the axis [m] (the unknown of force control)
+      double velocity     = 0; ///< of the last step [m/s]
+      double force        = 0; ///< the force the plate exerted on the material along its axis [N]
+      double tangential   = 0; ///< |tangential reaction| of a rough plate [N]
+      /// sum over the steps of h x (the largest difference between the velocity
+      /// a plate node moves the soil with and the plate's: the axis component,
+      /// and a rough plate's tangential ones against 0), in v^{t+1} and in the
+      /// remapped velocity: a bound on how far the plate's nodes moved apart [m]
+      double node_spread = 0;
+      /// sum over the steps of h x the largest tangential velocity of a plate
+      /// node in v^{t+1} (components no wall holds): 0 for a rough plate [m]
+      double node_slip = 0;
+    };
+    std::vector<PlateState> plate_state;
+    std::vector<unsigned int> force_plates; ///< indices of the force-controlled plates
+    /// per plate: grid nodes (global count) and axis DoFs it moves (not held by a wall)
+    std::vector<unsigned long long> plate_nodes, plate_axis_dofs;
+    /// per force plate k: the step's response to a unit plate velocity (its
+    /// predictor velocities of soil and water, nodal pressure increment, the
+    /// weak gradients of that increment, corrected velocities)
+    struct PlateResponse
+    {
+      Vector es, ew, dp, gs, gw, vs, vw;
+    };
+    std::vector<PlateResponse> plate_response;
+    /// Check the plates against the grid (collective; InputError naming the plate).
+    void check_plates();
     // App. B.4 initialisation: the models of the elastic stage (nor sand
     // without plasticity, the others as they are), per material
     std::vector<std::shared_ptr<const materials::Material>> initialisation_models;
@@ -757,10 +830,42 @@ namespace talus::semi_implicit
                   node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
               }
           }
+    // rigid plates: the axis DoFs they move (a wall keeps what it holds), the
+    // tangential DoFs of a rough plate held at zero for both phases (as a
+    // wall), p = 0 at a permeable plate's nodes (with the drained faces below)
+    plate_of.assign(nl, no_plate);
+    plate_tangential_of.assign(nl, no_plate);
+    std::vector<unsigned char> plate_drained(nl, 0);
+    plate_sealed.assign(nl, 0);
+    plate_node_of.assign(nl, no_plate);
+    for (const auto &e : loads::rigid_plate_node_dofs(grid, prm.rigid_plates, false))
+      {
+        const auto &pl = prm.rigid_plates[e.condition];
+        plate_node_of[e.node] = e.condition;
+        if (pl.permeable)
+          plate_drained[e.node] = 1;
+        else
+          plate_sealed[e.node] = 1;
+        if (constrained[e.dof] && plate_tangential_of[e.dof] == no_plate)
+          continue; // a fixed/roller wall holds this component: it keeps it
+        if (e.component == pl.axis)
+          {
+            if (plate_of[e.dof] == no_plate) // a DoF of two plates: refused by check_plates
+              plate_of[e.dof] = e.condition;
+          }
+        else
+          {
+            plate_tangential_of[e.dof] = e.condition;
+            constrained[e.dof]         = 1;
+          }
+      }
     // drained faces: their nodes get p = 0; the water's velocity component
     // normal to such a face is free there (the soil keeps the wall condition)
     water_constrained = constrained;
     drained.assign(nl, 0);
+    for (unsigned int i = 0; i < nl; ++i)
+      if (plate_drained[i])
+        drained[i] = 1;
     for (unsigned int i = 0; i < nl; ++i)
       for (const unsigned int id : prm.drained_boundaries)
         {
@@ -778,6 +883,10 @@ namespace talus::semi_implicit
     for (Vector *v : {&Mdj, &Mjt, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
                       &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
       grid.reinit_vector(*v);
+    plate_response.resize(force_plates.size());
+    for (auto &r : plate_response)
+      for (Vector *v : {&r.es, &r.ew, &r.dp, &r.gs, &r.gw, &r.vs, &r.vw})
+        grid.reinit_vector(*v);
     partition_changed = true; // the next step rebuilds the active set and the matrix
   }
 
@@ -789,7 +898,12 @@ namespace talus::semi_implicit
     grid.setup();
     if (prm.bspline())
       grid.setup_bspline_patches();
+    plate_state.assign(prm.rigid_plates.size(), PlateState());
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      if (prm.rigid_plates[k].control == loads::RigidPlate<dim>::Control::force)
+        force_plates.push_back(k);
     grid_changed();
+    check_plates();
 
     // layouts: soil points carry the solid model's history; both carry porosity
     unsigned int n_history = 0;
@@ -812,6 +926,11 @@ namespace talus::semi_implicit
       smooth_jacobian = smooth_jacobian || (prm.smoothed_specific_volume && m->model_name() == "nor sand");
     if (smooth_jacobian)
       fs.smoothed_jacobian = soil.layout.add_extra("smoothed_jacobian", 1);
+    if (!force_plates.empty())
+      {
+        fs.plate_flux = soil.layout.add_extra("plate_flux", dim, true);
+        fw.plate_flux = water.layout.add_extra("plate_flux", dim, true);
+      }
     fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
     fw.pressure_gradient           = water.layout.add_extra("pore_pressure_gradient", dim, true);
     fw.porosity                    = water.layout.add_extra("porosity", 1);
@@ -844,6 +963,57 @@ namespace talus::semi_implicit
     balance.initial();
   }
 
+  template <int dim>
+  void
+  Solver<dim>::check_plates()
+  {
+    const unsigned int n = prm.rigid_plates.size();
+    plate_nodes.assign(n, 0);
+    plate_axis_dofs.assign(n, 0);
+    if (n == 0)
+      return;
+    // owned nodes per plate, and a node claimed by two plates
+    std::vector<unsigned int> first_plate(n_local(), no_plate);
+    unsigned int              shared = no_plate; // the later plate of a shared node
+    std::set<std::pair<unsigned int, unsigned int>> seen; // (plate, node): a rough plate lists each node dim times
+    for (const auto &e : loads::rigid_plate_node_dofs(grid, prm.rigid_plates, true))
+      if (seen.insert({e.condition, e.node}).second)
+        {
+          ++plate_nodes[e.condition];
+          if (first_plate[e.node] == no_plate)
+            first_plate[e.node] = e.condition;
+          else if (first_plate[e.node] != e.condition)
+            shared = std::min(shared, e.condition);
+        }
+    const unsigned int owned = grid.partitioner->locally_owned_size();
+    for (unsigned int i = 0; i < owned; ++i)
+      if (plate_of[i] != no_plate)
+        ++plate_axis_dofs[plate_of[i]];
+    MPI_Allreduce(MPI_IN_PLACE, plate_nodes.data(), n, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm);
+    MPI_Allreduce(MPI_IN_PLACE, plate_axis_dofs.data(), n, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm);
+    shared          = dealii::Utilities::MPI::min(shared, comm);
+    if (shared != no_plate)
+      throw InputError(prm.rigid_plates[shared].where + ": " +
+                       "shares grid nodes with an earlier plate; allowed: plates whose node sets are disjoint");
+    const char *axes = "xyz";
+    for (unsigned int k = 0; k < n; ++k)
+      {
+        const auto &pl = prm.rigid_plates[k];
+        if (plate_nodes[k] == 0)
+          throw InputError(pl.where + ": " + (pl.target == loads::RigidPlate<dim>::Target::region
+                                       ? std::string("holds no grid node: its region contains no node of the grid; "
+                                                     "allowed: a region that contains at least one grid node")
+                                       : "holds no grid node: no face of the grid has boundary id " +
+                                           std::to_string(pl.boundary)));
+        if (plate_axis_dofs[k] == 0)
+          throw InputError(pl.where + ": moves along " + std::string(1,  axes[pl.axis]) +
+                                       ", but a fixed or roller wall holds that component at every one of its " +
+                                       std::to_string(plate_nodes[k]) +
+                                       " nodes (a wall keeps the components it holds); allowed: a direction or "
+                                       "nodes that no wall holds");
+      }
+  }
+
   // ---------------------------------------------------------------- checkpoints
   // The state between two steps is the two point sets with everything they
   // carry (soil: velocity, stress, the model's history with b_e, volume,
@@ -874,6 +1044,16 @@ namespace talus::semi_implicit
                                    f.set_attribute("pressure solves", std::int64_t(n_solves));
                                    f.set_attribute("pressure cg iterations", std::int64_t(solver_iterations));
                                    f.set_attribute("pressure amg setups", std::int64_t(pressure_solver.n_setups()));
+                                   for (unsigned int k = 0; k < plate_state.size(); ++k) // the plates' state
+                                     {
+                                       const std::string a = "rigid plate " + std::to_string(k) + " ";
+                                       f.set_attribute(a + "displacement", plate_state[k].displacement);
+                                       f.set_attribute(a + "velocity", plate_state[k].velocity);
+                                       f.set_attribute(a + "force", plate_state[k].force);
+                                       f.set_attribute(a + "tangential force", plate_state[k].tangential);
+                                       f.set_attribute(a + "node spread", plate_state[k].node_spread);
+                                       f.set_attribute(a + "node slip", plate_state[k].node_slip);
+                                     }
                                    write_points(f, soil, "soil");
                                    write_points(f, water, "water");
                                    write_pvd_times(f, "output/soil_pvd", pvd_records[0]);
@@ -896,6 +1076,19 @@ namespace talus::semi_implicit
     if (fp->has_attribute("pressure amg setups"))
       pressure_solver.set_n_setups(fp->get_int("pressure amg setups"));
     const std::string where = "checkpoint " + fp->path();
+    for (unsigned int k = 0; k < plate_state.size(); ++k)
+      {
+        const std::string a = "rigid plate " + std::to_string(k) + " ";
+        require(fp->has_attribute(a + "displacement"), where,
+                "has no state of 'boundary conditions/rigid plate " + std::to_string(k) +
+                  "' (written by a run without it); allowed: a checkpoint of the same scene");
+        plate_state[k].displacement = fp->get_double(a + "displacement");
+        plate_state[k].velocity     = fp->get_double(a + "velocity");
+        plate_state[k].force        = fp->get_double(a + "force");
+        plate_state[k].tangential   = fp->get_double(a + "tangential force");
+        plate_state[k].node_spread  = fp->get_double(a + "node spread");
+        plate_state[k].node_slip    = fp->get_double(a + "node slip");
+      }
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, soil, grid, where, "soil");
     read_points(*fp, water, grid, where, "water");
@@ -1021,6 +1214,24 @@ namespace talus::semi_implicit
         << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant)) << "), pressure: CG + ML AMG to "
         << prm.pressure_tolerance << " relative residual, AMG rebuilt every "
         << prm.pressure_rebuild_interval << " steps" << std::endl;
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        const auto &pl = prm.rigid_plates[k];
+        out << "  " << pl.where << ": "
+            << (pl.target == loads::RigidPlate<dim>::Target::boundary ? "boundary id " + std::to_string(pl.boundary)
+                                                                        : std::string("region"))
+            << ", " << plate_nodes[k] << " nodes"
+            << (plate_axis_dofs[k] < plate_nodes[k]
+                  ? " (" + std::to_string(plate_axis_dofs[k]) + " move along " + "xyz"[pl.axis] +
+                      ", the others' " + "xyz"[pl.axis] + " is held by a wall)"
+                  : std::string(" moving along ") + "xyz"[pl.axis])
+            << ", " << (pl.rough ? "rough" : "frictionless") << ", "
+            << (pl.permeable ? "permeable" : "impermeable") << ", "
+            << (pl.control == loads::RigidPlate<dim>::Control::force
+                  ? "force control: " + number_text(pl.force) + " N x f(t), displacement unknown"
+                  : "displacement control: " + number_text(pl.displacement) + " m x f(t), reaction reported")
+            << std::endl;
+      }
   }
 
   // ---------------------------------------------------------------- the step
@@ -1180,6 +1391,21 @@ namespace talus::semi_implicit
     // whose sum is the mixture equation (52); the printed sequence takes v_s^t
     // in the drag of (53), which amplifies v_s - v_w by about M_w / M_s per step
     // where M_w > M_s (the nodes at a free-water interface; docs/semi-implicit.md)
+    // Rigid plates (docs/semi-implicit.md 'Rigid plate'): at a plate's axis
+    // DoFs the soil moves with the plate, v_s* = V; the water too when the
+    // plate is impermeable (v_w* = V), else its own row with v_s = V. V is the
+    // history's for displacement control; for force control the step is
+    // solved for V = 0 and, per force plate, for a unit V (es, ew here, the
+    // pressure increment and correction below); V follows from the plate's
+    // momentum balance at the end of the step.
+    const unsigned int  n_plates = prm.rigid_plates.size();
+    std::vector<double> plate_v(n_plates, 0.0);
+    for (unsigned int k = 0; k < n_plates; ++k)
+      if (prm.rigid_plates[k].control == loads::RigidPlate<dim>::Control::displacement)
+        plate_v[k] = (prm.rigid_plates[k].displacement_at(time + h) - plate_state[k].displacement) / h;
+    for (auto &r : plate_response)
+      for (Vector *v : {&r.es, &r.ew, &r.dp, &r.gs, &r.gw})
+        *v = 0;
     for (unsigned int i = 0; i < nl; ++i)
       {
         const unsigned int j   = node_of[i];
@@ -1206,6 +1432,25 @@ namespace talus::semi_implicit
           vs = 0;
         if (water_constrained[i])
           vw = 0;
+        if (const unsigned int k = plate_of[i]; k != no_plate)
+          {
+            const bool permeable = prm.rigid_plates[k].permeable;
+            // the water's factor of V: 1 (impermeable), its row's drag share
+            // (permeable, with soil at the node), 0 (no coupling)
+            const double ew = !permeable ? (has_water ? 1.0 : 0.0)
+                                         : (has_soil && has_water ? h * Q / (Mwi + h * Q) : 0.0);
+            vs = plate_v[k];
+            if (!permeable)
+              vw = ew * plate_v[k];
+            else if (has_soil && has_water)
+              vw = (rwv + h * Q * plate_v[k]) / (Mwi + h * Q);
+            for (unsigned int r = 0; r < force_plates.size(); ++r)
+              if (force_plates[r] == k)
+                {
+                  plate_response[r].es.local_element(i) = 1.0;
+                  plate_response[r].ew.local_element(i) = ew;
+                }
+          }
         vw_star.local_element(i) = vw;
         vs_star.local_element(i) = vs;
       }
@@ -1292,8 +1537,9 @@ namespace talus::semi_implicit
           }
     }
     exchange({&near_wet});
-    dealii::AffineConstraints<double> dirichlet;
+    dealii::AffineConstraints<double> dirichlet, dirichlet_homogeneous; // the second: a plate's unit response
     dirichlet.reinit(pspace.locally_relevant_dofs());
+    dirichlet_homogeneous.reinit(pspace.locally_relevant_dofs());
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
         {
@@ -1301,10 +1547,11 @@ namespace talus::semi_implicit
           if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
             continue;
           const bool has_water = Mw.local_element(i) > mw_cut;
-          const bool surface   = dry.local_element(i) > 0;
+          const bool surface   = dry.local_element(i) > 0 && !plate_sealed[i];
           if (has_water && drained[i]) // a drained face: p^{t+1} = 0
             {
               dirichlet.add_line(gdof);
+              dirichlet_homogeneous.add_line(gdof);
               dirichlet.set_inhomogeneity(gdof, -p_node.local_element(i));
             }
           else if (!has_water || surface)
@@ -1318,10 +1565,12 @@ namespace talus::semi_implicit
               // pressure step every step (docs/semi-implicit.md, A6).
               const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
               dirichlet.add_line(gdof);
+              dirichlet_homogeneous.add_line(gdof);
               dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
             }
         }
     dirichlet.close();
+    dirichlet_homogeneous.close();
     const auto constraints = active.constraints_with(dirichlet);
     if (new_pattern)
       {
@@ -1364,6 +1613,65 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
         dp_node.local_element(i) = dp_solution(pspace.node_dof(i, 0));
+
+    // rigid plates under force control: the pressure increment of a unit
+    // plate velocity, on the same matrix and hierarchy, with homogeneous
+    // Dirichlet values (the equation is linear in V: dp = dp(V = 0) + V dp_1)
+    if (!force_plates.empty())
+      {
+        // without any Dirichlet row the pressure is fixed only up to a
+        // constant and a plate's unit inflow has no consistent answer
+        const unsigned int n_dirichlet = dealii::Utilities::MPI::sum(static_cast<unsigned int>(dirichlet.n_constraints()), comm);
+        require(n_dirichlet > 0, prm.rigid_plates[force_plates[0]].where,
+                "the pore water has no pressure reference: no free surface, drained boundary or permeable plate "
+                "(a closed, impermeable box); allowed: 'drainage = permeable', 'semi implicit/drained boundaries', "
+                "or water with a free surface");
+        const auto constraints_h = active.constraints_with(dirichlet_homogeneous);
+        for (auto &r : plate_response)
+          {
+            const double *es = at(r.es), *ew = at(r.ew);
+            transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+              double *P = it->get_properties().data();
+              double  v[dim];
+              s.vector_value(es, v);
+              for (unsigned int d = 0; d < dim; ++d)
+                P[fs.plate_flux + d] = (1 - P[fs.porosity]) * v[d];
+            });
+            transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
+              double *P = it->get_properties().data();
+              double  v[dim];
+              s.vector_value(ew, v);
+              for (unsigned int d = 0; d < dim; ++d)
+                P[fw.plate_flux + d] = P[fw.porosity] * v[d];
+            });
+            Vector rhs1, x1;
+            pspace.reinit_vector(rhs1);
+            pspace.reinit_vector(x1);
+            const PoissonFluxSource terms[2] = {{fs.plate_flux}, {fw.plate_flux}};
+            transfer::AssembleSystem<dim, K, 1, PoissonFluxSource> assembly(active, constraints_h, terms[0], nullptr, &rhs1);
+            transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
+                                                 [&](const unsigned int k) { assembly.integrand = terms[k]; });
+            transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, nullptr, &rhs1);
+            const auto          t0 = Clock::now();
+            LinearSolverOptions options;
+            options.method             = LinearSolverOptions::Method::cg_amg;
+            options.relative_tolerance = prm.pressure_tolerance;
+            if (rhs1.l2_norm() > 0)
+              {
+                const auto info = pressure_solver.solve(A, x1, rhs1, options, step_number);
+                solver_iterations += info.iterations;
+                last_solve.iterations += info.iterations;
+                last_solve.relative_residual = std::max(last_solve.relative_residual, info.relative_residual);
+              }
+            constraints_h.distribute(x1);
+            x1.update_ghost_values();
+            seconds_solve += seconds_since(t0);
+            for (unsigned int i = 0; i < nl; ++i)
+              if (component[i] == 0)
+                r.dp.local_element(i) = x1(pspace.node_dof(i, 0));
+          }
+        lap = Clock::now();
+      }
     }
 
     // (6) correction (64)-(68): sum V N grad(Delta p) over each phase's points
@@ -1373,20 +1681,152 @@ namespace talus::semi_implicit
       transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, gsv);
       transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), dpn, L::volume, gwv);
     }
+    for (auto &r : plate_response) // the unit responses' pressure forces
+      {
+        const double *dpn = at(r.dp);
+        transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, at(r.gs));
+        transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), dpn, L::volume, at(r.gw));
+        exchange({&r.gs, &r.gw});
+      }
     exchange({&gs, &gw});
     add_lap(phase.p2n);
+    // v^{t+1} from v* and the pressure increment's force; a plate's axis DoF
+    // moves with its velocity Vp[k] (the water too at an impermeable plate)
+    const auto correct = [&](const unsigned int i, const double vss, const double vws, const double gsi, const double gwi,
+                             const double *Vp, double &vs, double &vw) {
+      const unsigned int j   = node_of[i];
+      const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
+      vw = Mwi > 0 ? vws + h * n * gwi / Mwi : 0.0;
+      vs = Msi > ms_cut && !prm.rigid_skeleton ? vss + h * (1 - n) * gsi / Msi : 0.0;
+      if (constrained[i])
+        vs = 0;
+      if (water_constrained[i])
+        vw = 0;
+      if (const unsigned int k = plate_of[i]; k != no_plate)
+        {
+          vs = Vp[k];
+          if (!prm.rigid_plates[k].permeable)
+            vw = Mwi > 0 ? Vp[k] : 0.0;
+        }
+    };
     for (unsigned int i = 0; i < nl; ++i)
+      correct(i, vs_star.local_element(i), vw_star.local_element(i), gs.local_element(i), gw.local_element(i),
+              plate_v.data(), vs_new.local_element(i), vw_new.local_element(i));
+    if (n_plates > 0)
       {
-        const unsigned int j   = node_of[i];
-        const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
-        double vw = Mwi > 0 ? vw_star.local_element(i) + h * n * gw.local_element(i) / Mwi : 0.0;
-        double vs = Msi > ms_cut && !prm.rigid_skeleton ? vs_star.local_element(i) + h * (1 - n) * gs.local_element(i) / Msi : 0.0;
-        if (constrained[i])
-          vs = 0;
-        if (water_constrained[i])
-          vw = 0;
-        vw_new.local_element(i) = vw;
-        vs_new.local_element(i) = vs;
+        // The plates' momentum balance at the end of the step. Per plate j the
+        // force it exerts on the material along its axis is the mixture's
+        // residual over its owned axis DoFs (the drag between the phases
+        // cancels in the sum; at a permeable plate the water's own row is
+        // satisfied, so what remains is the soil's with the drag):
+        //   R_j = sum [M_s (v_s - v_s^t) + M_w (v_w - v_w^t)] / h
+        //         - F_s - M_w b - (1 - n)(G_s p^t + g_s) - n (G_w p^t + g_w),
+        // g_s, g_w the weak gradients of the pressure increment. Every term is
+        // affine in the force plates' velocities: R = R0 + R1 V, R0 from the
+        // step with V = 0, column r of R1 from force plate r's unit response.
+        const unsigned int owned = grid.partitioner->locally_owned_size();
+        const unsigned int nf    = force_plates.size();
+        // R0 (the V = 0 step, displacement plates at their velocities) and R1
+        std::vector<double> R(n_plates * (1 + nf), 0.0);
+        const auto add_residual = [&](const unsigned int column, const Vector &vsn, const Vector &vwn, const Vector &gsv,
+                                      const Vector &gwv, const bool base) {
+          for (unsigned int i = 0; i < owned; ++i)
+            if (const unsigned int k = plate_of[i]; k != no_plate)
+              {
+                const unsigned int j   = node_of[i];
+                const double       Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
+                double r = (Msi * vsn.local_element(i) + Mwi * vwn.local_element(i)) / h -
+                           (1 - n) * gsv.local_element(i) - n * gwv.local_element(i);
+                if (base)
+                  r -= (Msi * vs_t.local_element(i) + Mwi * vw_t.local_element(i)) / h + Fs.local_element(i) +
+                       Mwi * g[component[i]] + (1 - n) * Gps.local_element(i) + n * Gpw.local_element(i);
+                R[column * n_plates + k] += r;
+              }
+        };
+        add_residual(0, vs_new, vw_new, gs, gw, true);
+        for (unsigned int r = 0; r < nf; ++r)
+          {
+            PlateResponse &u = plate_response[r];
+            std::vector<double> unit(n_plates, 0.0);
+            unit[force_plates[r]] = 1.0;
+            for (unsigned int i = 0; i < nl; ++i)
+              correct(i, u.es.local_element(i), u.ew.local_element(i), u.gs.local_element(i), u.gw.local_element(i),
+                      unit.data(), u.vs.local_element(i), u.vw.local_element(i));
+            add_residual(1 + r, u.vs, u.vw, u.gs, u.gw, false);
+          }
+        // the same sums, so the same V, on every rank
+        MPI_Allreduce(MPI_IN_PLACE, R.data(), static_cast<int>(R.size()), MPI_DOUBLE, MPI_SUM, comm);
+        // force control: sum_r R1(f_q, r) V_r = F_q(t + h) - R0(f_q) (Gauss, nf <= 4)
+        if (nf > 0)
+          {
+            std::vector<double> a(nf * nf), x(nf);
+            for (unsigned int q = 0; q < nf; ++q)
+              {
+                const auto &pl = prm.rigid_plates[force_plates[q]];
+                for (unsigned int r = 0; r < nf; ++r)
+                  a[q * nf + r] = R[(1 + r) * n_plates + force_plates[q]];
+                x[q] = pl.force_at(time + h) - R[force_plates[q]];
+                if (!(a[q * nf + q] > 0))
+                  throw InstabilityError(pl.where + ": the plate touches no material (its nodes carry no mass), so "
+                                         "its velocity under a force is undetermined");
+              }
+            for (unsigned int c = 0; c < nf; ++c) // no pivoting: R1 is dominated by its diagonal (mass / h)
+              for (unsigned int q = c + 1; q < nf; ++q)
+                {
+                  const double f = a[q * nf + c] / a[c * nf + c];
+                  for (unsigned int r = c; r < nf; ++r)
+                    a[q * nf + r] -= f * a[c * nf + r];
+                  x[q] -= f * x[c];
+                }
+            for (unsigned int c = nf; c-- > 0;)
+              {
+                for (unsigned int r = c + 1; r < nf; ++r)
+                  x[c] -= a[c * nf + r] * x[r];
+                x[c] /= a[c * nf + c];
+              }
+            for (unsigned int r = 0; r < nf; ++r)
+              {
+                const double   V = x[r];
+                PlateResponse &u = plate_response[r];
+                plate_v[force_plates[r]] = V;
+                for (unsigned int i = 0; i < nl; ++i) // owned and ghost entries alike
+                  {
+                    vs_new.local_element(i) += V * u.vs.local_element(i);
+                    vw_new.local_element(i) += V * u.vw.local_element(i);
+                    dp_node.local_element(i) += V * u.dp.local_element(i);
+                    gs.local_element(i) += V * u.gs.local_element(i);
+                    gw.local_element(i) += V * u.gw.local_element(i);
+                  }
+              }
+          }
+        // the tangential reaction of a rough plate: the same residual over its
+        // held tangential DoFs, per component
+        std::vector<double> T(n_plates * dim, 0.0);
+        for (unsigned int i = 0; i < owned; ++i)
+          if (const unsigned int k = plate_tangential_of[i]; k != no_plate)
+            {
+              const unsigned int j   = node_of[i];
+              const double       Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
+              T[k * dim + component[i]] +=
+                (Msi * (vs_new.local_element(i) - vs_t.local_element(i)) + Mwi * (vw_new.local_element(i) - vw_t.local_element(i))) / h -
+                Fs.local_element(i) - Mwi * g[component[i]] - (1 - n) * (Gps.local_element(i) + gs.local_element(i)) -
+                n * (Gpw.local_element(i) + gw.local_element(i));
+            }
+        MPI_Allreduce(MPI_IN_PLACE, T.data(), static_cast<int>(T.size()), MPI_DOUBLE, MPI_SUM, comm);
+        for (unsigned int k = 0; k < n_plates; ++k)
+          {
+            PlateState &st = plate_state[k];
+            double      f  = R[k];
+            for (unsigned int r = 0; r < nf; ++r)
+              f += R[(1 + r) * n_plates + k] * plate_v[force_plates[r]];
+            double t2 = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              t2 += T[k * dim + d] * T[k * dim + d];
+            st.velocity = plate_v[k];
+            st.displacement += plate_v[k] * h;
+            st.force      = f;
+            st.tangential = std::sqrt(t2);
+          }
       }
     add_lap(phase.grid);
 
@@ -1427,6 +1867,31 @@ namespace talus::semi_implicit
       {
         const double m          = Ms.local_element(node_of[i]);
         vs_t.local_element(i)   = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
+        if (plate_of[i] != no_plate) // the plate's velocity, as the walls' zero (A11)
+          vs_t.local_element(i) = plate_v[plate_of[i]];
+      }
+    if (!prm.rigid_plates.empty()) // what the nodes moved the soil with: node_spread
+      {
+        // [0, n): axis spread; [n, 2n): tangential slip of the nodes
+        const unsigned int  np = prm.rigid_plates.size();
+        std::vector<double> spread(2 * np, 0.0);
+        for (unsigned int i = 0; i < grid.partitioner->locally_owned_size(); ++i)
+          {
+            const unsigned int k = plate_node_of[node_of[i]];
+            if (k == no_plate)
+              continue;
+            if (plate_of[i] != no_plate)
+              spread[k] = std::max({spread[k], std::abs(vs_new.local_element(i) - plate_v[k]),
+                                    std::abs(vs_t.local_element(i) - plate_v[k])});
+            else if (component[i] != prm.rigid_plates[k].axis && (!constrained[i] || plate_tangential_of[i] != no_plate))
+              spread[np + k] = std::max({spread[np + k], std::abs(vs_new.local_element(i)), std::abs(vs_t.local_element(i))});
+          }
+        MPI_Allreduce(MPI_IN_PLACE, spread.data(), static_cast<int>(spread.size()), MPI_DOUBLE, MPI_MAX, comm);
+        for (unsigned int k = 0; k < np; ++k)
+          {
+            plate_state[k].node_spread += 2 * h * spread[k];
+            plate_state[k].node_slip += h * spread[np + k];
+          }
       }
     add_lap(phase.n2p);
 
@@ -1730,6 +2195,13 @@ namespace talus::semi_implicit
     std::vector<std::string> c = {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
                                   "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume",
                                   "load_settlement", "pressure_amg_setups"};
+    for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
+      c.push_back(name);
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k) // this family's check that the nodes move as one
+      {
+        c.push_back("plate_" + std::to_string(k) + "_node_spread");
+        c.push_back("plate_" + std::to_string(k) + "_node_slip");
+      }
     balance.add_series_column(c);
     return c;
   }
@@ -1771,6 +2243,18 @@ namespace talus::semi_implicit
                              dealii::Utilities::MPI::sum(soil_volume, comm),
                              fsum > 0 ? fu / fsum : 0.0,
                              static_cast<double>(pressure_solver.n_setups())};
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        v.push_back(plate_state[k].displacement);
+        v.push_back(plate_state[k].force);
+        if (prm.rigid_plates[k].rough)
+          v.push_back(plate_state[k].tangential);
+      }
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        v.push_back(plate_state[k].node_spread);
+        v.push_back(plate_state[k].node_slip);
+      }
     balance.add_series_value(v);
     return v;
   }
