@@ -1,5 +1,5 @@
 // talus — point ops of the implicit updated-Lagrangian step (seed 001 §4.4,
-// Algorithm 1) on the walk of cell_walk.h:
+// Algorithm 1) on the walk of transfer/cell_walk.h:
 //
 //   UpdatedLagrangianForce   integrand for AssembleSystem: the residual
 //                            f_int - f_ext and the consistent tangent
