@@ -677,8 +677,8 @@ namespace talus::transfer
     std::vector<double> &      jbar;
 
     static constexpr bool prefetch_location = false;
-    typename K::Cell      cell;
-    double                un[K::n_nodes][dim];
+    typename K::Cell      cell{};
+    double                un[K::n_nodes][dim]{};
     double                sum_vj = 0, sum_v = 0;
 
     inline void
