@@ -272,7 +272,7 @@ TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles2D) { relocation_and_m
 TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline, true); }
 
 // ---------------------------------------------------------------- APIC (issue 12)
-// numerics/velocity transfer = apic (transfer/affine_ops.h). A rigidly rotating
+// numerics/velocity transfer = apic (formulations/explicit/affine_ops.h). A rigidly rotating
 // body: the P2G with the affine term must hand the grid exactly the points'
 // linear momentum sum m v and angular momentum sum m (x x v + eps : (C D)^T),
 // for any C_p (here the rotation's W plus a random perturbation); and the
@@ -280,9 +280,9 @@ TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles3D) { relocation_and_m
 // (G2P of v_i = W x_i gives v_p = W x_p, C_p = W; P2G of that gives back
 // v_i = W x_i at every node with mass), which FLIP/PIC do not (PIC loses the
 // rotation's angular momentum). Both kernels; 1 and 2 ranks.
+#include <talus/formulations/explicit/affine_ops.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
-#include <talus/transfer/affine_ops.h>
 
 /// node positions into a vector of the grid's layout (component d at the DoF of component d)
 template <int dim>

@@ -7,7 +7,7 @@
 // the shared entries; mass scaling below 1 is refused.
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
-#include <talus/loads/load_control.h>
+#include <talus/formulations/explicit/load_control.h>
 #include <talus/loads/time_function.h>
 
 #include <deal.II/base/mpi.h>

@@ -1,6 +1,6 @@
 // NodalSpace / ActiveSet and the matrix path of the implicit families
-// (grid/nodal_space.h, transfer/matrix_ops.h, solvers/linear_solver.h), for the
-// Q1 and the quadratic B-spline kernel, 2D and 3D:
+// (grid/nodal_space.h, transfer/active_set.h, transfer/matrix_ops.h,
+// solvers/linear_solver.h), for the Q1 and the quadratic B-spline kernel, 2D and 3D:
 //  * the sparsity covers the active region only: inactive rows hold their
 //    diagonal and nothing else; Q1: exactly the couplings of the cells with
 //    points; B-spline: only nodes within one 3-node window of each other;
@@ -16,6 +16,7 @@
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
 #include <talus/solvers/linear_solver.h>
+#include <talus/transfer/active_set.h>
 #include <talus/transfer/matrix_ops.h>
 #include <talus/transfer/point_ops.h>
 

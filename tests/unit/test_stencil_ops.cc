@@ -11,6 +11,7 @@
 #include <talus/particles/material_point_set.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
+#include <talus/transfer/active_set.h>
 #include <talus/transfer/stencil_ops.h>
 
 #include <deal.II/base/mpi.h>

@@ -97,6 +97,17 @@ namespace talus::io
         }
       return det;
     }
+
+    /// Sorts the first n (2 or 4) vertices of a face key. An insertion sort:
+    /// std::sort on the 4-entry array makes gcc 12 warn (-Warray-bounds) about
+    /// its branch for more than 16 entries, which is never taken.
+    void
+    sort_face_key(std::array<unsigned int, 4> &key, const unsigned int n)
+    {
+      for (unsigned int i = 1; i < n; ++i)
+        for (unsigned int j = i; j > 0 && key[j - 1] > key[j]; --j)
+          std::swap(key[j - 1], key[j]);
+    }
   } // namespace
 
   std::string
@@ -304,7 +315,7 @@ namespace talus::io
             for (unsigned int v = 0; v < nv; ++v)
               if (((v >> d) & 1u) == side)
                 key[k++] = m.cells[c * nv + v];
-            std::sort(key.begin(), key.begin() + nf);
+            sort_face_key(key, nf);
             cell_faces.push_back(key);
           }
     std::sort(cell_faces.begin(), cell_faces.end());
@@ -312,7 +323,7 @@ namespace talus::io
       {
         Key key{};
         std::copy(m.faces.begin() + k * nf, m.faces.begin() + (k + 1) * nf, key.begin());
-        std::sort(key.begin(), key.begin() + nf);
+        sort_face_key(key, nf);
         const auto range = std::equal_range(cell_faces.begin(), cell_faces.end(), key);
         const auto count = range.second - range.first;
         if (count != 1)

@@ -36,12 +36,6 @@ namespace talus::io
       MPI_Comm_rank(c, &r);
       return r;
     }
-    int size_of(MPI_Comm c)
-    {
-      int s = 1;
-      MPI_Comm_size(c, &s);
-      return s;
-    }
   } // namespace
 
   std::pair<std::uint64_t, std::uint64_t> block_range(const std::uint64_t n, const unsigned int rank,

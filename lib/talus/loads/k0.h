@@ -1,5 +1,5 @@
 // talus — the K0 procedure's stress (seed 000 §6.4; tension positive), the one
-// formula shared by the solvers' initial state (loads/load_control.cc) and the
+// formula shared by the solvers' initial state (formulations/explicit/load_control.cc) and the
 // particle files of talus-mesh (mesh/prepare.cc).
 #pragma once
 

@@ -9,7 +9,7 @@
 // here too; their time functions and how a family enforces them (the explicit
 // a = (vbar - v^t)/h, an implicit increment constraint) stay with the family.
 // Explicit-only loads (damping, mass scaling, convergence, wall friction)
-// stay in loads/load_control.
+// stay in the explicit family (formulations/explicit/load_control).
 #pragma once
 
 #include <talus/grid/background_grid.h>

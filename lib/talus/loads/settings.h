@@ -2,7 +2,7 @@
 // local damping, quasi-static convergence, mass scaling, K0 initial stresses
 // and staged calculations of the explicit solver (seed 000 §4.3.2, §5.2, §6.2,
 // §6.3-§6.5). Pure data plus declaration/parsing; the run-time logic is in
-// load_control.h.
+// formulations/explicit/load_control.h.
 #pragma once
 
 #include <talus/grid/background_grid.h>

@@ -212,7 +212,7 @@ namespace talus::materials
                                    Stress &                    tau,
                                    dealii::Tensor<4, 3> *      dtau_ddF) const
   {
-    const double detf = checked_increment_jacobian(dF, *this);
+    checked_increment_jacobian(dF, *this); // throws for det dF <= 0 (an inverted point)
     const Stress b_n = fs::load_sym(history_old, 0);
     const Stress b   = symmetrize(dF * dealii::Tensor<2, 3>(b_n) * transpose(dF));
     fs::store_sym(b, history_new, 0);

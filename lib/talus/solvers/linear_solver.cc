@@ -33,7 +33,7 @@ namespace talus
            const Vector &                                        b,
            const LinearSolverOptions &                           options,
            const dealii::TrilinosWrappers::PreconditionAMG &     preconditioner,
-           const typename KrylovSolver::AdditionalData &         data = {})
+           const typename KrylovSolver::AdditionalData &         data = typename KrylovSolver::AdditionalData())
     {
       // AztecOO's criterion is absolute (|r| <= tol, unscaled)
       dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b.l2_norm());

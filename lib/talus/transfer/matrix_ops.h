@@ -16,9 +16,9 @@
 // matrix (inactive rows get a diagonal of the matrix's scale).
 #pragma once
 
-#include <talus/grid/nodal_space.h>
 #include <talus/particles/material_points.h>
 #include <talus/shape/window3.h>
+#include <talus/transfer/active_set.h>
 #include <talus/transfer/cell_walk.h>
 
 #include <deal.II/base/numbers.h>

@@ -256,7 +256,7 @@ namespace talus::transfer
     StencilCache<dim, K> &     cache;
     static constexpr bool      prefetch_location = false;
     unsigned int               index = 0; ///< the point's place in the walk
-    typename K::Cell           cell;      ///< of cell `cell_of`, made at its first miss
+    typename K::Cell           cell{};    ///< of cell `cell_of`, made at its first miss
     unsigned int               cell_of = dealii::numbers::invalid_unsigned_int;
 
     inline void

@@ -1,5 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/explicit/affine_ops.h>
+#include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/formulations/explicit/with_kernel.h>
@@ -12,8 +14,6 @@
 #include <talus/io/vtu.h>
 #include <talus/io/png_snapshots.h>
 #include <talus/loads/kinematics.h>
-#include <talus/loads/load_control.h>
-#include <talus/transfer/affine_ops.h>
 #include <talus/transfer/point_ops.h>
 #include <talus/materials/strain_increments.h>
 

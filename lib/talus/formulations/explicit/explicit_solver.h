@@ -111,7 +111,7 @@ namespace talus::explicit_mpm
 
     /// P2G of the points' momentum m v into v (zeroed first; compressed).
     /// Collective. Used by the loads (nodal velocity before the step). With
-    /// velocity transfer = apic: m (v + C_p (x_i - x_p)) (transfer/affine_ops.h).
+    /// velocity transfer = apic: m (v + C_p (x_i - x_p)) (formulations/explicit/affine_ops.h).
     void scatter_point_momentum(Vector &v);
     /// Offset of the APIC affine matrix C_p (dim x dim, row-major) in the point
     /// properties; 0 when velocity transfer = flip (no such block).

@@ -1,8 +1,8 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
+#include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/with_kernel.h>
-#include <talus/loads/load_control.h>
 #include <talus/shape/q1.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/move_point.h>

@@ -7,10 +7,10 @@
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/implicit/implicit_solver.h>
+#include <talus/formulations/implicit/updated_lagrangian_ops.h>
 #include <talus/io/output.h>
 #include <talus/loads/kinematics.h>
 #include <talus/shape/with_kernel.h>
-#include <talus/transfer/updated_lagrangian_ops.h>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/solver_control.h>

@@ -22,6 +22,7 @@
 #include <talus/loads/settings.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/solvers/linear_solver.h>
+#include <talus/transfer/active_set.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/lac/affine_constraints.h>

@@ -35,6 +35,7 @@
 #include <talus/grid/nodal_space.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_point_set.h>
+#include <talus/transfer/active_set.h>
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>

@@ -27,6 +27,7 @@
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1_box.h>
 #include <talus/solvers/linear_solver.h>
+#include <talus/transfer/active_set.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/matrix_ops.h>
 #include <talus/transfer/point_ops.h>

@@ -1,5 +1,5 @@
 // talus — point ops of the implicit updated-Lagrangian step (seed 001 §4.4,
-// Algorithm 1) on the walk of cell_walk.h:
+// Algorithm 1) on the walk of transfer/cell_walk.h:
 //
 //   UpdatedLagrangianForce   integrand for AssembleSystem: the residual
 //                            f_int - f_ext and the consistent tangent
@@ -677,8 +677,8 @@ namespace talus::transfer
     std::vector<double> &      jbar;
 
     static constexpr bool prefetch_location = false;
-    typename K::Cell      cell;
-    double                un[K::n_nodes][dim];
+    typename K::Cell      cell{};
+    double                un[K::n_nodes][dim]{};
     double                sum_vj = 0, sum_v = 0;
 
     inline void

@@ -1,5 +1,5 @@
 // talus — the affine particle-in-cell transfer (APIC, Jiang et al. 2015) as ops
-// of the shared cell walk (cell_walk.h), for both box kernels (shape::Q1Box,
+// of the shared cell walk (transfer/cell_walk.h), for both box kernels (shape::Q1Box,
 // shape::BSpline2Box). Selected by numerics/velocity transfer = apic; the FLIP
 // ops of point_ops.h are untouched. docs/shape-functions.md, section "APIC".
 //

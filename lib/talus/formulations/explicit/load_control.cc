@@ -1,9 +1,9 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/with_kernel.h>
 #include <talus/loads/k0.h>
 #include <talus/loads/kinematics.h>
-#include <talus/loads/load_control.h>
 #include <talus/loads/local_damping.h>
 #include <talus/shape/q1.h>
 #include <talus/transfer/cell_walk.h>
