@@ -765,7 +765,7 @@ namespace talus::explicit_mpm
       }
     };
 
-    /// The same physics with the APIC G2P of the velocity (transfer/affine_ops.h):
+    /// The same physics with the APIC G2P of the velocity (formulations/explicit/affine_ops.h):
     /// v_p and C_p from the nodal velocity of the update pass (v^L), instead of
     /// the FLIP increment of the separate G2P/P2G pass.
     template <int dim, class K>
