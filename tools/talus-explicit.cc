@@ -1,5 +1,6 @@
 // talus-explicit: explicit dynamic MPM (Anura3D-style), driven by a .prm file.
 #include <talus/base/tool.h>
+#include <talus/formulations/common/tool_options.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 
@@ -15,6 +16,6 @@ main(int argc, char **argv)
   tool.declare = &talus::explicit_mpm::declare_parameters;
   tool.check   = &talus::explicit_mpm::check_scene;
   tool.run     = &talus::explicit_mpm::run;
-  tool.options = {{"--restart", "resume from the newest valid checkpoint (same as 'checkpoint/restart = true')"}};
+  tool.options = talus::formulation_tool_options();
   return talus::run_tool(argc, argv, tool);
 }

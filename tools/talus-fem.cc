@@ -3,6 +3,7 @@
 // 'ul-fem' for the updated Lagrangian variant). Same .prm, same time loop,
 // same outputs as talus-explicit; see docs/fem.md.
 #include <talus/base/tool.h>
+#include <talus/formulations/common/tool_options.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 
@@ -22,6 +23,6 @@ main(int argc, char **argv)
   };
   tool.check   = &talus::explicit_mpm::check_scene;
   tool.run     = &talus::explicit_mpm::run;
-  tool.options = {{"--restart", "resume from the newest valid checkpoint (same as 'checkpoint/restart = true')"}};
+  tool.options = talus::formulation_tool_options();
   return talus::run_tool(argc, argv, tool);
 }

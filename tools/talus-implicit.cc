@@ -1,5 +1,6 @@
 // talus-implicit: implicit updated-Lagrangian MPM (seed 001, Iaconeta 2019), driven by a .prm file.
 #include <talus/base/tool.h>
+#include <talus/formulations/common/tool_options.h>
 #include <talus/formulations/implicit/implicit_solver.h>
 
 int
@@ -16,5 +17,6 @@ main(int argc, char **argv)
   tool.declare = &talus::implicit_mpm::declare_parameters;
   tool.check   = &talus::implicit_mpm::check_scene;
   tool.run     = &talus::implicit_mpm::run;
+  tool.options = talus::formulation_tool_options();
   return talus::run_tool(argc, argv, tool);
 }

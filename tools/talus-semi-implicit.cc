@@ -1,6 +1,7 @@
 // talus-semi-implicit: the semi-implicit two-phase double-point MPM (seed 002),
 // driven by a .prm file.
 #include <talus/base/tool.h>
+#include <talus/formulations/common/tool_options.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 
 int
@@ -17,5 +18,6 @@ main(int argc, char **argv)
   tool.declare = &talus::semi_implicit::declare_parameters;
   tool.check   = &talus::semi_implicit::check_parameters;
   tool.run     = &talus::semi_implicit::run;
+  tool.options = talus::formulation_tool_options();
   return talus::run_tool(argc, argv, tool);
 }

@@ -281,12 +281,13 @@ namespace
     EXPECT_LT(tangent_error<3>(neo_hookean, "dynamic", 1e-2, 0, 9.81, rayleigh_beta), 1e-6);
   }
 
-  // 'shape function = quadratic bspline': every transfer on the B-spline basis
+  // 'numerics/shape function = quadratic bspline': every transfer on the B-spline basis
   // (a point couples the 3^dim nodes of its window, the walls' modified
   // splines at x = 0 and at the grid's faces). Mixed u-p couples the 4^dim
   // patch of a cell through the PPP cell means (ActiveSet::Reach::cell: with
   // the point pattern the assembly throws on an entry outside the sparsity).
-  const std::string bspline = " set shape function = quadratic bspline\n";
+  // ('numerics/shape function': the text leaves 'implicit', sets it and enters 'implicit' again)
+  const std::string bspline = "end\nsubsection numerics\n set shape function = quadratic bspline\nend\nsubsection implicit\n";
   TEST(ImplicitTangent, BSplineNeoHookeanStatic2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, bspline), 1e-6);

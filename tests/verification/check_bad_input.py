@@ -69,6 +69,28 @@ cases.update({
     "unknown velocity transfer": (tv.prm_set(base, "numerics/velocity transfer", "pic"),
                                   ["velocity transfer", "pic", "flip|apic"]),
 })
+# rigid plates (issue 37): each refused before any output, naming the plate
+plate = tv.prm_set(base, "boundary conditions/number of rigid plates", "1")
+plate = tv.prm_set(plate, "boundary conditions/rigid plate 0/boundary id", "1")
+plate = tv.prm_set(plate, "boundary conditions/rigid plate 0/direction", "x")
+plate = tv.prm_set(plate, "boundary conditions/rigid plate 0/total force", "-1")
+region = tv.prm_set(tv.prm_set(plate, "boundary conditions/rigid plate 0/apply to", "region"),
+                    "boundary conditions/rigid plate 0/region lower corner", "0.01, 0.005")
+cases.update({
+    "plate with a force and a displacement": (
+        tv.prm_set(plate, "boundary conditions/rigid plate 0/displacement", "-1e-3"),
+        ["boundary conditions/rigid plate 0", "not both"]),
+    "plate on a boundary id the grid lacks": (
+        tv.prm_set(plate, "boundary conditions/rigid plate 0/boundary id", "7"),
+        ["boundary conditions/rigid plate 0/boundary id", "boundary id 7"]),
+    "plate holding no node": (
+        tv.prm_set(region, "boundary conditions/rigid plate 0/region upper corner", "0.02, 0.01"),
+        ["boundary conditions/rigid plate 0", "holds no grid node"]),
+    "plate whose axis a wall holds everywhere": (
+        tv.prm_set(tv.prm_set(plate, "boundary conditions/rigid plate 0/boundary id", "3"),
+                   "boundary conditions/rigid plate 0/direction", "y"),
+        ["boundary conditions/rigid plate 0", "holds its direction component at every one of its 41 node(s)"]),
+})
 for name, (text, needles) in cases.items():
     rc, out, err = tv.run_tool(tool, text, work, name.replace(" ", "_"), expect_rc=None)
     msg = err.strip()

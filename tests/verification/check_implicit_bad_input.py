@@ -9,6 +9,9 @@ the right exit code, no NaN written.
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
+  * rigid plates: a force and a displacement, a boundary id the grid lacks, a
+    region holding no grid node, the axis held by a wall at every node, two
+    plates sharing a node;
   * the rigid footing: its span reversed, with two values in 2D, not a number; normal z in 2D;
     penalty 0; with contact walls on the nodes;
   * contact walls on the points: a misspelt 'contact method', 'points' without
@@ -40,6 +43,14 @@ for entry, value in (("rigid footing/enabled", "true"), ("rigid footing/level", 
                      ("rigid footing/lower corner", "0"), ("rigid footing/upper corner", "0.5"),
                      ("rigid footing/velocity", "-0.001")):
     footing_base = tv.prm_set(footing_base, entry, value)
+
+
+def plate(entries):
+    """base with one rigid plate whose entries are `entries` ("entry=value")"""
+    t = tv.prm_set(base, "boundary conditions/number of rigid plates", "1")
+    return tv.prm_set_args(t, ["boundary conditions/rigid plate 0/" + e for e in entries])
+
+
 cases = {
     "no finite-strain form": (tv.prm_set(base, "material 0/model", "linear elastic"),
                               ["material 0/model", "linear elastic", "finite-strain", "neo hookean"]),
@@ -70,12 +81,12 @@ cases = {
                             ["implicit/volumetric stabilisation", "irreducible", "mixed up"]),
     "volumetric stabilisation misspelt": (tv.prm_set(base, "implicit/volumetric stabilisation", "fbar"),
                                           ["volumetric stabilisation", "fbar", "none|f-bar"]),
-    "f-bar with B-splines": (tv.prm_set(tv.prm_set(base, "implicit/shape function", "quadratic bspline"),
+    "f-bar with B-splines": (tv.prm_set(tv.prm_set(base, "numerics/shape function", "quadratic bspline"),
                                         "implicit/volumetric stabilisation", "f-bar"),
                              ["implicit/volumetric stabilisation", "quadratic bspline", "none"]),
-    "shape function misspelt": (tv.prm_set(base, "implicit/shape function", "bspline"),
+    "shape function misspelt": (tv.prm_set(base, "numerics/shape function", "bspline"),
                                 ["shape function", "bspline", "linear|quadratic bspline"]),
-    "B-splines on a grid 2 cells high": (tv.prm_set(tv.prm_set(base, "implicit/shape function", "quadratic bspline"),
+    "B-splines on a grid 2 cells high": (tv.prm_set(tv.prm_set(base, "numerics/shape function", "quadratic bspline"),
                                                     "grid/cells", "17, 2"),
                                          ["B-spline", "3 cells", "y"]),
     "negligible nodal mass out of range": (tv.prm_set(base, "implicit/negligible nodal mass", "2"),
@@ -144,6 +155,25 @@ cases = {
                                   ["rigid footing/upper corner", "half"]),
     "footing with contact walls on the nodes": (tv.prm_set(footing_base, "boundary conditions/contact", "3"),
                                                 ["rigid footing/enabled", "contact method = points"]),
+    # rigid plates (issue 37): both controls, a boundary id the grid lacks, a region
+    # between grid nodes, a plate whose axis a wall holds at every node
+    "plate with a force and a displacement": (plate(["total force=-1", "displacement=-0.01"]),
+                                              ["boundary conditions/rigid plate 0", "not both"]),
+    "plate on a missing boundary": (plate(["boundary id=7", "total force=-1"]),
+                                    ["boundary conditions/rigid plate 0/boundary id", "does not exist"]),
+    "plate holding no node": (plate(["apply to=region", "region lower corner=1.1, 1", "region upper corner=1.2, 1",
+                                     "total force=-1"]),
+                              ["boundary conditions/rigid plate 0", "holds no grid node"]),
+    "plate held by a wall everywhere": (plate(["boundary id=0", "direction=x", "total force=-1"]),
+                                        ["boundary conditions/rigid plate 0", "held by a fixed/roller wall",
+                                         "every one of its nodes"]),
+    "plates sharing a node": (
+        tv.prm_set_args(plate(["apply to=region", "region lower corner=1, 1", "region upper corner=2, 1",
+                               "total force=-1"]),
+                        ["boundary conditions/number of rigid plates=2"] +
+                        ["boundary conditions/rigid plate 1/" + e for e in
+                         ["apply to=region", "region lower corner=2, 1", "region upper corner=3, 1", "total force=-1"]]),
+        ["boundary conditions/rigid plate 1", "shares 1 node(s) with another rigid plate"]),
     "velocity on a missing boundary": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
                                                   "loads/velocity 0/boundary id", "7"),
                                        ["loads/velocity 0/boundary id", "does not exist"]),
@@ -162,8 +192,8 @@ cases.update({
     "axisymmetric mixed up": (tv.prm_set(tv.prm_set(axi, "implicit/formulation", "mixed up"),
                                          "material 0/neo hookean/volumetric energy", "split"),
                               ["implicit/geometry", "irreducible"]),
-    "B-splines with axisymmetric": (tv.prm_set(axi, "implicit/shape function", "quadratic bspline"),
-                                    ["implicit/shape function", "axisymmetric", "linear"]),
+    "B-splines with axisymmetric": (tv.prm_set(axi, "numerics/shape function", "quadratic bspline"),
+                                    ["numerics/shape function", "axisymmetric", "linear"]),
     "f-bar with axisymmetric": (tv.prm_set(axi, "implicit/volumetric stabilisation", "f-bar"),
                                 ["implicit/volumetric stabilisation", "axisymmetric", "none"]),
     "axisymmetric grid below x = 0": (tv.prm_set(axi, "grid/lower corner", "-0.5, 0"),

@@ -42,7 +42,7 @@ tools, prm_path, work, tol = args[1], args[2], args[3], float(args[4])
 ns = [int(n) for n in args[5:]]
 base = open(prm_path).read()
 if bspline:
-    base = tv.prm_set(base, "implicit/shape function", "quadratic bspline")
+    base = tv.prm_set(base, "numerics/shape function", "quadratic bspline")
 refs = {"0.33": 0.323, "0.499999": 0.275}
 # thesis Table 5.1 (triangles, one point per element): U, UP no stab, UP stab
 thesis = {

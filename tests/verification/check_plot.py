@@ -14,7 +14,14 @@ drawn by the solver itself (png snapshots = every output) and by talus-plot:
   * a 2-rank run draws its last output from both VTU pieces;
   * a failure to draw after a complete run is a warning (exit 0, results in place); a solver
     without talus-plot next to it refuses png snapshots with exit 2 before running;
-  * talus-fem accepts and draws `png snapshots = final`.
+  * talus-fem accepts and draws `png snapshots = final`;
+  * talus-semi-implicit draws its water set's pore pressure itself (png snapshots = final), and
+    talus-plot draws both sets (soil.pvd, water.pvd) of every output in one window; the pore
+    pressure and the soil's stress of the geostatic column and the deflection of the implicit
+    cantilever are gradients (many colours of points inside the plot frame, not only the colour bar);
+  * talus-implicit draws its last output and the Newton iteration and residual plots;
+  * a png field the family never writes (pore pressure in talus-implicit, free surface in
+    talus-semi-implicit, a z component in 2D) is refused with exit 2 before the run.
 Usage: check_plot.py TOOLS_DIR WORKDIR
 """
 import os
@@ -322,4 +329,133 @@ rc, out, err = tv.run_tool(os.path.join(tools, "talus-fem"), text, work, "blockf
 paths = [os.path.join(work, x) for x in announced(out)]
 tv.check(sum("snapshot_displacement_magnitude_" in x for x in paths) == 1 and all(os.path.isfile(x) for x in paths),
          f"talus-fem: png snapshots = final drew {len(paths)} PNGs (one snapshot)")
+
+
+def window_lines(stdout):
+    """The reported mapping of each set drawn: (set or '', window and pixels text)."""
+    return re.findall(r"snapshots of '[^']*'(?: on the (\w+) points)?, colour range \(\w+\) \[[^\]]*\], (window .*)$",
+                      stdout, re.M)
+
+
+def interior_colours(path, stdout):
+    """Distinct saturated colours of the pixels inside the reported plot frame that equal their four
+    neighbours: the colours of the points themselves, without the antialiased edges, the frame, the
+    text and the colour bar (which holds the whole palette whatever is drawn)."""
+    _, _, _, rows = read_png(path)
+    m = re.search(r"pixels x \[(\d+), (\d+)\] y \[(\d+), (\d+)\]", stdout)
+    x0, x1, y1, y0 = (int(m.group(i)) for i in range(1, 5))
+    out = set()
+    for y in range(y0 + 3, y1 - 3):
+        for x in range(x0 + 3, x1 - 3):
+            c = rows[y][x]
+            if max(c) - min(c) > 40 and c == rows[y - 1][x] == rows[y + 1][x] == rows[y][x - 1] == rows[y][x + 1]:
+                out.add(c)
+    return out
+
+
+vdir = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "parameter_files", "verification")
+idir = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "parameter_files", "implicit")
+
+# ---- 9. talus-semi-implicit: the soil and water sets (soil.pvd, water.pvd), pore pressure on the water
+# the geostatic saturated column (480 soil + 480 water points), 20 steps, 3 outputs
+semi = open(os.path.join(vdir, "semi_implicit_hydrostatic.prm")).read()
+for k, v in {"output/directory": "runsemi", "time/end time": "0.003", "output/vtu interval": "0.0015",
+             "output/series interval": "0", "output/final particles csv": "false",
+             "output/png snapshots": "final", "output/png field": "pore pressure"}.items():
+    semi = tv.prm_set(semi, k, v)
+rc, out, err = tv.run_tool(os.path.join(tools, "talus-semi-implicit"), semi, work, "semi")
+runsemi = os.path.join(work, "runsemi")
+n_semi = len(re.findall(r"<DataSet ", open(os.path.join(runsemi, "water.pvd")).read()))
+paths = [os.path.join(work, x) for x in announced(out)]
+names = sorted(os.path.basename(x) for x in paths)
+snaps = [x for x in names if x.startswith("snapshot_")]
+tv.check(n_semi == 3 and snaps == [f"snapshot_water_pore_pressure_{n_semi - 1:04d}.png"],
+         f"talus-semi-implicit, png snapshots = final, png field = pore pressure: the water set's last output "
+         f"drawn, no soil picture (snapshots: {snaps}, {n_semi} outputs)")
+want = ["series_energies.png", "series_iterations.png", "series_residuals.png"]
+tv.check(all(w in names for w in want), f"talus-semi-implicit series plots {want} drawn (got {names})")
+tv.check(sorted(os.path.abspath(x) for x in paths) == files_below(os.path.join(runsemi, "png")),
+         "talus-semi-implicit: nothing but the announced PNGs in runsemi/png")
+pp = [x for x in paths if "/snapshot_water_pore_pressure_" in x]
+size = read_png(pp[0])[:2] if pp else (0, 0)  # auto: a tall scene is less than 800 wide
+tv.check(size[0] <= 800 and size[1] <= 820, f"auto size of the tall column: {size[0]} x {size[1]}")
+check_pngs(pp, size, "talus-semi-implicit snapshot")
+check_pngs([x for x in paths if "/series_" in x], (800, 500), "talus-semi-implicit series plots")
+cols = interior_colours(pp[0], out) if pp else set()
+# the hydrostatic pore pressure grows with depth: a colour per row of water points (40 rows)
+tv.check(len(cols) >= 10, f"the water's pore pressure is drawn as a gradient: {len(cols)} colours of points")
+fields = open(os.path.join(runsemi, "fields.txt")).read()
+tv.check("integration = mpm" in fields and "material 0 = linear elastic" in fields,
+         "talus-semi-implicit wrote fields.txt")
+
+# talus-plot on the semi-implicit run: every output of both sets, one window for both
+p = run_plot(["--frames=all", "--field=velocity magnitude", "--size=400,700", "--series=none", "--output=psemi",
+              "runsemi"])
+names = sorted(os.path.basename(x) for x in announced(p.stdout))
+exp = sorted([f"snapshot_{s}_velocity_magnitude_{i:04d}.png" for s in ("soil", "water") for i in range(n_semi)])
+tv.check(p.returncode == 0 and names == exp, f"talus-plot on a semi-implicit run: soil and water snapshots of every "
+         f"output ({len(names)} of {len(exp)})")
+check_pngs([os.path.join(work, "psemi", x) for x in names], (400, 700), "semi-implicit soil and water snapshots")
+wl = window_lines(p.stdout)
+tv.check(len(wl) == 2 and {w[0] for w in wl} == {"soil", "water"} and wl[0][1] == wl[1][1],
+         f"one window for the soil and the water pictures ({wl})")
+p = run_plot(["--frames=first", "--field=stress yy", "--series=none", "--output=psemi_s", "runsemi"])
+names = [os.path.basename(x) for x in announced(p.stdout)]
+sy = [os.path.join(work, "psemi_s", x) for x in names if x.startswith("snapshot_soil_stress_yy")]
+tv.check(p.returncode == 0 and len(sy) == 1 and len(interior_colours(sy[0], p.stdout)) >= 10,
+         f"the soil's effective stress yy at t = 0 drawn as a gradient ({names})")
+p = run_plot(["--output=bad", "--field=free surface", "runsemi"], 2)
+tv.check(p.returncode == 2 and "'free surface' is not available" in p.stderr and "water points:" in p.stderr
+         and not os.path.exists(os.path.join(work, "bad")),
+         f"a field neither set has: exit {p.returncode}, {p.stderr.strip()[:200]}")
+
+# a semi-implicit run without water bodies: its water pieces hold no point (deal.II writes them without
+# <Points>); pore pressure is then a warning after the run, the soil is drawn alone
+dry = tv.prm_set(semi, "output/directory", "runsoil")
+for k, v in {"initial state/geostatic": "false", "body 0/phase": "soil", "time/end time": "0.0015"}.items():
+    dry = tv.prm_set(dry, k, v)
+rc, out, err = tv.run_tool(os.path.join(tools, "talus-semi-implicit"), dry, work, "soil_only")
+tv.check(rc == 0 and "the pictures were not drawn" in err and "hold no material point" in err
+         and os.path.isfile(os.path.join(work, "runsoil", "series.csv")),
+         f"pore pressure of a run without water points: exit {rc}, warning: {err.strip()[-200:]}")
+p = run_plot(["--frames=all", "--series=none", "--output=psoil", "runsoil"])
+names = sorted(os.path.basename(x) for x in announced(p.stdout))
+tv.check(p.returncode == 0 and names == [f"snapshot_soil_displacement_magnitude_{i:04d}.png" for i in range(2)]
+         and "water: no points in the frames drawn" in p.stdout,
+         f"the soil drawn alone, the empty water set noted ({names})")
+
+# ---- 10. talus-implicit: the cantilever under self-weight in two load steps (512 points)
+imp = open(os.path.join(idir, "cantilever_self_weight.prm")).read()
+for k, v in {"output/directory": "runimp", "time/time step": "0.5", "output/vtu interval": "0.5",
+             "output/final particles csv": "false", "output/png snapshots": "final",
+             "output/png field": "displacement y"}.items():
+    imp = tv.prm_set(imp, k, v)
+rc, out, err = tv.run_tool(os.path.join(tools, "talus-implicit"), imp, work, "implicit")
+paths = [os.path.join(work, x) for x in announced(out)]
+names = sorted(os.path.basename(x) for x in paths)
+tv.check([x for x in names if x.startswith("snapshot_")] == ["snapshot_displacement_y_0002.png"],
+         f"talus-implicit, png snapshots = final: the last of 3 outputs drawn ({names})")
+want = ["series_energies.png", "series_iterations.png", "series_residuals.png"]
+tv.check(all(w in names for w in want), f"talus-implicit series plots {want} drawn (got {names})")
+dy = [x for x in paths if "/snapshot_displacement_y_" in x]
+check_pngs(dy, (800, read_png(dy[0])[1]) if dy else (0, 0), "talus-implicit snapshot")
+check_pngs([x for x in paths if "/series_" in x], (800, 500), "talus-implicit series plots")
+cols = interior_colours(dy[0], out) if dy else set()
+tv.check(len(cols) >= 10, f"the cantilever's deflection is drawn as a gradient: {len(cols)} colours of points")
+p = run_plot(["--frames=all", "--field=von mises stress", "--series=iterations,residuals", "--output=pimp", "runimp"])
+names = sorted(os.path.basename(x) for x in announced(p.stdout))
+tv.check(p.returncode == 0 and names == ["series_iterations.png", "series_residuals.png"] +
+         [f"snapshot_von_mises_stress_{i:04d}.png" for i in range(3)],
+         f"talus-plot on an implicit run: every output and the Newton plots ({names})")
+
+# ---- 11. png field: a field the family never writes is refused before the run (exit 2, nothing written)
+for tool, text, field in (("talus-implicit", imp, "pore pressure"), ("talus-semi-implicit", semi, "free surface"),
+                          ("talus-explicit", BLOCK, "displacement z")):
+    t = tv.prm_set(text, "output/directory", "refused")
+    t = tv.prm_set(t, "output/png snapshots", "final")
+    t = tv.prm_set(t, "output/png field", field)
+    rc, out, err = tv.run_tool(os.path.join(tools, tool), t, work, "refused", expect_rc=None)
+    tv.check(rc == 2 and "png field" in err and field in err and "displacement magnitude" in err
+             and not os.path.exists(os.path.join(work, "refused")),
+             f"{tool}: png field = {field} refused before the run: exit {rc}, {err.strip()[:220]}")
 tv.finish()

@@ -37,7 +37,7 @@ def analytic(zeta, T):
 
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 if kernel:
-    base = tv.prm_set(base, "semi implicit/shape function", kernel)
+    base = tv.prm_set(base, "numerics/shape function", kernel)
 for T in times:
     t_end = T * H * H / cv
     n_steps = max(1, round(t_end / 3e-4))

@@ -23,7 +23,7 @@ tool, prm_path, work = [a for a in sys.argv if not a.startswith("--")][1:4]
 g, Hw, Hs, n, rs, rw = 9.81, 1.2, 1.0, 0.3, 2650.0, 1000.0
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 if linear:
-    base = tv.prm_set(base, "semi implicit/shape function", "linear")
+    base = tv.prm_set(base, "numerics/shape function", "linear")
 for k in ("1e-3", "1e-7"):
     text = tv.prm_set(base, "material 0/soil/hydraulic conductivity", k)
     name = f"k{k}"

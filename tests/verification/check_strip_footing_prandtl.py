@@ -42,7 +42,7 @@ Usage: check_strip_footing_prandtl.py TOOLS_DIR PRM WORKDIR [--h=H] [--ppd=N] [-
        [--window=A,B] [--no-window] [--peak=S] [--tol=T] [--rise=S1,...] [--max-its=N] [--u-settlement=S]
        [--zig-u=Z] [--zig-up=Z] [--ranks=N] [--ranks-klu] [--yield=Y] [--fixed-nodes] [--line-search] [--width-b2]
        [--edge=X] [--alpha=A] [--smooth] [--fine-ppd=N] [--negligible=F] [--points] [--set=entry=value ...]
-(--set: any other .prm entry, e.g. --set=implicit/shape function=quadratic bspline)
+(--set: any other .prm entry, e.g. --set=numerics/shape function=quadratic bspline)
 """
 import math
 import sys

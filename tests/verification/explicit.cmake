@@ -47,6 +47,19 @@ function(talus_verification_bspline name script prm)
 endfunction()
 talus_verification_bspline(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
 talus_verification_bspline(explicit_block_friction check_block_friction.py verification/block_friction.prm)
+# rigid plate (issue 37, docs/explicit.md "Rigid plate"): the shared layer with Q1, quadratic
+# B-splines and FEM integration (settlement within 1 %), displacement control (reaction within
+# 1 %), the plate nodes moving as one (frictionless), rough vs frictionless, permeable and impermeable
+# plates on Terzaghi's column (coupled 2-phase), 1 vs 2 ranks, restart
+foreach(_case layer layer_bspline layer_fem displacement frictionless rough two_phase ranks restart)
+  add_test(NAME verification.explicit_rigid_plate_${_case}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_rigid_plate_explicit.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/rigid_plate/layer_explicit.prm ${_w}/rigid_plate_${_case} ${_case})
+  set_tests_properties(verification.explicit_rigid_plate_${_case} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 900)
+endforeach()
+set_tests_properties(verification.explicit_rigid_plate_ranks verification.explicit_rigid_plate_restart
+                     PROPERTIES PROCESSORS 2)
 talus_verification(explicit_staged_column check_stages.py verification/staged_column.prm)
 talus_verification(explicit_k0_column check_k0.py verification/k0_column.prm)
 # chapter 6 numerics (issue 5): contact (§6.2)

@@ -10,12 +10,12 @@ add_test(NAME verification.implicit_cantilever
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cantilever.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_cantilever 0.005 0.5 0.25 0.125 0.0625)
 set_tests_properties(verification.implicit_cantilever PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
-# the same on quadratic B-splines ('implicit/shape function'; docs/implicit.md "Quadratic
+# the same on quadratic B-splines ('numerics/shape function'; docs/implicit.md "Quadratic
 # B-splines"): h = 0.125 m -0.676984 (0.39 %), observed order 2.04, Newton order >= 3.08
 add_test(NAME verification.implicit_cantilever_bspline
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cantilever.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_cantilever_bspline 0.005 0.5 0.25 0.125
-                 "--set=implicit/shape function=quadratic bspline")
+                 "--set=numerics/shape function=quadratic bspline")
 set_tests_properties(verification.implicit_cantilever_bspline PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 # GMRES + ML AMG ('linear solver/method = gmres amg') on the non-symmetric F-bar tangent: h = 0.5 / 0.25 m
 # give the direct solver's -0.716838 / -0.684435 m, Newton order >= 3.08 (at h = 0.125 m this slender
@@ -337,7 +337,7 @@ add_test(NAME verification.implicit_checkpoint_restart_footing_bspline
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_checkpoint_restart_footing_bspline
                  "grid/cells=30, 22" "time/time step=0.01" "rigid footing/velocity=-0.2"
                  "linear solver/direct package=klu" "implicit/ramp loads=false"
-                 "implicit/shape function=quadratic bspline")
+                 "numerics/shape function=quadratic bspline")
 set_tests_properties(verification.implicit_checkpoint_restart_footing_bspline PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1800 PROCESSORS 2)
 
@@ -427,7 +427,7 @@ add_test(NAME verification.implicit_strip_footing_points_bspline
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points_bspline
                  --points --settlement=0.06 --window=0.02,0.06 --tol=0.03 --ranks=10
-                 "--set=implicit/shape function=quadratic bspline")
+                 "--set=numerics/shape function=quadratic bspline")
 set_tests_properties(verification.implicit_strip_footing_points_bspline PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
 # the rising curve of thesis Fig. 6.8 (docs/implicit.md "Quadratic B-splines"): B-splines and the
@@ -437,7 +437,7 @@ add_test(NAME verification.implicit_strip_footing_bspline_rise
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_bspline_rise
                  --points --settlement=0.21 --window=0.03,0.06 --tol=0.03 --rise=0.1,0.2 --max-its=25 --alpha=8
-                 "--set=implicit/shape function=quadratic bspline")
+                 "--set=numerics/shape function=quadratic bspline")
 set_tests_properties(verification.implicit_strip_footing_bspline_rise PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900)
 # the same to s = 0.5 B in a grid 0.6 m taller than the body: 5.43, 5.60, 5.73, 5.78, 5.94 at
@@ -446,7 +446,7 @@ add_test(NAME verification.implicit_strip_footing_bspline_rise_large
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_bspline_rise_large
                  --points --settlement=0.5 --window=0.03,0.06 --tol=0.03 --rise=0.1,0.2,0.3,0.4,0.49 --max-its=25
-                 --alpha=8 "--set=implicit/shape function=quadratic bspline" "--set=grid/upper corner=3, 2.6"
+                 --alpha=8 "--set=numerics/shape function=quadratic bspline" "--set=grid/upper corner=3, 2.6"
                  "--set=grid/cells=30, 26")
 set_tests_properties(verification.implicit_strip_footing_bspline_rise_large PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1800)
@@ -462,3 +462,23 @@ add_test(NAME verification.implicit_strip_footing_points_large
                  --points --settlement=0.19 --window=0.02,0.06 --tol=0.03 --max-its=25)
 set_tests_properties(verification.implicit_strip_footing_points_large PROPERTIES LABELS "verify"
                      ENVIRONMENT "${_env}" TIMEOUT 1200)
+
+# rigid plates (issue 37; docs/implicit.md "Rigid plate"): the shared layer scene's settlement
+# within 1 % (Q1, quadratic B-splines, mixed u-p); a displacement-driven plate's reaction within
+# 1 %; a footing-like region plate whose nodes move as one (recovered from the points), frictionless
+# vs rough sideways, its force balance at convergence; 1 vs 2 ranks to 1e-10; checkpoint/restart
+foreach(_case layer displacement dynamic footing ranks)
+  add_test(NAME verification.implicit_rigid_plate_${_case}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rigid_plate.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                   ${_w}/implicit_rigid_plate_${_case} ${_case})
+  set_tests_properties(verification.implicit_rigid_plate_${_case} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 600)
+endforeach()
+set_tests_properties(verification.implicit_rigid_plate_ranks PROPERTIES PROCESSORS 2)
+add_test(NAME verification.implicit_rigid_plate_restart
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rigid_plate_footing.prm ${_w}/implicit_rigid_plate_restart
+                 "grid/cells=8, 8" "time/time step=0.02" "boundary conditions/rigid plate 0/surface=rough"
+                 "implicit/ramp loads=false")
+set_tests_properties(verification.implicit_rigid_plate_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900 PROCESSORS 2)

@@ -21,6 +21,45 @@ namespace talus
 {
   namespace
   {
+    /// Parse a .prm file. deal.II opens the file of an `include FILE` line
+    /// relative to the working directory; talus resolves it relative to the
+    /// directory of the .prm given, so a shared scene fragment travels with
+    /// the .prm files that include it (the parse runs in that directory).
+    void
+    parse_prm_file(dealii::ParameterHandler &prm, const std::string &prm_file, const bool skip_undefined,
+                   const bool assert_mandatory)
+    {
+      bool has_include = false;
+      {
+        std::ifstream in(prm_file);
+        std::string   line;
+        while (!has_include && std::getline(in, line))
+          {
+            const auto b = line.find_first_not_of(" \t");
+            has_include  = b != std::string::npos && (line.compare(b, 8, "include ") == 0 ||
+                                                     line.compare(b, 8, "INCLUDE ") == 0);
+          }
+      }
+      if (!has_include)
+        {
+          prm.parse_input(prm_file, "", skip_undefined, assert_mandatory);
+          return;
+        }
+      const std::filesystem::path file = std::filesystem::absolute(prm_file);
+      const std::filesystem::path cwd  = std::filesystem::current_path();
+      std::filesystem::current_path(file.parent_path());
+      try
+        {
+          prm.parse_input(file.string(), "", skip_undefined, assert_mandatory);
+        }
+      catch (...)
+        {
+          std::filesystem::current_path(cwd);
+          throw;
+        }
+      std::filesystem::current_path(cwd);
+    }
+
     struct NullBuffer : public std::streambuf
     {
       int overflow(int c) override { return c; }
@@ -287,7 +326,7 @@ namespace talus
     for (std::size_t i = 0; i < path.size(); ++i)
       prm.leave_subsection();
     if (!prm_file.empty())
-      prm.parse_input(prm_file, "", /*skip_undefined=*/true);
+      parse_prm_file(prm, prm_file, /*skip_undefined=*/true, /*assert_mandatory=*/false);
     for (const auto &p : path)
       prm.enter_subsection(p);
     const std::string v = prm.get(entry);
@@ -421,7 +460,7 @@ namespace talus
             try
               {
                 tool.declare(prm, prm_file);
-                prm.parse_input(prm_file, "", /*skip_undefined=*/false, /*assert_mandatory=*/true);
+                parse_prm_file(prm, prm_file, /*skip_undefined=*/false, /*assert_mandatory=*/true);
               }
             catch (const dealii::ExceptionBase &e)
               {

@@ -7,6 +7,7 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -24,10 +25,11 @@ namespace talus::io
   namespace
   {
     // the field names of talus-plot (tools/talus-plot, FIELDS)
-    const char *png_fields = "displacement magnitude|displacement x|displacement y|displacement z|"
-                             "velocity magnitude|velocity x|velocity y|velocity z|stress xx|stress yy|"
-                             "stress zz|stress xy|stress yz|stress xz|mean stress|von mises stress|"
-                             "pore pressure|plastic strain|material id|body id|free surface";
+    const std::vector<std::string> png_fields = {
+      "displacement magnitude", "displacement x", "displacement y", "displacement z", "velocity magnitude",
+      "velocity x", "velocity y", "velocity z", "stress xx", "stress yy", "stress zz", "stress xy", "stress yz",
+      "stress xz", "mean stress", "von mises stress", "pore pressure", "plastic strain", "material id",
+      "body id", "free surface"};
 
     std::filesystem::path
     plot_tool()
@@ -57,15 +59,27 @@ namespace talus::io
   } // namespace
 
   void
-  declare_png_snapshot_parameters(dealii::ParameterHandler &prm)
+  declare_png_snapshot_parameters(dealii::ParameterHandler &prm, const unsigned int dim,
+                                  const std::vector<std::string> &not_written)
   {
+    std::string fields;
+    for (const auto &f : png_fields)
+      {
+        // a 2D run has stress zz (plane strain) but no z displacement, velocity or shear
+        const bool z_component = f == "displacement z" || f == "velocity z" || f == "stress yz" || f == "stress xz";
+        if ((dim == 2 && z_component) || std::find(not_written.begin(), not_written.end(), f) != not_written.end())
+          continue;
+        fields += (fields.empty() ? "" : "|") + f;
+      }
     prm.declare_entry("png snapshots", "none", dealii::Patterns::Selection("none|final|every output"),
                       "PNG pictures drawn by talus-plot (next to this executable; needs gnuplot) when the run "
                       "has completed: 'final' the last particle output, 'every output' every VTU output, plus "
                       "the time-series plots of series.csv, in <output directory>/png. A failure to draw is a "
                       "warning: the run still exits 0 (docs/plot.md).");
-    prm.declare_entry("png field", "displacement magnitude", dealii::Patterns::Selection(png_fields),
-                      "Field the points of the PNG snapshots are coloured by (talus-plot --field).");
+    prm.declare_entry("png field", "displacement magnitude", dealii::Patterns::Selection(fields),
+                      "Field the points of the PNG snapshots are coloured by (talus-plot --field); the fields "
+                      "this tool's runs can have in this dimension. A run with several point sets (talus-semi-"
+                      "implicit: soil and water) draws it on every set that has it (pore pressure: the water).");
   }
 
   void
@@ -102,9 +116,10 @@ namespace talus::io
         auto &     s = f.stream();
         s << "# talus: meaning of the particle fields of this run (read by talus-plot)\n"
           << "dimension = " << prm.get("dimension") << "\n";
-        prm.enter_subsection("numerics");
-        s << "integration = " << prm.get("integration") << "\n";
-        prm.leave_subsection();
+        // FEM / UL-FEM points are drawn at X + u; families without the entry are MPM
+        s << "integration = "
+          << (prm.subsection_path_exists({"numerics"}) ? prm.get({"numerics"}, "integration") : std::string("mpm"))
+          << "\n";
         const unsigned int n = prm.get_integer("number of materials");
         for (unsigned int k = 0; k < n; ++k)
           {

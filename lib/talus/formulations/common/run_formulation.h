@@ -1,8 +1,8 @@
 // talus — the one `run()` of every formulation family's tool: dispatch on
 // 'dimension', parse the family's parameters, build its Solver, set it up, run
-// the time loop (time_loop.h), then (families whose .prm has 'numerics/
-// integration', so far the explicit one) draw the pictures 'output/png
-// snapshots' asks for. A family's tool entry is one line:
+// the time loop (time_loop.h), then write fields.txt and draw the pictures
+// 'output/png snapshots' asks for (io/png_snapshots.h; every family, every point
+// set it writes). A family's tool entry is one line:
 //
 //   int run(dealii::ParameterHandler &prm, const std::string &)
 //   { return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>); }
@@ -38,15 +38,13 @@ namespace talus
   int
   run_formulation(dealii::ParameterHandler &prm,
                   Parameters2 (*parse_2d)(dealii::ParameterHandler &),
-                  Parameters3 (*parse_3d)(dealii::ParameterHandler &),
-                  const bool png_snapshots = false)
+                  Parameters3 (*parse_3d)(dealii::ParameterHandler &))
   {
     if (prm.get_integer("dimension") == 2)
       run_solver<Solver<2>>(parse_2d(prm), MPI_COMM_WORLD);
     else
       run_solver<Solver<3>>(parse_3d(prm), MPI_COMM_WORLD);
-    if (png_snapshots)
-      io::draw_png_snapshots(prm, MPI_COMM_WORLD); // after every output file is complete
+    io::draw_png_snapshots(prm, MPI_COMM_WORLD); // after every output file is complete
     return exit_ok;
   }
 

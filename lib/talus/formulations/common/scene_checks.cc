@@ -93,7 +93,19 @@ namespace talus
                   std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
                   "boundary id " + std::to_string(bc.id) + " does not exist in the grid file '" + p.grid_file +
                     "' (ids present: " + (list.empty() ? "none" : list) + ")");
+        for (const auto &plate : p.rigid_plates)
+          if (plate.target == loads::RigidPlate<dim>::Target::boundary)
+            require(std::find(ids.begin(), ids.end(), plate.boundary) != ids.end(), plate.where + "/boundary id",
+                    "boundary id " + std::to_string(plate.boundary) + " does not exist in the grid file '" +
+                      p.grid_file + "' (ids present: " + (list.empty() ? "none" : list) + ")");
       }
+    for (const auto &plate : p.rigid_plates)
+      if (plate.target == loads::RigidPlate<dim>::Target::region)
+        for (unsigned int d = 0; d < dim; ++d)
+          require(plate.lower[d] <= p.grid_upper[d] && plate.upper[d] >= p.grid_lower[d],
+                  plate.where + "/region lower corner",
+                  "the region lies outside the grid (grid extent " + std::to_string(p.grid_lower[d]) + " .. " +
+                    std::to_string(p.grid_upper[d]) + " along " + std::string(1, char('x' + d)) + ")");
     // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
     for (const auto &bc : p.grid_mesh ? std::vector<BoundaryCondition>() : p.boundary_conditions)
       require(bc.id < 2 * dim,

@@ -67,6 +67,7 @@ namespace talus
     c.n_materials =
       dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of materials", "1", Integer(1, 64)));
     c.n_bodies = dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of bodies", "1", Integer(1, 64)));
+    c.n_rigid_plates = loads::peek_rigid_plates(prm_file);
     return c;
   }
 
@@ -101,7 +102,18 @@ namespace talus
                         "Boundary ids (comma-separated) on which every velocity component is zero.");
       prm.declare_entry("roller", "", Anything(),
                         "Boundary ids on which the velocity component normal to the boundary is zero.");
+      loads::declare_rigid_plate_parameters(prm, dim, counts.n_rigid_plates);
     }
+    prm.leave_subsection();
+
+    prm.enter_subsection("numerics");
+    prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
+                      "Shape functions of every particle-grid transfer, in every family: 'linear' (Q1 on the grid "
+                      "cells) or 'quadratic bspline' (uniform quadratic B-splines on the grid nodes, 3 nodes per "
+                      "direction per point: no cell-crossing noise; at the grid walls the outside node is a ghost "
+                      "carrying the linear extrapolation, so fixed and roller walls hold exactly at the wall; "
+                      "needs a uniform box grid with at least 3 cells per direction; docs/shape-functions.md). A "
+                      "family refuses the combinations with its own options that it cannot honour, naming them.");
     prm.leave_subsection();
 
     prm.enter_subsection("gravity");
@@ -152,11 +164,11 @@ namespace talus
 
   SceneCounts
   declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
-                            const std::string &time_step_doc)
+                            const std::string &time_step_doc, const std::vector<std::string> &png_fields_not_written)
   {
     const SceneCounts counts = peek_scene_counts(prm_file);
     declare_scene_parameters(prm, counts);
-    declare_run_parameters(prm);
+    declare_run_parameters(prm, counts.dim, png_fields_not_written);
     prm.enter_subsection("time");
     prm.declare_entry("time step", "0", Double(0), time_step_doc);
     prm.leave_subsection();
@@ -164,7 +176,8 @@ namespace talus
   }
 
   void
-  declare_run_parameters(dealii::ParameterHandler &prm)
+  declare_run_parameters(dealii::ParameterHandler &prm, const unsigned int dim,
+                         const std::vector<std::string> &png_fields_not_written)
   {
     prm.enter_subsection("time");
     {
@@ -201,7 +214,7 @@ namespace talus
                         "series.csv (energies, momentum, probes over time), the probe displacements, velocities "
                         "and stresses over time, the final material point fields and the final fields mapped to "
                         "the grid nodes (lumped projection). Layout in docs/fem.md.");
-      io::declare_png_snapshot_parameters(prm);
+      io::declare_png_snapshot_parameters(prm, dim, png_fields_not_written);
     }
     prm.leave_subsection();
 
@@ -277,10 +290,16 @@ namespace talus
       p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::fixed});
     for (const auto id : parse_ids(prm.get("roller"), "boundary conditions/roller"))
       p.boundary_conditions.push_back({static_cast<dealii::types::boundary_id>(id), BoundaryCondition::Kind::roller});
+    p.rigid_plates = loads::parse_rigid_plate_parameters<dim>(prm, !p.grid_mesh);
     prm.leave_subsection();
 
     prm.enter_subsection("gravity");
     p.gravity = parse_point<dim>(prm.get("acceleration"), "gravity/acceleration");
+    prm.leave_subsection();
+
+    prm.enter_subsection("numerics");
+    p.shape_function =
+      prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline : ShapeFunction::linear;
     prm.leave_subsection();
 
     const unsigned int n_materials = prm.get_integer("number of materials");

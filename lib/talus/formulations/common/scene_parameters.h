@@ -9,8 +9,10 @@
 #include <talus/formulations/common/formulation.h>
 #include <talus/grid/background_grid.h>
 #include <talus/io/grid_mesh.h>
+#include <talus/loads/rigid_plate.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
+#include <talus/shape/shape_function.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
@@ -21,7 +23,7 @@
 
 namespace talus
 {
-  /// Grid, boundary conditions, gravity, materials and bodies.
+  /// Grid, boundary conditions, gravity, materials, bodies and the shape functions.
   template <int dim>
   struct SceneParameters
   {
@@ -33,9 +35,13 @@ namespace talus
     std::string                         grid_file;
     std::shared_ptr<const io::GridMesh> grid_mesh;
     std::vector<BoundaryCondition>      boundary_conditions;
+    /// 'boundary conditions/rigid plate k' (loads/rigid_plate.h)
+    std::vector<loads::RigidPlate<dim>> rigid_plates;
     dealii::Tensor<1, dim>              gravity;
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                        bodies;
+    ShapeFunction shape_function = ShapeFunction::linear;
+    bool          bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
   };
 
   /// End time, step limit, lost points, output and checkpoint settings.
@@ -81,9 +87,10 @@ namespace talus
   /// The counts a .prm declares before its numbered subsections.
   struct SceneCounts
   {
-    unsigned int dim = 2, n_materials = 1, n_bodies = 1;
+    unsigned int dim = 2, n_materials = 1, n_bodies = 1, n_rigid_plates = 0;
   };
-  /// 'dimension', 'number of materials', 'number of bodies' read from the
+  /// 'dimension', 'number of materials', 'number of bodies', 'boundary
+  /// conditions/number of rigid plates' read from the
   /// file before the declaration (the declaration depends on them).
   SceneCounts peek_scene_counts(const std::string &prm_file);
 
@@ -92,13 +99,19 @@ namespace talus
   /// points per direction, clipping, initial velocity).
   void declare_scene_parameters(dealii::ParameterHandler &prm, const SceneCounts &counts);
   /// Declare time (end time, maximum steps), stability (lost particles), output
-  /// (with io/png_snapshots' entries), checkpoint and load balancing.
-  void declare_run_parameters(dealii::ParameterHandler &prm);
+  /// (with io/png_snapshots' entries: 'png field' offers the fields of a run of
+  /// dimension `dim` but those the family never writes), checkpoint and load
+  /// balancing.
+  void declare_run_parameters(dealii::ParameterHandler &prm, unsigned int dim = 3,
+                              const std::vector<std::string> &png_fields_not_written = {});
   /// The head of every family's declaration: the counts peeked from `prm_file`,
   /// the scene and run entries, and 'time/time step' (default 0) with the
-  /// family's own meaning in `time_step_doc`. Returns the counts.
+  /// family's own meaning in `time_step_doc`; `png_fields_not_written`: the
+  /// talus-plot fields the family's VTU files never hold (e.g. {"pore pressure"}),
+  /// refused in 'output/png field'. Returns the counts.
   SceneCounts declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
-                                        const std::string &time_step_doc);
+                                        const std::string &time_step_doc,
+                                        const std::vector<std::string> &png_fields_not_written = {});
 
   template <int dim>
   void parse_scene_parameters(dealii::ParameterHandler &prm, SceneParameters<dim> &p);

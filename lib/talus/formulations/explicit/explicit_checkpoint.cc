@@ -23,6 +23,7 @@
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/load_control.h>
 #include <talus/io/hdf5.h>
 
 #include <deal.II/base/bounding_box.h>
@@ -148,6 +149,8 @@ namespace talus::explicit_mpm
     write_pvd_times(f, "output/grid_pvd", grid_pvd_records);
     std::vector<double> probes(probe_ids.begin(), probe_ids.end());
     f.write_global("probes/ids", probes, 1);
+    if (!prm.rigid_plates.empty()) // the plates' state (the same on every rank)
+      f.write_global("plates/state", control->rigid_plate_state(), loads::LoadControl<dim>::rigid_plate_state_size);
     balance.write(f); // the partition of the last rebalance
     f.commit();
 
@@ -241,6 +244,11 @@ namespace talus::explicit_mpm
       probe_ids.push_back(static_cast<dealii::types::particle_index>(id));
     probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
     probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
+    if (!prm.rigid_plates.empty())
+      {
+        require(f.exists("plates/state"), where, "has no rigid plate state ('plates/state'), but the scene has rigid plates");
+        control->restore_rigid_plate_state(f.read_all("plates/state"));
+      }
     restored_from = file;
     return true;
   }

@@ -5,6 +5,7 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/formulations/explicit/with_kernel.h>
+#include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/run_formulation.h>
@@ -288,10 +289,11 @@ namespace talus::explicit_mpm
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
     points.layout.n_history = n_history;
-    if (prm.loads.active())
+    if (prm.loads.active() || !prm.rigid_plates.empty())
       {
         control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
         control->extend_layout(points.layout);
+        control->setup_rigid_plates(*this); // node checks (exit 2) and log lines, before any output
       }
     // 2-phase / traction properties and the free-surface flag: only when used
     if (prm.liquid.any_coupled() || prm.liquid.any_traction())
@@ -324,31 +326,18 @@ namespace talus::explicit_mpm
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
-      std::vector<double> density;
-      for (const auto &m : prm.materials)
-        density.push_back(m->density());
-      auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
-      const auto filed  = insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
-      for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-        seeded.volume_per_body[b] += filed.volume_per_body[b];
-      log_clipping(prm, seeded, filed); // what 'clip to grid' left out (input_checks.h)
-      if (fem) // the cells these points occupy get Gauss points instead (fem.h)
-        seeded = fem->seed(density);
-      for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-        require(seeded.volume_per_body[b] > 0, "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
-                "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+      const std::vector<double> density = material_densities(prm);
+      // FEM: the cells these points occupy get Gauss points instead (fem.h)
+      auto seeded = seed_scene_bodies(grid, prm.bodies, density, points, "material point", &prm, {}, fem != nullptr);
+      if (fem)
+        {
+          seeded = fem->seed(density);
+          require_seeded(prm.bodies, seeded.volume_per_body, "material point");
+        }
       if (control)
         control->initial_state(*this); // K0 stresses, stage 0 (gravity, boundaries, mass scaling)
-
-      // history initialisation
-      for (auto &pt : points.handler)
-        {
-          auto        P = pt.get_properties();
-          const auto &m = *prm.materials[static_cast<unsigned int>(P[PropertyLayout<dim>::material])];
-          if (points.layout.n_history)
-            m.initialize_history(PropertyLayout<dim>::get_stress(P.data()),
-                                 dealii::ArrayView<double>(P.data() + points.layout.history, m.n_history()));
-        }
+      if (points.layout.n_history)
+        initialize_point_histories(prm.materials, points, points.layout.history);
       if (two_phase)
         two_phase->initialize_particles(); // restored points carry their 2-phase state
       }
@@ -1262,6 +1251,8 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < probe_ids.size(); ++k)
       for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
         c.push_back("probe" + std::to_string(k) + "_" + names[PropertyLayout<dim>::stress + q]);
+    for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
+      c.push_back(name);
     return c;
   }
 
@@ -1320,6 +1311,11 @@ namespace talus::explicit_mpm
       }
     r.insert(r.end(), probes.begin(), probes.end());
     r.insert(r.end(), probe_sigma.begin(), probe_sigma.end());
+    if (!prm.rigid_plates.empty())
+      {
+        const auto v = control->rigid_plate_series();
+        r.insert(r.end(), v.begin(), v.end());
+      }
     return r;
   }
 
@@ -1371,7 +1367,7 @@ namespace talus::explicit_mpm
   int
   run(dealii::ParameterHandler &prm, const std::string &)
   {
-    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>, /*png_snapshots=*/true);
+    return run_formulation<Solver>(prm, &parse_parameters<2>, &parse_parameters<3>);
   }
 
   TALUS_INSTANTIATE_FORMULATION(class);

@@ -93,46 +93,6 @@ namespace talus::explicit_mpm
   }
 
 
-  template <int dim>
-  void
-  log_clipping(const Parameters<dim> &p, const SeedingResult &seeded, const SeedingResult &filed)
-  {
-    for (unsigned int k = 0; k < p.bodies.size(); ++k)
-      {
-        const auto &b = p.bodies[k];
-        if (!b.clip_to_grid)
-          continue;
-        std::ostringstream os;
-        os.precision(10);
-        os << "  body " << k << " ('" << b.name << "'), clip to grid: ";
-        if (b.shape == BodyDescription<dim>::Shape::file)
-          {
-            const double n = k < filed.dropped_points.size() ? filed.dropped_points[k] : 0;
-            const double v = k < filed.dropped_volume.size() ? filed.dropped_volume[k] : 0;
-            os << n << " material points of '" << b.particle_file << "' outside the grid dropped, volume lost "
-               << v;
-          }
-        else if (!p.grid_mesh)
-          {
-            const auto c = clipped_by_box_grid(b, p.grid_lower, p.grid_upper, p.grid_cells);
-            if (c.counted)
-              os << c.points << " seeding positions outside the grid dropped, volume lost " << c.volume;
-            else
-              os << "the positions outside the grid were not counted (more than 5e7)";
-          }
-        else
-          {
-            const double v = b.volume();
-            os << "volume lost about " << v - seeded.volume_per_body[k]
-               << " (the shape's volume minus the seeded volume; grid from a file)";
-          }
-        os << "; seeded volume " << seeded.volume_per_body[k] << " (" << b.name << ")";
-        log() << os.str() << std::endl;
-      }
-  }
-
-  template void   log_clipping<2>(const Parameters<2> &, const SeedingResult &, const SeedingResult &);
-  template void   log_clipping<3>(const Parameters<3> &, const SeedingResult &, const SeedingResult &);
   template void   check_consistency<2>(const Parameters<2> &);
   template void   check_consistency<3>(const Parameters<3> &);
   template double critical_time_step_of<2>(const Parameters<2> &);

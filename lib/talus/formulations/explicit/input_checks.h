@@ -27,13 +27,6 @@ namespace talus::explicit_mpm
   template <int dim>
   double critical_time_step_of(const Parameters<dim> &p);
 
-  /// Log what 'clip to grid' left out of each body: the seeding positions
-  /// outside the grid and their volume (box grid: counted on the grid's
-  /// sub-cell lattice; file bodies: the rows outside and their volumes; a
-  /// shape body on a grid file: the volume of the shape minus what was seeded).
-  template <int dim>
-  void log_clipping(const Parameters<dim> &p, const SeedingResult &seeded, const SeedingResult &filed);
-
   /// The talus-explicit check: parse_parameters() (with check_consistency) for
   /// the file's dimension, and the output directory must be creatable/writable.
   void check_scene(dealii::ParameterHandler &prm, const std::string &prm_file);

@@ -170,6 +170,8 @@ namespace talus::loads
         const bool glob = j < current->n_global_velocities;
         settle_time = std::max(settle_time, current->velocities[j].function.settle_time() - (glob ? stage_t0 : 0.0));
       }
+    for (const auto &plate : s.prm.rigid_plates) // absolute time
+      settle_time = std::max(settle_time, plate.function.settle_time() - stage_t0);
 
     if (settings.max_tractions > 0)
       assign_tractions(s);
@@ -295,7 +297,19 @@ namespace talus::loads
     // reduced against the other ranks' next collective (ExcMPI on one rank, a hang
     // on the others: a prescribed base velocity on 2 ranks)
     any_prescribed = dealii::Utilities::MPI::logical_or(!prescribed_dofs.empty(), s.comm);
-    need_vt = any_friction || any_prescribed || current->damping > 0 || current->viscous_damping > 0;
+    // rigid plates: their owned DoFs (axis; every component of a rough plate)
+    // that no wall of this stage holds (the wall keeps what it holds); the
+    // nodes' own forces are reactions inside the plate: out of the force ratio,
+    // the plate's unbalanced force enters it instead (nodal_forces)
+    any_plate = !s.prm.rigid_plates.empty();
+    plate_dofs.clear();
+    for (const auto &p : rigid_plate_node_dofs(s.grid, s.prm.rigid_plates))
+      if (!s.constrained[p.dof])
+        {
+          plate_dofs.push_back(p);
+          excluded[p.dof] = 1;
+        }
+    need_vt = any_friction || any_prescribed || any_plate || current->damping > 0 || current->viscous_damping > 0;
     if ((need_vt || current->convergence.enabled) && vt.size() == 0)
       s.grid.reinit_vector(vt);
     if (forces.any() && trac.size() == 0)
@@ -411,6 +425,8 @@ namespace talus::loads
         for (const unsigned int i : s.active_dofs)
           F[i] += T[i];
       }
+    if (any_plate) // the plates' momentum balance, on the force before damping
+      rigid_plate_balance(s, F, M);
     // quasi-static convergence (seed 000 §6.4), on the unbalanced force before damping
     if (check_step(s))
       {
@@ -432,6 +448,18 @@ namespace talus::loads
           if (M[i] > 0)
             v[2] += 0.5 * Pm[i] * Pm[i] / M[i];
         v[3] = s.local_energies.gravity_potential;
+        // rigid plates (once, on rank 0): a force-controlled plate adds its
+        // unbalanced force and its load; a displacement-controlled one is
+        // balanced by construction and adds its reaction as a load on the
+        // material (without it a scene loaded only by the plate has no
+        // external force to measure the unbalance against)
+        if (dealii::Utilities::MPI::this_mpi_process(s.comm) == 0)
+          for (unsigned int k = 0; k < plate_run.size(); ++k)
+            {
+              if (s.prm.rigid_plates[k].control == RigidPlate<dim>::Control::force)
+                v[0] += plate_run[k].unbalanced * plate_run[k].unbalanced;
+              v[1] += plate_run[k].force * plate_run[k].force;
+            }
         evaluate_convergence(s, v);
       }
     // local damping (Eq. 6.23) with the nodal velocity at t
@@ -492,6 +520,8 @@ namespace talus::loads
         for (const unsigned int i : s.active_dofs)
           F[i] += T[i];
       }
+    if (any_plate) // the plates' sums before the damping (coupled: V after the liquid's a_L)
+      rigid_plate_balance(s, F, MS);
     if (!check_step(s))
       return;
     // Static equilibrium of both phases: the mixture force and the liquid's
@@ -532,6 +562,13 @@ namespace talus::loads
           v[2] += 0.5 * PL[i] * PL[i] / mLn[i];
       }
     v[3] = s.local_energies.gravity_potential; // of both masses (TwoPhase::step)
+    if (dealii::Utilities::MPI::this_mpi_process(s.comm) == 0) // rigid plates, as in nodal_forces
+      for (unsigned int k = 0; k < plate_run.size(); ++k)
+        {
+          if (s.prm.rigid_plates[k].control == RigidPlate<dim>::Control::force)
+            v[0] += plate_run[k].unbalanced * plate_run[k].unbalanced;
+          v[1] += plate_run[k].force * plate_run[k].force;
+        }
     evaluate_convergence(s, v);
   }
 
@@ -543,7 +580,7 @@ namespace talus::loads
     // the ranks below, also by a rank that owns none of the prescribed nodes (a
     // rank-local test here left the other ranks waiting in the sum: a prescribed
     // base velocity hung on 2 ranks)
-    if (!any_friction && !any_prescribed)
+    if (!any_friction && !any_prescribed && !any_plate)
       return;
     double *const       A  = s.nodal_a.begin();
     const double *const M  = s.nodal_mass.begin();
@@ -643,6 +680,33 @@ namespace talus::loads
       }
     if (any_prescribed)
       s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+    // rigid plates (after the friction walls and prescribed nodes: the plate
+    // wins there): a = (V - v_i^t) / h along the axis, (0 - v_i^t) / h for the
+    // tangential components of a rough plate; the plate's work was counted by
+    // rigid_plate_balance
+    if (any_plate && cp)
+      {
+        // the liquid's share of the plate nodes' balance, sum beta Mbar_L a_L per
+        // plate and component (a_L of the 2-phase nodal solve), then V
+        std::vector<double> liquid(s.prm.rigid_plates.size() * dim, 0.0);
+        for (const auto &p : plate_dofs)
+          if (plate_active[p.dof] && M[p.dof] > 0 && mLn[p.dof] > 0)
+            liquid[p.condition * dim + p.component] += beta * mLn[p.dof] * AL[p.dof];
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(liquid), s.comm,
+                                    dealii::ArrayView<double>(liquid));
+        rigid_plate_velocities(s, liquid.data());
+      }
+    for (const auto &p : plate_dofs)
+      if (plate_active[p.dof] && M[p.dof] > 0)
+        {
+          const auto & pl = s.prm.rigid_plates[p.condition];
+          const bool   on_axis = p.component == pl.axis;
+          const double V       = on_axis ? plate_run[p.condition].velocity : 0.0;
+          A[p.dof]             = (V - Pm[p.dof] / M[p.dof]) / h;
+          // impermeable: the pore liquid moves with the plate along its axis
+          if (cp && on_axis && !pl.permeable && mLn[p.dof] > 0)
+            AL[p.dof] = (V - PL[p.dof] / mLn[p.dof]) / h;
+        }
   }
 
   template <int dim>
@@ -734,7 +798,233 @@ namespace talus::loads
         if (VL)
           VL[p.dof] = V[p.dof];
       }
+    for (const auto &p : plate_dofs)
+      if (plate_active[p.dof] && s.nodal_mass.local_element(p.dof) > 0)
+        {
+          const auto &pl      = s.prm.rigid_plates[p.condition];
+          const bool  on_axis = p.component == pl.axis;
+          V[p.dof]            = on_axis ? plate_run[p.condition].velocity : 0.0;
+          if (VL && on_axis && !pl.permeable && s.two_phase->m_liquid_n.local_element(p.dof) > 0)
+            VL[p.dof] = V[p.dof];
+        }
   }
+
+  // ---------------------------------------------------------------- rigid plates
+  template <int dim>
+  void
+  LoadControl<dim>::setup_rigid_plates(Solver &s)
+  {
+    const auto &plates = s.prm.rigid_plates;
+    this->plates       = &plates;
+    plate_run.assign(plates.size(), PlateRun());
+    if (plates.empty())
+      return;
+    const auto         dofs    = rigid_plate_node_dofs(s.grid, plates); // owned
+    const unsigned int n_owned = s.grid.partitioner->locally_owned_size();
+    const unsigned int n       = plates.size();
+    // per plate: nodes, nodes whose axis component the walls of stage j hold
+    // (one count per stage), nodes it shares with an earlier plate
+    const unsigned int   n_stages = settings.stages.size();
+    const unsigned int   nc       = 2 + n_stages;
+    std::vector<double>  count(n * nc, 0.0);
+    std::vector<int>     owner(n_owned, -1);
+    std::vector<std::vector<unsigned char>> flags;
+    for (const auto &st : settings.stages)
+      flags.push_back(wall_dof_flags(s.grid, st.boundary_conditions));
+    for (const auto &p : dofs)
+      {
+        if (p.component != plates[p.condition].axis)
+          continue;
+        double *c = &count[p.condition * nc];
+        c[0] += 1;
+        if (owner[p.node] >= 0 && owner[p.node] != static_cast<int>(p.condition))
+          c[1] += 1;
+        owner[p.node] = static_cast<int>(p.condition);
+        for (unsigned int j = 0; j < n_stages; ++j)
+          if (flags[j][p.dof])
+            c[2 + j] += 1;
+      }
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(count), s.comm, dealii::ArrayView<double>(count));
+    for (unsigned int k = 0; k < n; ++k)
+      {
+        const auto &  pl = plates[k];
+        const double *c  = &count[k * nc];
+        require(c[0] > 0, pl.where,
+                pl.target == RigidPlate<dim>::Target::boundary ?
+                  "holds no grid node: the grid has no face with boundary id " + std::to_string(pl.boundary) :
+                  std::string("holds no grid node: no node of the grid lies inside its region (widen 'region lower "
+                              "corner' / 'region upper corner' to reach at least one grid node)"));
+        require(c[1] == 0, pl.where,
+                "shares " + std::to_string(static_cast<long>(c[1])) +
+                  " node(s) with another rigid plate; a grid node can belong to one plate only");
+        for (unsigned int j = 0; j < n_stages; ++j)
+          require(c[2 + j] < c[0], pl.where,
+                  "a fixed/roller wall holds its direction component at every one of its " +
+                    std::to_string(static_cast<long>(c[0])) + " node(s)" +
+                    (settings.staged ? " in stage '" + settings.stages[j].name + "'" : std::string()) +
+                    ", so the plate cannot move: release that wall (roller on the other axis) or choose "
+                    "another 'direction'");
+        PlateRun &r = plate_run[k];
+        r.force     = pl.control == RigidPlate<dim>::Control::force ? pl.force_at(s.time) : 0.0;
+        std::ostringstream os;
+        const char         ax[] = {'x', 'y', 'z'};
+        os << "  rigid plate " << k << " ("
+           << (pl.target == RigidPlate<dim>::Target::boundary ? "boundary id " + std::to_string(pl.boundary) :
+                                                                std::string("region"))
+           << "): " << static_cast<long>(c[0]) << " node(s)";
+        if (c[2] > 0)
+          os << " (" << static_cast<long>(c[2]) << " held along " << ax[pl.axis] << " by a wall, they stay)";
+        os << ", direction " << ax[pl.axis] << ", " << (pl.rough ? "rough" : "frictionless") << ", "
+           << (pl.control == RigidPlate<dim>::Control::force ?
+                 "force control: total force " + dealii::Utilities::to_string(pl.force) + " N x f(t)" :
+                 "displacement control: displacement " + dealii::Utilities::to_string(pl.displacement) +
+                   " m x f(t), reaction reported");
+        log() << os.str() << std::endl;
+      }
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::rigid_plate_balance(Solver &s, const double *F, const double *M)
+  {
+    const auto &       plates  = s.prm.rigid_plates;
+    const unsigned int n_owned = s.nodal_mass.locally_owned_size();
+    // the nodes of this step (a DoF off the active list may hold a stale mass)
+    plate_active.assign(n_owned, 0);
+    for (const unsigned int i : s.active_dofs)
+      plate_active[i] = 1;
+    // per plate (plate_sum_size values): M_P, F_P, P_P along the axis, the
+    // pore liquid's Mbar_L and momentum along the axis (coupled 2-phase), then
+    // F_d, P_d per component (the tangential reaction of a rough plate)
+    const bool    cp  = s.two_phase && s.two_phase->coupled;
+    const double *mLn = cp ? s.two_phase->m_liquid_n.begin() : nullptr;
+    const double *PL  = cp ? s.two_phase->p_liquid.begin() : nullptr;
+    plate_sum.assign(plates.size() * plate_sum_size, 0.0);
+    const double *const Pm = vt.begin();
+    for (const auto &p : plate_dofs)
+      if (plate_active[p.dof] && M[p.dof] > 0)
+        {
+          double *q = &plate_sum[p.condition * plate_sum_size];
+          if (p.component == plates[p.condition].axis)
+            {
+              q[0] += M[p.dof];
+              q[1] += F[p.dof];
+              q[2] += Pm[p.dof];
+              if (cp && mLn[p.dof] > 0)
+                {
+                  q[3] += mLn[p.dof];
+                  q[4] += PL[p.dof];
+                }
+            }
+          else
+            {
+              q[5 + p.component] += F[p.dof];
+              q[5 + dim + p.component] += Pm[p.dof];
+            }
+        }
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(plate_sum), s.comm,
+                                dealii::ArrayView<double>(plate_sum));
+    if (!cp) // else after the liquid's accelerations (nodal_accelerations)
+      rigid_plate_velocities(s, nullptr);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::rigid_plate_velocities(Solver &s, const double *liquid)
+  {
+    const auto & plates = s.prm.rigid_plates;
+    const double beta = current->mass_scaling, alpha = current->damping, av = current->viscous_damping;
+    for (unsigned int k = 0; k < plates.size(); ++k)
+      {
+        const auto &  pl = plates[k];
+        const double *q  = &plate_sum[k * plate_sum_size];
+        // the plate's inertia and its force: the solid alone (1-phase; a
+        // permeable plate, through which the liquid flows with its own
+        // acceleration a_L, carried by the solid's equation as -beta Mbar_L a_L),
+        // or solid and liquid moving together (impermeable)
+        const double *lq = liquid ? &liquid[k * dim] : nullptr; // sum beta Mbar_L a_L per component
+        double        Mp = q[0], Fp = q[1], Pp = q[2];
+        if (lq && pl.permeable)
+          Fp -= lq[pl.axis];
+        else if (lq)
+          {
+            Mp += q[3];
+            Pp += q[4];
+          }
+        PlateRun &r = plate_run[k];
+        double    V = 0;
+        if (pl.control == RigidPlate<dim>::Control::force)
+          {
+            // M_P dV/dt = F_P + F_plate (+ local and viscous damping of the
+            // plate's own unbalanced force and momentum); a plate without
+            // material under it (M_P = 0) waits at rest
+            r.force      = pl.force_at(s.time);
+            double R     = Fp + r.force;
+            r.unbalanced = R;
+            if (alpha > 0)
+              R += local_damping_force(alpha, R, Pp);
+            R -= av * Pp;
+            V = Mp > 0 ? Pp / Mp + h * R / (beta * Mp) : 0.0;
+          }
+        else
+          {
+            V       = (pl.displacement_at(s.time + h) - r.displacement) / h;
+            r.force = beta * (Mp * V - Pp) / h - Fp; // sum (beta m a - f) over the nodes
+          }
+        if (pl.rough) // the liquid slides along the plate: its a_L enters as in the solid's equation
+          {
+            double t2 = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              if (d != pl.axis)
+                {
+                  const double Rd = beta * (0.0 - q[5 + dim + d]) / h - q[5 + d] + (lq ? lq[d] : 0.0);
+                  t2 += Rd * Rd;
+                }
+            r.tangential = std::sqrt(t2);
+          }
+        r.velocity = V;
+        r.displacement += h * V;
+        s.external_work += r.force * h * V; // identical on every rank
+      }
+  }
+
+  template <int dim>
+  std::vector<double>
+  LoadControl<dim>::rigid_plate_series() const
+  {
+    std::vector<double> v;
+    for (unsigned int k = 0; k < plate_run.size(); ++k)
+      {
+        v.push_back(plate_run[k].displacement);
+        v.push_back(plate_run[k].force);
+        if ((*plates)[k].rough)
+          v.push_back(plate_run[k].tangential);
+      }
+    return v;
+  }
+
+  template <int dim>
+  std::vector<double>
+  LoadControl<dim>::rigid_plate_state() const
+  {
+    std::vector<double> v;
+    for (const auto &r : plate_run)
+      v.insert(v.end(), {r.displacement, r.velocity, r.force, r.tangential});
+    return v;
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::restore_rigid_plate_state(const std::vector<double> &v)
+  {
+    AssertThrow(v.size() == rigid_plate_state_size * plate_run.size(), dealii::ExcInternalError());
+    for (unsigned int k = 0; k < plate_run.size(); ++k)
+      {
+        const double *x = &v[k * rigid_plate_state_size];
+        plate_run[k]    = {x[0], x[1], x[2], x[3], 0.0};
+      }
+  }
+
 
   template class LoadControl<2>;
   template class LoadControl<3>;

@@ -20,6 +20,21 @@
 //   v = p / m (solver)
 //   nodal_velocities     prescribed values, no penetration / stick at friction nodes
 //
+// Rigid plates (loads/rigid_plate.h, issue 37; the scene's
+// 'boundary conditions/rigid plate k', s.prm.rigid_plates) ride on the same
+// hooks: nodal_forces sums the plate's nodes (mass M_P, force F_P and momentum
+// P_P at t along its axis; the tangential ones of a rough plate) over the ranks
+// before the damping, and gives the plate its new velocity V^{t+h}: force
+// control V = P_P / M_P + h (F_P + F_plate(t) + damping) / (beta M_P), the
+// local damping acting on the plate's own unbalanced force; displacement
+// control V = (u(t+h) - u_P) / h, reaction beta (M_P V - P_P) / h - F_P.
+// nodal_accelerations gives every plate node a = (V - v_i^t) / h along the
+// axis (0 - v_i^t for the tangential components of a rough plate),
+// nodal_velocities sets V. Wall-held components keep their wall. Coupled
+// 2-phase: the sums in nodal_forces_two_phase, V in nodal_accelerations after
+// the liquid's a_L (permeable: the solid alone, the liquid flows through with
+// its own a_L; impermeable: both phases move with the plate along its axis).
+//
 // The 2-phase single-point step (explicit_two_phase.cc, seed 000 §4.5.7) calls
 // the same hooks at the same places, and they act on both phases there:
 //   (its P2G pass)       traction point forces -> f_trac (begin/end_traction_scatter)
@@ -39,6 +54,7 @@
 #include <talus/grid/background_grid.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/point_forces.h>
+#include <talus/loads/rigid_plate.h>
 #include <talus/loads/settings.h>
 
 #include <limits>
@@ -106,6 +122,20 @@ namespace talus::loads
     void particle_velocities(Solver &s);
     void nodal_velocities(Solver &s);
 
+    /// Rigid plates, at setup (fresh or restored run, before any output): the
+    /// plate state, the checks that need the grid (InputError naming 'boundary
+    /// conditions/rigid plate k': a plate holding no grid node, a plate whose
+    /// axis component a fixed/roller wall holds at every one of its nodes in
+    /// some stage, a node shared by two plates) and the log line of each plate.
+    void setup_rigid_plates(Solver &s);
+    /// series.csv values of the plates, in the order of rigid_plate_series_columns().
+    std::vector<double> rigid_plate_series() const;
+    /// Checkpointed plate state: per plate (displacement, velocity, force,
+    /// tangential force), identical on every rank; and its restore.
+    std::vector<double> rigid_plate_state() const;
+    void                restore_rigid_plate_state(const std::vector<double> &state);
+    static constexpr unsigned int rigid_plate_state_size = 4;
+
     /// The convergence criterion of the stage was met (and ends the stage).
     bool stage_converged() const { return converged; }
     /// After a repartition of the grid (load balancing): the nodal vectors and
@@ -168,6 +198,33 @@ namespace talus::loads
       (void)index;
       return global ? t_abs : t_abs - stage_t0;
     }
+    /// Rigid plates: the run state of each plate (the same on every rank).
+    struct PlateRun
+    {
+      double displacement = 0; ///< along the axis [m]
+      double velocity     = 0; ///< V^{t+h} of the last step
+      double force        = 0; ///< on the material along the axis (given or reaction) [N]
+      double tangential   = 0; ///< |tangential reaction| of a rough plate [N]
+      double unbalanced   = 0; ///< force control: F_P + F_plate before damping (convergence ratio)
+    };
+    const std::vector<RigidPlate<dim>> *plates = nullptr; ///< the scene's (set by setup_rigid_plates)
+    std::vector<PlateRun>          plate_run;
+    std::vector<PrescribedNodeDof> plate_dofs;   ///< owned plate DoFs that no wall of the stage holds
+    std::vector<unsigned char>     plate_active; ///< per owned DoF: active in this step
+    bool                           any_plate = false; ///< the scene has rigid plates
+    /// Sum the plate nodes' mass, force and momentum over the ranks and set
+    /// each plate's velocity V^{t+h}, force/reaction and displacement; F: the
+    /// nodal force before damping, M: the nodal mass (solid).
+    void rigid_plate_balance(Solver &s, const double *F, const double *M);
+    /// From the sums: each plate's V^{t+h}, force/reaction, displacement and
+    /// work. `liquid` (coupled 2-phase, after the liquid's accelerations): per
+    /// plate and component sum beta Mbar_L a_L over its nodes; a permeable
+    /// plate moves the solid only (the liquid flows through with its own a_L),
+    /// an impermeable one the solid and the liquid together along its axis.
+    void rigid_plate_velocities(Solver &s, const double *liquid);
+    static constexpr unsigned int plate_sum_size = 5 + 2 * dim;
+    std::vector<double>           plate_sum; ///< per plate, summed over the ranks
+
     void assign_tractions(Solver &s);
     void update_factors(const Solver &s);
     void build_node_lists(Solver &s);

@@ -20,14 +20,10 @@ namespace talus::explicit_mpm
   {
     using namespace dealii::Patterns;
     prm.enter_subsection("numerics");
-    prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
-                      "Shape functions of the particle-grid transfers: 'linear' (Q1 on the grid cells) or "
-                      "'quadratic bspline' (uniform quadratic B-splines on the grid nodes, 3 nodes per direction "
-                      "per point: no cell-crossing noise; at the grid walls the outside node is a ghost carrying "
-                      "the linear extrapolation, so fixed and roller walls hold exactly at the wall; "
-                      "docs/shape-functions.md). Quadratic B-splines need a uniform box grid with at least 3 "
-                      "cells per direction and integration = mpm, without strain smoothing, contact, 2-phase "
-                      "materials, tractions, friction or prescribed velocities of bodies.");
+    // 'shape function' is declared with the shared scene (scene_parameters.cc);
+    // quadratic B-splines need integration = mpm, without strain smoothing,
+    // contact, 2-phase materials, tractions, friction or prescribed velocities
+    // of bodies (refused by parse_parameters in explicit_solver.cc)
     prm.declare_entry("velocity transfer", "flip", Selection("flip|apic"),
                       "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
                       "velocity from the points' momentum) or 'apic' (affine particle-in-cell, Jiang et al. 2015: "
@@ -76,9 +72,8 @@ namespace talus::explicit_mpm
   {
     NumericsOptions o;
     prm.enter_subsection("numerics");
-    o.shape_function = prm.get("shape function") == "quadratic bspline" ?
-                         NumericsOptions::ShapeFunction::quadratic_bspline :
-                         NumericsOptions::ShapeFunction::linear;
+    o.shape_function = prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline
+                                                                           : ShapeFunction::linear;
     o.velocity_transfer = prm.get("velocity transfer") == "apic" ? NumericsOptions::VelocityTransfer::apic :
                                                                      NumericsOptions::VelocityTransfer::flip;
     {

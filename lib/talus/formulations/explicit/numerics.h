@@ -10,6 +10,7 @@
 #include <talus/formulations/explicit/forward.h>
 #include <talus/grid/background_grid.h>
 #include <talus/materials/material.h>
+#include <talus/shape/shape_function.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -35,12 +36,9 @@ namespace talus::explicit_mpm
       cell, ///< volumetric strain increment replaced by the cell average (mean dilatation)
       nodal ///< nodal mixed discretisation: cell values averaged to the nodes and back (Eqs. 6.35-6.37)
     };
-    /// Shape functions of the particle-grid transfers (docs/shape-functions.md).
-    enum class ShapeFunction
-    {
-      linear,           ///< Q1 on the box cells (shape/q1_box.h)
-      quadratic_bspline ///< quadratic B-splines, 3^dim nodes per point (shape/bspline2_box.h)
-    };
+    /// Shape functions of the particle-grid transfers ('numerics/shape function',
+    /// declared with the shared scene; docs/shape-functions.md).
+    using ShapeFunction = talus::ShapeFunction;
     ShapeFunction shape_function = ShapeFunction::linear;
     bool bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
     /// Velocity transfer of the 1-phase step (docs/shape-functions.md, "APIC").

@@ -1,5 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
 #include <talus/formulations/common/scene_checks.h>
@@ -12,7 +13,12 @@
 #include <talus/shape/with_kernel.h>
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
+
+#include <Epetra_CrsMatrix.h>
+#include <Epetra_Map.h>
 
 #include <cmath>
 #include <limits>
@@ -76,7 +82,8 @@ namespace talus::implicit_mpm
       declare_common_parameters(prm, prm_file,
                                 "Time step [s] (static analysis: the load step, in the same units as 'end time'); "
                                 "> 0, required. Not limited by the explicit critical step; a step whose Newton "
-                                "iteration fails is halved and retried (at most 6 times in a row).");
+                                "iteration fails is halved and retried (at most 6 times in a row).",
+                                /*png fields not written:*/ {"pore pressure", "free surface"});
     loads::declare_traction_parameters(prm, prm_file, counts.dim, true);
     prm.enter_subsection("boundary conditions");
     {
@@ -156,11 +163,6 @@ namespace talus::implicit_mpm
                         "cell). Removes the volumetric locking of Q1 cells with several points (near "
                         "incompressible elasticity, isochoric plastic flow). Not with 'mixed up' or "
                         "'axisymmetric'.");
-      prm.declare_entry("shape function", "linear", Selection("linear|quadratic bspline"),
-                        "The grid basis of every transfer (mass, forces, tangent, convective phase): linear Q1, or "
-                        "quadratic B-splines with the wall treatment of docs/shape-functions.md (C1 across cell "
-                        "faces: no force jump when a point crosses a cell face; a point couples the 3^dim nodes "
-                        "around it). Not with 'volumetric stabilisation = f-bar' or 'geometry = axisymmetric'.");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
@@ -264,7 +266,6 @@ namespace talus::implicit_mpm
     p.mixed_up       = prm.get("formulation") == "mixed up";
     p.stabilisation  = prm.get_double("stabilisation factor");
     p.fbar           = prm.get("volumetric stabilisation") == "f-bar";
-    p.bspline        = prm.get("shape function") == "quadratic bspline";
     p.axisymmetric   = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
@@ -274,10 +275,10 @@ namespace talus::implicit_mpm
     require(!p.fbar || !p.mixed_up, "implicit/volumetric stabilisation",
             "'f-bar' is for 'formulation = irreducible' (the mixed u-p form treats the volume through its pressure "
             "field); allowed with 'mixed up': none");
-    require(!p.fbar || !p.bspline, "implicit/volumetric stabilisation",
+    require(!p.fbar || !p.bspline(), "implicit/volumetric stabilisation",
             "'f-bar' (a mean over the points of a cell) is for 'shape function = linear': a B-spline point "
             "reaches beyond its cell; allowed with 'quadratic bspline': none");
-    require(!p.bspline || !p.axisymmetric, "implicit/shape function",
+    require(!p.bspline() || !p.axisymmetric, "numerics/shape function",
             "'quadratic bspline' is not available with 'geometry = axisymmetric' (the axis is no wall of the "
             "B-spline basis); allowed there: linear");
     require(!p.fbar || !p.axisymmetric, "implicit/volumetric stabilisation",
@@ -570,7 +571,7 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::with_kernel(F &&f) const
   {
-    shape::with_kernel<dim>(prm.bspline, std::forward<F>(f));
+    shape::with_kernel<dim>(prm.bspline(), std::forward<F>(f));
   }
 
   template <int dim>
@@ -594,7 +595,7 @@ namespace talus::implicit_mpm
   {
     grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
-    if (prm.bspline)
+    if (prm.bspline())
       grid.setup_bspline_patches(); // the 4^dim node patch of every owned cell
     space.setup();
 
@@ -644,7 +645,7 @@ namespace talus::implicit_mpm
               }
             planes.push_back(c);
           }
-        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric, prm.bspline);
+        point_contact = std::make_unique<PointContact<dim>>(planes, prm.materials, prm.axisymmetric, prm.bspline());
         point_contact->extend_layout(points.layout);
       }
     if (prm.mixed_up)
@@ -655,26 +656,24 @@ namespace talus::implicit_mpm
       }
     points.initialize();
 
+    const unsigned int n_plates = prm.rigid_plates.size();
+    plate_displacement.assign(n_plates, 0.0);
+    plate_step.assign(n_plates, 0.0);
+    plate_c.assign(n_plates, 0.0);
+    plate_target.assign(n_plates, 0.0);
+    plate_sum.assign(n_plates, 0.0);
+    plate_reaction.assign(n_plates, dealii::Tensor<1, dim>());
+    plate_owned.assign(n_plates, {});
+    idle_plates.assign(n_plates, 0);
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
-        std::vector<double> density;
-        for (const auto &m : prm.materials)
-          density.push_back(m->density());
-        auto       seeded = seed_bodies(grid, prm.bodies, density, points.layout, points.handler);
-        const auto filed =
-          insert_file_bodies(grid, prm.bodies, density, points.layout, points.handler, seeded.n_particles);
-        for (unsigned int b = 0; b < prm.bodies.size(); ++b)
-          require(seeded.volume_per_body[b] + filed.volume_per_body[b] > 0,
-                  "body " + std::to_string(b) + " ('" + prm.bodies[b].name + "')",
-                  "contains no material point: it lies outside the grid or is smaller than one sub-cell");
+        seed_scene_bodies(grid, prm.bodies, material_densities(prm), points, "material point", &prm);
         using L = PropertyLayout<dim>;
+        initialize_point_histories(prm.materials, points, L::history);
         for (auto &pt : points.handler)
           {
-            auto        P = pt.get_properties();
-            const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
-            m.initialize_history(L::get_stress(P.data()),
-                                 dealii::ArrayView<double>(P.data() + L::history, m.n_history()));
+            auto P = pt.get_properties();
             for (unsigned int d = 0; d < dim; ++d)
               P[acceleration_offset + d] = 0.0;
             if (prm.mixed_up) // the mean of the initial stress
@@ -688,6 +687,7 @@ namespace talus::implicit_mpm
             "the checkpoint is in stage " + std::to_string(current_stage) + " but the .prm has " +
               std::to_string(prm.stages.size()) + " stage(s)");
     enter_stage(current_stage);
+    check_plates();
     points.collect_active_cells();
     if (!prm.tractions.empty())
       point_forces.assign(prm.tractions, points, grid, prm.bodies, comm);
@@ -819,7 +819,7 @@ namespace talus::implicit_mpm
   Solver<dim>::enter_stage(const unsigned int k)
   {
     stage_nodes(k);
-    idle_conditions.assign(prm.stages[k].velocities.size(), 0);
+    idle_conditions.assign(prm.stages[k].velocities.size() + prm.rigid_plates.size(), 0);
     region_shift.assign(prm.stages[k].velocities.size(), dealii::Tensor<1, dim>());
   }
 
@@ -837,6 +837,111 @@ namespace talus::implicit_mpm
     // the grid nodes of the stage's 'velocity k' (owned and ghost: constraints
     // of a distributed assembly must be known where a rank assembles)
     prescribed_dofs = loads::prescribed_node_dofs(grid, st.velocities, false);
+    // the plates' nodes (their walls are those of the stage)
+    plate_nodes = loads::rigid_plate_node_dofs(grid, prm.rigid_plates, false);
+    append_plate_dofs();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::append_plate_dofs()
+  {
+    // a component a fixed/roller wall holds stays the wall's (wall_constraints
+    // would let a prescribed line win); the axis component of a force plate is
+    // no prescribed DoF but the plate's unknown
+    const unsigned int n_vel = n_velocities();
+    for (const auto &p : plate_nodes)
+      {
+        const auto &plate = prm.rigid_plates[p.condition];
+        if (boundary_flags[p.dof] || (force_plate(p.condition) && p.component == plate.axis))
+          continue;
+        prescribed_dofs.push_back({p.dof, p.node, n_vel + p.condition, p.component});
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::check_plates()
+  {
+    // per plate: owned nodes, nodes shared with another plate, and per stage
+    // the nodes whose axis component that stage's walls hold
+    const unsigned int  n = prm.rigid_plates.size(), n_stages = prm.stages.size(), nc = 2 + n_stages;
+    std::vector<double> count(n * nc, 0.0);
+    const unsigned int  n_owned = grid.partitioner->locally_owned_size();
+    std::vector<std::vector<unsigned char>> flags;
+    for (const auto &st : prm.stages)
+      flags.push_back(loads::wall_dof_flags(grid, st.boundary_conditions));
+    std::vector<int> owner(n_owned, -1);
+    for (const auto &p : plate_nodes)
+      if (p.node < n_owned && p.component == prm.rigid_plates[p.condition].axis)
+        {
+          double *c = &count[p.condition * nc];
+          c[0] += 1;
+          if (owner[p.node] >= 0 && owner[p.node] != static_cast<int>(p.condition))
+            c[1] += 1;
+          owner[p.node] = static_cast<int>(p.condition);
+          for (unsigned int j = 0; j < n_stages; ++j)
+            if (flags[j][p.dof])
+              c[2 + j] += 1;
+        }
+    dealii::Utilities::MPI::sum(count, comm, count);
+    const char *ax[] = {"x", "y", "z"};
+    for (unsigned int k = 0; k < n; ++k)
+      {
+        const auto &  plate = prm.rigid_plates[k];
+        const double *c     = &count[k * nc];
+        require(c[0] > 0, plate.where,
+                plate.target == loads::RigidPlate<dim>::Target::boundary
+                  ? "holds no grid node (no face of the grid has boundary id " + std::to_string(plate.boundary) + ")"
+                  : std::string("holds no grid node: no node of the grid lies inside its region (widen the region "
+                                "to reach a row of grid nodes)"));
+        require(c[1] == 0, plate.where,
+                "shares " + std::to_string(static_cast<long>(c[1])) +
+                  " node(s) with another rigid plate; a grid node can belong to one plate only");
+        for (unsigned int j = 0; j < n_stages; ++j)
+          require(c[2 + j] < c[0], plate.where,
+                  std::string("its axis component (") + ax[plate.axis] +
+                    ") is held by a fixed/roller wall at every one of its nodes" +
+                    (prm.staged ? " in stage " + std::to_string(j) : std::string()) +
+                    ": the plate cannot move; allowed: a direction no wall holds at its nodes, or remove the wall");
+        std::ostringstream os;
+        os << "  rigid plate " << k << " (" << plate.where << "): " << c[0] << " grid nodes ("
+           << c[0] - c[2 + current_stage] << " free along " << ax[plate.axis] << "), "
+           << (plate.rough ? "rough" : "frictionless") << ", "
+           << (force_plate(k) ? "force control: total force " + std::to_string(plate.force)
+                              : "displacement control: displacement " + std::to_string(plate.displacement))
+           << " x f(t) along " << ax[plate.axis] << " (its own time function, absolute time)";
+        log() << os.str() << std::endl;
+      }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::find_plate_dofs()
+  {
+    // the axis DoFs of each force plate that the step leaves free (not held by
+    // a wall, a prescribed line, contact, the inactive pins or the negligible
+    // mass rule, which includes the prescribed lines of displacement plates;
+    // plates share no node: check_plates)
+    const auto &owned = space.locally_owned_dofs();
+    std::vector<dealii::types::global_dof_index> mine;
+    for (auto &v : plate_owned)
+      v.clear();
+    for (const auto &p : plate_nodes)
+      {
+        const auto &plate = prm.rigid_plates[p.condition];
+        if (!force_plate(p.condition) || p.component != plate.axis)
+          continue;
+        const auto i = space.node_dof(p.node, p.component);
+        if (!owned.is_element(i) || constraints.is_constrained(i))
+          continue;
+        plate_owned[p.condition].push_back(i);
+        mine.push_back(i);
+      }
+    plate_all.clear();
+    for (const auto &v : dealii::Utilities::MPI::all_gather(comm, mine))
+      plate_all.insert(plate_all.end(), v.begin(), v.end());
+    std::sort(plate_all.begin(), plate_all.end());
   }
 
   template <int dim>
@@ -857,6 +962,7 @@ namespace talus::implicit_mpm
               velocities[k].upper += region_shift[k];
             }
         prescribed_dofs = loads::prescribed_node_dofs(grid, velocities, false);
+        append_plate_dofs();
       }
     // the cell terms (PPP cell means, F-bar's cell mean) couple all the nodes a cell's points touch
     const auto reach = prm.mixed_up || prm.fbar ? ActiveSet<dim>::Reach::cell : ActiveSet<dim>::Reach::point;
@@ -872,6 +978,8 @@ namespace talus::implicit_mpm
     if (point_contact) // x_n of the points, read by the contact terms of the step
       point_contact->start_step(points);
     constraints = step_constraints();
+    if (any_force_plate())
+      find_plate_dofs();
   }
 
   template <int dim>
@@ -924,7 +1032,7 @@ namespace talus::implicit_mpm
   template <int dim>
   dealii::AffineConstraints<double>
   Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact,
-                                const bool with_prescribed) const
+                                const bool with_prescribed, const bool hold_plates) const
   {
     // the contact nodes now in contact: their normal DoF, with no slip all
     std::vector<dealii::types::global_dof_index> held;
@@ -939,6 +1047,10 @@ namespace talus::implicit_mpm
               held.push_back(space.node_dof(c.node, d));
         }
     held.insert(held.end(), negligible_dofs.begin(), negligible_dofs.end());
+    if (hold_plates) // the force plates' axis DoFs at zero increment (the predictor)
+      for (const auto &p : plate_nodes)
+        if (force_plate(p.condition) && p.component == prm.rigid_plates[p.condition].axis)
+          held.push_back(space.node_dof(p.node, p.component));
     return active.constraints_with(
       loads::wall_constraints(grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values,
                               &held));
@@ -1062,7 +1174,15 @@ namespace talus::implicit_mpm
   double
   Solver<dim>::prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const
   {
-    return condition_increment(p.condition, h)[p.component];
+    const unsigned int n_vel = n_velocities();
+    if (p.condition < n_vel)
+      return condition_increment(p.condition, h)[p.component];
+    // a plate: its displacement history along its axis (absolute time; the
+    // static ramp does not scale it), zero tangential increments (rough)
+    const auto &plate = prm.rigid_plates[p.condition - n_vel];
+    if (plate.control != loads::RigidPlate<dim>::Control::displacement || p.component != plate.axis)
+      return 0.0;
+    return plate.displacement_at(time + h) - plate.displacement_at(time);
   }
 
   template <int dim>
@@ -1088,7 +1208,9 @@ namespace talus::implicit_mpm
     std::swap(constraints, free_prescribed);
     const auto &owned = space.locally_owned_dofs();
     const auto &pins  = active.constraints();
-    std::vector<double>                          f(dim, 0.0);
+    // the velocity conditions' sum per component, then each plate's per component
+    const unsigned int                           n_vel = n_velocities();
+    std::vector<double>                          f(dim * (1 + prm.rigid_plates.size()), 0.0);
     std::vector<dealii::types::global_dof_index> seen; // a node of two conditions counts once
     for (const auto &p : prescribed_dofs)
       {
@@ -1097,11 +1219,15 @@ namespace talus::implicit_mpm
             std::find(seen.begin(), seen.end(), i) != seen.end())
           continue;
         seen.push_back(i);
-        f[p.component] += residual(i);
+        const unsigned int slot = p.condition < n_vel ? 0 : 1 + p.condition - n_vel;
+        f[slot * dim + p.component] += residual(i);
       }
     dealii::Utilities::MPI::sum(f, comm, f);
     for (unsigned int d = 0; d < dim; ++d)
       last.prescribed_force[d] = f[d];
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      for (unsigned int d = 0; d < dim; ++d)
+        plate_reaction[k][d] = f[(1 + k) * dim + d];
     residual = kept;
   }
 
@@ -1109,8 +1235,15 @@ namespace talus::implicit_mpm
   LinearSolveInfo
   Solver<dim>::solve_for_delta()
   {
+    return solve_for_delta(residual);
+  }
+
+  template <int dim>
+  LinearSolveInfo
+  Solver<dim>::solve_for_delta(const Vector &r)
+  {
     const auto start = Clock::now();
-    Vector     rhs(residual);
+    Vector     rhs(r);
     rhs *= -1.0;
     delta = 0;
     LinearSolveInfo info;
@@ -1139,6 +1272,93 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
+  LinearSolveInfo
+  Solver<dim>::solve_several(std::vector<Vector> &r)
+  {
+    // iterative methods: one solve_for_delta per right-hand side
+    if (prm.linear.method != LinearSolverOptions::Method::direct)
+      {
+        LinearSolveInfo info;
+        for (auto &x : r)
+          {
+            // a zero right-hand side (the first iteration of a step whose only
+            // load is a plate's force: the free rows are in balance) has the
+            // solution 0; a Krylov solver would stop with a breakdown on it
+            if (x.linfty_norm() == 0)
+              continue;
+            const auto one = solve_for_delta(x);
+            info.method = one.method;
+            info.iterations += one.iterations;
+            info.relative_residual = std::max(info.relative_residual, one.relative_residual);
+            x = delta;
+          }
+        return info;
+      }
+    // direct: one factorisation for all of them (solve_linear's solve and
+    // iterative refinement per right-hand side)
+    const auto      start = Clock::now();
+    LinearSolveInfo info;
+    info.method = "direct (" + prm.linear.direct_package + ", one factorisation for " + std::to_string(r.size()) +
+                  " right-hand sides)";
+    try
+      {
+        dealii::SolverControl                                  control(1, 0);
+        dealii::TrilinosWrappers::SolverDirect::AdditionalData data(false, prm.linear.direct_package);
+        dealii::TrilinosWrappers::SolverDirect                 solver(control, data);
+        solver.initialize(tangent);
+        Vector b, x, res, d;
+        for (Vector *v : {&b, &x, &res, &d})
+          space.reinit_vector(*v);
+        for (auto &rk : r)
+          {
+            b = rk;
+            b *= -1.0;
+            x = 0;
+            solver.solve(x, b);
+            const double b_norm        = b.l2_norm();
+            const auto   residual_norm = [&]() {
+              tangent.vmult(res, x);
+              res.sadd(-1.0, 1.0, b);
+              return res.l2_norm();
+            };
+            double rn = residual_norm();
+            for (unsigned int k = 0; k < 3 && rn > 1e-9 * b_norm; ++k)
+              {
+                d = 0;
+                solver.solve(d, res);
+                x += d;
+                const double rn_new = residual_norm();
+                if (!(rn_new < rn))
+                  {
+                    x -= d;
+                    break;
+                  }
+                rn = rn_new;
+              }
+            const double rel = b_norm > 0 ? rn / b_norm : rn;
+            ++info.iterations;
+            info.relative_residual = std::max(info.relative_residual, rel);
+            rk                     = x;
+          }
+      }
+    catch (const std::exception &e)
+      {
+        throw NewtonFailure(std::string("linear solve failed: ") + e.what());
+      }
+    seconds_solve += seconds_since(start);
+    n_solves += r.size();
+    if (!(info.relative_residual <= 1e-6))
+      {
+        std::ostringstream os;
+        os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
+           << " after the " << info.method
+           << " solve): are rigid-body motions of every body prevented by boundary conditions?";
+        throw NewtonFailure(os.str());
+      }
+    return info;
+  }
+
+  template <int dim>
   void
   Solver<dim>::predict_prescribed(const double h, const dealii::Tensor<1, dim> &g)
   {
@@ -1152,8 +1372,10 @@ namespace talus::implicit_mpm
     std::vector<double> minus_increment(prescribed_dofs.size());
     for (std::size_t k = 0; k < prescribed_dofs.size(); ++k)
       minus_increment[k] = -prescribed_increment(prescribed_dofs[k], h);
-    auto lifted = step_constraints(&minus_increment);
+    // a force plate's DoFs are held here (Newton moves them as one from this iterate on)
+    auto lifted = step_constraints(&minus_increment, true, true, true);
     std::swap(constraints, lifted);
+    plates_held = true;
     try
       {
         // the out-of-balance force the prescribed increment creates: the scale
@@ -1165,9 +1387,14 @@ namespace talus::implicit_mpm
     catch (...)
       {
         std::swap(constraints, lifted);
+        plates_held = false;
         throw;
       }
     std::swap(constraints, lifted);
+    plates_held = false;
+    for (const auto &dofs : plate_owned)
+      for (const auto i : dofs)
+        delta[i] = 0.0;
 
     // Du: the solve's free values, the prescribed increments at the prescribed
     // DoFs of active nodes, 0 at the other constrained DoFs
@@ -1175,7 +1402,7 @@ namespace talus::implicit_mpm
     const auto &        pins  = active.constraints(); // inactive nodes: no mass, pinned to 0
     const auto &        owned = space.locally_owned_dofs();
     const auto &        velocities = prm.stages[current_stage].velocities;
-    std::vector<double> n_active(velocities.size(), 0.0);
+    std::vector<double> n_active(velocities.size() + prm.rigid_plates.size(), 0.0);
     for (const auto &p : prescribed_dofs)
       {
         const auto i = space.node_dof(p.node, p.component);
@@ -1192,10 +1419,12 @@ namespace talus::implicit_mpm
     // (once per condition) instead of letting a displacement control go slack
     dealii::Utilities::MPI::sum(n_active, comm, n_active);
     for (unsigned int k = 0; k < n_active.size(); ++k)
-      if (n_active[k] == 0 && !idle_conditions[k])
+      if (n_active[k] == 0 && !idle_conditions[k] && (k < velocities.size() || !force_plate(k - velocities.size())))
         {
           idle_conditions[k] = 1;
-          log() << "  WARNING: " << velocities[k].where << " reaches no grid node next to material at t = "
+          log() << "  WARNING: "
+                << (k < velocities.size() ? velocities[k].where : prm.rigid_plates[k - velocities.size()].where)
+                << " reaches no grid node next to material at t = "
                 << time << " s (the prescribed nodes are fixed in space and the material has left their cells): "
                 << "the condition has no effect from here on" << std::endl;
         }
@@ -1342,7 +1571,194 @@ namespace talus::implicit_mpm
       }
     seconds_assembly += seconds_since(start);
     ++n_assemblies;
-    return residual.l2_norm();
+    if (!any_force_plate() || plates_held)
+      return residual.l2_norm();
+    // force plates: their DoFs' equations are the plates' balances, one per
+    // plate: sum_{i in P_k} r_i = F_k (the force the plate exerts on the
+    // material). The sums are kept and the rows zeroed (the solve's right-hand
+    // side there is 0); the norm Newton tests is that of the free rows and the
+    // plates' out-of-balance forces.
+    const unsigned int  n = prm.rigid_plates.size();
+    std::vector<double> sums(n, 0.0);
+    for (unsigned int k = 0; k < n; ++k)
+      for (const auto i : plate_owned[k])
+        {
+          sums[k] += residual(i);
+          residual(i) = 0.0;
+        }
+    dealii::Utilities::MPI::sum(sums, comm, sums);
+    double norm2 = residual.norm_sqr();
+    for (unsigned int k = 0; k < n; ++k)
+      if (force_plate(k))
+        {
+          plate_sum[k] = sums[k];
+          norm2 += (sums[k] - plate_target[k]) * (sums[k] - plate_target[k]);
+        }
+    return std::sqrt(norm2);
+  }
+
+  namespace
+  {
+    /// Zero the rows and columns of the global DoFs `dofs` (sorted, the same
+    /// list on every rank) of a filled Trilinos matrix, keeping each row's
+    /// diagonal: the matrix of the system with those DoFs prescribed
+    /// (symmetric if A is). In place on Epetra's values (the pattern is kept).
+    void
+    zero_rows_and_columns(dealii::TrilinosWrappers::SparseMatrix &            A,
+                          const std::vector<dealii::types::global_dof_index> &dofs)
+    {
+      auto &            E    = const_cast<Epetra_CrsMatrix &>(A.trilinos_matrix());
+      const Epetra_Map &rows = E.RowMap(), &cols = E.ColMap();
+      std::vector<unsigned char> col_hit(E.NumMyCols(), 0);
+      for (const auto g : dofs)
+        {
+          const int l = cols.LID(static_cast<int>(g));
+          if (l >= 0)
+            col_hit[l] = 1;
+        }
+      for (int r = 0; r < E.NumMyRows(); ++r)
+        {
+          int     n = 0;
+          double *values = nullptr;
+          int *   indices = nullptr;
+          E.ExtractMyRowView(r, n, values, indices);
+          const int  gid  = rows.GID(r);
+          const bool hit  = std::binary_search(dofs.begin(), dofs.end(), dealii::types::global_dof_index(gid));
+          for (int j = 0; j < n; ++j)
+            if ((hit && cols.GID(indices[j]) != gid) || (!hit && col_hit[indices[j]]))
+              values[j] = 0.0;
+        }
+      // values changed behind Epetra's back: drop its cached norms
+      E.SumIntoMyValues(0, 0, nullptr, nullptr);
+    }
+
+    /// Solve the small dense system M c = b (n x n, row-major) by Gaussian
+    /// elimination with partial pivoting; the same arithmetic on every rank.
+    std::vector<double>
+    solve_dense(std::vector<double> M, std::vector<double> b)
+    {
+      const unsigned int n = b.size();
+      for (unsigned int k = 0; k < n; ++k)
+        {
+          unsigned int p = k;
+          for (unsigned int i = k + 1; i < n; ++i)
+            if (std::abs(M[i * n + k]) > std::abs(M[p * n + k]))
+              p = i;
+          for (unsigned int j = 0; j < n; ++j)
+            std::swap(M[k * n + j], M[p * n + j]);
+          std::swap(b[k], b[p]);
+          for (unsigned int i = k + 1; i < n; ++i)
+            {
+              const double f = M[i * n + k] / M[k * n + k];
+              for (unsigned int j = k; j < n; ++j)
+                M[i * n + j] -= f * M[k * n + j];
+              b[i] -= f * b[k];
+            }
+        }
+      std::vector<double> c(n, 0.0);
+      for (unsigned int k = n; k-- > 0;)
+        {
+          double s = b[k];
+          for (unsigned int j = k + 1; j < n; ++j)
+            s -= M[k * n + j] * c[j];
+          c[k] = s / M[k * n + k];
+        }
+      return c;
+    }
+  } // namespace
+
+  template <int dim>
+  LinearSolveInfo
+  Solver<dim>::solve_with_plates()
+  {
+    // The plates' DoFs condensed by superposition (docs/implicit.md, "Rigid
+    // plate"): exact, the same solution as a master-slave line u_i = u_m per
+    // plate node, without couplings of the master in the sparsity or the
+    // master as a ghost on every rank.
+    const auto         start = Clock::now();
+    const unsigned int n_all = prm.rigid_plates.size();
+    std::vector<unsigned int> ks; // the force plates
+    for (unsigned int k = 0; k < n_all; ++k)
+      if (force_plate(k))
+        ks.push_back(k);
+    const unsigned int  n = ks.size();
+    std::vector<Vector> e(n), v(n), w(n), z(n);
+    std::vector<double> size(n, 0.0);
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        for (Vector *x : {&e[a], &v[a], &w[a], &z[a]})
+          space.reinit_vector(*x);
+        for (const auto i : plate_owned[ks[a]])
+          e[a][i] = 1.0;
+        size[a] = plate_owned[ks[a]].size();
+        tangent.vmult(v[a], e[a]);  // K e: the plate's column sum (K_FP 1 in the free rows)
+        tangent.Tvmult(w[a], e[a]); // K^T e: its row sum, sum_{i in P} K_ij
+      }
+    dealii::Utilities::MPI::sum(size, comm, size);
+    zero_rows_and_columns(tangent, plate_all);
+    const auto zero_plate_entries = [&](Vector &x) {
+      for (const auto &dofs : plate_owned)
+        for (const auto i : dofs)
+          x[i] = 0.0;
+    };
+    // z_0 (the plates held) and z_a (the response to a unit displacement of
+    // plate a), from one factorisation with the direct solver
+    std::vector<Vector> x(1 + n);
+    x[0] = residual; // its plate rows are 0 (assemble)
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        x[1 + a] = v[a];
+        zero_plate_entries(x[1 + a]);
+      }
+    seconds_plates += seconds_since(start);
+    const auto      start_solve = Clock::now();
+    LinearSolveInfo info        = solve_several(x);
+    const double    t_solve     = seconds_since(start_solve);
+    const auto      start2      = Clock::now();
+    Vector          z0(x[0]);
+    zero_plate_entries(z0);
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        z[a] = x[1 + a];
+        zero_plate_entries(z[a]);
+      }
+    seconds_plates_solve += t_solve;
+    // the linearised balance of plate a: sum_{i in P_a} (r + K delta)_i = F_a,
+    // delta = z_0 + sum_b c_b (z_b + e_b): sum_b (w_a . z_b + e_a . v_b) c_b = F_a - R_a - w_a . z_0
+    std::vector<double> M(n * n), b(n);
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        const auto k = ks[a];
+        if (size[a] == 0)
+          {
+            // the plate acts on no free node next to material: its force has
+            // nothing to act on (said once), its increment is 0
+            for (unsigned int c = 0; c < n; ++c)
+              M[a * n + c] = c == a ? 1.0 : 0.0;
+            b[a] = 0;
+            if (!idle_plates[k])
+              {
+                idle_plates[k] = 1;
+                log() << "  WARNING: " << prm.rigid_plates[k].where << " reaches no free grid node next to material at t = "
+                      << time << " s: its force acts on nothing from here on" << std::endl;
+              }
+            continue;
+          }
+        for (unsigned int c = 0; c < n; ++c)
+          M[a * n + c] = (w[a] * z[c]) + (e[a] * v[c]);
+        b[a] = plate_target[k] - plate_sum[k] - (w[a] * z0);
+      }
+    const std::vector<double> c = solve_dense(M, b);
+    delta = z0;
+    for (unsigned int a = 0; a < n; ++a)
+      {
+        delta.add(c[a], z[a]);
+        plate_c[ks[a]] = c[a];
+        for (const auto i : plate_owned[ks[a]])
+          delta[i] = c[a]; // exactly c: the plate's nodes move as one
+      }
+    seconds_plates += seconds_since(start2);
+    return info;
   }
 
   template <int dim>
@@ -1481,6 +1897,14 @@ namespace talus::implicit_mpm
         });
         f_ext = residual.l2_norm();
       }
+    // the plates' forces at t + h (their own time functions) join the scale
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        plate_target[k] = force_plate(k) ? prm.rigid_plates[k].force_at(time + h) : 0.0;
+        plate_step[k]   = 0.0;
+        plate_c[k]      = 0.0;
+        f_ext           = std::sqrt(f_ext * f_ext + plate_target[k] * plate_target[k]);
+      }
 
     du = 0;
     du.update_ghost_values();
@@ -1508,7 +1932,7 @@ namespace talus::implicit_mpm
     NewtonProblem problem;
     problem.assemble = [&](const bool with_tangent) { return assemble(with_tangent, g); };
     problem.solve    = [&]() {
-      const LinearSolveInfo info = solve_for_delta();
+      const LinearSolveInfo info = any_force_plate() ? solve_with_plates() : solve_for_delta();
       linear_iterations += info.iterations;
       worst_linear_residual = std::max(worst_linear_residual, info.relative_residual);
       constraints.set_zero(delta);
@@ -1518,6 +1942,8 @@ namespace talus::implicit_mpm
     problem.apply = [&](const double alpha) {
       du.add(alpha, delta);
       du.update_ghost_values();
+      for (unsigned int k = 0; k < plate_step.size(); ++k)
+        plate_step[k] += alpha * plate_c[k];
     };
     problem.step_increment_norm = [&]() { return du.l2_norm(); };
     problem.residual_reference  = [&]() { return std::max(f_ext, lifted_residual); };
@@ -1559,6 +1985,8 @@ namespace talus::implicit_mpm
             break;
           }
         constraints = step_constraints();
+        if (any_force_plate())
+          find_plate_dofs();
         constraints.set_zero(du);
         du.update_ghost_values();
       }
@@ -1620,7 +2048,7 @@ namespace talus::implicit_mpm
         return StepOutcome::cut_back;
       }
 
-    if (any_velocity_condition()) // collective: the same on every rank
+    if (any_velocity_condition() || any_plate_reaction()) // collective: the same on every rank
       {
         try
           {
@@ -1635,6 +2063,12 @@ namespace talus::implicit_mpm
       }
     for (unsigned int k = 0; k < region_shift.size(); ++k)
       region_shift[k] += condition_increment(k, h);
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        const auto &plate = prm.rigid_plates[k];
+        plate_displacement[k] +=
+          force_plate(k) ? plate_step[k] : plate.displacement_at(time + h) - plate.displacement_at(time);
+      }
 
     if (point_contact)
       {
@@ -1677,6 +2111,9 @@ namespace talus::implicit_mpm
             << last.point_contact.max_penetration_ratio;
     if (prm.footing.enabled)
       log() << "; footing force " << last.point_contact.footing_force;
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      log() << "; plate " << k << " displacement " << std::setprecision(8) << plate_displacement[k] << ", force "
+            << (force_plate(k) ? plate_sum[k] : plate_reaction[k][prm.rigid_plates[k].axis]) << std::setprecision(6);
     if (any_contact)
       log() << "; contact: " << passes << " pass(es), " << released << " released, " << added << " in contact again, "
             << last.contact_nodes << " nodes in contact" << pass_log.str();
@@ -1792,10 +2229,10 @@ namespace talus::implicit_mpm
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
         << "), time step " << dt << std::endl;
     out << "  formulation: "
-        << (prm.mixed_up ? std::string(prm.bspline ? "mixed u-p (equal-order B-splines" : "mixed u-p (Q1-Q1") +
+        << (prm.mixed_up ? std::string(prm.bspline() ? "mixed u-p (equal-order B-splines" : "mixed u-p (Q1-Q1") +
                              ", PPP stabilisation alpha = " + std::to_string(prm.stabilisation) + ")"
                          : std::string("irreducible (displacement)"))
-        << (prm.bspline ? ", quadratic B-splines" : ", linear shape functions")
+        << (prm.bspline() ? ", quadratic B-splines" : ", linear shape functions")
         << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
         << (prm.velocities.empty() ? "" :
                                      ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")
@@ -1882,6 +2319,8 @@ namespace talus::implicit_mpm
     if (any_velocity_condition())
       for (unsigned int d = 0; d < dim; ++d)
         c.push_back(std::string("prescribed_force_") + ax[d]);
+    for (const auto &n : loads::rigid_plate_series_columns(prm.rigid_plates))
+      c.push_back(n);
     balance.add_series_column(c);
     return c;
   }
@@ -1923,6 +2362,23 @@ namespace talus::implicit_mpm
     if (any_velocity_condition())
       for (unsigned int d = 0; d < dim; ++d)
         v.push_back(after_step ? last.prescribed_force[d] : 0.0);
+    // the plates (rigid_plate_series_columns): displacement, the force on the
+    // material along the axis (force control: F(t); displacement control: the
+    // reaction), the tangential reaction's magnitude (rough)
+    for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+      {
+        const auto &plate = prm.rigid_plates[k];
+        v.push_back(plate_displacement[k]);
+        v.push_back((force_plate(k) ? plate.force_at(time) : after_step ? plate_reaction[k][plate.axis] : 0.0) + 0.0); // no -0
+        if (plate.rough)
+          {
+            double t2 = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              if (d != plate.axis)
+                t2 += plate_reaction[k][d] * plate_reaction[k][d];
+            v.push_back(after_step ? std::sqrt(t2) : 0.0);
+          }
+      }
     balance.add_series_value(v);
     return v;
   }
@@ -1953,6 +2409,16 @@ namespace talus::implicit_mpm
                                    f.set_attribute("newton iterations", std::int64_t(total_iterations));
                                    f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
                                    f.set_attribute("cut-backs", std::int64_t(cut_backs));
+                                   for (unsigned int k = 0; k < plate_displacement.size(); ++k)
+                                     {
+                                       // the plate's state, and its last reaction for the series
+                                       f.set_attribute("plate " + std::to_string(k) + " displacement",
+                                                       plate_displacement[k]);
+                                       for (unsigned int d = 0; d < dim; ++d)
+                                         f.set_attribute("plate " + std::to_string(k) + " reaction " +
+                                                           std::to_string(d),
+                                                         plate_reaction[k][d]);
+                                     }
                                    write_points(f, points);
                                    write_pvd_times(f, "output/pvd", pvd_records);
                                    balance.write(f); // the partition of the last rebalance
@@ -1978,6 +2444,12 @@ namespace talus::implicit_mpm
     total_iterations        = fp->get_int("newton iterations");
     total_linear_iterations = fp->get_int("linear iterations");
     cut_backs               = fp->get_int("cut-backs");
+    for (unsigned int k = 0; k < plate_displacement.size(); ++k)
+      {
+        plate_displacement[k] = fp->get_double("plate " + std::to_string(k) + " displacement");
+        for (unsigned int d = 0; d < dim; ++d)
+          plate_reaction[k][d] = fp->get_double("plate " + std::to_string(k) + " reaction " + std::to_string(d));
+      }
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, points, grid, "checkpoint " + fp->path());
     pvd_records = read_pvd_records(*fp, "output/pvd", "particles");
@@ -2010,6 +2482,11 @@ namespace talus::implicit_mpm
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;
+    if (any_force_plate())
+      log() << "  rigid plates: the Newton solves " << seconds_plates_solve
+            << " s (1 + number of force plates right-hand sides each, within the linear solve above), the products "
+               "K e, K^T e, the row and column zeroing and the combination "
+            << seconds_plates << " s" << std::endl;
   }
 
   int

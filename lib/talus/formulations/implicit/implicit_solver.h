@@ -18,6 +18,7 @@
 #include <talus/materials/neo_hookean.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/point_forces.h>
+#include <talus/loads/rigid_plate.h>
 #include <talus/loads/settings.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/solvers/linear_solver.h>
@@ -57,9 +58,7 @@ namespace talus::implicit_mpm
     /// dFbar = (jbar / j)^(1/dim) dF, jbar the volume-weighted mean det dF of its grid cell,
     /// with the exact tangent (docs/implicit.md, "F-bar")
     bool fbar = false;
-    /// 'implicit/shape function = quadratic bspline': the kernel of every grid
-    /// transfer (else linear Q1; docs/implicit.md 'Quadratic B-splines')
-    bool bspline = false;
+    // 'numerics/shape function' (SceneParameters::bspline()): the kernel of every grid transfer
     double   time_step = 0; ///< > 0 (required)
     double   gamma = 0.5, beta = 0.25;
     double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
@@ -238,7 +237,8 @@ namespace talus::implicit_mpm
     /// and the contact nodes now in contact) merged with the inactive pins.
     dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values = nullptr,
                                                        const bool with_contact = true,
-                                                       const bool with_prescribed = true) const;
+                                                       const bool with_prescribed = true,
+                                                       const bool hold_plates = false) const;
     /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
     /// normal DoF of each node, decided by the owner, ghosts updated.
     std::vector<loads::ContactNode> contact_nodes;
@@ -293,7 +293,7 @@ namespace talus::implicit_mpm
       else
         f(std::integral_constant<unsigned int, dim>());
     }
-    /// f(K()) with K the shape kernel of 'implicit/shape function'
+    /// f(K()) with K the shape kernel of 'numerics/shape function'
     /// (defined in implicit_solver.cc, its only user)
     template <class F>
     void with_kernel(F &&f) const;
@@ -330,6 +330,70 @@ namespace talus::implicit_mpm
     dealii::Tensor<1, dim> condition_increment(const unsigned int k, const double h) const;
     /// the reaction of the prescribed nodes at the converged iterate (StepReport)
     void prescribed_reaction(const dealii::Tensor<1, dim> &g);
+
+    // ---- rigid plates ('boundary conditions/rigid plate k'; docs/implicit.md "Rigid plate")
+    // A displacement-controlled plate and the held tangential components of a
+    // rough one are prescribed DoFs (prescribed_dofs, condition index
+    // n_velocities() + plate index): the lifting, the increments and the
+    // reaction of 'loads/velocity k'. The axis component of a force-controlled
+    // plate is one unknown per plate: its nodes' DoFs are free in the assembly
+    // (the tangent and residual keep their rows) and solve_with_plates()
+    // condenses them exactly by superposition.
+    unsigned int n_velocities() const { return prm.stages[current_stage].velocities.size(); }
+    bool force_plate(const unsigned int k) const
+    {
+      return prm.rigid_plates[k].control == loads::RigidPlate<dim>::Control::force;
+    }
+    bool any_force_plate() const
+    {
+      for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+        if (force_plate(k))
+          return true;
+      return false;
+    }
+    /// some plate has prescribed DoFs (displacement control or rough): reactions
+    bool any_plate_reaction() const
+    {
+      for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
+        if (!force_plate(k) || prm.rigid_plates[k].rough)
+          return true;
+      return false;
+    }
+    /// The plates' prescribed DoFs appended to prescribed_dofs (a component a
+    /// fixed/roller wall holds stays the wall's).
+    void append_plate_dofs();
+    /// Setup: every plate holds a grid node, shares none with another plate
+    /// and has one whose axis component no wall of any stage holds
+    /// (InputError naming the plate); the log line per plate.
+    void check_plates();
+    /// After the step's constraints: the owned axis DoFs of each force plate
+    /// that are free this step, and all of them (every rank) for the matrix.
+    void find_plate_dofs();
+    /// The step's Newton solve with force plates: with the tangent K and the
+    /// residual r assembled with the plate DoFs free, e_k the indicator of
+    /// plate k's DoFs, K_c = K with their rows and columns zeroed (diagonal
+    /// kept): z_0 = K_c^-1 (-r), z_k = K_c^-1 (-K e_k), and delta = z_0 + sum
+    /// c_k (z_k + e_k) with c from the linearised force balance of each plate,
+    /// sum_{i in P_k} (r + K delta)_i = F_k. Leaves K_c in the tangent.
+    LinearSolveInfo solve_with_plates();
+    /// plate displacement along its axis (the plates' state, checkpointed)
+    std::vector<double> plate_displacement;
+    /// per plate: its step increment along the axis so far (force control: the
+    /// sum of the accepted alpha c_k), and c_k of the last solve
+    std::vector<double> plate_step, plate_c;
+    /// per plate: F_k(t + h) (force control) and sum of r over its DoFs at the last assembly
+    std::vector<double> plate_target, plate_sum;
+    /// per plate: the converged reaction along the axis (displacement control)
+    /// and the tangential one (rough), per component
+    std::vector<dealii::Tensor<1, dim>> plate_reaction;
+    std::vector<loads::PrescribedNodeDof> plate_nodes; ///< rigid_plate_node_dofs (owned + ghost)
+    /// per force plate: its owned free axis DoFs this step
+    std::vector<std::vector<dealii::types::global_dof_index>> plate_owned;
+    std::vector<dealii::types::global_dof_index>              plate_all; ///< every rank's, sorted
+    std::vector<unsigned char> idle_plates; ///< per plate: reported as acting on nothing
+    bool plates_held = false; ///< the predictor holds the force plates' DoFs (their increment 0)
+    double seconds_plates = 0; ///< the plates' extra linear algebra (products, zeroing, combination)
+    double seconds_plates_solve = 0; ///< the plates' Newton solves (all right-hand sides)
     /// The displacement of a prescribed DoF over the step [t, t + h].
     double prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const;
     /// du before Newton: one linear solve with the prescribed increments lifted
@@ -339,6 +403,10 @@ namespace talus::implicit_mpm
     /// delta from tangent delta = -residual (the step's linear solve, timed and
     /// counted); a failed or singular solve throws NewtonFailure.
     LinearSolveInfo solve_for_delta();
+    /// delta from tangent delta = -r
+    LinearSolveInfo solve_for_delta(const Vector &r);
+    /// each r[k] replaced by x solving tangent x = -r[k] (direct: one factorisation)
+    LinearSolveInfo solve_several(std::vector<Vector> &r);
     dealii::TrilinosWrappers::SparseMatrix  tangent;
     /// 'rayleigh beta' > 0: the stiffness K_n of the step's start (du = 0), whose beta K_n v^{n+1}
     /// is the damping force of the step (assemble_damping_stiffness)

@@ -10,6 +10,7 @@
 #include <talus/formulations/common/load_balance.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/run_formulation.h>
+#include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/time_loop.h>
 #include <talus/formulations/semi_implicit/fbar.h>
@@ -64,7 +65,7 @@ namespace talus::semi_implicit
       declare_common_parameters(prm, prm_file,
                                 "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
                                 "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
-                                "conductivity (seed 002 §5.3).");
+                                "conductivity (seed 002 §5.3).", /*png fields not written:*/ {"free surface"});
     prm.enter_subsection("time");
     {
       prm.declare_entry("courant number", "0.5", Double(0, 1),
@@ -73,8 +74,6 @@ namespace talus::semi_implicit
     prm.leave_subsection();
     prm.enter_subsection("semi implicit");
     {
-      prm.declare_entry("shape function", "quadratic bspline", Selection("quadratic bspline|linear"),
-                        "Basis of velocity and pressure (equal order, seed 002 §4.2).");
       prm.declare_entry("water density", "1000", Double(0), "rho_w [kg/m^3], > 0.");
       prm.declare_entry("unit weight gravity", "9.81", Double(0),
                         "g of the Darcy drag n^2 rho_w g / k (Eq. 15) [m/s^2], > 0; kept when the body force "
@@ -256,7 +255,7 @@ namespace talus::semi_implicit
                 "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
                   "D box has the ids 0 to " + std::to_string(2 * dim - 1) + ": x-, x+, y-, y+" +
                   (dim == 3 ? ", z-, z+)" : ")"));
-      if (p.bspline)
+      if (p.bspline())
         for (unsigned int d = 0; d < dim; ++d)
           require(p.grid_cells[d] >= 3, "grid/cells",
                   "quadratic B-splines need at least 3 cells in every direction (a point's 3-node window)");
@@ -313,13 +312,13 @@ namespace talus::semi_implicit
     Parameters<dim> p;
     parse_run_parameters<dim>(prm, p);
     parse_scene_parameters<dim>(prm, p);
+    loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit", "not built in this family yet");
     prm.enter_subsection("time");
     p.time_step = prm.get_double("time step");
     p.courant   = prm.get_double("courant number");
     require(p.courant > 0, "time/courant number", "must be > 0");
     prm.leave_subsection();
     prm.enter_subsection("semi implicit");
-    p.bspline               = prm.get("shape function") == "quadratic bspline";
     p.water_density         = prm.get_double("water density");
     p.unit_weight_gravity   = prm.get_double("unit weight gravity");
     p.free_surface_fraction = prm.get_double("free surface volume fraction");
@@ -585,7 +584,7 @@ namespace talus::semi_implicit
     double      begin_stage(const unsigned int, const bool, const bool) override { return prm.end_time; }
     StepOutcome advance_by(const double h) override
     {
-      if (prm.bspline)
+      if (prm.bspline())
         step<shape::BSpline2Box<dim>>(h);
       else
         step<shape::Q1Box<dim>>(h);
@@ -789,7 +788,7 @@ namespace talus::semi_implicit
   {
     grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
     grid.setup();
-    if (prm.bspline)
+    if (prm.bspline())
       grid.setup_bspline_patches();
     grid_changed();
 
@@ -840,13 +839,7 @@ namespace talus::semi_implicit
     seed();
     if (prm.geostatic)
       geostatic_state();
-    for (auto &pt : soil.handler)
-      {
-        auto        P = pt.get_properties();
-        const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
-        if (soil.layout.n_history)
-          m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + soil.layout.history, m.n_history()));
-      }
+    initialize_point_histories(prm.materials, soil, soil.layout.history);
     dt = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
     // load balancing: partition by the points of both sets from the start
     balance.initial();
@@ -940,16 +933,10 @@ namespace talus::semi_implicit
               body_index.push_back(b);
             }
         std::vector<double> unit_density(prm.materials.size(), 1.0); // masses set below
-        auto       seeded = seed_bodies(grid, bodies, unit_density, set.layout, set.handler);
         // file bodies: the rows of their particle files, the same rows for both
         // sets of a saturated body (the single-point variant relies on it)
-        const auto filed = insert_file_bodies(grid, bodies, unit_density, set.layout, set.handler, seeded.n_particles);
-        for (unsigned int k = 0; k < bodies.size(); ++k)
-          seeded.volume_per_body[k] += filed.volume_per_body[k];
-        for (unsigned int k = 0; k < bodies.size(); ++k)
-          require(seeded.volume_per_body[k] > 0, "body " + std::to_string(body_index[k]) + " ('" + bodies[k].name + "')",
-                  "contains no " + std::string(is_soil ? "soil" : "water") +
-                    " point: it lies outside the grid or is smaller than one sub-cell");
+        seed_scene_bodies(grid, bodies, unit_density, set, is_soil ? "soil point" : "water point",
+                          is_soil ? &prm : nullptr, body_index);
         const Fields &f = is_soil ? fs : fw;
         for (auto &pt : set.handler)
           {
@@ -1029,7 +1016,7 @@ namespace talus::semi_implicit
   {
     const auto ns = soil.handler.n_global_particles(), nw = water.handler.n_global_particles();
     out << "talus-semi-implicit: " << dim << "D, grid " << grid.tria.n_global_active_cells() << " cells (h_min "
-        << grid.min_cell_size() << " m), " << (prm.bspline ? "quadratic B-splines" : "linear shape functions")
+        << grid.min_cell_size() << " m), " << (prm.bspline() ? "quadratic B-splines" : "linear shape functions")
         << ", " << ns << " soil + " << nw << " water points\n"
         << "  time step " << dt << " s (soil skeleton critical step " << dt_soil_critical << " s"
         << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant)) << "), pressure: CG + ML AMG to "
@@ -1876,7 +1863,7 @@ namespace talus::semi_implicit
           << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
-    const double walk = prm.bspline ? shape_walk_seconds<shape::BSpline2Box<dim>>() : shape_walk_seconds<shape::Q1Box<dim>>();
+    const double walk = prm.bspline() ? shape_walk_seconds<shape::BSpline2Box<dim>>() : shape_walk_seconds<shape::Q1Box<dim>>();
     log() << std::setprecision(4) << "  breakdown [s]: P2N " << phase.p2n << ", grid " << phase.grid << ", Poisson assembly "
           << phase.poisson << ", pressure solve " << seconds_solve << " (AMG set-up "
           << pressure_solver.setup_seconds() << "), N2P " << phase.n2p << ", update+stress "

@@ -70,7 +70,6 @@ namespace talus::semi_implicit
     // time step: fixed, or courant x the soil skeleton's critical step
     double time_step = 0, courant = 0.5;
     // 'semi implicit' subsection
-    bool   bspline                  = true;  ///< quadratic B-spline (else linear Q1)
     double water_density            = 1000;  ///< rho_w [kg/m^3]
     double unit_weight_gravity      = 9.81;  ///< g of the drag (Eq. 15), kept when the body force is 0
     double free_surface_fraction    = 0.5;   ///< a cell is wet when its water volume / cell volume >= this

@@ -1,0 +1,22 @@
+# The scene layer shared by the three families (issue 37): one scene fragment
+# solved by every family, the shared vocabulary refused alike by every tool.
+# Label "fast": make test / CI.
+set(_v ${CMAKE_CURRENT_SOURCE_DIR}/verification)
+set(_w ${CMAKE_BINARY_DIR}/tests/verification)
+set(_env "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1;PYTHONPATH=${_v}")
+
+# one scene, three tools: the elastic layer loaded through a rigid plate
+# (parameter_files/verification/rigid_plate/layer.inc) by talus-explicit (to
+# rest), talus-implicit (static) and talus-semi-implicit (drained, end of
+# consolidation): plate settlement within 1 % of q H / E_oed and of each
+# other; every formulation tool accepts --restart
+add_test(NAME verification.rigid_plate_families
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_rigid_plate_families.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/rigid_plate_families 0.01)
+set_tests_properties(verification.rigid_plate_families PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+
+# bad rigid-plate entries: exit 2 naming the entry, nothing written, in every family
+add_test(NAME verification.rigid_plate_bad_input
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_rigid_plate_input.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/rigid_plate_bad_input)
+set_tests_properties(verification.rigid_plate_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
