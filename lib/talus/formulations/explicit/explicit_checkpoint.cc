@@ -23,8 +23,8 @@
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/explicit/explicit_solver.h>
-#include <talus/io/hdf5.h>
 #include <talus/formulations/explicit/load_control.h>
+#include <talus/io/hdf5.h>
 
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/mpi.h>
