@@ -120,12 +120,32 @@ def absolute_input_files(text, path):
     return "\n".join(lines) + ("\n" if text.endswith("\n") else "")
 
 
+def expand_includes(text, path, depth=0):
+    """The text with every `include FILE` line replaced by that file's text (talus
+    resolves FILE relative to the including .prm's directory), so that the
+    mutations reach the entries of a shared scene fragment too and the mutated
+    file stands alone."""
+    out = []
+    for line in text.splitlines():
+        m = re.match(r"\s*include\s+(\S.*?)\s*$", line, re.I)
+        if m and depth < 8:
+            name = m.group(1)
+            inc = name if os.path.isabs(name) else os.path.join(os.path.dirname(os.path.abspath(path)), name)
+            if os.path.isfile(inc):
+                out.append(expand_includes(open(inc, encoding="utf-8", errors="replace").read(), inc, depth + 1))
+                continue
+        out.append(line)
+    return "\n".join(out) + ("\n" if text.endswith("\n") else "")
+
+
 class Prm:
-    """A .prm file as lines with their subsection path, key and value."""
+    """A .prm file as lines with their subsection path, key and value (the
+    fragments it includes pasted in)."""
 
     def __init__(self, path):
         self.path = path
-        self.text = absolute_input_files(open(path, encoding="utf-8", errors="replace").read(), path)
+        raw = open(path, encoding="utf-8", errors="replace").read()
+        self.text = absolute_input_files(expand_includes(raw, path), path)
         self.lines = self.text.splitlines()
         self.entries = []  # (line index, subsection path tuple, key, value)
         self.subsections = []  # (line index of 'subsection', path tuple)

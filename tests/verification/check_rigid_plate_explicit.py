@@ -165,7 +165,7 @@ if case in ("layer", "layer_bspline", "layer_fem"):
     if case == "layer_fem":
         t = tv.prm_set(t, "numerics/integration", "fem")
     s, out = run(case, t)
-    tv.check("rigid plate 0 (boundary id 3): 9 node(s)" in out and "force control" in out,
+    tv.check("rigid plate 0 (boundary id 3): 9 grid node(s)" in out and "force control" in out,
              "the log names the plate, its 9 nodes and its control")
     converged(case, s, 30)
     u, ua = s["plate_0_displacement"][-1], -q * H / E_oed

@@ -116,10 +116,19 @@ namespace talus::io
         auto &     s = f.stream();
         s << "# talus: meaning of the particle fields of this run (read by talus-plot)\n"
           << "dimension = " << prm.get("dimension") << "\n";
-        // FEM / UL-FEM points are drawn at X + u; families without the entry are MPM
-        s << "integration = "
-          << (prm.subsection_path_exists({"numerics"}) ? prm.get({"numerics"}, "integration") : std::string("mpm"))
-          << "\n";
+        // FEM / UL-FEM points are drawn at X + u; families without the entry
+        // 'numerics/integration' are MPM (every family has a 'numerics'
+        // subsection, for the shared 'shape function')
+        std::string integration = "mpm";
+        try
+          {
+            integration = prm.get({"numerics"}, "integration");
+          }
+        catch (const dealii::ExceptionBase &)
+          {}
+        if (integration.empty()) // deal.II 9.4 answers "" for an entry a path does not declare
+          integration = "mpm";
+        s << "integration = " << integration << "\n";
         const unsigned int n = prm.get_integer("number of materials");
         for (unsigned int k = 0; k < n; ++k)
           {

@@ -2,11 +2,15 @@
 #include <talus/base/tool.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/rigid_plate.h>
+#include <talus/loads/rigid_plate_nodes.h>
+
+#include <deal.II/base/mpi.h>
 
 #include <deal.II/base/utilities.h>
 
 #include <array>
 #include <cmath>
+#include <sstream>
 
 namespace talus::loads
 {
@@ -17,7 +21,33 @@ namespace talus::loads
   namespace
   {
     constexpr unsigned int max_rigid_plates = 4;
-  }
+
+    // the errors of the node checks, worded once for the box check (parse) and
+    // the grid check (setup)
+    template <int dim>
+    std::string
+    no_node_message(const RigidPlate<dim> &p)
+    {
+      return p.target == RigidPlate<dim>::Target::boundary
+               ? "holds no grid node: no face of the grid has boundary id " + std::to_string(p.boundary)
+               : std::string("holds no grid node: no node of the grid lies inside its region; allowed: a region "
+                             "that contains at least one grid node");
+    }
+    std::string
+    shared_message(const std::string &count)
+    {
+      return "shares " + count + " node(s) with another rigid plate; a grid node can belong to one plate only";
+    }
+    template <int dim>
+    std::string
+    held_message(const RigidPlate<dim> &p, const std::string &count, const std::string &stage)
+    {
+      const char axes[] = {'x', 'y', 'z'};
+      return "a fixed/roller wall holds its direction component at every one of its " + count + " node(s)" + stage +
+             ", so the plate cannot move along " + std::string(1, axes[p.axis]) +
+             " (a wall keeps the components it holds); allowed: a direction or nodes that no wall holds";
+    }
+  } // namespace
 
   template <int dim>
   PrescribedVelocity<dim>
@@ -196,8 +226,7 @@ namespace talus::loads
               }
             any = any && i0[d] <= i1[d];
           }
-        require(any, p.where, "holds no grid node: its region contains no node of the grid (node spacing per axis: "
-                              "the grid's cell size); allowed: a region that contains at least one grid node");
+        require(any, p.where, no_node_message(p));
         // a node is free along the axis unless it lies on a face whose wall
         // holds that component: some node is free iff every axis has an index
         // in the range on no such face
@@ -212,11 +241,10 @@ namespace talus::loads
             const int held = (holds[0] && i0[d] == 0) + (holds[1] && i1[d] == n && n != 0);
             free           = free && i1[d] - i0[d] + 1 > held;
           }
-        const char *axes = "xyz";
-        require(free, p.where,
-                std::string("moves along ") + axes[p.axis] +
-                  ", but a fixed or roller wall holds that component at every node of the plate (a wall keeps the "
-                  "components it holds); allowed: a direction or nodes that no wall holds");
+        unsigned long long n_nodes = 1;
+        for (unsigned int d = 0; d < dim; ++d)
+          n_nodes *= static_cast<unsigned long long>(i1[d] - i0[d] + 1);
+        require(free, p.where, held_message(p, std::to_string(n_nodes), ""));
         std::array<int, 2 * dim> r;
         for (unsigned int d = 0; d < dim; ++d)
           r[2 * d] = i0[d], r[2 * d + 1] = i1[d];
@@ -225,12 +253,83 @@ namespace talus::loads
             bool overlap = true;
             for (unsigned int d = 0; d < dim; ++d)
               overlap = overlap && std::max(r[2 * d], ranges[j][2 * d]) <= std::min(r[2 * d + 1], ranges[j][2 * d + 1]);
-            require(!overlap, p.where,
-                    "shares grid nodes with 'boundary conditions/rigid plate " + std::to_string(j) +
-                      "'; allowed: plates whose node sets are disjoint");
+            unsigned long long n_shared = 1;
+            for (unsigned int d = 0; d < dim; ++d)
+              n_shared *= overlap ? static_cast<unsigned long long>(std::min(r[2 * d + 1], ranges[j][2 * d + 1]) -
+                                                                    std::max(r[2 * d], ranges[j][2 * d]) + 1)
+                                  : 0;
+            require(!overlap, p.where, shared_message(std::to_string(n_shared)));
           }
         ranges.push_back(r);
       }
+  }
+
+  template <int dim>
+  std::vector<RigidPlateNodes>
+  check_rigid_plate_nodes(const BackgroundGrid<dim> &grid, const std::vector<RigidPlate<dim>> &plates,
+                          const std::vector<std::vector<BoundaryCondition>> &stage_walls,
+                          const std::vector<std::string> &stage_names, MPI_Comm comm)
+  {
+    const unsigned int n = plates.size(), n_stages = stage_walls.size(), nc = 2 + n_stages;
+    // per plate: owned nodes, nodes shared with an earlier plate, and per stage
+    // the nodes whose axis component that stage's walls hold
+    std::vector<unsigned long long>         count(n * nc, 0);
+    const unsigned int                      n_owned = grid.partitioner->locally_owned_size();
+    std::vector<std::vector<unsigned char>> flags;
+    for (const auto &walls : stage_walls)
+      flags.push_back(wall_dof_flags(grid, walls));
+    std::vector<int> owner(n_owned, -1);
+    for (const auto &p : rigid_plate_node_dofs(grid, plates, /*owned_only=*/true))
+      {
+        if (p.component != plates[p.condition].axis)
+          continue;
+        unsigned long long *c = &count[p.condition * nc];
+        c[0] += 1;
+        if (owner[p.node] >= 0 && owner[p.node] != static_cast<int>(p.condition))
+          c[1] += 1;
+        owner[p.node] = static_cast<int>(p.condition);
+        for (unsigned int j = 0; j < n_stages; ++j)
+          if (flags[j][p.dof])
+            c[2 + j] += 1;
+      }
+    if (n > 0)
+      MPI_Allreduce(MPI_IN_PLACE, count.data(), static_cast<int>(count.size()), MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm);
+    std::vector<RigidPlateNodes> out(n);
+    for (unsigned int k = 0; k < n; ++k)
+      {
+        const auto &              pl = plates[k];
+        const unsigned long long *c  = &count[k * nc];
+        require(c[0] > 0, pl.where, no_node_message(pl));
+        require(c[1] == 0, pl.where, shared_message(std::to_string(c[1])));
+        for (unsigned int j = 0; j < n_stages; ++j)
+          require(c[2 + j] < c[0], pl.where,
+                  held_message(pl, std::to_string(c[0]),
+                               n_stages > 1 ? " in stage '" + stage_names[j] + "'" : std::string()));
+        out[k].nodes = c[0];
+        out[k].held.assign(c + 2, c + nc);
+      }
+    return out;
+  }
+
+  template <int dim>
+  std::string
+  rigid_plate_log_line(const RigidPlate<dim> &pl, const unsigned int k, const RigidPlateNodes &count)
+  {
+    const char         ax[] = {'x', 'y', 'z'};
+    std::ostringstream os;
+    os << "  rigid plate " << k << " ("
+       << (pl.target == RigidPlate<dim>::Target::boundary ? "boundary id " + std::to_string(pl.boundary)
+                                                          : std::string("region"))
+       << "): " << count.nodes << " grid node(s)";
+    if (!count.held.empty() && count.held[0] > 0)
+      os << " (" << count.held[0] << " held along " << ax[pl.axis] << " by a wall, they stay)";
+    os << ", direction " << ax[pl.axis] << ", " << (pl.rough ? "rough" : "frictionless") << ", "
+       << (pl.control == RigidPlate<dim>::Control::force
+             ? "force control: total force " + dealii::Utilities::to_string(pl.force) + " N x f(t)"
+             : "displacement control: displacement " + dealii::Utilities::to_string(pl.displacement) +
+                 " m x f(t), reaction reported")
+       << " (its own time function, absolute time)";
+    return os.str();
   }
 
   template <int dim>
@@ -257,6 +356,16 @@ namespace talus::loads
   template void check_rigid_plates_on_box(const std::vector<RigidPlate<3>> &, const dealii::Point<3> &,
                                           const dealii::Point<3> &, const std::vector<unsigned int> &,
                                           const std::vector<BoundaryCondition> &);
+  template std::vector<RigidPlateNodes> check_rigid_plate_nodes(const BackgroundGrid<2> &,
+                                                                 const std::vector<RigidPlate<2>> &,
+                                                                 const std::vector<std::vector<BoundaryCondition>> &,
+                                                                 const std::vector<std::string> &, MPI_Comm);
+  template std::vector<RigidPlateNodes> check_rigid_plate_nodes(const BackgroundGrid<3> &,
+                                                                 const std::vector<RigidPlate<3>> &,
+                                                                 const std::vector<std::vector<BoundaryCondition>> &,
+                                                                 const std::vector<std::string> &, MPI_Comm);
+  template std::string rigid_plate_log_line(const RigidPlate<2> &, unsigned int, const RigidPlateNodes &);
+  template std::string rigid_plate_log_line(const RigidPlate<3> &, unsigned int, const RigidPlateNodes &);
   template void refuse_rigid_plates(const std::vector<RigidPlate<2>> &, const std::string &, const std::string &);
   template void refuse_rigid_plates(const std::vector<RigidPlate<3>> &, const std::string &, const std::string &);
 } // namespace talus::loads

@@ -3,6 +3,7 @@
 #include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/with_kernel.h>
 #include <talus/loads/k0.h>
+#include <talus/loads/rigid_plate_nodes.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/local_damping.h>
 #include <talus/shape/q1.h>
@@ -819,67 +820,18 @@ namespace talus::loads
     plate_run.assign(plates.size(), PlateRun());
     if (plates.empty())
       return;
-    const auto         dofs    = rigid_plate_node_dofs(s.grid, plates); // owned
-    const unsigned int n_owned = s.grid.partitioner->locally_owned_size();
-    const unsigned int n       = plates.size();
-    // per plate: nodes, nodes whose axis component the walls of stage j hold
-    // (one count per stage), nodes it shares with an earlier plate
-    const unsigned int   n_stages = settings.stages.size();
-    const unsigned int   nc       = 2 + n_stages;
-    std::vector<double>  count(n * nc, 0.0);
-    std::vector<int>     owner(n_owned, -1);
-    std::vector<std::vector<unsigned char>> flags;
+    // the shared node checks (exit 2 naming the plate) of every stage's walls
+    std::vector<std::vector<BoundaryCondition>> walls;
+    std::vector<std::string>                    names;
     for (const auto &st : settings.stages)
-      flags.push_back(wall_dof_flags(s.grid, st.boundary_conditions));
-    for (const auto &p : dofs)
+      walls.push_back(st.boundary_conditions), names.push_back(st.name);
+    const auto counts = check_rigid_plate_nodes(s.grid, plates, walls, names, s.comm);
+    for (unsigned int k = 0; k < plates.size(); ++k)
       {
-        if (p.component != plates[p.condition].axis)
-          continue;
-        double *c = &count[p.condition * nc];
-        c[0] += 1;
-        if (owner[p.node] >= 0 && owner[p.node] != static_cast<int>(p.condition))
-          c[1] += 1;
-        owner[p.node] = static_cast<int>(p.condition);
-        for (unsigned int j = 0; j < n_stages; ++j)
-          if (flags[j][p.dof])
-            c[2 + j] += 1;
-      }
-    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(count), s.comm, dealii::ArrayView<double>(count));
-    for (unsigned int k = 0; k < n; ++k)
-      {
-        const auto &  pl = plates[k];
-        const double *c  = &count[k * nc];
-        require(c[0] > 0, pl.where,
-                pl.target == RigidPlate<dim>::Target::boundary ?
-                  "holds no grid node: the grid has no face with boundary id " + std::to_string(pl.boundary) :
-                  std::string("holds no grid node: no node of the grid lies inside its region (widen 'region lower "
-                              "corner' / 'region upper corner' to reach at least one grid node)"));
-        require(c[1] == 0, pl.where,
-                "shares " + std::to_string(static_cast<long>(c[1])) +
-                  " node(s) with another rigid plate; a grid node can belong to one plate only");
-        for (unsigned int j = 0; j < n_stages; ++j)
-          require(c[2 + j] < c[0], pl.where,
-                  "a fixed/roller wall holds its direction component at every one of its " +
-                    std::to_string(static_cast<long>(c[0])) + " node(s)" +
-                    (settings.staged ? " in stage '" + settings.stages[j].name + "'" : std::string()) +
-                    ", so the plate cannot move: release that wall (roller on the other axis) or choose "
-                    "another 'direction'");
+        const auto &pl = plates[k];
         PlateRun &r = plate_run[k];
         r.force     = pl.control == RigidPlate<dim>::Control::force ? pl.force_at(s.time) : 0.0;
-        std::ostringstream os;
-        const char         ax[] = {'x', 'y', 'z'};
-        os << "  rigid plate " << k << " ("
-           << (pl.target == RigidPlate<dim>::Target::boundary ? "boundary id " + std::to_string(pl.boundary) :
-                                                                std::string("region"))
-           << "): " << static_cast<long>(c[0]) << " node(s)";
-        if (c[2] > 0)
-          os << " (" << static_cast<long>(c[2]) << " held along " << ax[pl.axis] << " by a wall, they stay)";
-        os << ", direction " << ax[pl.axis] << ", " << (pl.rough ? "rough" : "frictionless") << ", "
-           << (pl.control == RigidPlate<dim>::Control::force ?
-                 "force control: total force " + dealii::Utilities::to_string(pl.force) + " N x f(t)" :
-                 "displacement control: displacement " + dealii::Utilities::to_string(pl.displacement) +
-                   " m x f(t), reaction reported");
-        log() << os.str() << std::endl;
+        log() << rigid_plate_log_line(pl, k, counts[k]) << std::endl;
       }
   }
 

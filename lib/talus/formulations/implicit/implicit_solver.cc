@@ -9,6 +9,7 @@
 #include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/formulations/implicit/updated_lagrangian_ops.h>
 #include <talus/io/output.h>
+#include <talus/loads/rigid_plate_nodes.h>
 #include <talus/loads/kinematics.h>
 #include <talus/shape/with_kernel.h>
 
@@ -863,56 +864,14 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::check_plates()
   {
-    // per plate: owned nodes, nodes shared with another plate, and per stage
-    // the nodes whose axis component that stage's walls hold
-    const unsigned int  n = prm.rigid_plates.size(), n_stages = prm.stages.size(), nc = 2 + n_stages;
-    std::vector<double> count(n * nc, 0.0);
-    const unsigned int  n_owned = grid.partitioner->locally_owned_size();
-    std::vector<std::vector<unsigned char>> flags;
+    // the shared node checks (exit 2 naming the plate) of every stage's walls
+    std::vector<std::vector<BoundaryCondition>> walls;
+    std::vector<std::string>                    names;
     for (const auto &st : prm.stages)
-      flags.push_back(loads::wall_dof_flags(grid, st.boundary_conditions));
-    std::vector<int> owner(n_owned, -1);
-    for (const auto &p : plate_nodes)
-      if (p.node < n_owned && p.component == prm.rigid_plates[p.condition].axis)
-        {
-          double *c = &count[p.condition * nc];
-          c[0] += 1;
-          if (owner[p.node] >= 0 && owner[p.node] != static_cast<int>(p.condition))
-            c[1] += 1;
-          owner[p.node] = static_cast<int>(p.condition);
-          for (unsigned int j = 0; j < n_stages; ++j)
-            if (flags[j][p.dof])
-              c[2 + j] += 1;
-        }
-    dealii::Utilities::MPI::sum(count, comm, count);
-    const char *ax[] = {"x", "y", "z"};
-    for (unsigned int k = 0; k < n; ++k)
-      {
-        const auto &  plate = prm.rigid_plates[k];
-        const double *c     = &count[k * nc];
-        require(c[0] > 0, plate.where,
-                plate.target == loads::RigidPlate<dim>::Target::boundary
-                  ? "holds no grid node (no face of the grid has boundary id " + std::to_string(plate.boundary) + ")"
-                  : std::string("holds no grid node: no node of the grid lies inside its region (widen the region "
-                                "to reach a row of grid nodes)"));
-        require(c[1] == 0, plate.where,
-                "shares " + std::to_string(static_cast<long>(c[1])) +
-                  " node(s) with another rigid plate; a grid node can belong to one plate only");
-        for (unsigned int j = 0; j < n_stages; ++j)
-          require(c[2 + j] < c[0], plate.where,
-                  std::string("its axis component (") + ax[plate.axis] +
-                    ") is held by a fixed/roller wall at every one of its nodes" +
-                    (prm.staged ? " in stage " + std::to_string(j) : std::string()) +
-                    ": the plate cannot move; allowed: a direction no wall holds at its nodes, or remove the wall");
-        std::ostringstream os;
-        os << "  rigid plate " << k << " (" << plate.where << "): " << c[0] << " grid nodes ("
-           << c[0] - c[2 + current_stage] << " free along " << ax[plate.axis] << "), "
-           << (plate.rough ? "rough" : "frictionless") << ", "
-           << (force_plate(k) ? "force control: total force " + std::to_string(plate.force)
-                              : "displacement control: displacement " + std::to_string(plate.displacement))
-           << " x f(t) along " << ax[plate.axis] << " (its own time function, absolute time)";
-        log() << os.str() << std::endl;
-      }
+      walls.push_back(st.boundary_conditions), names.push_back(st.name);
+    const auto counts = loads::check_rigid_plate_nodes(grid, prm.rigid_plates, walls, names, comm);
+    for (unsigned int k = 0; k < counts.size(); ++k)
+      log() << loads::rigid_plate_log_line(prm.rigid_plates[k], k, counts[k]) << std::endl;
   }
 
   template <int dim>

@@ -21,6 +21,7 @@
 #include <talus/io/particle_file.h>
 #include <talus/io/vtu.h>
 #include <talus/loads/k0.h>
+#include <talus/loads/rigid_plate_nodes.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/rigid_plate.h>
 #include <talus/particles/material_point_set.h>
@@ -973,46 +974,20 @@ namespace talus::semi_implicit
     plate_axis_dofs.assign(n, 0);
     if (n == 0)
       return;
-    // owned nodes per plate, and a node claimed by two plates
-    std::vector<unsigned int> first_plate(n_local(), no_plate);
-    unsigned int              shared = no_plate; // the later plate of a shared node
-    std::set<std::pair<unsigned int, unsigned int>> seen; // (plate, node): a rough plate lists each node dim times
-    for (const auto &e : loads::rigid_plate_node_dofs(grid, prm.rigid_plates, true))
-      if (seen.insert({e.condition, e.node}).second)
-        {
-          ++plate_nodes[e.condition];
-          if (first_plate[e.node] == no_plate)
-            first_plate[e.node] = e.condition;
-          else if (first_plate[e.node] != e.condition)
-            shared = std::min(shared, e.condition);
-        }
+    // the shared node checks (exit 2 naming the plate) with the scene's walls
+    const auto counts = loads::check_rigid_plate_nodes(grid, prm.rigid_plates, {prm.boundary_conditions}, {""}, comm);
+    for (unsigned int k = 0; k < n; ++k)
+      plate_nodes[k] = counts[k].nodes;
     const unsigned int owned = grid.partitioner->locally_owned_size();
     for (unsigned int i = 0; i < owned; ++i)
       if (plate_of[i] != no_plate)
         ++plate_axis_dofs[plate_of[i]];
-    MPI_Allreduce(MPI_IN_PLACE, plate_nodes.data(), n, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm);
     MPI_Allreduce(MPI_IN_PLACE, plate_axis_dofs.data(), n, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm);
-    shared          = dealii::Utilities::MPI::min(shared, comm);
-    if (shared != no_plate)
-      throw InputError(prm.rigid_plates[shared].where + ": " +
-                       "shares grid nodes with an earlier plate; allowed: plates whose node sets are disjoint");
-    const char *axes = "xyz";
+    // the wall check above counts a node held if a wall holds its axis
+    // component; plate_of[] leaves out the same DoFs, so no plate is left
+    // without an axis DoF here
     for (unsigned int k = 0; k < n; ++k)
-      {
-        const auto &pl = prm.rigid_plates[k];
-        if (plate_nodes[k] == 0)
-          throw InputError(pl.where + ": " + (pl.target == loads::RigidPlate<dim>::Target::region
-                                       ? std::string("holds no grid node: its region contains no node of the grid; "
-                                                     "allowed: a region that contains at least one grid node")
-                                       : "holds no grid node: no face of the grid has boundary id " +
-                                           std::to_string(pl.boundary)));
-        if (plate_axis_dofs[k] == 0)
-          throw InputError(pl.where + ": moves along " + std::string(1,  axes[pl.axis]) +
-                                       ", but a fixed or roller wall holds that component at every one of its " +
-                                       std::to_string(plate_nodes[k]) +
-                                       " nodes (a wall keeps the components it holds); allowed: a direction or "
-                                       "nodes that no wall holds");
-      }
+      AssertThrow(plate_axis_dofs[k] > 0, dealii::ExcInternalError());
   }
 
   // ---------------------------------------------------------------- checkpoints
