@@ -66,30 +66,34 @@ namespace talus
   } // namespace
 
   LinearSolveInfo
-  solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A,
-               Vector &                                      x,
-               const Vector &                                b,
-               const LinearSolverOptions &                   options,
-               const std::vector<std::vector<bool>> &        constant_modes)
+  solve_direct(const dealii::TrilinosWrappers::SparseMatrix &A,
+               std::vector<Vector> &                         xs,
+               const std::vector<Vector> &                   bs,
+               const std::string &                           direct_package)
   {
     LinearSolveInfo info;
-    const double    b_norm = b.l2_norm();
-    if (options.method == LinearSolverOptions::Method::direct)
+    info.method = "direct (" + direct_package + ")";
+    dealii::SolverControl                                  control(1, 0);
+    dealii::TrilinosWrappers::SolverDirect::AdditionalData data(false, direct_package);
+    dealii::TrilinosWrappers::SolverDirect                 solver(control, data);
+    solver.initialize(A);
+    xs.resize(bs.size());
+    for (unsigned int k = 0; k < bs.size(); ++k)
       {
-        info.method = "direct (" + options.direct_package + ")";
-        dealii::SolverControl                           control(1, 0);
-        dealii::TrilinosWrappers::SolverDirect::AdditionalData data(false, options.direct_package);
-        dealii::TrilinosWrappers::SolverDirect          solver(control, data);
-        solver.initialize(A);
+        const Vector &b = bs[k];
+        Vector &      x = xs[k];
+        x.reinit(b, true);
+        x = 0;
         solver.solve(x, b);
-        info.iterations = 1;
+        ++info.iterations;
         // Iterative refinement with the same factorisation when the direct
         // solve leaves a visible round-off residual: badly scaled systems (the
         // mixed u-p tangent of a stiff material, E = 1e7 Pa: u rows ~ E, the
         // 1/K-scaled p rows ~ V / G ~ 1e-8) lose digits in KLU's pivoting;
         // a few refinement steps bring |b - A x| / |b| back to round-off. Not
         // entered (results unchanged) when the first solve is already clean.
-        Vector r, d;
+        const double b_norm = b.l2_norm();
+        Vector       r, d;
         r.reinit(b, true);
         d.reinit(x, true);
         const auto residual_norm = [&]() {
@@ -98,7 +102,7 @@ namespace talus
           return r.l2_norm();
         };
         double rn = residual_norm();
-        for (unsigned int k = 0; k < 3 && rn > 1e-9 * b_norm; ++k)
+        for (unsigned int i = 0; i < 3 && rn > 1e-9 * b_norm; ++i)
           {
             d = 0;
             solver.solve(d, r);
@@ -111,6 +115,25 @@ namespace talus
               }
             rn = rn_new;
           }
+        info.relative_residual = std::max(info.relative_residual, b_norm > 0 ? rn / b_norm : rn);
+      }
+    return info;
+  }
+
+  LinearSolveInfo
+  solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A,
+               Vector &                                      x,
+               const Vector &                                b,
+               const LinearSolverOptions &                   options,
+               const std::vector<std::vector<bool>> &        constant_modes)
+  {
+    LinearSolveInfo info;
+    if (options.method == LinearSolverOptions::Method::direct)
+      {
+        std::vector<Vector> xs;
+        info = solve_direct(A, xs, {b}, options.direct_package);
+        x.copy_locally_owned_data_from(xs[0]);
+        return info;
       }
     else
       {

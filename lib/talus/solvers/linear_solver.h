@@ -59,6 +59,15 @@ namespace talus
                                const LinearSolverOptions &                   options,
                                const std::vector<std::vector<bool>> &        constant_modes = {});
 
+  /// The direct solve of solve_linear (one factorisation of A, with its
+  /// iterative refinement) for several right-hand sides: xs[k] from bs[k]
+  /// (xs resized like bs). `iterations` counts the right-hand sides,
+  /// `relative_residual` is the largest of them. Collective.
+  LinearSolveInfo solve_direct(const dealii::TrilinosWrappers::SparseMatrix &A,
+                               std::vector<Vector> &                         xs,
+                               const std::vector<Vector> &                   bs,
+                               const std::string &                           direct_package);
+
   /// CG + ML AMG whose hierarchy is kept from one solve to the next (the ML
   /// set-up has a fixed cost of ~3 ms per call, most of a small system's
   /// solve). A kept hierarchy was built from an older matrix: CG still

@@ -1190,6 +1190,25 @@ namespace talus::implicit_mpm
     residual = kept;
   }
 
+  namespace
+  {
+    /// A singular tangent (a body free to move as a rigid body in a static
+    /// analysis, a point set cut loose) gives a direct solve without error but
+    /// a solution that does not solve the system: a failed step.
+    void
+    require_solved(const LinearSolveInfo &info)
+    {
+      if (!(info.relative_residual <= 1e-6))
+        {
+          std::ostringstream os;
+          os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
+             << " after the " << info.method
+             << " solve): are rigid-body motions of every body prevented by boundary conditions?";
+          throw NewtonFailure(os.str());
+        }
+    }
+  } // namespace
+
   template <int dim>
   LinearSolveInfo
   Solver<dim>::solve_for_delta()
@@ -1216,17 +1235,7 @@ namespace talus::implicit_mpm
       }
     seconds_solve += seconds_since(start);
     ++n_solves;
-    // a singular tangent (a body free to move as a rigid body in a static
-    // analysis, a point set cut loose) gives a direct solve without error but
-    // a solution that does not solve the system
-    if (!(info.relative_residual <= 1e-6))
-      {
-        std::ostringstream os;
-        os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
-           << " after the " << info.method
-           << " solve): are rigid-body motions of every body prevented by boundary conditions?";
-        throw NewtonFailure(os.str());
-      }
+    require_solved(info);
     return info;
   }
 
@@ -1253,52 +1262,23 @@ namespace talus::implicit_mpm
           }
         return info;
       }
-    // direct: one factorisation for all of them (solve_linear's solve and
-    // iterative refinement per right-hand side)
+    // direct: one factorisation for all of them (solvers/linear_solver.h)
     const auto      start = Clock::now();
     LinearSolveInfo info;
-    info.method = "direct (" + prm.linear.direct_package + ", one factorisation for " + std::to_string(r.size()) +
-                  " right-hand sides)";
     try
       {
-        dealii::SolverControl                                  control(1, 0);
-        dealii::TrilinosWrappers::SolverDirect::AdditionalData data(false, prm.linear.direct_package);
-        dealii::TrilinosWrappers::SolverDirect                 solver(control, data);
-        solver.initialize(tangent);
-        Vector b, x, res, d;
-        for (Vector *v : {&b, &x, &res, &d})
-          space.reinit_vector(*v);
-        for (auto &rk : r)
+        std::vector<Vector> b(r.size()), x;
+        for (unsigned int k = 0; k < r.size(); ++k)
           {
-            b = rk;
-            b *= -1.0;
-            x = 0;
-            solver.solve(x, b);
-            const double b_norm        = b.l2_norm();
-            const auto   residual_norm = [&]() {
-              tangent.vmult(res, x);
-              res.sadd(-1.0, 1.0, b);
-              return res.l2_norm();
-            };
-            double rn = residual_norm();
-            for (unsigned int k = 0; k < 3 && rn > 1e-9 * b_norm; ++k)
-              {
-                d = 0;
-                solver.solve(d, res);
-                x += d;
-                const double rn_new = residual_norm();
-                if (!(rn_new < rn))
-                  {
-                    x -= d;
-                    break;
-                  }
-                rn = rn_new;
-              }
-            const double rel = b_norm > 0 ? rn / b_norm : rn;
-            ++info.iterations;
-            info.relative_residual = std::max(info.relative_residual, rel);
-            rk                     = x;
+            b[k].reinit(r[k], true);
+            b[k] = r[k];
+            b[k] *= -1.0;
           }
+        info = solve_direct(tangent, x, b, prm.linear.direct_package);
+        for (unsigned int k = 0; k < r.size(); ++k)
+          r[k].copy_locally_owned_data_from(x[k]);
+        info.method = "direct (" + prm.linear.direct_package + ", one factorisation for " + std::to_string(r.size()) +
+                      " right-hand sides)";
       }
     catch (const std::exception &e)
       {
@@ -1306,14 +1286,7 @@ namespace talus::implicit_mpm
       }
     seconds_solve += seconds_since(start);
     n_solves += r.size();
-    if (!(info.relative_residual <= 1e-6))
-      {
-        std::ostringstream os;
-        os << "the linear system is singular or nearly so (|b - A x| / |b| = " << info.relative_residual
-           << " after the " << info.method
-           << " solve): are rigid-body motions of every body prevented by boundary conditions?";
-        throw NewtonFailure(os.str());
-      }
+    require_solved(info);
     return info;
   }
 
