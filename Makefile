@@ -11,7 +11,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export OMP_NUM_THREADS=1
 
-.PHONY: all deps configure build demo test verify verify-paper campaign sanitize bench clean
+.PHONY: all deps format configure build demo test verify verify-paper campaign sanitize bench clean
 
 all: build
 
@@ -20,6 +20,10 @@ deps:
 
 $(BUILD_DIR)/build.ninja: | deps
 	cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+
+# rewrite every tracked .h/.cc with the root .clang-format (ctest style.clang_format checks it)
+format: deps
+	bash scripts/format.sh
 
 configure: deps $(BUILD_DIR)/build.ninja
 
