@@ -35,8 +35,7 @@ namespace
     dealii::Tensor<2, 3> Wp;
     Path()
     {
-      B1[0][0] = -2.0, B1[1][1] = 1.0, B1[2][2] = 0.4, B1[0][1] = 0.7, B1[1][2] = -0.4,
-      B1[0][2] = 0.3;
+      B1[0][0] = -2.0, B1[1][1] = 1.0, B1[2][2] = 0.4, B1[0][1] = 0.7, B1[1][2] = -0.4, B1[0][2] = 0.3;
       B2[0][0] = 1.0, B2[1][1] = -1.5, B2[0][2] = 0.9, B2[1][2] = 0.5;
       Wp[0][1] = 0.3, Wp[1][0] = -0.3;
     }
@@ -74,8 +73,7 @@ namespace
   }
 
   double
-  bench_finite(const Material &m, const unsigned int N, const unsigned int S, const double a,
-               const bool tangent)
+  bench_finite(const Material &m, const unsigned int N, const unsigned int S, const double a, const bool tangent)
   {
     const Path          P;
     const unsigned int  nh = m.n_history();
@@ -90,15 +88,11 @@ namespace
       {
         for (unsigned int i = 0; i < N; ++i)
           {
-            dealii::Tensor<2, 3> dF =
-              dealii::Tensor<2, 3>(a * (P.B1 + std::sin(0.3 * k + 0.01 * i) * P.B2)) + a * P.Wp;
+            dealii::Tensor<2, 3> dF = dealii::Tensor<2, 3>(a * (P.B1 + std::sin(0.3 * k + 0.01 * i) * P.B2)) + a * P.Wp;
             for (unsigned int d = 0; d < 3; ++d)
               dF[d][d] += 1.0;
-            m.finite_strain_update(dF,
-                                   ArrayView<const double>(h.data() + i * nh, nh),
-                                   ArrayView<double>(hn.data() + i * nh, nh),
-                                   tau,
-                                   tangent ? &T : nullptr);
+            m.finite_strain_update(dF, ArrayView<const double>(h.data() + i * nh, nh),
+                                   ArrayView<double>(hn.data() + i * nh, nh), tau, tangent ? &T : nullptr);
             sink += tau[0][0];
           }
         std::swap(h, hn);
@@ -123,44 +117,46 @@ namespace
   int
   bench(const unsigned int N, const unsigned int S)
   {
-  std::cout << "| model | small strain, elastic [ns] | small strain, loading [ns] | "
-               "finite strain [ns] | finite strain + tangent [ns] |\n"
-               "|---|---:|---:|---:|---:|\n";
-  for (const auto &name : registered_models())
-    {
-      dealii::ParameterHandler prm;
-      prm.enter_subsection("material");
-      declare_material_parameters(prm);
-      prm.set("model", name);
-      std::unique_ptr<Material> m = create_material(prm, "material", 0);
-      prm.leave_subsection();
-      double e = -1, l = -1, f = -1, ft = -1;
-      try
-        {
-          bench_small(*m, N, 5, 1e-9); // warm-up
-          e = bench_small(*m, N, S, 1e-9);
-          l = bench_small(*m, N, S, 1e-4);
-        }
-      catch (const std::exception &)
-        {}
-      if (m->has_finite_strain_form())
-        {
-          try
-            {
-              bench_finite(*m, N, 5, 1e-4, false);
-              f  = bench_finite(*m, N, S, 1e-4, false);
-              ft = bench_finite(*m, N, S, 1e-4, true);
-            }
-          catch (const std::exception &)
-            {}
-        }
-      std::cout << "| " << name << " | " << fmt(e) << " | " << fmt(l) << " | " << fmt(f)
-                << " | " << fmt(ft) << " |\n";
-    }
-  if (sink == 12345.678)
-    std::cout << sink;
-  return 0;
-}
+    std::cout << "| model | small strain, elastic [ns] | small strain, loading [ns] | "
+                 "finite strain [ns] | finite strain + tangent [ns] |\n"
+                 "|---|---:|---:|---:|---:|\n";
+    for (const auto &name : registered_models())
+      {
+        dealii::ParameterHandler prm;
+        prm.enter_subsection("material");
+        declare_material_parameters(prm);
+        prm.set("model", name);
+        std::unique_ptr<Material> m = create_material(prm, "material", 0);
+        prm.leave_subsection();
+        double e = -1, l = -1, f = -1, ft = -1;
+        try
+          {
+            bench_small(*m, N, 5, 1e-9); // warm-up
+            e = bench_small(*m, N, S, 1e-9);
+            l = bench_small(*m, N, S, 1e-4);
+          }
+        catch (const std::exception &)
+          {
+          }
+        if (m->has_finite_strain_form())
+          {
+            try
+              {
+                bench_finite(*m, N, 5, 1e-4, false);
+                f  = bench_finite(*m, N, S, 1e-4, false);
+                ft = bench_finite(*m, N, S, 1e-4, true);
+              }
+            catch (const std::exception &)
+              {
+              }
+          }
+        std::cout << "| " << name << " | " << fmt(e) << " | " << fmt(l) << " | " << fmt(f) << " | " << fmt(ft)
+                  << " |\n";
+      }
+    if (sink == 12345.678)
+      std::cout << sink;
+    return 0;
+  }
 } // namespace
 
 int

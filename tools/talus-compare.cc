@@ -49,9 +49,9 @@ namespace
 
   struct Settings
   {
-    std::string         a, b, report;
-    io::CompareOptions  options;
-    std::string         norm_name, time_name;
+    std::string        a, b, report;
+    io::CompareOptions options;
+    std::string        norm_name, time_name;
   };
 
   Settings
@@ -59,18 +59,18 @@ namespace
   {
     Settings s;
     prm.enter_subsection("compare");
-    s.a              = tool_option_value("--a", prm.get("file a"));
-    s.b              = tool_option_value("--b", prm.get("file b"));
-    s.report         = tool_option_value("--report", prm.get("report file"));
-    std::string q    = tool_option_value("--quantities", prm.get("quantities"));
-    s.time_name      = tool_option_value("--time", prm.get("time"));
-    s.norm_name      = tool_option_value("--norm", prm.get("norm"));
-    std::string tol  = tool_option_value("--tolerance", prm.get("tolerance"));
+    s.a             = tool_option_value("--a", prm.get("file a"));
+    s.b             = tool_option_value("--b", prm.get("file b"));
+    s.report        = tool_option_value("--report", prm.get("report file"));
+    std::string q   = tool_option_value("--quantities", prm.get("quantities"));
+    s.time_name     = tool_option_value("--time", prm.get("time"));
+    s.norm_name     = tool_option_value("--norm", prm.get("norm"));
+    std::string tol = tool_option_value("--tolerance", prm.get("tolerance"));
     prm.leave_subsection();
     for (const auto &x : dealii::Utilities::split_string_list(q, ','))
       s.options.quantities.push_back(x);
-    require(!s.options.quantities.empty(), "compare/quantities", "must name at least one quantity (allowed: " +
-                                                                   io::quantity_help() + ")");
+    require(!s.options.quantities.empty(), "compare/quantities",
+            "must name at least one quantity (allowed: " + io::quantity_help() + ")");
     if (s.time_name == "all")
       s.options.time = io::CompareOptions::Time::all;
     else if (s.time_name == "final")
@@ -88,7 +88,7 @@ namespace
     require(found, "compare/norm (--norm)",
             "'" + s.norm_name + "' is not allowed (allowed: relative-l2, relative-linf, l2, linf)");
     {
-      char *       end = nullptr;
+      char        *end = nullptr;
       const double t   = std::strtod(tol.c_str(), &end);
       require(!tol.empty() && end && *end == '\0' && std::isfinite(t) && t >= 0, "compare/tolerance (--tolerance)",
               "'" + tol + "' is not a number >= 0");
@@ -114,23 +114,23 @@ namespace
     const auto     a = io::read_results(s.a);
     const auto     b = io::read_results(s.b);
     const auto     d = io::compare(a, b, s.options);
-    std::ostream & o = log();
+    std::ostream  &o = log();
     o << "talus-compare: a = " << s.a << " (" << a.integration << ", t = " << a.time << " s), b = " << s.b << " ("
       << b.integration << ", t = " << b.time << " s)\n"
-      << "  time = " << s.time_name << ", norm = " << s.norm_name << ", tolerance = " << s.options.tolerance
-      << "\n";
+      << "  time = " << s.time_name << ", norm = " << s.norm_name << ", tolerance = " << s.options.tolerance << "\n";
     o << "  " << std::left << std::setw(28) << "quantity" << std::right << std::setw(8) << "n" << std::setw(13)
       << "L2(a-b)" << std::setw(13) << "Linf(a-b)" << std::setw(13) << "L2(b)" << std::setw(13) << "rel L2"
-      << std::setw(13) << "rel Linf" << "  status\n";
+      << std::setw(13) << "rel Linf"
+      << "  status\n";
     unsigned int n_bad = 0;
     for (const auto &x : d)
       {
         const bool ok = x.value(s.options.norm) <= s.options.tolerance;
         n_bad += ok ? 0 : 1;
-        o << "  " << std::left << std::setw(28) << x.name << std::right << std::setw(8) << x.n
-          << std::setprecision(4) << std::scientific << std::setw(13) << x.l2 << std::setw(13) << x.linf
-          << std::setw(13) << x.ref_l2 << std::setw(13) << x.relative_l2() << std::setw(13) << x.relative_linf()
-          << std::defaultfloat << "  " << (ok ? "ok" : "EXCEEDS") << "\n";
+        o << "  " << std::left << std::setw(28) << x.name << std::right << std::setw(8) << x.n << std::setprecision(4)
+          << std::scientific << std::setw(13) << x.l2 << std::setw(13) << x.linf << std::setw(13) << x.ref_l2
+          << std::setw(13) << x.relative_l2() << std::setw(13) << x.relative_linf() << std::defaultfloat << "  "
+          << (ok ? "ok" : "EXCEEDS") << "\n";
       }
     if (!s.report.empty() && dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
       {
@@ -138,15 +138,15 @@ namespace
         f.stream() << "quantity,n,l2,linf,ref_l2,ref_linf,relative_l2,relative_linf,within_tolerance\n"
                    << std::setprecision(12);
         for (const auto &x : d)
-          f.stream() << x.name << "," << x.n << "," << x.l2 << "," << x.linf << "," << x.ref_l2 << ","
-                     << x.ref_linf << "," << x.relative_l2() << "," << x.relative_linf() << ","
+          f.stream() << x.name << "," << x.n << "," << x.l2 << "," << x.linf << "," << x.ref_l2 << "," << x.ref_linf
+                     << "," << x.relative_l2() << "," << x.relative_linf() << ","
                      << (x.value(s.options.norm) <= s.options.tolerance ? 1 : 0) << "\n";
         f.commit();
       }
     if (n_bad)
       {
-        o << "talus-compare: " << n_bad << " of " << d.size() << " item(s) exceed the tolerance "
-          << s.options.tolerance << " (" << s.norm_name << ")" << std::endl;
+        o << "talus-compare: " << n_bad << " of " << d.size() << " item(s) exceed the tolerance " << s.options.tolerance
+          << " (" << s.norm_name << ")" << std::endl;
         return 1;
       }
     o << "talus-compare: all " << d.size() << " item(s) within the tolerance " << s.options.tolerance << " ("
@@ -164,9 +164,9 @@ main(int argc, char **argv)
   unsigned int             n_files = 0;
   for (int i = 1; i < argc; ++i)
     {
-      const std::string x = argv[i];
-      const bool positional = !x.empty() && x[0] != '-' && (x.size() < 4 || x.substr(x.size() - 4) != ".prm");
-      const bool value_of_option = i > 1 && std::string(argv[i - 1]).rfind("--", 0) == 0 &&
+      const std::string x          = argv[i];
+      const bool        positional = !x.empty() && x[0] != '-' && (x.size() < 4 || x.substr(x.size() - 4) != ".prm");
+      const bool        value_of_option = i > 1 && std::string(argv[i - 1]).rfind("--", 0) == 0 &&
                                    std::string(argv[i - 1]).find('=') == std::string::npos &&
                                    std::string(argv[i - 1]) != "--check" && std::string(argv[i - 1]) != "--help" &&
                                    std::string(argv[i - 1]) != "--print-parameters";
@@ -196,11 +196,11 @@ main(int argc, char **argv)
   tool.run          = &run;
   tool.prm_optional = true;
   tool.options      = {{"--a=", "results file a (checked)"},
-                  {"--b=", "results file b (reference)"},
-                  {"--quantities=", "comma-separated quantities (default: probes, energies)"},
-                  {"--time=", "all | final (series)"},
-                  {"--norm=", "relative-l2 | relative-linf | l2 | linf"},
-                  {"--tolerance=", "largest allowed norm (default 0.01)"},
-                  {"--report=", "CSV file of the differences"}};
+                       {"--b=", "results file b (reference)"},
+                       {"--quantities=", "comma-separated quantities (default: probes, energies)"},
+                       {"--time=", "all | final (series)"},
+                       {"--norm=", "relative-l2 | relative-linf | l2 | linf"},
+                       {"--tolerance=", "largest allowed norm (default 0.01)"},
+                       {"--report=", "CSV file of the differences"}};
   return talus::run_tool(static_cast<int>(av.size() - 1), av.data(), tool);
 }

@@ -31,7 +31,7 @@ namespace
   {
     if (!tool_option_given("--crossing-velocity"))
       return 0;
-    const std::string v = tool_option_value("--crossing-velocity", "");
+    const std::string v    = tool_option_value("--crossing-velocity", "");
     std::size_t       used = 0;
     double            x    = -1;
     try
@@ -53,9 +53,9 @@ namespace
   {
     if (prm_file.empty())
       return false;
-    std::ifstream     in(prm_file);
-    std::string       line;
-    const std::regex  opening(R"(^\s*subsection\s+implicit\s*(#.*)?$)");
+    std::ifstream    in(prm_file);
+    std::string      line;
+    const std::regex opening(R"(^\s*subsection\s+implicit\s*(#.*)?$)");
     while (std::getline(in, line))
       if (std::regex_match(line, opening))
         return true;
@@ -69,15 +69,15 @@ namespace
   int
   run_implicit(dealii::ParameterHandler &prm)
   {
-    using P      = implicit_mpm::Parameters<dim>;
-    const auto p = implicit_mpm::parse_parameters<dim>(prm);
+    using P            = implicit_mpm::Parameters<dim>;
+    const auto   p     = implicit_mpm::parse_parameters<dim>(prm);
     const double L_min = smallest_cell_edge(p);
-    const auto  rows = explicit_mpm::critical_time_steps(p.materials, {}, L_min);
-    std::size_t ctrl = 0;
+    const auto   rows  = explicit_mpm::critical_time_steps(p.materials, {}, L_min);
+    std::size_t  ctrl  = 0;
     for (std::size_t i = 1; i < rows.size(); ++i)
       if (rows[i].dt < rows[ctrl].dt)
         ctrl = i;
-    const double dt_cr   = rows[ctrl].dt;
+    const double dt_cr = rows[ctrl].dt;
     // the smallest step of the run (with stages: of any stage)
     const double h       = *std::min_element(p.stage_time_steps.begin(), p.stage_time_steps.end());
     const bool   dynamic = p.analysis == P::Analysis::dynamic;
@@ -90,8 +90,8 @@ namespace
     const double h_limit       = unconditional ? std::numeric_limits<double>::infinity() : 0.5 * omega_crit * dt_cr;
 
     log() << std::setprecision(6) << "talus-critical-dt: implicit MPM scene (talus-implicit), analysis = "
-          << (dynamic ? "dynamic, Newmark gamma = " + std::to_string(p.gamma) + ", beta = " + std::to_string(p.beta) :
-                        std::string("static"))
+          << (dynamic ? "dynamic, Newmark gamma = " + std::to_string(p.gamma) + ", beta = " + std::to_string(p.beta)
+                      : std::string("static"))
           << "\n  L_min = " << L_min << " m (smallest cell edge of the grid)\n";
     for (const auto &r : rows)
       log() << "  " << r.material << " (" << r.model << "): c = " << r.wave_speed << " m/s, explicit dt_cr = " << r.dt
@@ -113,8 +113,9 @@ namespace
     log() << "  controlling material: " << rows[ctrl].material << "; explicit critical time step " << dt_cr << " s\n"
           << "  implicit time step in use: " << h << " s = " << h / dt_cr
           << " x the explicit critical step (explicit steps per implicit step)"
-          << (unconditional ? "" : (h <= h_limit ? "; within the finite-element Newmark bound" :
-                                                   "; ABOVE the finite-element Newmark bound"))
+          << (unconditional ? ""
+                            : (h <= h_limit ? "; within the finite-element Newmark bound"
+                                            : "; ABOVE the finite-element Newmark bound"))
           << "\n";
 
     const std::string csv = tool_option_value("--csv", "");
@@ -139,7 +140,7 @@ namespace
   int
   run(dealii::ParameterHandler &prm)
   {
-    auto p = explicit_mpm::parse_parameters<dim>(prm);
+    auto p     = explicit_mpm::parse_parameters<dim>(prm);
     p.progress = false;
     explicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
     s.setup();
@@ -176,7 +177,7 @@ namespace
           const double h    = cell->minimum_vertex_distance();
           if (h < h_loc[m])
             {
-              h_loc[m] = h;
+              h_loc[m]  = h;
               id_loc[m] = cell->id().to_string();
               std::ostringstream c;
               c << std::setprecision(6) << "(" << cell->center() << ")";
@@ -248,12 +249,13 @@ namespace
       for (unsigned int m = 0; m < n_mat; ++m)
         if (f_scheme[m] > 0)
           {
-            courant_m[m]      = dt / rows[m].dt_wave; // dt c / h of this material
-            const double voc  = V_cross / rows[m].wave_speed;
+            courant_m[m]     = dt / rows[m].dt_wave; // dt c / h of this material
+            const double voc = V_cross / rows[m].wave_speed;
             if (voc * courant_m[m] < 1e-3)
               throw InputError("option --crossing-velocity: V dt / h = " + std::to_string(voc * courant_m[m]) +
-                               " < 1e-3 for " + rows[m].material + " (the analysis needs K = h / (V dt) <= 1000 steps)");
-            growth[m]  = analysis::crossing_growth_per_step(n_points[m], courant_m[m], voc, 8, &v_used[m]);
+                               " < 1e-3 for " + rows[m].material +
+                               " (the analysis needs K = h / (V dt) <= 1000 steps)");
+            growth[m]         = analysis::crossing_growth_per_step(n_points[m], courant_m[m], voc, 8, &v_used[m]);
             const double rate = std::log(growth[m]) / dt;
             log() << "  cell crossing at V = " << V_cross << " m/s, " << rows[m].material << " (V/c = " << voc
                   << ", analysed at " << v_used[m] << ", dt c / h = " << courant_m[m] << "): growth per step "
@@ -261,12 +263,12 @@ namespace
                   << " 1/s (e-folding time " << (rate > 0 ? 1.0 / rate : 0.0) << " s)"
                   << (growth[m] > 1 + 1e-9 ? ": unstable while the points cross cells" : "") << "\n";
           }
-    log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s (" << rows[ctrl].formula
-          << ", the default), controlling cell " << cell_of[ctrl].id << "\n"
+    log() << "  controlling material: " << rows[ctrl].material << "; critical time step " << dt_cr << " s ("
+          << rows[ctrl].formula << ", the default), controlling cell " << cell_of[ctrl].id << "\n"
           << "  time step in use: " << dt << " s = " << dt / dt_cr << " x critical"
           << (p.time_step > 0 ? " (fixed time step)" : " (Courant number " + std::to_string(p.courant) + ")") << "\n";
 
-    double measured = 0, probe_lo = 0, probe_hi = 0;
+    double     measured = 0, probe_lo = 0, probe_hi = 0;
     const bool probe = tool_option_given("--probe");
     if (probe)
       {
@@ -300,18 +302,18 @@ namespace
         else
           for (int it = 0; it < 8; ++it)
             {
-              const double mid = 0.5 * (lo + hi);
+              const double mid        = 0.5 * (lo + hi);
               (stable(mid) ? lo : hi) = mid;
             }
         probe_lo = lo;
         probe_hi = hi;
         measured = lo * dt_cr;
         log() << "  probe (" << n_steps << " steps per run, bisection): stable at " << lo << " x, unstable at " << hi
-              << " x critical; measured critical time step " << measured << " s = " << lo
-              << " x the formula";
+              << " x critical; measured critical time step " << measured << " s = " << lo << " x the formula";
         if (dt_scheme[ctrl] > 0)
-          log() << ", " << measured / dt_scheme[ctrl] << " x the scheme limit " << dt_scheme[ctrl] << " s (regular points), "
-                << measured / dt_moved[ctrl] << " x " << dt_moved[ctrl] << " s (moved points)";
+          log() << ", " << measured / dt_scheme[ctrl] << " x the scheme limit " << dt_scheme[ctrl]
+                << " s (regular points), " << measured / dt_moved[ctrl] << " x " << dt_moved[ctrl]
+                << " s (moved points)";
         log() << "\n";
       }
 
@@ -326,13 +328,13 @@ namespace
                       "crossing_v_over_c_analysed,crossing_growth_per_step,crossing_growth_rate,dt_scheme_moved\n";
         for (std::size_t i = 0; i < rows.size(); ++i)
           f.stream() << rows[i].material << "," << rows[i].model << "," << rows[i].phase << ",\"" << rows[i].formula
-                     << "\"," << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << rows[i].dt_wave << ","
-                     << rows[i].dt_other << "," << rows[i].dt_4_122 << "," << (i == ctrl ? 1 : 0) << "," << dt << "," << dt / dt_cr << ","
-                     << (probe && i == ctrl ? measured : 0.0) << "," << (probe && i == ctrl ? probe_lo : 0.0) << ","
-                     << (probe && i == ctrl ? probe_hi : 0.0) << "," << cell_of[i].id << "," << cell_of[i].h << ","
-                     << n_points[i] << "," << f_scheme[i] << "," << dt_scheme[i] << "," << V_cross << "," << v_used[i]
-                     << "," << growth[i] << "," << (growth[i] > 0 ? std::log(growth[i]) / dt : 0.0) << ","
-                     << dt_moved[i] << "\n";
+                     << "\"," << rows[i].wave_speed << "," << L_min << "," << rows[i].dt << "," << rows[i].dt_wave
+                     << "," << rows[i].dt_other << "," << rows[i].dt_4_122 << "," << (i == ctrl ? 1 : 0) << "," << dt
+                     << "," << dt / dt_cr << "," << (probe && i == ctrl ? measured : 0.0) << ","
+                     << (probe && i == ctrl ? probe_lo : 0.0) << "," << (probe && i == ctrl ? probe_hi : 0.0) << ","
+                     << cell_of[i].id << "," << cell_of[i].h << "," << n_points[i] << "," << f_scheme[i] << ","
+                     << dt_scheme[i] << "," << V_cross << "," << v_used[i] << "," << growth[i] << ","
+                     << (growth[i] > 0 ? std::log(growth[i]) / dt : 0.0) << "," << dt_moved[i] << "\n";
         f.commit();
       }
     return exit_ok;
@@ -378,8 +380,8 @@ main(int argc, char **argv)
         for (const char *o : {"--probe", "--probe-steps", "--crossing-velocity"})
           if (talus::tool_option_given(o))
             throw talus::InputError(std::string("option ") + o +
-                                    ": the probe runs and the crossing analysis are those of the explicit scheme; "
-                                    "not available for an implicit scene (allowed: --csv=FILE)");
+                                      ": the probe runs and the crossing analysis are those of the explicit scheme; "
+                                        "not available for an implicit scene (allowed: --csv=FILE)");
       }
     else if (two)
       talus::explicit_mpm::parse_parameters<2>(prm);
@@ -390,7 +392,7 @@ main(int argc, char **argv)
     if (talus::tool_option_given("--csv"))
       talus::require_output_file(talus::tool_option_value("--csv", ""), "option --csv");
   };
-  tool.run     = [](dealii::ParameterHandler &prm, const std::string &prm_file) {
+  tool.run = [](dealii::ParameterHandler &prm, const std::string &prm_file) {
     const bool two = prm.get_integer("dimension") == 2;
     if (is_implicit_scene(prm_file))
       return two ? run_implicit<2>(prm) : run_implicit<3>(prm);

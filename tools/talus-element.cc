@@ -28,75 +28,52 @@ using namespace talus::materials;
 
 namespace
 {
-  const char *summary =
-    "Runs one constitutive model (subsection 'material') along a homogeneous\n"
-    "laboratory path (subsection 'test') and writes a CSV of strains, stresses,\n"
-    "invariants and history variables plus PNG plots through gnuplot.\n"
-    "Conventions: axis x is the axial direction; stresses sig_* and strains eps_*\n"
-    "in the CSV are tension positive; eps_a, eps_v, p and q are geotechnical\n"
-    "(compression positive), p = -tr(sigma)/3, q = sqrt(3 J2).";
+  const char *summary = "Runs one constitutive model (subsection 'material') along a homogeneous\n"
+                        "laboratory path (subsection 'test') and writes a CSV of strains, stresses,\n"
+                        "invariants and history variables plus PNG plots through gnuplot.\n"
+                        "Conventions: axis x is the axial direction; stresses sig_* and strains eps_*\n"
+                        "in the CSV are tension positive; eps_a, eps_v, p and q are geotechnical\n"
+                        "(compression positive), p = -tr(sigma)/3, q = sqrt(3 J2).";
 
   void
   declare(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection("test");
-    prm.declare_entry("path",
-                      "drained triaxial compression",
-                      dealii::Patterns::Selection(element_path_names()),
+    prm.declare_entry("path", "drained triaxial compression", dealii::Patterns::Selection(element_path_names()),
                       "Loading path (must be set). Triaxial and oedometer: axial strain along x controlled; "
                       "drained triaxial: lateral stresses held at their initial value (Newton "
                       "loop on the lateral strains); undrained: isochoric; simple shear: "
                       "grad u = gamma e_x (x) e_y (with its spin).",
                       /*has_to_be_set=*/true);
-    prm.declare_entry("strain form",
-                      "small",
-                      dealii::Patterns::Selection("small|finite"),
+    prm.declare_entry("strain form", "small", dealii::Patterns::Selection("small|finite"),
                       "small: rate form (update_stress with d_eps, d_omega); finite: "
                       "finite_strain_update with dF (only models with a finite-strain form).");
-    prm.declare_entry("target strain",
-                      "0.1",
-                      dealii::Patterns::Double(0),
+    prm.declare_entry("target strain", "0.1", dealii::Patterns::Double(0),
                       "Final magnitude (> 0) of the controlled strain [-]: axial strain "
                       "(triaxial, oedometer), volumetric strain (isotropic compression), "
                       "engineering shear strain gamma (simple shear). Logarithmic in the "
                       "finite-strain form.");
-    prm.declare_entry("number of increments",
-                      "1000",
-                      dealii::Patterns::Integer(1),
+    prm.declare_entry("number of increments", "1000", dealii::Patterns::Integer(1),
                       "Number of equal strain increments (>= 1).");
-    prm.declare_entry("time increment",
-                      "1e-3",
-                      dealii::Patterns::Double(0),
+    prm.declare_entry("time increment", "1e-3", dealii::Patterns::Double(0),
                       "Time per increment dt [s], > 0 (sets the strain rate of the "
                       "rate-dependent liquid models).");
-    prm.declare_entry("initial mean effective stress",
-                      "100e3",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("initial mean effective stress", "100e3", dealii::Patterns::Double(),
                       "Initial mean effective stress p0' [Pa], compression positive.");
-    prm.declare_entry("initial stress ratio",
-                      "1",
-                      dealii::Patterns::Double(0),
+    prm.declare_entry("initial stress ratio", "1", dealii::Patterns::Double(0),
                       "Initial lateral / axial effective stress ratio K0 [-], > 0 (1: isotropic).");
-    prm.declare_entry("newton tolerance",
-                      "1e-11",
-                      dealii::Patterns::Double(0),
+    prm.declare_entry("newton tolerance", "1e-11", dealii::Patterns::Double(0),
                       "Relative tolerance of the drained (mixed-control) Newton loop on the "
                       "lateral stresses.");
-    prm.declare_entry("max newton iterations",
-                      "50",
-                      dealii::Patterns::Integer(1),
+    prm.declare_entry("max newton iterations", "50", dealii::Patterns::Integer(1),
                       "Iteration limit of the drained Newton loop per increment.");
     prm.leave_subsection();
 
     prm.enter_subsection("output");
-    prm.declare_entry("csv file",
-                      "element.csv",
-                      dealii::Patterns::FileName(dealii::Patterns::FileName::output),
+    prm.declare_entry("csv file", "element.csv", dealii::Patterns::FileName(dealii::Patterns::FileName::output),
                       "Result table (one row per increment, plus the initial state). "
                       "Written to a temporary name and renamed when complete.");
-    prm.declare_entry("plots",
-                      "true",
-                      dealii::Patterns::Bool(),
+    prm.declare_entry("plots", "true", dealii::Patterns::Bool(),
                       "Write PNG plots next to the CSV (<csv stem>_q_eps.png, _q_p.png, "
                       "_epsv_eps.png) with gnuplot; skipped with a warning if gnuplot is "
                       "not available.");
@@ -129,9 +106,7 @@ namespace
   }
 
   void
-  write_plots(const std::filesystem::path &csv,
-              const bool                   shear_path,
-              const std::string &          title)
+  write_plots(const std::filesystem::path &csv, const bool shear_path, const std::string &title)
   {
     std::string terminal;
     if (!have_gnuplot(terminal))
@@ -146,10 +121,10 @@ namespace
     {
       std::string file, x, y, xlabel, ylabel;
     };
-    const Plot plots[] = {{stem + "_q_eps.png", xcol, "q", xlab, "q [kPa]"},
-                          {stem + "_q_p.png", "p", "q", "p' [kPa] (compression +)", "q [kPa]"},
-                          {stem + "_epsv_eps.png", xcol, "eps_v", xlab, "volumetric strain eps_v [-] (compression +)"}};
-    const std::string script = stem + ".gp.tmp";
+    const Plot        plots[] = {{stem + "_q_eps.png", xcol, "q", xlab, "q [kPa]"},
+                                 {stem + "_q_p.png", "p", "q", "p' [kPa] (compression +)", "q [kPa]"},
+                                 {stem + "_epsv_eps.png", xcol, "eps_v", xlab, "volumetric strain eps_v [-] (compression +)"}};
+    const std::string script  = stem + ".gp.tmp";
     {
       std::ofstream gp(script);
       gp << "set datafile separator ','\nset datafile columnheaders\nset terminal " << terminal << "\nset grid\n"
@@ -160,10 +135,8 @@ namespace
             return "column('" + n + "')" + ((n == "p" || n == "q") ? "/1000.0" : "");
           };
           gp << "set output '" << p.file << ".tmp'\n"
-             << "set xlabel \"" << p.xlabel << "\" noenhanced\nset ylabel \"" << p.ylabel
-             << "\" noenhanced\n"
-             << "plot '" << csv.string() << "' using (" << col(p.x) << "):(" << col(p.y)
-             << ") with lines lw 2\n";
+             << "set xlabel \"" << p.xlabel << "\" noenhanced\nset ylabel \"" << p.ylabel << "\" noenhanced\n"
+             << "plot '" << csv.string() << "' using (" << col(p.x) << "):(" << col(p.y) << ") with lines lw 2\n";
         }
       gp << "unset output\n";
     }
@@ -231,8 +204,7 @@ namespace
     prm.enter_subsection("material");
     u.m = create_material(prm, "material", 0);
     prm.leave_subsection();
-    require(!set.finite_strain || u.m->has_finite_strain_form(),
-            "test/strain form",
+    require(!set.finite_strain || u.m->has_finite_strain_form(), "test/strain form",
             "model '" + u.m->model_name() + "' has no finite-strain form (allowed for it: small)");
     return u;
   }
@@ -240,7 +212,7 @@ namespace
   int
   run(dealii::ParameterHandler &prm)
   {
-    const Setup u = parse(prm);
+    const Setup u         = parse(prm);
     const auto &set       = u.set;
     const auto &csv       = u.csv;
     const auto &plots     = u.plots;
@@ -264,10 +236,9 @@ namespace
         run_element_test(*m, set, [&](const ElementRecord &r) {
           const auto &e = r.eps;
           const auto &s = r.sigma;
-          f << r.step << "," << r.time << "," << e[0][0] << "," << e[1][1] << "," << e[2][2]
-            << "," << e[0][1] << "," << e[1][2] << "," << e[0][2] << "," << s[0][0] << ","
-            << s[1][1] << "," << s[2][2] << "," << s[0][1] << "," << s[1][2] << "," << s[0][2]
-            << "," << r.eps_axial() << "," << r.eps_vol() << "," << r.gamma << "," << r.p()
+          f << r.step << "," << r.time << "," << e[0][0] << "," << e[1][1] << "," << e[2][2] << "," << e[0][1] << ","
+            << e[1][2] << "," << e[0][2] << "," << s[0][0] << "," << s[1][1] << "," << s[2][2] << "," << s[0][1] << ","
+            << s[1][2] << "," << s[0][2] << "," << r.eps_axial() << "," << r.eps_vol() << "," << r.gamma << "," << r.p()
             << "," << r.q() << "," << r.newton_iterations;
           for (const double h : r.history)
             f << "," << h;
@@ -278,10 +249,10 @@ namespace
         require(!f.fail(), "output/csv file", "error while writing '" + tmp.string() + "'");
         std::filesystem::rename(tmp, csv);
         std::cout << "talus-element: " << m->model_name() << ", " << path_name << " ("
-                  << (set.finite_strain ? "finite" : "small") << " strain), "
-                  << set.n_increments << " increments: final p' = " << last.p()
-                  << " Pa, q = " << last.q() << " Pa, eps_a = " << last.eps_axial()
-                  << ", eps_v = " << last.eps_vol() << "\nwrote " << csv.string() << "\n";
+                  << (set.finite_strain ? "finite" : "small") << " strain), " << set.n_increments
+                  << " increments: final p' = " << last.p() << " Pa, q = " << last.q()
+                  << " Pa, eps_a = " << last.eps_axial() << ", eps_v = " << last.eps_vol() << "\nwrote " << csv.string()
+                  << "\n";
       }
     catch (...)
       {
@@ -290,8 +261,7 @@ namespace
         throw;
       }
     if (plots)
-      write_plots(csv, set.path == ElementPath::simple_shear,
-                  m->model_name() + ": " + path_name);
+      write_plots(csv, set.path == ElementPath::simple_shear, m->model_name() + ": " + path_name);
     return 0;
   }
 } // namespace

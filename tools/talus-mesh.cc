@@ -30,7 +30,6 @@ namespace
   }
 
 
-
   /// Peak memory of talus-mesh for a box grid of n cells (docs/reliability.md:
   /// measured in 2D, 170 MB + 156 B per cell; 3D scaled by the vertices per cell).
   double
@@ -59,7 +58,8 @@ namespace
   void
   declare(dealii::ParameterHandler &prm, const std::string &prm_file)
   {
-    const unsigned int dim = dealii::Utilities::string_to_int(peek_entry(prm_file, "", "dimension", "2", Selection("2|3")));
+    const unsigned int dim =
+      dealii::Utilities::string_to_int(peek_entry(prm_file, "", "dimension", "2", Selection("2|3")));
     const unsigned int n_bodies =
       dealii::Utilities::string_to_int(peek_entry(prm_file, "", "number of bodies", "1", Integer(0, 64)));
     prm.declare_entry("dimension", "2", Selection("2|3"), "Spatial dimension.");
@@ -76,7 +76,8 @@ namespace
                         "Boundary ids come from the physical groups of dimension dim-1, material ids from those "
                         "of dimension dim: names 'boundary <id> [label]' / 'material <id> [label]', unnamed "
                         "groups by their tag, other names through 'boundary groups' / 'material groups'.");
-      prm.declare_entry("recombine", "true", Bool(), "gmsh .geo: recombine triangles into quadrangles (Mesh.RecombineAll).");
+      prm.declare_entry("recombine", "true", Bool(),
+                        "gmsh .geo: recombine triangles into quadrangles (Mesh.RecombineAll).");
       prm.declare_entry("subdivide", "false", Bool(),
                         "gmsh .geo: split every element into quadrangles/hexahedra (Mesh.SubdivisionAlgorithm).");
       prm.declare_entry("round coordinates", "true", Bool(),
@@ -111,9 +112,10 @@ namespace
                           "cell; or 'gmsh': the elements of a body mesh ('file', 'groups'; triangles/quadrangles, "
                           "tetrahedra/hexahedra), n per direction per element. Earlier bodies win where "
                           "grid-seeded bodies overlap.");
-        prm.declare_entry("material", "0", Anything(),
-                          "Material id (integer 0..65535), or 'groups': from the material groups of the mesh "
-                          "(the grid cell's material id; for gmsh bodies the 'material <id>' groups of the body mesh).");
+        prm.declare_entry(
+          "material", "0", Anything(),
+          "Material id (integer 0..65535), or 'groups': from the material groups of the mesh "
+          "(the grid cell's material id; for gmsh bodies the 'material <id>' groups of the body mesh).");
         prm.declare_entry("lower corner", zeros(dim), Anything(), "box: lower corner [m].");
         prm.declare_entry("upper corner", dim == 2 ? "1, 1" : "1, 1, 1", Anything(), "box: upper corner [m].");
         prm.declare_entry("center", zeros(dim), Anything(), "ball: center [m].");
@@ -123,7 +125,8 @@ namespace
         prm.declare_entry("groups", "", Anything(),
                           "grid / gmsh: physical groups of dimension dim (names or numeric tags, comma-separated) "
                           "whose cells/elements form the body; empty = all.");
-        prm.declare_entry("points per direction", "2", Integer(1, 10), "Material points per cell/element and direction.");
+        prm.declare_entry("points per direction", "2", Integer(1, 10),
+                          "Material points per cell/element and direction.");
         prm.declare_entry("clip to grid", "false", Bool(),
                           "box/ball/polygon: false = a body not wholly inside the grid is refused (naming the "
                           "coordinate outside and the grid extent); true = its points outside the grid are "
@@ -182,12 +185,12 @@ namespace
                   " MB are available (MemAvailable of /proc/meminfo, or the cgroup limit)");
         require(total <= 1e8, "grid/cells", "more than 1e8 cells in total");
       }
-    s.grid_options.recombine = prm.get_bool("recombine");
-    s.grid_options.subdivide = prm.get_bool("subdivide");
+    s.grid_options.recombine         = prm.get_bool("recombine");
+    s.grid_options.subdivide         = prm.get_bool("subdivide");
     s.grid_options.round_coordinates = prm.get_bool("round coordinates");
-    s.boundary_map           = parse_map(prm.get("boundary groups"), "grid/boundary groups");
-    s.material_map           = parse_map(prm.get("material groups"), "grid/material groups");
-    s.allow_distorted        = prm.get_bool("allow distorted cells");
+    s.boundary_map                   = parse_map(prm.get("boundary groups"), "grid/boundary groups");
+    s.material_map                   = parse_map(prm.get("material groups"), "grid/material groups");
+    s.allow_distorted                = prm.get_bool("allow distorted cells");
     prm.leave_subsection();
 
     const unsigned int n = prm.get_integer("number of bodies");
@@ -196,12 +199,15 @@ namespace
         const std::string where = "body " + std::to_string(k);
         prm.enter_subsection(where);
         mesh::BodySpec<dim> b;
-        b.name                 = prm.get("name");
-        const std::string src  = prm.get("source");
-        using S                = typename mesh::BodySpec<dim>::Source;
-        b.source               = src == "box" ? S::box : src == "ball" ? S::ball : src == "polygon" ? S::polygon :
-                                 src == "grid" ? S::grid : S::gmsh;
-        const std::string mat  = prm.get("material");
+        b.name                = prm.get("name");
+        const std::string src = prm.get("source");
+        using S               = typename mesh::BodySpec<dim>::Source;
+        b.source              = src == "box"       ? S::box
+                                : src == "ball"    ? S::ball
+                                : src == "polygon" ? S::polygon
+                                : src == "grid"    ? S::grid
+                                                   : S::gmsh;
+        const std::string mat = prm.get("material");
         if (mesh::normalise_name(mat) == "groups")
           b.material = -1;
         else
@@ -244,7 +250,7 @@ namespace
           b.groups = dealii::Utilities::split_string_list(prm.get("groups"), ',');
         else
           require(prm.get("groups").empty(), where + "/groups", "only for source = grid or gmsh");
-        b.n     = prm.get_integer("points per direction");
+        b.n                             = prm.get_integer("points per direction");
         b.shape.clip_to_grid            = prm.get_bool("clip to grid");
         b.shape.particles_per_direction = b.n;
         b.shape.name                    = b.name;
@@ -260,8 +266,8 @@ namespace
                     out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
                           "the grid, or set 'clip to grid = true' to drop the points outside)");
           }
-        b.gauss = prm.get("positions") == "gauss";
-        b.k0    = prm.get_double("k0");
+        b.gauss      = prm.get("positions") == "gauss";
+        b.k0         = prm.get_double("k0");
         b.k0_density = prm.get_double("k0 density");
         b.k0_gravity = prm.get_double("k0 gravity");
         if (b.k0 > 0)
@@ -344,9 +350,9 @@ namespace
   int
   run_dim(dealii::ParameterHandler &prm)
   {
-    const MPI_Comm comm = MPI_COMM_WORLD;
-    const auto     s    = parse<dim>(prm);
-    const auto     out  = parse_outputs(prm);
+    const MPI_Comm    comm = MPI_COMM_WORLD;
+    const auto        s    = parse<dim>(prm);
+    const auto        out  = parse_outputs(prm);
     mesh::Result<dim> r;
     on_root(comm, [&]() { r = mesh::prepare(s); });
     const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
@@ -366,12 +372,14 @@ namespace
         if (!out.csv.empty())
           {
             std::ofstream f(out.csv + ".part");
-            const auto &t       = r.particles;
-            const bool  stress  = !t.stress.empty();
+            const auto   &t      = r.particles;
+            const bool    stress = !t.stress.empty();
             f << (dim == 2 ? "x,y" : "x,y,z") << ",volume,material_id,body_id"
-              << (!stress ? "" : dim == 2 ? ",stress_xx,stress_yy,stress_zz,stress_xy" :
-                                            ",stress_xx,stress_yy,stress_zz,stress_xy,stress_yz,stress_xz")
-              << "\n" << std::setprecision(17);
+              << (!stress    ? ""
+                  : dim == 2 ? ",stress_xx,stress_yy,stress_zz,stress_xy"
+                             : ",stress_xx,stress_yy,stress_zz,stress_xy,stress_yz,stress_xz")
+              << "\n"
+              << std::setprecision(17);
             for (std::size_t i = 0; i < t.size(); ++i)
               {
                 for (unsigned int d = 0; d < dim; ++d)
@@ -386,7 +394,7 @@ namespace
             std::filesystem::rename(out.csv + ".part", out.csv);
           }
         io::write_msh(r.grid, out.grid);
-        auto &os = log();
+        auto       &os = log();
         const auto &sm = r.summary;
         os << "talus-mesh: grid: " << r.grid.n_cells() << " cells, " << r.grid.vertices.size() << " vertices, min edge "
            << r.grid.min_edge() << " m\n  boundary ids (faces):";

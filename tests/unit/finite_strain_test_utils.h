@@ -38,7 +38,7 @@ namespace talus_test
   inline T2
   rotation(const double x, const double y, const double z, const double t)
   {
-    const double n = std::sqrt(x * x + y * y + z * z);
+    const double n    = std::sqrt(x * x + y * y + z * z);
     const double a[3] = {x / n, y / n, z / n};
     T2           K;
     K[0][1] = -a[2];
@@ -62,10 +62,8 @@ namespace talus_test
   {
     Step s;
     s.hist.resize(h_old.size());
-    m.finite_strain_update(dF,
-                           dealii::ArrayView<const double>(h_old.data(), h_old.size()),
-                           dealii::ArrayView<double>(s.hist.data(), s.hist.size()),
-                           s.tau,
+    m.finite_strain_update(dF, dealii::ArrayView<const double>(h_old.data(), h_old.size()),
+                           dealii::ArrayView<double>(s.hist.data(), s.hist.size()), s.tau,
                            tangent ? &s.tangent : nullptr);
     return s;
   }
@@ -104,8 +102,8 @@ namespace talus_test
 
   /// || analytic - FD ||_F / max(|| FD ||_F, floor).
   inline double
-  tangent_error(const Material &m, const T2 &dF, const std::vector<double> &h_old,
-                const double floor = 0.0, const double h = 1e-6)
+  tangent_error(const Material &m, const T2 &dF, const std::vector<double> &h_old, const double floor = 0.0,
+                const double h = 1e-6)
   {
     const T4 a  = step(m, dF, h_old, true).tangent;
     const T4 fd = fd_tangent(m, dF, h_old, h);

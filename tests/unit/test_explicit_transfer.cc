@@ -57,11 +57,11 @@ template <int dim>
 void
 conservation(const Shape shape = Shape::linear)
 {
-  const auto               p = scene<dim>(shape);
+  const auto                p = scene<dim>(shape);
   explicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
   s.setup();
-  const double m_particles = s.total_mass();
-  const auto   p_particles = s.total_momentum();
+  const double m_particles    = s.total_mass();
+  const auto   p_particles    = s.total_momentum();
   const auto [m_grid, p_grid] = s.grid_mass_and_momentum();
   EXPECT_GT(m_particles, 0.0);
   EXPECT_NEAR(m_grid, m_particles, 1e-13 * m_particles);
@@ -69,10 +69,22 @@ conservation(const Shape shape = Shape::linear)
     EXPECT_NEAR(p_grid[d], p_particles[d], 1e-13 * m_particles);
 }
 
-TEST(ExplicitTransfer, P2GConservesMassAndMomentum2D) { conservation<2>(); }
-TEST(ExplicitTransfer, P2GConservesMassAndMomentum3D) { conservation<3>(); }
-TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum2D) { conservation<2>(Shape::quadratic_bspline); }
-TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum3D) { conservation<3>(Shape::quadratic_bspline); }
+TEST(ExplicitTransfer, P2GConservesMassAndMomentum2D)
+{
+  conservation<2>();
+}
+TEST(ExplicitTransfer, P2GConservesMassAndMomentum3D)
+{
+  conservation<3>();
+}
+TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum2D)
+{
+  conservation<2>(Shape::quadratic_bspline);
+}
+TEST(ExplicitTransfer, BSplineP2GConservesMassAndMomentum3D)
+{
+  conservation<3>(Shape::quadratic_bspline);
+}
 
 /// The ball of scene() plus two small bodies sliding along the bottom, one
 /// behind the other: cells become active for the first time, are vacated, and
@@ -87,10 +99,10 @@ sliding_scene(const Shape shape, const bool apic)
   p.gravity = dealii::Tensor<1, dim>();
   // two small bodies slide along the bottom, one behind the other: cells become
   // active for the first time, are vacated, and are re-entered (stale nodal entries)
-  auto b2      = p.bodies[0];
-  b2.radius    = 0.04;
-  b2.center[0] = 0.72;
-  b2.center[1] = 0.08;
+  auto b2           = p.bodies[0];
+  b2.radius         = 0.04;
+  b2.center[0]      = 0.72;
+  b2.center[1]      = 0.08;
   b2.velocity_field = [](const dealii::Point<dim> &) {
     dealii::Tensor<1, dim> v;
     v[0] = -0.4;
@@ -111,15 +123,15 @@ relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = fal
   const auto                p = sliding_scene<dim>(shape, apic);
   explicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
   s.setup();
-  const auto         n0  = s.n_particles();
-  const double       m0  = s.total_mass();
-  const auto         p0  = s.total_momentum();
+  const auto   n0 = s.n_particles();
+  const double m0 = s.total_mass();
+  const auto   p0 = s.total_momentum();
   // large steps (still below the critical one) so that particles cross cells;
   // after each, the fused P2G and the kept (cell, count) list must match a
   // fresh computation
-  double                                                         worst = 0;
+  double                                                                 worst = 0;
   std::map<dealii::types::particle_index, dealii::types::particle_index> slot_of_id;
-  unsigned long long                                             moved_keeping_slot = 0;
+  unsigned long long                                                     moved_keeping_slot = 0;
   for (int i = 0; i < 40; ++i)
     {
       slot_of_id.clear();
@@ -175,7 +187,7 @@ relocation_and_momentum(const Shape shape = Shape::linear, const bool apic = fal
   std::vector<dealii::types::particle_index> ids;
   for (const auto &pt : s.points.handler)
     ids.push_back(pt.get_id());
-  auto all = dealii::Utilities::MPI::all_gather(MPI_COMM_WORLD, ids);
+  auto                                       all = dealii::Utilities::MPI::all_gather(MPI_COMM_WORLD, ids);
   std::vector<dealii::types::particle_index> merged;
   for (auto &v : all)
     merged.insert(merged.end(), v.begin(), v.end());
@@ -201,7 +213,7 @@ memory_order(const Shape shape = Shape::linear)
   b.setup();
   a.points.relocator().resort_fraction = 0.0;  // rebuild whenever a point moved
   b.points.relocator().resort_fraction = 1e30; // never
-  unsigned int rebuilds = 0;
+  unsigned int rebuilds                = 0;
   for (int i = 0; i < 40; ++i)
     {
       const double h = a.time_step();
@@ -215,7 +227,7 @@ memory_order(const Shape shape = Shape::linear)
       ++rebuilds;
       EXPECT_FALSE(a.points.relocator().sorted_last);
       bool         ascending = true;
-      unsigned int last      = 0, k = 0;
+      unsigned int last = 0, k = 0;
       for (const auto &pt : a.points.handler)
         {
           ascending = ascending && (k++ == 0 || pt.get_local_index() > last);
@@ -256,20 +268,47 @@ memory_order(const Shape shape = Shape::linear)
   for (std::size_t j = 0; j < n_columns; ++j)
     EXPECT_LE(worst[j], 1e-12 * scale[j]) << "column " << j << ": the rebuild changed the points beyond round-off";
 }
-TEST(ExplicitTransfer, MemoryOrderRebuild2D) { memory_order<2>(); }
-TEST(ExplicitTransfer, MemoryOrderRebuild3D) { memory_order<3>(); }
-TEST(ExplicitTransfer, BSplineMemoryOrderRebuild3D) { memory_order<3>(Shape::quadratic_bspline); }
+TEST(ExplicitTransfer, MemoryOrderRebuild2D)
+{
+  memory_order<2>();
+}
+TEST(ExplicitTransfer, MemoryOrderRebuild3D)
+{
+  memory_order<3>();
+}
+TEST(ExplicitTransfer, BSplineMemoryOrderRebuild3D)
+{
+  memory_order<3>(Shape::quadratic_bspline);
+}
 
-TEST(ExplicitTransfer, RelocationKeepsParticles2D) { relocation_and_momentum<2>(); }
-TEST(ExplicitTransfer, RelocationKeepsParticles3D) { relocation_and_momentum<3>(); }
+TEST(ExplicitTransfer, RelocationKeepsParticles2D)
+{
+  relocation_and_momentum<2>();
+}
+TEST(ExplicitTransfer, RelocationKeepsParticles3D)
+{
+  relocation_and_momentum<3>();
+}
 // the same with quadratic B-splines: the fused P2G of the update pass and of
 // the moved points equals a fresh P2G on the 4^dim patches after every step
-TEST(ExplicitTransfer, BSplineRelocationKeepsParticles2D) { relocation_and_momentum<2>(Shape::quadratic_bspline); }
-TEST(ExplicitTransfer, BSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline); }
+TEST(ExplicitTransfer, BSplineRelocationKeepsParticles2D)
+{
+  relocation_and_momentum<2>(Shape::quadratic_bspline);
+}
+TEST(ExplicitTransfer, BSplineRelocationKeepsParticles3D)
+{
+  relocation_and_momentum<3>(Shape::quadratic_bspline);
+}
 // the APIC step (velocity transfer = apic): same relocation, fused = fresh P2G, and sum m v_p
 // conserved without external forces (sum_i m_i v_i^L = sum_p m_p v_p, G2P returns it exactly)
-TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles2D) { relocation_and_momentum<2>(Shape::quadratic_bspline, true); }
-TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles3D) { relocation_and_momentum<3>(Shape::quadratic_bspline, true); }
+TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles2D)
+{
+  relocation_and_momentum<2>(Shape::quadratic_bspline, true);
+}
+TEST(ExplicitTransfer, ApicBSplineRelocationKeepsParticles3D)
+{
+  relocation_and_momentum<3>(Shape::quadratic_bspline, true);
+}
 
 // ---------------------------------------------------------------- APIC (issue 12)
 // numerics/velocity transfer = apic (formulations/explicit/affine_ops.h). A rigidly rotating
@@ -324,20 +363,20 @@ template <int dim, class K>
 void
 apic_transfer(const Shape shape)
 {
-  using L = PropertyLayout<dim>;
-  auto p  = scene<dim>(shape);
+  using L                      = PropertyLayout<dim>;
+  auto p                       = scene<dim>(shape);
   p.numerics.velocity_transfer = explicit_mpm::NumericsOptions::VelocityTransfer::apic;
   // the rotation about the body's centre, so the body stays in the grid
-  const auto W      = rotation_W<dim>(2.0);
+  const auto         W = rotation_W<dim>(2.0);
   dealii::Point<dim> x0;
   for (unsigned int d = 0; d < dim; ++d)
     x0[d] = 0.5;
   dealii::Tensor<1, dim> v0;
-  v0[0] = 0.1; // plus a translation
+  v0[0]                      = 0.1; // plus a translation
   p.bodies[0].velocity_field = [=](const dealii::Point<dim> &x) { return dealii::Tensor<1, dim>(W * (x - x0) + v0); };
   // and a second, small body against the lower wall (wall half cells of the B-spline)
-  auto b2   = p.bodies[0];
-  b2.radius = 0.06;
+  auto b2      = p.bodies[0];
+  b2.radius    = 0.06;
   b2.center[0] = 0.2;
   b2.center[1] = shape == Shape::linear ? 0.05 : -0.2;
   p.bodies.push_back(b2);
@@ -356,8 +395,8 @@ apic_transfer(const Shape shape)
         for (unsigned int k = 0; k < dim; ++k)
           P[A + c * dim + k] = W[c][k] + 0.5 * u(rng);
     }
-  constexpr unsigned int na = dim == 2 ? 1 : 3;
-  double point_sums[dim + na] = {}, mass = 0;
+  constexpr unsigned int na                   = dim == 2 ? 1 : 3;
+  double                 point_sums[dim + na] = {}, mass = 0;
   for (auto &pt : s.points.handler)
     {
       const double *P = pt.get_properties().data();
@@ -372,8 +411,8 @@ apic_transfer(const Shape shape)
   node_positions(s, X);
   s.grid.reinit_vector(Pn);
   s.scatter_point_momentum(Pn);
-  double grid_sums[dim + na] = {};
-  const unsigned int n_owned = Pn.locally_owned_size();
+  double             grid_sums[dim + na] = {};
+  const unsigned int n_owned             = Pn.locally_owned_size();
   // owned nodes: the component-0 DoFs; the node's components follow from its cells
   std::vector<std::array<unsigned int, dim>> node_dofs;
   {
@@ -442,31 +481,34 @@ apic_transfer(const Shape shape)
             V.local_element(dofs[a]) = w;
           }
       }
-  V.update_ghost_values(); // B-spline patches reach ghost nodes of ghost cells: take owners' values
-  const double h = 1e-3;   // any scale: du = h V
+  V.update_ghost_values();     // B-spline patches reach ghost nodes of ghost cells: take owners' values
+  const double h       = 1e-3; // any scale: du = h V
   double       worst_v = 0, worst_C = 0;
-  transfer::for_each_active_cell(s.points, [](unsigned int) {}, [&](const unsigned int c, auto &it) {
-    const auto        cell = K::cell(s.grid, c);
-    typename K::Field du;
-    K::gather(cell, V.begin(), h, du, true);
-    typename K::Eval e;
-    K::evaluate(cell, it->get_reference_location(), e);
-    double gu[dim][dim], dx[dim];
-    transfer::default_increments<dim, K>(cell, e, du, gu, dx);
-    double *P = it->get_properties().data();
-    transfer::apic_point_velocity<dim, K>(cell, e, du, h, gu, dx, P + L::velocity, P + A);
-    const auto x = it->get_location();
-    for (unsigned int a = 0; a < dim; ++a)
-      {
-        double w = v0[a];
-        for (unsigned int k = 0; k < dim; ++k)
-          {
-            w += W[a][k] * (x[k] - x0[k]);
-            worst_C = std::max(worst_C, std::abs(P[A + a * dim + k] - W[a][k]));
-          }
-        worst_v = std::max(worst_v, std::abs(P[L::velocity + a] - w));
-      }
-  }, [](unsigned int) {});
+  transfer::for_each_active_cell(
+    s.points, [](unsigned int) {},
+    [&](const unsigned int c, auto &it) {
+      const auto        cell = K::cell(s.grid, c);
+      typename K::Field du;
+      K::gather(cell, V.begin(), h, du, true);
+      typename K::Eval e;
+      K::evaluate(cell, it->get_reference_location(), e);
+      double gu[dim][dim], dx[dim];
+      transfer::default_increments<dim, K>(cell, e, du, gu, dx);
+      double *P = it->get_properties().data();
+      transfer::apic_point_velocity<dim, K>(cell, e, du, h, gu, dx, P + L::velocity, P + A);
+      const auto x = it->get_location();
+      for (unsigned int a = 0; a < dim; ++a)
+        {
+          double w = v0[a];
+          for (unsigned int k = 0; k < dim; ++k)
+            {
+              w += W[a][k] * (x[k] - x0[k]);
+              worst_C = std::max(worst_C, std::abs(P[A + a * dim + k] - W[a][k]));
+            }
+          worst_v = std::max(worst_v, std::abs(P[L::velocity + a] - w));
+        }
+    },
+    [](unsigned int) {});
   worst_v = dealii::Utilities::MPI::max(worst_v, MPI_COMM_WORLD);
   worst_C = dealii::Utilities::MPI::max(worst_C, MPI_COMM_WORLD);
   EXPECT_LT(worst_v, 1e-12) << "G2P: v_p = W x_p";
@@ -480,8 +522,8 @@ apic_transfer(const Shape shape)
     transfer::for_each_active_cell(s.points, op);
   }
   M.compress(dealii::VectorOperation::add);
-  double worst_node = 0;
-  unsigned int n_mass = 0;
+  double       worst_node = 0;
+  unsigned int n_mass     = 0;
   for (unsigned int i = 0; i < n_owned; ++i)
     if (M.local_element(i) > 1e-12 * mass)
       {
@@ -504,7 +546,19 @@ apic_transfer(const Shape shape)
     }
 }
 
-TEST(ExplicitTransfer, ApicConservesMomentumQ1_2D) { apic_transfer<2, shape::Q1Box<2>>(Shape::linear); }
-TEST(ExplicitTransfer, ApicConservesMomentumQ1_3D) { apic_transfer<3, shape::Q1Box<3>>(Shape::linear); }
-TEST(ExplicitTransfer, ApicConservesMomentumBSpline2D) { apic_transfer<2, shape::BSpline2Box<2>>(Shape::quadratic_bspline); }
-TEST(ExplicitTransfer, ApicConservesMomentumBSpline3D) { apic_transfer<3, shape::BSpline2Box<3>>(Shape::quadratic_bspline); }
+TEST(ExplicitTransfer, ApicConservesMomentumQ1_2D)
+{
+  apic_transfer<2, shape::Q1Box<2>>(Shape::linear);
+}
+TEST(ExplicitTransfer, ApicConservesMomentumQ1_3D)
+{
+  apic_transfer<3, shape::Q1Box<3>>(Shape::linear);
+}
+TEST(ExplicitTransfer, ApicConservesMomentumBSpline2D)
+{
+  apic_transfer<2, shape::BSpline2Box<2>>(Shape::quadratic_bspline);
+}
+TEST(ExplicitTransfer, ApicConservesMomentumBSpline3D)
+{
+  apic_transfer<3, shape::BSpline2Box<3>>(Shape::quadratic_bspline);
+}

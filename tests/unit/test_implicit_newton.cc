@@ -38,12 +38,20 @@ namespace
     Newmark nm;
 
     Oscillator(const double gamma, const double beta, const double dt)
-      : nm(gamma, beta, dt)
+        : nm(gamma, beta, dt)
     {
       a = -k * u / m;
     }
-    double omega() const { return std::sqrt(k / m); }
-    double energy() const { return 0.5 * m * v * v + 0.5 * k * u * u; }
+    double
+    omega() const
+    {
+      return std::sqrt(k / m);
+    }
+    double
+    energy() const
+    {
+      return 0.5 * m * v * v + 0.5 * k * u * u;
+    }
     void
     step()
     {
@@ -118,7 +126,7 @@ namespace
         EXPECT_NEAR(vn, nm.velocity_from_accelerations(v, a, an), 1e-12);
         EXPECT_NEAR(du, nm.known_increment(v, a) + b * dt * dt * an, 1e-13);
 
-        const unsigned int                         n = 5;
+        const unsigned int                                 n = 5;
         dealii::LinearAlgebra::distributed::Vector<double> dU(n), V(n), A(n), Vn(n), An(n), Vp(n), Ap(n);
         for (unsigned int i = 0; i < n; ++i)
           {
@@ -157,11 +165,11 @@ namespace
     for (const double omega_dt : {0.05, 0.5, 10.0})
       {
         Oscillator   osc(0.5, 0.25, omega_dt / (2 * pi));
-        const double w  = osc.omega();
-        const double e0 = osc.energy();
-        const auto   z  = [&] { return std::complex<double>(w * osc.u, osc.v); };
+        const double w      = osc.omega();
+        const double e0     = osc.energy();
+        const auto   z      = [&] { return std::complex<double>(w * osc.u, osc.v); };
         double       turned = 0, max_drift = 0;
-        const int    n      = 1000;
+        const int    n = 1000;
         for (int i = 0; i < n; ++i)
           {
             const auto z0 = z();
@@ -225,7 +233,7 @@ namespace
   {
     for (const bool mass : {true, false})
       {
-        Oscillator osc(0.5, 0.25, 1.0 / 200); // omega = 2 pi: 200 steps per period
+        Oscillator   osc(0.5, 0.25, 1.0 / 200); // omega = 2 pi: 200 steps per period
         const double w = osc.omega();
         if (mass)
           osc.alpha_r = 0.2;
@@ -273,11 +281,19 @@ namespace
   {
     double              F = 2.0, tangent_scale = 1.0;
     std::vector<double> u = {0, 0}, r = {0, 0}, du = {0, 0};
-    double              K[2][2] = {{0, 0}, {0, 0}};
+    double              K[2][2]    = {{0, 0}, {0, 0}};
     unsigned int        assemblies = 0, tangents = 0;
 
-    static double f(const double e) { return e + e * e * e; }
-    static double df(const double e) { return 1 + 3 * e * e; }
+    static double
+    f(const double e)
+    {
+      return e + e * e * e;
+    }
+    static double
+    df(const double e)
+    {
+      return 1 + 3 * e * e;
+    }
 
     NewtonProblem
     problem()
@@ -286,7 +302,7 @@ namespace
       p.assemble = [this](const bool with_tangent) {
         ++assemblies;
         const double e1 = u[0], e2 = u[1] - u[0];
-        r               = {f(e1) - f(e2), f(e2) - F};
+        r = {f(e1) - f(e2), f(e2) - F};
         if (with_tangent)
           {
             ++tangents;
@@ -315,8 +331,7 @@ namespace
   void
   print(const char *name, const NewtonResult &r)
   {
-    std::printf("  %s: %s, %u iterations, order %.3f; |r|:", name, r.message.c_str(), r.iterations,
-                r.observed_order);
+    std::printf("  %s: %s, %u iterations, order %.3f; |r|:", name, r.message.c_str(), r.iterations, r.observed_order);
     for (const auto &h : r.history)
       std::printf(" %.2e", h.residual);
     std::printf("\n");
@@ -332,8 +347,8 @@ namespace
     EXPECT_EQ(s.increment_relative, 1e-4);
     EXPECT_EQ(s.increment_absolute, 1e-9);
     EXPECT_EQ(s.criterion, NewtonCriterion::residual);
-    for (const auto c : {NewtonCriterion::residual, NewtonCriterion::increment,
-                         NewtonCriterion::residual_and_increment, NewtonCriterion::residual_or_increment})
+    for (const auto c : {NewtonCriterion::residual, NewtonCriterion::increment, NewtonCriterion::residual_and_increment,
+                         NewtonCriterion::residual_or_increment})
       EXPECT_EQ(parse_newton_criterion(to_string(c)), c);
     EXPECT_THROW(parse_newton_criterion("residual_and_increment"), InputError);
     s.max_iterations = 0;
@@ -341,14 +356,14 @@ namespace
     s                   = NewtonSettings();
     s.divergence_factor = 0.5;
     EXPECT_THROW(NewtonSolver{s}, InputError);
-    s          = NewtonSettings();
-    s.armijo   = 1.0;
+    s        = NewtonSettings();
+    s.armijo = 1.0;
     EXPECT_THROW(NewtonSolver{s}, InputError);
   }
 
   TEST(ImplicitNewton, ExactTangentIsQuadraticWrongTangentLinear)
   {
-    Springs exact;
+    Springs    exact;
     const auto re = NewtonSolver().solve(exact.problem());
     print("exact tangent", re);
     ASSERT_TRUE(re.converged);
@@ -379,7 +394,7 @@ namespace
     NewtonSettings s;
     s.residual_relative = 1e-12;
     s.residual_absolute = 0;
-    Springs tight;
+    Springs    tight;
     const auto rt = NewtonSolver(s).solve(tight.problem());
     print("exact tangent, rel 1e-12", rt);
     ASSERT_TRUE(rt.converged);
@@ -391,7 +406,7 @@ namespace
     // increment criterion: relative to |Du| of the step
     s           = NewtonSettings();
     s.criterion = NewtonCriterion::increment;
-    Springs inc;
+    Springs    inc;
     const auto ri = NewtonSolver(s).solve(inc.problem());
     ASSERT_TRUE(ri.converged);
     EXPECT_LE(ri.history.back().increment, 1e-4 * ri.history.back().step_increment);
@@ -400,7 +415,7 @@ namespace
     // without step_increment_norm the first increment is the reference; with
     // it, its value is (a huge |Du| passes the test at once)
     s.criterion = NewtonCriterion::increment;
-    Springs first, huge;
+    Springs       first, huge;
     NewtonProblem pf = first.problem(), ph = huge.problem();
     pf.step_increment_norm = nullptr;
     ph.step_increment_norm = [] { return 1e8; };
@@ -412,16 +427,16 @@ namespace
 
     // "and" needs at least as many iterations as either test alone
     s.criterion = NewtonCriterion::residual_and_increment;
-    Springs both;
+    Springs    both;
     const auto rb = NewtonSolver(s).solve(both.problem());
     s.criterion   = NewtonCriterion::residual;
-    Springs res;
+    Springs    res;
     const auto rr = NewtonSolver(s).solve(res.problem());
     s.criterion   = NewtonCriterion::residual_or_increment;
-    Springs either;
+    Springs    either;
     const auto ro = NewtonSolver(s).solve(either.problem());
-    std::printf("  iterations: residual %u, increment %u, and %u, or %u\n", rr.iterations, ri.iterations,
-                rb.iterations, ro.iterations);
+    std::printf("  iterations: residual %u, increment %u, and %u, or %u\n", rr.iterations, ri.iterations, rb.iterations,
+                ro.iterations);
     ASSERT_TRUE(rb.converged && rr.converged && ro.converged);
     EXPECT_EQ(rb.iterations, std::max(rr.iterations, ri.iterations));
     EXPECT_EQ(ro.iterations, std::min(rr.iterations, ri.iterations));
@@ -431,10 +446,10 @@ namespace
     linear.tangent_scale = 1.0;
     NewtonProblem p      = linear.problem();
     p.assemble           = [&](const bool) {
-      linear.r        = {2 * linear.u[0] - linear.u[1], linear.u[1] - linear.u[0] - 1.0};
-      linear.K[0][0]  = 2;
-      linear.K[0][1]  = linear.K[1][0] = -1;
-      linear.K[1][1]  = 1;
+      linear.r       = {2 * linear.u[0] - linear.u[1], linear.u[1] - linear.u[0] - 1.0};
+      linear.K[0][0] = 2;
+      linear.K[0][1] = linear.K[1][0] = -1;
+      linear.K[1][1]                  = 1;
       return std::hypot(linear.r[0], linear.r[1]);
     };
     const auto rl = NewtonSolver().solve(p);
@@ -457,10 +472,10 @@ namespace
     Springs tiny, tiny_ref;
     tiny.F = tiny_ref.F = 1e-6;
     tiny.tangent_scale = tiny_ref.tangent_scale = 1.3;
-    NewtonProblem pt      = tiny_ref.problem();
-    pt.residual_reference = [] { return 1.0; };
-    const auto rref       = NewtonSolver(s).solve(pt);
-    const auto rno        = NewtonSolver(s).solve(tiny.problem());
+    NewtonProblem pt                            = tiny_ref.problem();
+    pt.residual_reference                       = [] { return 1.0; };
+    const auto rref                             = NewtonSolver(s).solve(pt);
+    const auto rno                              = NewtonSolver(s).solve(tiny.problem());
     std::printf("  r_0 = 1e-6: %u iterations relative to r_0, %u relative to a reference 1\n", rno.iterations,
                 rref.iterations);
     EXPECT_TRUE(rref.converged && rno.converged);
@@ -475,7 +490,7 @@ namespace
     double x = 2.0, dx = 0, r = 0, drdx = 1;
     /// x at each solve; where the tangent in use was assembled
     std::vector<double> x_at_solve;
-    double              x_tangent = 0;
+    double              x_tangent      = 0;
     unsigned int        stale_tangents = 0;
     NewtonProblem
     problem()
@@ -554,9 +569,9 @@ namespace
     // residual growth by the factor over the window
     Springs grow;
     grow.K[0][0] = grow.K[1][1] = 1; // the assembly below sets no tangent
-    NewtonProblem p = grow.problem();
-    p.assemble      = [&](const bool) { return std::pow(10.0, 2.0 * grow.assemblies++); };
-    const auto rg   = NewtonSolver().solve(p);
+    NewtonProblem p             = grow.problem();
+    p.assemble                  = [&](const bool) { return std::pow(10.0, 2.0 * grow.assemblies++); };
+    const auto rg               = NewtonSolver().solve(p);
     EXPECT_EQ(rg.status, NewtonStatus::residual_diverged) << rg.message;
     EXPECT_EQ(rg.iterations, 3u); // 1e6 > 1e3 * 1e0 at k = 3
     EXPECT_EQ(rg.outcome(), StepOutcome::cut_back);
@@ -564,9 +579,9 @@ namespace
     // NaN from the assembly
     Springs nan;
     nan.K[0][0] = nan.K[1][1] = 1;
-    p           = nan.problem();
-    p.assemble = [&](const bool) { return nan.assemblies++ ? std::nan("") : 1.0; };
-    const auto rn = NewtonSolver().solve(p);
+    p                         = nan.problem();
+    p.assemble                = [&](const bool) { return nan.assemblies++ ? std::nan("") : 1.0; };
+    const auto rn             = NewtonSolver().solve(p);
     EXPECT_EQ(rn.status, NewtonStatus::non_finite);
     EXPECT_EQ(rn.iterations, 1u);
     EXPECT_EQ(rn.outcome(), StepOutcome::cut_back);
@@ -577,12 +592,12 @@ namespace
     EXPECT_EQ(rn0.outcome(), StepOutcome::cut_back);
 
     // a solve that returns NaN leaves the iterate alone
-    Springs       nan_solve;
-    unsigned int  applied = 0;
-    p                     = nan_solve.problem();
-    p.solve               = [] { return std::nan(""); };
-    p.apply               = [&](const double) { ++applied; };
-    const auto rs         = NewtonSolver().solve(p);
+    Springs      nan_solve;
+    unsigned int applied = 0;
+    p                    = nan_solve.problem();
+    p.solve              = [] { return std::nan(""); };
+    p.apply              = [&](const double) { ++applied; };
+    const auto rs        = NewtonSolver().solve(p);
     EXPECT_EQ(rs.status, NewtonStatus::non_finite);
     EXPECT_NE(rs.message.find("increment"), std::string::npos);
     EXPECT_EQ(applied, 0u);
@@ -599,9 +614,9 @@ namespace
 
     // with line search, a rejected full step (e.g. inverted point) is halved
     Springs inverted;
-    p                  = inverted.problem();
-    const auto base    = p.assemble;
-    p.assemble         = [&](const bool t) {
+    p               = inverted.problem();
+    const auto base = p.assemble;
+    p.assemble      = [&](const bool t) {
       if (inverted.u[1] > 3.0) // pretend det F <= 0 beyond this (the full first step reaches 4)
         throw NewtonFailure("det F <= 0");
       return base(t);
@@ -625,13 +640,13 @@ namespace
   // the energy to O(dt^2) (exactly only for linear systems).
   TEST(ImplicitNewton, NewmarkDuffingOscillator)
   {
-    const double m = 1.0, k = 4 * pi * pi, c = 400.0, dt = 0.005;
-    Newmark      nm(0.5, 0.25, dt);
-    double       u = 1.0, v = 0.0, a = -(k * u + c * u * u * u) / m;
-    const auto   energy = [&] { return 0.5 * m * v * v + 0.5 * k * u * u + 0.25 * c * u * u * u * u; };
-    const double e0     = energy();
-    double       du = 0, ddu = 0, r = 0, kt = 1, max_drift = 0;
-    unsigned int max_it = 0, total_it = 0;
+    const double  m = 1.0, k = 4 * pi * pi, c = 400.0, dt = 0.005;
+    Newmark       nm(0.5, 0.25, dt);
+    double        u = 1.0, v = 0.0, a = -(k * u + c * u * u * u) / m;
+    const auto    energy = [&] { return 0.5 * m * v * v + 0.5 * k * u * u + 0.25 * c * u * u * u * u; };
+    const double  e0     = energy();
+    double        du = 0, ddu = 0, r = 0, kt = 1, max_drift = 0;
+    unsigned int  max_it = 0, total_it = 0;
     NewtonProblem p;
     p.assemble = [&](const bool) {
       const double x = u + du;
@@ -643,11 +658,11 @@ namespace
       ddu = -r / kt;
       return std::abs(ddu);
     };
-    p.apply                 = [&](const double alpha) { du += alpha * ddu; };
-    p.step_increment_norm   = [&] { return std::abs(du); };
+    p.apply               = [&](const double alpha) { du += alpha * ddu; };
+    p.step_increment_norm = [&] { return std::abs(du); };
     NewtonSettings s;
-    s.residual_relative     = 1e-8;
-    s.residual_absolute     = 1e-12;
+    s.residual_relative = 1e-8;
+    s.residual_absolute = 1e-12;
     const NewtonSolver newton(s);
     for (int n = 0; n < 1000; ++n)
       {
@@ -679,10 +694,22 @@ namespace
     unsigned int newton_failures = 0;
     std::string  last_message;
 
-    std::string tool_name() const override { return "talus-test"; }
-    void        describe(std::ostream &) const override {}
-    double      begin_stage(const unsigned int, const bool, const bool) override { return 1e9; }
-    StepOutcome advance_by(const double h) override
+    std::string
+    tool_name() const override
+    {
+      return "talus-test";
+    }
+    void
+    describe(std::ostream &) const override
+    {
+    }
+    double
+    begin_stage(const unsigned int, const bool, const bool) override
+    {
+      return 1e9;
+    }
+    StepOutcome
+    advance_by(const double h) override
     {
       double        z = x, dz = 0, r = 0, drdz = 1;
       NewtonProblem p;
@@ -695,7 +722,7 @@ namespace
         dz = -r / drdz;
         return std::abs(dz);
       };
-      p.apply          = [&](const double alpha) { z += alpha * dz; };
+      p.apply = [&](const double alpha) { z += alpha * dz; };
       NewtonSettings ns;
       ns.residual_relative = 1e-12;
       const auto res       = NewtonSolver(ns).solve(p);
@@ -708,16 +735,35 @@ namespace
         }
       return res.outcome();
     }
-    void check_stability() const override
+    void
+    check_stability() const override
     {
       if (!std::isfinite(x))
         throw InstabilityError("x is not finite");
     }
-    std::vector<std::string> series_columns() const override { return {"x"}; }
-    std::vector<double>      series_values(const bool) override { return {x}; }
-    void                     write_vtu(const unsigned int) override {}
-    std::string              write_checkpoint() override { return ""; }
-    void                     summary(const LoopTimings &) override {}
+    std::vector<std::string>
+    series_columns() const override
+    {
+      return {"x"};
+    }
+    std::vector<double>
+    series_values(const bool) override
+    {
+      return {x};
+    }
+    void
+    write_vtu(const unsigned int) override
+    {
+    }
+    std::string
+    write_checkpoint() override
+    {
+      return "";
+    }
+    void
+    summary(const LoopTimings &) override
+    {
+    }
   };
 
   TEST(ImplicitNewton, FailedNewtonCutsBackInTheTimeLoop)

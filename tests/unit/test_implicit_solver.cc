@@ -28,15 +28,17 @@ namespace
                 const std::string &boundary = " set fixed = 0\n")
   {
     // the B-spline needs 3 cells per direction
-    const std::string ny = implicit_extra.find("bspline") != std::string::npos ? "3" : "2";
+    const std::string  ny = implicit_extra.find("bspline") != std::string::npos ? "3" : "2";
     std::ostringstream prm_text;
     prm_text << "set dimension = " << dim << "\n"
              << "subsection time\n set end time = 1\n set time step = 0.5\nend\n"
-             << "subsection implicit\n set analysis = " << analysis << "\n" << implicit_extra << "end\n"
-             << "subsection grid\n set lower corner = 0, 0" << (dim == 3 ? ", 0" : "")
-             << "\n set upper corner = 2, 1" << (dim == 3 ? ", 1" : "") << "\n set cells = 4, " << ny
-             << (dim == 3 ? ", " + ny : std::string()) << "\nend\n"
-             << "subsection boundary conditions\n" << boundary << "end\n"
+             << "subsection implicit\n set analysis = " << analysis << "\n"
+             << implicit_extra << "end\n"
+             << "subsection grid\n set lower corner = 0, 0" << (dim == 3 ? ", 0" : "") << "\n set upper corner = 2, 1"
+             << (dim == 3 ? ", 1" : "") << "\n set cells = 4, " << ny << (dim == 3 ? ", " + ny : std::string())
+             << "\nend\n"
+             << "subsection boundary conditions\n"
+             << boundary << "end\n"
              << "subsection gravity\n set acceleration = 0, " << (dim == 3 ? "0, " : "") << -gravity << "\nend\n"
              << "subsection output\n set directory = test_implicit_out\n set progress = false\nend\n"
              << "set number of materials = 1\nsubsection material 0\n set density = 1000\n"
@@ -51,8 +53,8 @@ namespace
     dealii::ParameterHandler prm;
     implicit_mpm::declare_parameters(prm, file);
     prm.parse_input(file);
-    const auto                    p = implicit_mpm::parse_parameters<dim>(prm);
-    implicit_mpm::Solver<dim>     s(p, MPI_COMM_WORLD);
+    const auto                p = implicit_mpm::parse_parameters<dim>(prm);
+    implicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
     s.setup();
     // a deformed, stressed state (b_n != I, points off their seeding positions)
     TimeLoop(s, loop_settings(p), MPI_COMM_WORLD).advance_steps(steps_before);
@@ -64,18 +66,30 @@ namespace
 
   const std::string neo_hookean = " set model = neo hookean\n subsection neo hookean\n  set young modulus = 1e6\n"
                                   "  set poisson ratio = 0.3\n end\n";
-  const std::string hencky_mc = " set model = hencky mohr coulomb\n subsection hencky mohr coulomb\n"
-                                "  set young modulus = 1e6\n  set poisson ratio = 0.3\n  set cohesion = 1e3\n"
-                                "  set friction angle = 30\n  set dilatancy angle = 5\n end\n";
-  const std::string j2 = " set model = j2 plasticity\n subsection j2 plasticity\n  set young modulus = 1e6\n"
-                         "  set poisson ratio = 0.3\n  set yield stress = 5e3\n  set hardening modulus = 1e4\n end\n";
+  const std::string hencky_mc   = " set model = hencky mohr coulomb\n subsection hencky mohr coulomb\n"
+                                  "  set young modulus = 1e6\n  set poisson ratio = 0.3\n  set cohesion = 1e3\n"
+                                  "  set friction angle = 30\n  set dilatancy angle = 5\n end\n";
+  const std::string j2          = " set model = j2 plasticity\n subsection j2 plasticity\n  set young modulus = 1e6\n"
+                                  "  set poisson ratio = 0.3\n  set yield stress = 5e3\n  set hardening modulus = 1e4\n end\n";
 
   // increments of 1e-2 m over 0.25 m cells: strains of a few percent, rotations
   // of the same order (geometric stiffness matters; plastic models yield)
-  TEST(ImplicitTangent, NeoHookeanStatic2D) { EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2), 1e-6); }
-  TEST(ImplicitTangent, NeoHookeanDynamic2D) { EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2), 1e-6); }
-  TEST(ImplicitTangent, NeoHookeanStatic3D) { EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2), 1e-6); }
-  TEST(ImplicitTangent, HenckyMohrCoulombPlastic2D) { EXPECT_LT(tangent_error<2>(hencky_mc, "static", 1e-2), 1e-5); }
+  TEST(ImplicitTangent, NeoHookeanStatic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2), 1e-6);
+  }
+  TEST(ImplicitTangent, NeoHookeanDynamic2D)
+  {
+    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2), 1e-6);
+  }
+  TEST(ImplicitTangent, NeoHookeanStatic3D)
+  {
+    EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2), 1e-6);
+  }
+  TEST(ImplicitTangent, HenckyMohrCoulombPlastic2D)
+  {
+    EXPECT_LT(tangent_error<2>(hencky_mc, "static", 1e-2), 1e-5);
+  }
   TEST(ImplicitTangent, NeoHookeanAfterLoadSteps2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-3, 2, 200.0), 1e-6);
@@ -135,7 +149,7 @@ namespace
   // (x = 0: the radial displacement there is constrained automatically; a
   // bottom roller holds it axially). Increments of 1e-2 m at points from r =
   // 0.125 m: hoop stretches of up to 8 %.
-  const std::string axisymmetric = " set geometry = axisymmetric\n";
+  const std::string axisymmetric  = " set geometry = axisymmetric\n";
   const std::string bottom_roller = " set roller = 2\n";
   TEST(ImplicitTangent, AxisymmetricNeoHookeanStatic)
   {
@@ -203,7 +217,10 @@ namespace
   {
     EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2, 0, 9.81, "", 1.0, footing(3, "smooth")), 1e-6);
   }
-  TEST(ImplicitTangent, J2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5); }
+  TEST(ImplicitTangent, J2Plastic3D)
+  {
+    EXPECT_LT(tangent_error<3>(j2, "static", 1e-2), 1e-5);
+  }
 
   // F-bar ('volumetric stabilisation = f-bar'): each point's model sees dFbar with
   // the volume-weighted mean det dF of its cell, so the tangent couples all points
@@ -226,8 +243,14 @@ namespace
   {
     EXPECT_LT(tangent_error<2>(neo_hookean_split_incompressible, "static", 1e-4, 0, 9.81, fbar), 1e-6);
   }
-  TEST(ImplicitTangent, FbarJ2Plastic2D) { EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, fbar), 1e-5); }
-  TEST(ImplicitTangent, FbarJ2Plastic3D) { EXPECT_LT(tangent_error<3>(j2, "static", 1e-2, 0, 9.81, fbar), 1e-5); }
+  TEST(ImplicitTangent, FbarJ2Plastic2D)
+  {
+    EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, fbar), 1e-5);
+  }
+  TEST(ImplicitTangent, FbarJ2Plastic3D)
+  {
+    EXPECT_LT(tangent_error<3>(j2, "static", 1e-2, 0, 9.81, fbar), 1e-5);
+  }
   TEST(ImplicitTangent, FbarHenckyMohrCoulomb2D)
   {
     EXPECT_LT(tangent_error<2>(hencky_mc, "static", 1e-2, 0, 9.81, fbar), 1e-5);
@@ -238,7 +261,7 @@ namespace
   // alpha_R M v) and in the tangent (coef M) on the free DoFs. With h = 0.01 s
   // the inertia (1/(beta h^2) m_p ~ 6e5 N/m per point) is as large as the
   // stiffness, so a wrong factor or a wrong block shows.
-  const std::string consistent = " set mass matrix = consistent\n";
+  const std::string consistent        = " set mass matrix = consistent\n";
   const std::string consistent_damped = " set mass matrix = consistent\n set rayleigh alpha = 1.5\n";
   TEST(ImplicitTangent, ConsistentMassDynamic2D)
   {
@@ -254,9 +277,9 @@ namespace
   }
   TEST(ImplicitTangent, ConsistentMassAxisymmetricDynamic)
   {
-    EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, axisymmetric + consistent_damped, 1.0,
-                               bottom_roller),
-              1e-8);
+    EXPECT_LT(
+      tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, axisymmetric + consistent_damped, 1.0, bottom_roller),
+      1e-8);
   }
   TEST(ImplicitTangent, ConsistentMassPointContact2D)
   {
@@ -287,7 +310,8 @@ namespace
   // patch of a cell through the PPP cell means (ActiveSet::Reach::cell: with
   // the point pattern the assembly throws on an entry outside the sparsity).
   // ('numerics/shape function': the text leaves 'implicit', sets it and enters 'implicit' again)
-  const std::string bspline = "end\nsubsection numerics\n set shape function = quadratic bspline\nend\nsubsection implicit\n";
+  const std::string bspline =
+    "end\nsubsection numerics\n set shape function = quadratic bspline\nend\nsubsection implicit\n";
   TEST(ImplicitTangent, BSplineNeoHookeanStatic2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, bspline), 1e-6);
@@ -300,7 +324,10 @@ namespace
   {
     EXPECT_LT(tangent_error<3>(neo_hookean, "static", 1e-2, 0, 9.81, bspline), 1e-6);
   }
-  TEST(ImplicitTangent, BSplineJ2Plastic2D) { EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, bspline), 1e-5); }
+  TEST(ImplicitTangent, BSplineJ2Plastic2D)
+  {
+    EXPECT_LT(tangent_error<2>(j2, "static", 1e-2, 0, 9.81, bspline), 1e-5);
+  }
   TEST(ImplicitTangent, BSplineConsistentMassDynamic2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, bspline + consistent_damped), 1e-6);

@@ -12,13 +12,15 @@ using talus::io::H5File;
 
 namespace
 {
-  int rank()
+  int
+  rank()
   {
     int r;
     MPI_Comm_rank(MPI_COMM_WORLD, &r);
     return r;
   }
-  int size()
+  int
+  size()
   {
     int s;
     MPI_Comm_size(MPI_COMM_WORLD, &s);
@@ -59,7 +61,7 @@ TEST(HDF5, RowsInRankOrderAndAttributes)
   EXPECT_TRUE(std::filesystem::exists(path));
   EXPECT_FALSE(std::filesystem::exists(path + ".part"));
 
-  H5File f(path, H5File::Mode::read, MPI_COMM_WORLD);
+  H5File        f(path, H5File::Mode::read, MPI_COMM_WORLD);
   std::uint64_t total = 0;
   for (int r = 0; r < size(); ++r)
     total += 3 * r;

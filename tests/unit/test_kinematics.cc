@@ -22,12 +22,12 @@ TEST(Kinematics, FixedAndRollerFlagsAndConstraints)
   BackgroundGrid<dim> grid(MPI_COMM_WORLD);
   grid.make_box(dealii::Point<dim>(0, 0), dealii::Point<dim>(4, 3), {4, 3});
   grid.setup();
-  const std::vector<BoundaryCondition> bcs = {{2, BoundaryCondition::Kind::fixed},
-                                              {0, BoundaryCondition::Kind::roller}};
-  const auto flags = loads::wall_dof_flags(grid, bcs);
+  const std::vector<BoundaryCondition> bcs   = {{2, BoundaryCondition::Kind::fixed},
+                                                {0, BoundaryCondition::Kind::roller}};
+  const auto                           flags = loads::wall_dof_flags(grid, bcs);
 
   // the position and component of every flagged local DoF, from the cells' vertices
-  unsigned int n_flagged = 0, n_expected = 0;
+  unsigned int               n_flagged = 0, n_expected = 0;
   std::vector<unsigned char> seen(flags.size(), 0);
   for (const auto &cell : grid.dof_handler.active_cell_iterators())
     if (!cell->is_artificial())
@@ -37,9 +37,9 @@ TEST(Kinematics, FixedAndRollerFlagsAndConstraints)
             const unsigned int i = grid.cells[cell->active_cell_index()].dofs[v * dim + k];
             if (seen[i])
               continue;
-            seen[i]            = 1;
-            const auto   x     = cell->vertex(v);
-            const bool   fixed = x[1] == 0.0, roller = x[0] == 0.0 && k == 0;
+            seen[i]          = 1;
+            const auto x     = cell->vertex(v);
+            const bool fixed = x[1] == 0.0, roller = x[0] == 0.0 && k == 0;
             n_expected += (fixed || roller);
             n_flagged += flags[i];
             EXPECT_EQ(flags[i] != 0, fixed || roller) << "node (" << x[0] << ", " << x[1] << "), component " << k;
@@ -49,7 +49,7 @@ TEST(Kinematics, FixedAndRollerFlagsAndConstraints)
 
   NodalSpace<dim> space(grid, dim);
   space.setup();
-  const auto walls = loads::wall_constraints(grid, space, flags);
+  const auto   walls   = loads::wall_constraints(grid, space, flags);
   unsigned int n_lines = 0;
   for (const auto &line : walls.get_lines())
     {

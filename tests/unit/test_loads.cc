@@ -125,8 +125,8 @@ end
     dealii::ParameterHandler prm;
     explicit_mpm::declare_parameters(prm, name);
     prm.parse_input(name);
-    const auto               p = explicit_mpm::parse_parameters<2>(prm);
-    explicit_mpm::Solver<2>  s(p, MPI_COMM_WORLD);
+    const auto              p = explicit_mpm::parse_parameters<2>(prm);
+    explicit_mpm::Solver<2> s(p, MPI_COMM_WORLD);
     s.setup();
     f(s);
   }
@@ -135,13 +135,13 @@ end
 TEST(Loads, K0InitialStressesExact)
 {
   with_solver("", [](explicit_mpm::Solver<2> &s) {
-    using L          = PropertyLayout<2>;
-    double worst_ratio = 0, worst_sv = 0;
+    using L                  = PropertyLayout<2>;
+    double       worst_ratio = 0, worst_sv = 0;
     unsigned int n = 0;
     for (const auto &pt : s.points.handler)
       {
-        const auto P  = pt.get_properties();
-        const int  b  = static_cast<int>(P[L::body]);
+        const auto   P     = pt.get_properties();
+        const int    b     = static_cast<int>(P[L::body]);
         const double K0    = b == 0 ? 0.4 : 1.0 - std::sin(M_PI / 6);
         const double top   = b == 0 ? 1.0 : 0.8;
         const double q     = b == 0 ? 1000.0 : 0.0;
@@ -161,12 +161,12 @@ TEST(Loads, K0InitialStressesExact)
 TEST(Loads, TractionForcesSumToTractionTimesArea)
 {
   with_solver("", [](explicit_mpm::Solver<2> &s) {
-    using L            = PropertyLayout<2>;
+    using L = PropertyLayout<2>;
     ASSERT_TRUE(s.control);
     ASSERT_EQ(s.control->n_point_force_slots(), 1u);
     const unsigned off = s.control->point_force_offset();
-    double fx = 0, fy = 0;
-    unsigned int n = 0;
+    double         fx = 0, fy = 0;
+    unsigned int   n = 0;
     for (const auto &pt : s.points.handler)
       {
         const auto P = pt.get_properties();
@@ -272,7 +272,7 @@ TEST(Loads, K0CoupledEffectiveStressAndHydrostaticPorePressure)
         const double depth = top - pt.get_location()[1];
         const double sv    = -((1 - n) * (2650 - 1000) * g * depth + q); // buoyant weight
         worst_sv           = std::max(worst_sv, std::abs(P[L::stress + 1] - sv) / std::abs(sv));
-        worst_p = std::max(worst_p, std::abs(P[s.two_phase->pore_pressure] - 1000 * g * depth) / (1000 * g * top));
+        worst_p  = std::max(worst_p, std::abs(P[s.two_phase->pore_pressure] - 1000 * g * depth) / (1000 * g * top));
         worst_k0 = std::max(worst_k0, std::abs(P[L::stress + 0] / P[L::stress + 1] - 0.6));
         EXPECT_NEAR(P[L::mass], (1 - n) * 2650 * P[L::volume], 1e-12); // solid mass
       }

@@ -14,8 +14,8 @@ using namespace talus::materials;
 namespace
 {
   ElementRecord
-  run(const Material &m, const ElementPath path, const double strain, const unsigned int n,
-      const double p0, std::vector<ElementRecord> *all = nullptr)
+  run(const Material &m, const ElementPath path, const double strain, const unsigned int n, const double p0,
+      std::vector<ElementRecord> *all = nullptr)
   {
     ElementTestSettings set;
     set.path             = path;
@@ -43,9 +43,8 @@ TEST(ModifiedCamClay, UndrainedCompressionEndsOnCriticalStateLine)
     {
       ModifiedCamClay            m(M, lam, kap, 0.25, 1.0, ocr);
       std::vector<ElementRecord> rec;
-      const ElementRecord last =
-        run(m, ElementPath::undrained_triaxial_compression, 0.4, 4000, p0, &rec);
-      const double pf = std::pow(ocr * p0 / 2, Lambda) * std::pow(p0, 1 - Lambda);
+      const ElementRecord        last = run(m, ElementPath::undrained_triaxial_compression, 0.4, 4000, p0, &rec);
+      const double               pf   = std::pow(ocr * p0 / 2, Lambda) * std::pow(p0, 1 - Lambda);
       EXPECT_NEAR(last.p(), pf, 1e-6 * pf) << "OCR " << ocr;
       EXPECT_NEAR(last.q(), M * pf, 1e-6 * pf) << "OCR " << ocr;
       EXPECT_NEAR(last.history[ModifiedCamClay::h_preconsolidation], 2 * pf, 1e-6 * pf);
@@ -80,8 +79,8 @@ TEST(ModifiedCamClay, IsotropicCompressionFollowsNormalCompressionLine)
 {
   // on the NCL dv = -lambda d ln p'; with v updated as v exp(-d eps_v) and
   // lambda* = lambda / v_n the integration is first order in the increment
-  const double    lam = 0.15, kap = 0.03, e0 = 1.2, p0 = 100e3;
-  ModifiedCamClay m(1.0, lam, kap, 0.3, e0, 1.0);
+  const double        lam = 0.15, kap = 0.03, e0 = 1.2, p0 = 100e3;
+  ModifiedCamClay     m(1.0, lam, kap, 0.3, e0, 1.0);
   const ElementRecord last = run(m, ElementPath::isotropic_compression, 0.1, 4000, p0);
   const double        v    = last.history[ModifiedCamClay::h_specific_volume];
   EXPECT_NEAR(v, (1 + e0) * std::exp(-0.1), 1e-12);
@@ -90,7 +89,7 @@ TEST(ModifiedCamClay, IsotropicCompressionFollowsNormalCompressionLine)
   EXPECT_NEAR(last.q(), 0.0, 1e-6);
 
   // unloading is elastic along kappa: p_c stays, the plastic strain stays
-  ModifiedCamClay oc(1.0, lam, kap, 0.3, e0, 3.0);
+  ModifiedCamClay     oc(1.0, lam, kap, 0.3, e0, 3.0);
   const ElementRecord r1 = run(oc, ElementPath::isotropic_compression, 0.01, 100, p0);
   EXPECT_NEAR(r1.history[ModifiedCamClay::h_preconsolidation], 3 * p0, 1e-9 * p0);
   EXPECT_EQ(r1.history[ModifiedCamClay::h_plastic_vol_strain], 0.0);

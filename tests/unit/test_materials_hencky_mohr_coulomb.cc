@@ -78,7 +78,7 @@ TEST(HenckyMohrCoulomb, TangentMatchesFiniteDifferenceInEveryRegion)
 TEST(HenckyMohrCoulomb, ReturnsSatisfyYieldAndFlowRule)
 {
   HenckyMohrCoulomb m(E, nu, C, PHI, PSI);
-  const auto        h   = iso(m);
+  const auto        h    = iso(m);
   const double      sphi = std::sin(PHI * M_PI / 180), spsi = std::sin(PSI * M_PI / 180);
   const double      k = (1 + sphi) / (1 - sphi), mm = (1 + spsi) / (1 - spsi);
   // plane: f = 0 and plastic log-strain increment parallel to (m, 0, -1)
@@ -129,8 +129,12 @@ TEST(HenckyMohrCoulomb, ObjectivityUnderSuperposedRotation)
           ba[c][c] = a.hist[c];
           bb[c][c] = b.hist[c];
         }
-      ba[0][1] = a.hist[3]; ba[1][2] = a.hist[4]; ba[0][2] = a.hist[5];
-      bb[0][1] = b.hist[3]; bb[1][2] = b.hist[4]; bb[0][2] = b.hist[5];
+      ba[0][1] = a.hist[3];
+      ba[1][2] = a.hist[4];
+      ba[0][2] = a.hist[5];
+      bb[0][1] = b.hist[3];
+      bb[1][2] = b.hist[4];
+      bb[0][2] = b.hist[5];
       EXPECT_LT((rotate(ba, Q) - bb).norm(), 1e-10 * ba.norm());
       for (unsigned int i = 6; i < 9; ++i)
         EXPECT_NEAR(a.hist[i], b.hist[i], 1e-10 * (1 + std::abs(a.hist[i])));
@@ -148,7 +152,7 @@ TEST(HenckyMohrCoulomb, RateFormAndModulus)
       T2 g;
       g[2][2] = -1e-3;
       g[0][0] = g[1][1] = 3e-4;
-      g[0][2] = 5e-4;
+      g[0][2]           = 5e-4;
       m.update_stress(symmetrize(g), 0.5 * (g - transpose(g)), 1e-3, sigma,
                       dealii::ArrayView<double>(h1.data(), h1.size()));
       const Step st = step(m, identity2() + g, h2, false);
@@ -172,6 +176,5 @@ TEST(HenckyMohrCoulomb, RejectsBadParameters)
   Stress            bad;
   bad[0][0] = -1e6; // uniaxial compression far beyond the strength
   std::vector<double> h(m.n_history());
-  EXPECT_THROW(m.initialize_history(bad, dealii::ArrayView<double>(h.data(), h.size())),
-               talus::InputError);
+  EXPECT_THROW(m.initialize_history(bad, dealii::ArrayView<double>(h.data(), h.size())), talus::InputError);
 }

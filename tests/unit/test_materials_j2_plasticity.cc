@@ -18,7 +18,7 @@ namespace
   T2
   shear_dF(const double g)
   {
-    T2 f = identity2();
+    T2 f    = identity2();
     f[0][1] = g;
     f[1][2] = 0.3 * g;
     f[2][2] += 0.2 * g;
@@ -29,7 +29,7 @@ namespace
   plastic_history(const J2Plasticity &m)
   {
     // a first plastic step so that bbar_e != I and alpha > 0
-    T2 f = identity2();
+    T2 f    = identity2();
     f[0][0] = 1.01;
     f[1][0] = 0.004;
     f[2][2] = 0.995;
@@ -45,13 +45,13 @@ TEST(J2Plasticity, TangentMatchesFiniteDifference)
       const auto   h0 = init_history(m);
       const auto   hp = plastic_history(m);
       ASSERT_GT(hp[7], 0.0);
-      const double e_el  = tangent_error(m, shear_dF(2e-4), h0);        // elastic
-      const double e_pl1 = tangent_error(m, shear_dF(5e-3), h0);        // plastic, from virgin state
-      const double e_pl2 = tangent_error(m, shear_dF(-3e-3), hp);       // plastic, prestrained history
+      const double e_el  = tangent_error(m, shear_dF(2e-4), h0);            // elastic
+      const double e_pl1 = tangent_error(m, shear_dF(5e-3), h0);            // plastic, from virgin state
+      const double e_pl2 = tangent_error(m, shear_dF(-3e-3), hp);           // plastic, prestrained history
       const double e_eq  = tangent_error(m, diag(1.004, 0.998, 0.998), h0); // two equal stretches, plastic
-      const double e_big = tangent_error(m, shear_dF(0.2), hp);          // large plastic step
-      std::printf("J2 (H=%g) tangent FD rel. errors: elastic %.2e plastic %.2e %.2e equal-stretch %.2e large %.2e\n",
-                  h, e_el, e_pl1, e_pl2, e_eq, e_big);
+      const double e_big = tangent_error(m, shear_dF(0.2), hp);             // large plastic step
+      std::printf("J2 (H=%g) tangent FD rel. errors: elastic %.2e plastic %.2e %.2e equal-stretch %.2e large %.2e\n", h,
+                  e_el, e_pl1, e_pl2, e_eq, e_big);
       EXPECT_LT(e_el, 1e-6);
       EXPECT_LT(e_pl1, 1e-6);
       EXPECT_LT(e_pl2, 1e-6);
@@ -78,11 +78,15 @@ TEST(J2Plasticity, ObjectivityUnderSuperposedRotation)
       ba[c][c] = a.hist[c];
       bb[c][c] = b.hist[c];
     }
-  ba[0][1] = a.hist[3]; ba[1][2] = a.hist[4]; ba[0][2] = a.hist[5];
-  bb[0][1] = b.hist[3]; bb[1][2] = b.hist[4]; bb[0][2] = b.hist[5];
+  ba[0][1] = a.hist[3];
+  ba[1][2] = a.hist[4];
+  ba[0][2] = a.hist[5];
+  bb[0][1] = b.hist[3];
+  bb[1][2] = b.hist[4];
+  bb[0][2] = b.hist[5];
   EXPECT_LT((rotate(ba, Q) - bb).norm(), 1e-10 * ba.norm());
-  EXPECT_NEAR(a.hist[6], b.hist[6], 1e-14);               // J unchanged
-  EXPECT_NEAR(a.hist[7], b.hist[7], 1e-10 * a.hist[7]);   // alpha unchanged
+  EXPECT_NEAR(a.hist[6], b.hist[6], 1e-14);             // J unchanged
+  EXPECT_NEAR(a.hist[7], b.hist[7], 1e-10 * a.hist[7]); // alpha unchanged
 }
 
 TEST(J2Plasticity, UniaxialTensionYieldAndHardeningSlope)
@@ -95,11 +99,11 @@ TEST(J2Plasticity, UniaxialTensionYieldAndHardeningSlope)
   // * Hardening: with additive log strains eps = eps_e + eps_p, eps_e = tau11/E and
   //   alpha = eps_p (isochoric flow along n = diag(2,-1,-1)/sqrt 6), the slope is
   //   d tau11 / d eps = E H / (E + H)   (= 18.18 GPa here), to O(eps_e) = 1e-3.
-  J2Plasticity m(E, nu, SY, H);
-  auto         h   = init_history(m);
-  const double de  = 1e-4;
-  const int    n   = 500;
-  double       eps_first_yield = -1, tau_last_elastic = 0;
+  J2Plasticity        m(E, nu, SY, H);
+  auto                h               = init_history(m);
+  const double        de              = 1e-4;
+  const int           n               = 500;
+  double              eps_first_yield = -1, tau_last_elastic = 0;
   std::vector<double> tau11(n + 1, 0.0), alpha(n + 1, 0.0);
   for (int s = 1; s <= n; ++s)
     {
@@ -154,9 +158,9 @@ TEST(J2Plasticity, RateFormMatchesFiniteStrainForm)
   for (int s = 0; s < 20; ++s)
     {
       T2 g; // grad du
-      g[0][1] = 4e-4;
-      g[0][0] = 1e-4;
-      g[2][2] = -2e-4;
+      g[0][1]   = 4e-4;
+      g[0][0]   = 1e-4;
+      g[2][2]   = -2e-4;
       Strain de = symmetrize(g);
       Spin   w  = 0.5 * (g - transpose(g));
       m.update_stress(de, w, 1e-3, sigma, dealii::ArrayView<double>(h1.data(), h1.size()));
@@ -171,10 +175,10 @@ TEST(J2Plasticity, InitialStressAndModulus)
 {
   J2Plasticity m(E, nu, SY, H);
   Stress       s;
-  s[0][0] = -50e6;
-  s[1][1] = -80e6;
-  s[2][2] = -60e6;
-  s[1][2] = 20e6;
+  s[0][0]      = -50e6;
+  s[1][1]      = -80e6;
+  s[2][2]      = -60e6;
+  s[1][2]      = 20e6;
   const auto h = init_history(m, s);
   EXPECT_LT((step(m, identity2(), h, false).tau - s).norm(), 1e-8 * s.norm());
   Stress big;

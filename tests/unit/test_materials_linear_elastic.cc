@@ -32,10 +32,10 @@ TEST(LinearElastic, ObjectiveUnderRigidRotation)
   // stress must rotate with the body (Jaumann rate) and its invariants stay fixed.
   LinearElastic m(1e7, 0.25);
   Stress        s;
-  s[0][0] = -100.0;
-  s[1][1] = -40.0;
-  s[0][1] = 15.0;
-  s[2][2] = -60.0;
+  s[0][0]         = -100.0;
+  s[1][1]         = -40.0;
+  s[0][1]         = 15.0;
+  s[2][2]         = -60.0;
   const double I1 = trace(s), J2 = second_invariant(deviator(s));
   const int    n     = 2000;
   const double theta = M_PI / 2;

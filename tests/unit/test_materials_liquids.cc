@@ -20,8 +20,7 @@ namespace
 {
   // Steady simple shear at rate gdot: returns tau_xy after n steps of dt.
   ElementRecord
-  shear(const Material &m, const double gdot, const double p0, const unsigned int n = 200,
-        const double dt = 1e-3)
+  shear(const Material &m, const double gdot, const double p0, const unsigned int n = 200, const double dt = 1e-3)
   {
     ElementTestSettings set;
     set.path             = ElementPath::simple_shear;
@@ -62,11 +61,11 @@ TEST(Newtonian, CavitationThreshold)
   const double K = 2e9, p_cav = -50e3, mu = 1e-3;
   Newtonian    m(K, mu, p_cav);
   m.incremental_cavitation = false; // the density form (Eqs. 7.30-7.32)
-  Stress       s;
+  Stress s;
   s[0][0] = s[1][1] = s[2][2] = -100e3; // p0 = 100 kPa
   std::vector<double> h(1);
   m.initialize_history(s, ArrayView<double>(h.data(), 1));
-  Strain d;
+  Strain       d;
   const double de = 1e-5; // isotropic expansion steps, dp = -K de = -20 kPa each (pure volumetric)
   for (unsigned int i = 0; i < 3; ++i)
     d[i][i] = de / 3;
@@ -83,7 +82,7 @@ TEST(Newtonian, CavitationThreshold)
   // recompression: stays at p_cav until the cavitated volume is closed again
   // (the unclamped pressure reached -140 kPa: -120, -100, -80, -60 are still below
   // the threshold, then -40, -20)
-  const Strain dc = -d;
+  const Strain        dc = -d;
   std::vector<double> pr;
   for (int k = 0; k < 6; ++k)
     {
@@ -95,9 +94,9 @@ TEST(Newtonian, CavitationThreshold)
   EXPECT_NEAR(pr[4], -40e3, 1e-6);
   EXPECT_NEAR(pr[5], -20e3, 1e-6);
   // a cavitated liquid carries no shear stress
-  Stress sc = s;
+  Stress              sc = s;
   std::vector<double> hc = {1e-3}; // expanded far into the cavitated range
-  Strain g;
+  Strain              g;
   g[0][1] = 1e-3;
   m.update_stress(g, Spin(), 1e-3, sc, ArrayView<double>(hc.data(), 1));
   EXPECT_DOUBLE_EQ(sc[0][1], 0.0);
@@ -149,8 +148,8 @@ TEST(Bingham, ShearStressVsShearRate)
   // capped: at tiny rates the effective viscosity is mu_max
   {
     Stress s;
-    s[0][1]                 = tau_y * (1 - 1e-7); // just below yield
-    std::vector<double> h   = {0.0, 0.0};
+    s[0][1]               = tau_y * (1 - 1e-7); // just below yield
+    std::vector<double> h = {0.0, 0.0};
     Strain              d;
     d[0][1] = 0.5 * 1e-6 * 1e-3; // gdot = 1e-6, elastic trial exceeds tau_y
     m.update_stress(d, Spin(), 1e-3, s, ArrayView<double>(h.data(), 2));
@@ -161,11 +160,11 @@ TEST(Bingham, ShearStressVsShearRate)
 
 TEST(FrictionalFluid, YieldStressFromPressure)
 {
-  const double phi = 30, mu = 2, p0 = 40e3;
+  const double    phi = 30, mu = 2, p0 = 40e3;
   FrictionalFluid m(5e6, 0.3, 1e8, phi, mu, 1e6, -1e9);
   for (const double gdot : {1.0, 10.0, 100.0})
     {
-      const ElementRecord r = shear(m, gdot, p0, 4000, 1e-3);
+      const ElementRecord r        = shear(m, gdot, p0, 4000, 1e-3);
       const double        expected = p0 * std::sin(phi * M_PI / 180) + mu * gdot;
       EXPECT_NEAR(r.sigma[0][1], expected, 1e-12 * expected) << gdot;
       EXPECT_NEAR(-trace(r.sigma) / 3, p0, 1e-9 * p0);
@@ -200,8 +199,7 @@ TEST(Liquids, RejectBadParameters)
     }
   catch (const talus::InputError &e)
     {
-      EXPECT_NE(std::string(e.what()).find("water/newtonian/bulk modulus"), std::string::npos)
-        << e.what();
+      EXPECT_NE(std::string(e.what()).find("water/newtonian/bulk modulus"), std::string::npos) << e.what();
     }
   prm.leave_subsection();
 }

@@ -33,8 +33,7 @@ namespace
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = 0; j < 3; ++j)
         if (i != j)
-          f = std::max(f, (s[i] - s[j]) + (s[i] + s[j]) * std::sin(phi * deg) -
-                            2 * c * std::cos(phi * deg));
+          f = std::max(f, (s[i] - s[j]) + (s[i] + s[j]) * std::sin(phi * deg) - 2 * c * std::cos(phi * deg));
     return f;
   }
 
@@ -78,8 +77,8 @@ namespace
 
 TEST(MohrCoulomb, DrainedTriaxialCompressionFailureAndDilatancy)
 {
-  const double E = 30e6, nu = 0.25, c = 8e3, phi = 32, psi = 12;
-  MohrCoulomb  m(E, nu, c, phi, psi);
+  const double        E = 30e6, nu = 0.25, c = 8e3, phi = 32, psi = 12;
+  MohrCoulomb         m(E, nu, c, phi, psi);
   ElementTestSettings set;
   set.path             = ElementPath::drained_triaxial_compression;
   set.target_strain    = 0.03;
@@ -89,9 +88,9 @@ TEST(MohrCoulomb, DrainedTriaxialCompressionFailureAndDilatancy)
   run_element_test(m, set, [&](const ElementRecord &r) { rec.push_back(r); });
   ASSERT_EQ(rec.size(), 301u);
 
-  const double s3   = 150e3;
-  const double sf   = std::sin(phi * deg);
-  const double s1_f = s3 * (1 + sf) / (1 - sf) + 2 * c * std::cos(phi * deg) / (1 - sf);
+  const double         s3   = 150e3;
+  const double         sf   = std::sin(phi * deg);
+  const double         s1_f = s3 * (1 + sf) / (1 - sf) + 2 * c * std::cos(phi * deg) / (1 - sf);
   const ElementRecord &last = rec.back();
   // geotechnical: sigma_1' = -sigma_xx
   EXPECT_NEAR(-last.sigma[0][0], s1_f, 1e-8 * s1_f);
@@ -105,15 +104,14 @@ TEST(MohrCoulomb, DrainedTriaxialCompressionFailureAndDilatancy)
 
   // plastic flow at constant stress: all of the strain rate is plastic and
   // d eps_v / d eps_a = -2 sin psi / (1 - sin psi) (compression positive)
-  const ElementRecord &prev = rec[rec.size() - 2];
-  const double         dea  = last.eps_axial() - prev.eps_axial();
-  const double         dev  = last.eps_vol() - prev.eps_vol();
-  const double         sp   = std::sin(psi * deg);
+  const ElementRecord &prev     = rec[rec.size() - 2];
+  const double         dea      = last.eps_axial() - prev.eps_axial();
+  const double         dev      = last.eps_vol() - prev.eps_vol();
+  const double         sp       = std::sin(psi * deg);
   const double         expected = -2 * sp / (1 - sp);
   EXPECT_NEAR(dev / dea, expected, 1e-6 * std::abs(expected));
   // and the recorded plastic volumetric strain grows at the same rate (dilation positive)
-  const double dvp = last.history[MohrCoulomb::h_plastic_vol_strain] -
-                     prev.history[MohrCoulomb::h_plastic_vol_strain];
+  const double dvp = last.history[MohrCoulomb::h_plastic_vol_strain] - prev.history[MohrCoulomb::h_plastic_vol_strain];
   EXPECT_NEAR(dvp, -dev, 1e-6 * std::abs(dev));
 }
 
@@ -158,16 +156,16 @@ TEST(MohrCoulomb, FaceReturnIsOnFaceWithPotentialFlow)
 
 TEST(MohrCoulomb, EdgeReturnsLandOnEdges)
 {
-  const double E = 10e6, nu = 0.3, c = 10e3, phi = 30, psi = 10;
-  MohrCoulomb  m(E, nu, c, phi, psi);
-  const double sf = std::sin(phi * deg), sp = std::sin(psi * deg), cf = std::cos(phi * deg);
+  const double        E = 10e6, nu = 0.3, c = 10e3, phi = 30, psi = 10;
+  MohrCoulomb         m(E, nu, c, phi, psi);
+  const double        sf = std::sin(phi * deg), sp = std::sin(psi * deg), cf = std::cos(phi * deg);
   std::vector<double> h;
   {
     // triaxial-compression edge sigma_1 = sigma_2 (tension positive): slightly
     // unequal lateral strains that a face-only return would reorder
-    const auto eps = strain_for_trial({{-40e3, -42e3, -200e3}}, E, nu);
-    const Stress                s   = one_step(m, eps, h);
-    const auto                  p   = principal(s);
+    const auto   eps = strain_for_trial({{-40e3, -42e3, -200e3}}, E, nu);
+    const Stress s   = one_step(m, eps, h);
+    const auto   p   = principal(s);
     EXPECT_NEAR(p[0], p[1], 1e-9 * std::abs(p[2]));
     EXPECT_NEAR((p[0] - p[2]) + (p[0] + p[2]) * sf - 2 * c * cf, 0.0, 1e-9 * c);
     EXPECT_LE(mc_max(p, c, phi), 1e-9 * c);
@@ -181,14 +179,14 @@ TEST(MohrCoulomb, EdgeReturnsLandOnEdges)
   }
   {
     // triaxial-extension edge sigma_2 = sigma_3
-    const auto eps = strain_for_trial({{-20e3, -150e3, -152e3}}, E, nu);
-    const Stress                s   = one_step(m, eps, h);
-    const auto                  p   = principal(s);
+    const auto   eps = strain_for_trial({{-20e3, -150e3, -152e3}}, E, nu);
+    const Stress s   = one_step(m, eps, h);
+    const auto   p   = principal(s);
     EXPECT_NEAR(p[1], p[2], 1e-9 * std::abs(p[2]));
     EXPECT_NEAR((p[0] - p[2]) + (p[0] + p[2]) * sf - 2 * c * cf, 0.0, 1e-9 * c);
     EXPECT_LE(mc_max(p, c, phi), 1e-9 * c);
     EXPECT_EQ(h[MohrCoulomb::h_yield_state], 2.0);
-    const auto   ep = plastic_strain(eps, s, E, nu);
+    const auto ep = plastic_strain(eps, s, E, nu);
     // ep = x b13 + y b12 with b12 = (1+sp, -(1-sp), 0)
     const double x = -ep[2] / (1 - sp), y = -ep[1] / (1 - sp);
     EXPECT_GT(x, 0.0);
@@ -199,9 +197,9 @@ TEST(MohrCoulomb, EdgeReturnsLandOnEdges)
 
 TEST(MohrCoulomb, ApexReturn)
 {
-  const double c = 10e3, phi = 30;
-  MohrCoulomb  m(10e6, 0.3, c, phi, 20);
-  const double apex = c / std::tan(phi * deg);
+  const double        c = 10e3, phi = 30;
+  MohrCoulomb         m(10e6, 0.3, c, phi, 20);
+  const double        apex = c / std::tan(phi * deg);
   std::vector<double> h;
   for (const std::array<double, 3> eps :
        {std::array<double, 3>{{5e-3, 5e-3, 5e-3}}, std::array<double, 3>{{9e-3, 6e-3, 4e-3}}})
@@ -244,9 +242,9 @@ TEST(MohrCoulomb, TensionCutOff)
   }
   {
     // corner between the MC face and the tension plane
-    const auto eps = strain_for_trial({{20e3, -10e3, -60e3}}, E, nu);
-    const Stress                s   = one_step(m, eps, h);
-    const auto                  p   = principal(s);
+    const auto   eps = strain_for_trial({{20e3, -10e3, -60e3}}, E, nu);
+    const Stress s   = one_step(m, eps, h);
+    const auto   p   = principal(s);
     EXPECT_NEAR(p[0], T, 1e-10 * T);
     EXPECT_NEAR(mc_max(p, c, phi), 0.0, 1e-9 * c);
   }
@@ -290,9 +288,8 @@ TEST(MohrCoulomb, RejectsBadParameters)
 TEST(Tresca, UndrainedTriaxialFailsAtTwiceSu)
 {
   const double su = 25e3;
-  for (const auto path :
-       {ElementPath::undrained_triaxial_compression, ElementPath::undrained_triaxial_extension,
-        ElementPath::drained_triaxial_compression})
+  for (const auto path : {ElementPath::undrained_triaxial_compression, ElementPath::undrained_triaxial_extension,
+                          ElementPath::drained_triaxial_compression})
     {
       Tresca              m(15e6, 0.45, su);
       ElementTestSettings set;

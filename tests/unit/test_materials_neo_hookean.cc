@@ -32,7 +32,7 @@ namespace
   std::vector<double>
   prestrained(const NeoHookean &m)
   {
-    T2 f = identity2();
+    T2 f    = identity2();
     f[0][0] = 1.3;
     f[0][1] = 0.2;
     f[2][1] = -0.1;
@@ -45,7 +45,7 @@ TEST(NeoHookean, TangentMatchesFiniteDifference)
 {
   for (const auto energy : {NeoHookean::Energy::coupled, NeoHookean::Energy::split})
     {
-      NeoHookean m(E, nu, energy);
+      NeoHookean   m(E, nu, energy);
       const double e1 = tangent_error(m, general_dF(), init_history(m));
       const double e2 = tangent_error(m, general_dF(), prestrained(m));
       // two equal principal stretches (b = diag(a, a, c))
@@ -60,22 +60,22 @@ TEST(NeoHookean, TangentMatchesFiniteDifference)
 
 TEST(NeoHookean, SplitParts)
 {
-  NeoHookean m(E, 0.45, NeoHookean::Energy::split);
-  const auto h0 = prestrained(m);
-  const T2   f  = general_dF();
-  Stress     tdev;
-  double     J;
-  T4         dtdev;
+  NeoHookean          m(E, 0.45, NeoHookean::Energy::split);
+  const auto          h0 = prestrained(m);
+  const T2            f  = general_dF();
+  Stress              tdev;
+  double              J;
+  T4                  dtdev;
   std::vector<double> h1(6);
-  m.split_update(f, dealii::ArrayView<const double>(h0.data(), 6),
-                 dealii::ArrayView<double>(h1.data(), 6), tdev, J, &dtdev);
+  m.split_update(f, dealii::ArrayView<const double>(h0.data(), 6), dealii::ArrayView<double>(h1.data(), 6), tdev, J,
+                 &dtdev);
   const Step full = step(m, f, h0);
   // tau = J p I + tau_dev with p = K U'(J)
   const Stress recon = tdev + J * m.pressure(J) * dealii::unit_symmetric_tensor<3>();
   EXPECT_LT((recon - full.tau).norm(), 1e-12 * full.tau.norm());
   EXPECT_NEAR(trace(tdev), 0.0, 1e-9 * tdev.norm());
   // d tau_dev / d dF (from Eq. 3.52) against a central difference
-  T4 fd;
+  T4           fd;
   const double hh = 1e-6;
   for (unsigned int k = 0; k < 3; ++k)
     for (unsigned int l = 0; l < 3; ++l)
@@ -85,10 +85,10 @@ TEST(NeoHookean, SplitParts)
         q[k][l] -= hh;
         Stress tp, tq;
         double Jp, Jq;
-        m.split_update(p, dealii::ArrayView<const double>(h0.data(), 6),
-                       dealii::ArrayView<double>(h1.data(), 6), tp, Jp, nullptr);
-        m.split_update(q, dealii::ArrayView<const double>(h0.data(), 6),
-                       dealii::ArrayView<double>(h1.data(), 6), tq, Jq, nullptr);
+        m.split_update(p, dealii::ArrayView<const double>(h0.data(), 6), dealii::ArrayView<double>(h1.data(), 6), tp,
+                       Jp, nullptr);
+        m.split_update(q, dealii::ArrayView<const double>(h0.data(), 6), dealii::ArrayView<double>(h1.data(), 6), tq,
+                       Jq, nullptr);
         for (unsigned int i = 0; i < 3; ++i)
           for (unsigned int j = 0; j < 3; ++j)
             fd[i][j][k][l] = (tp[i][j] - tq[i][j]) / (2 * hh);
@@ -117,11 +117,19 @@ TEST(NeoHookean, ObjectivityUnderSuperposedRotation)
       EXPECT_LT((rotate(a.tau, Q) - b.tau).norm(), 1e-10 * a.tau.norm());
       // history b rotates as a spatial tensor
       std::vector<double> hr(6);
-      Stress ba, bb;
-      ba[0][0] = a.hist[0]; ba[1][1] = a.hist[1]; ba[2][2] = a.hist[2];
-      ba[0][1] = a.hist[3]; ba[1][2] = a.hist[4]; ba[0][2] = a.hist[5];
-      bb[0][0] = b.hist[0]; bb[1][1] = b.hist[1]; bb[2][2] = b.hist[2];
-      bb[0][1] = b.hist[3]; bb[1][2] = b.hist[4]; bb[0][2] = b.hist[5];
+      Stress              ba, bb;
+      ba[0][0] = a.hist[0];
+      ba[1][1] = a.hist[1];
+      ba[2][2] = a.hist[2];
+      ba[0][1] = a.hist[3];
+      ba[1][2] = a.hist[4];
+      ba[0][2] = a.hist[5];
+      bb[0][0] = b.hist[0];
+      bb[1][1] = b.hist[1];
+      bb[2][2] = b.hist[2];
+      bb[0][1] = b.hist[3];
+      bb[1][2] = b.hist[4];
+      bb[0][2] = b.hist[5];
       EXPECT_LT((rotate(ba, Q) - bb).norm(), 1e-10 * ba.norm());
     }
 }
@@ -135,8 +143,8 @@ TEST(NeoHookean, UniaxialStressClosedForm)
   // Newton on its own tangent); the reference l2 is found by bisection.
   NeoHookean   m(E, nu);
   const double lam = m.lame_lambda(), mu = m.shear_modulus();
-  auto h = init_history(m);
-  double l1 = 1.0, l2 = 1.0;
+  auto         h  = init_history(m);
+  double       l1 = 1.0, l2 = 1.0;
   for (int s = 1; s <= 50; ++s)
     {
       const double l1n = 1.0 + 0.5 * s / 50.0;
@@ -144,7 +152,7 @@ TEST(NeoHookean, UniaxialStressClosedForm)
       Step         st;
       for (int it = 0; it < 30; ++it)
         {
-          st = step(m, diag(l1n / l1, r, r), h);
+          st              = step(m, diag(l1n / l1, r, r), h);
           const double g  = st.tau[1][1];
           const double dg = st.tangent[1][1][1][1] + st.tangent[1][1][2][2];
           r -= g / dg;
@@ -159,7 +167,7 @@ TEST(NeoHookean, UniaxialStressClosedForm)
       double lo = 0.5, hi = 1.0;
       for (int it = 0; it < 200; ++it)
         {
-          const double mid = 0.5 * (lo + hi);
+          const double mid                                                      = 0.5 * (lo + hi);
           (lam * std::log(l1 * mid * mid) + mu * (mid * mid - 1) > 0 ? hi : lo) = mid;
         }
       const double l2ref  = 0.5 * (lo + hi);
@@ -182,19 +190,19 @@ TEST(NeoHookean, SimpleShearClosedForm)
   // 100 increments to gamma = 1; sigma = tau (J = 1).
   for (const auto energy : {NeoHookean::Energy::coupled, NeoHookean::Energy::split})
     {
-      NeoHookean m(E, nu, energy);
+      NeoHookean   m(E, nu, energy);
       const double mu = m.shear_modulus();
-      auto   h = init_history(m);
-      Stress sigma;
-      const int n = 100;
+      auto         h  = init_history(m);
+      Stress       sigma;
+      const int    n = 100;
       for (int s = 1; s <= n; ++s)
         {
-          Strain de;
-          Spin   w;
+          Strain       de;
+          Spin         w;
           const double dg = 1.0 / n;
-          de[0][1] = 0.5 * dg;
-          w[0][1]  = 0.5 * dg;
-          w[1][0]  = -0.5 * dg;
+          de[0][1]        = 0.5 * dg;
+          w[0][1]         = 0.5 * dg;
+          w[1][0]         = -0.5 * dg;
           m.update_stress(de, w, 1e-3, sigma, dealii::ArrayView<double>(h.data(), h.size()));
           const double g = s * dg;
           const bool   c = energy == NeoHookean::Energy::coupled;

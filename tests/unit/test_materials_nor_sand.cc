@@ -72,16 +72,16 @@ TEST(NorSand, TangentMatchesFiniteDifference)
   std::vector<double> h = h0;
   for (int s = 0; s < 50; ++s)
     h = step(m, diag(std::exp(-1e-3), std::exp(5e-4), std::exp(5e-4)), h, false).hist;
-  T2 f = diag(0.999, 1.0004, 1.0005);
+  T2 f    = diag(0.999, 1.0004, 1.0005);
   f[0][1] = 3e-4;
   f[2][0] = -2e-4;
   struct Case
   {
-    const char *                name;
-    T2                          f;
-    const std::vector<double> * h;
+    const char                *name;
+    T2                         f;
+    const std::vector<double> *h;
   };
-  const T2   fe = diag(1.00001, 0.99999, 1.0);
+  const T2   fe      = diag(1.00001, 0.99999, 1.0);
   const Case cases[] = {{"plastic, general", f, &h},
                         {"plastic, two equal stretches", diag(0.999, 1.0005, 1.0005), &h},
                         {"plastic from the initial (tip) state", diag(0.999, 1.0005, 1.0005), &h0},
@@ -91,22 +91,21 @@ TEST(NorSand, TangentMatchesFiniteDifference)
     {
       const Step   st  = step(m, c.f, *c.h, false);
       const double err = tangent_error(m, c.f, *c.h, 0.0, 1e-7);
-      std::printf("NorSand tangent FD rel. error, %-40s %.2e (dEd = %.2e)\n", c.name, err,
-                  st.hist[9] - (*c.h)[9]);
+      std::printf("NorSand tangent FD rel. error, %-40s %.2e (dEd = %.2e)\n", c.name, err, st.hist[9] - (*c.h)[9]);
       EXPECT_LT(err, 1e-6) << c.name;
     }
-  EXPECT_GT(step(m, f, h, false).hist[9], h[9]);                                  // plastic
-  EXPECT_EQ(step(m, diag(1.0002, 0.9999, 0.9999), h, false).hist[9], h[9]);        // elastic
+  EXPECT_GT(step(m, f, h, false).hist[9], h[9]);                            // plastic
+  EXPECT_EQ(step(m, diag(1.0002, 0.9999, 0.9999), h, false).hist[9], h[9]); // elastic
 }
 
 TEST(NorSand, ObjectivityUnderSuperposedRotation)
 {
-  NorSand    m(hostun(1.63, 100e3));
-  auto       h = init_history(m);
+  NorSand m(hostun(1.63, 100e3));
+  auto    h = init_history(m);
   for (int s = 0; s < 20; ++s)
     h = step(m, diag(std::exp(-1e-3), std::exp(5e-4), std::exp(5e-4)), h, false).hist;
-  T2 f = diag(0.998, 1.001, 1.0008);
-  f[0][2] = 5e-4;
+  T2 f         = diag(0.998, 1.001, 1.0008);
+  f[0][2]      = 5e-4;
   const T2   Q = rotation(-0.5, 1, 0.25, 0.9);
   const Step a = step(m, f, h, false), b = step(m, Q * f, h, false);
   EXPECT_LT((rotate(a.tau, Q) - b.tau).norm(), 1e-10 * a.tau.norm());
@@ -136,13 +135,13 @@ TEST(NorSand, UndrainedTriaxialDenseDilatesLooseContracts)
   const double M = 1.0;
   {
     NorSand    m(hostun(1.63, 100e3)); // dense: psi_i = -0.08 at the start
-    const Path r = undrained(m, 0.3, 3000);
+    const Path r   = undrained(m, 0.3, 3000);
     size_t     ipt = 0;
     for (size_t i = 1; i < r.p.size(); ++i)
       if (r.p[i] < r.p[ipt] || ipt == 0)
         ipt = i;
-    std::printf("dense: PT at ea = %.4f, p' = %.1f Pa, q = %.1f Pa, eta = %.4f; end q = %.1f, eta = %.4f\n",
-                r.ea[ipt], r.p[ipt], r.q[ipt], r.q[ipt] / r.p[ipt], r.q.back(), r.q.back() / r.p.back());
+    std::printf("dense: PT at ea = %.4f, p' = %.1f Pa, q = %.1f Pa, eta = %.4f; end q = %.1f, eta = %.4f\n", r.ea[ipt],
+                r.p[ipt], r.q[ipt], r.q[ipt] / r.p[ipt], r.q.back(), r.q.back() / r.p.back());
     EXPECT_NEAR(r.q[ipt] / r.p[ipt], M, 0.005);   // physics: PT on q = M p'
     EXPECT_NEAR(r.ea[ipt], 0.0070, 0.0005);       // regression
     EXPECT_NEAR(r.p[ipt], 49.0e3, 0.02 * 49.0e3); // regression
@@ -153,18 +152,18 @@ TEST(NorSand, UndrainedTriaxialDenseDilatesLooseContracts)
         ASSERT_GT(r.p[i], r.p[i - 1]) << "at ea = " << r.ea[i];
       }
     EXPECT_GT(r.q.back(), 3.5 * r.q[ipt]);
-    EXPECT_LT(r.p.back(), 491e3);                          // still below p'_cs
-    EXPECT_NEAR(r.q.back() / r.p.back(), M, 0.01);         // along the CSL direction
+    EXPECT_LT(r.p.back(), 491e3);                  // still below p'_cs
+    EXPECT_NEAR(r.q.back() / r.p.back(), M, 0.01); // along the CSL direction
   }
   {
     NorSand    m(hostun(2.0, 100e3)); // loose: psi_i = +0.32 at the start
-    const Path r = undrained(m, 0.3, 3000);
+    const Path r   = undrained(m, 0.3, 3000);
     size_t     ipk = 0;
     for (size_t i = 1; i < r.q.size(); ++i)
       if (r.q[i] > r.q[ipk])
         ipk = i;
-    std::printf("loose: peak q = %.1f Pa at ea = %.4f, p' = %.1f Pa, eta = %.4f; end p' = %.1f q = %.1f\n",
-                r.q[ipk], r.ea[ipk], r.p[ipk], r.q[ipk] / r.p[ipk], r.p.back(), r.q.back());
+    std::printf("loose: peak q = %.1f Pa at ea = %.4f, p' = %.1f Pa, eta = %.4f; end p' = %.1f q = %.1f\n", r.q[ipk],
+                r.ea[ipk], r.p[ipk], r.q[ipk] / r.p[ipk], r.p.back(), r.q.back());
     EXPECT_NEAR(r.q[ipk], 36.8e3, 0.02 * 36.8e3); // regression
     EXPECT_NEAR(r.ea[ipk], 0.0030, 0.0005);       // regression
     EXPECT_LT(r.q[ipk] / r.p[ipk], M);            // peak below the CSL
@@ -189,7 +188,7 @@ TEST(NorSand, GasCutoffAndInitialisation)
   // Eq. 113 with OCR = 1, N = 0.1: p_i = p0 (1-N)^((1-N)/N) = 0.3874 p0 (compression)
   EXPECT_NEAR(h[8], -100e3 * std::pow(0.9, 9.0), 1e-6);
   // isotropic stretch to v > 1.6 v0: zero stress and tangent, b_e = I
-  const double a = std::cbrt(1.7);
+  const double a  = std::cbrt(1.7);
   const Step   st = step(m, diag(a, a, a), h);
   EXPECT_EQ(st.tau.norm(), 0.0);
   EXPECT_EQ(norm4(st.tangent), 0.0);

@@ -34,10 +34,10 @@ namespace
 
   struct Case
   {
-    std::string                         name;
+    std::string                                name;
     std::function<std::unique_ptr<Material>()> make;
-    double                              scale;   ///< strain increment size
-    unsigned int                        check_h; ///< history slot that must become non-zero
+    double                                     scale;   ///< strain increment size
+    unsigned int                               check_h; ///< history slot that must become non-zero
   };
 
   void
@@ -52,12 +52,12 @@ namespace
     const Spin         w = W;
 
     Stress sA;
-    sA[0][0] = -100e3;
-    sA[1][1] = -80e3;
-    sA[2][2] = -120e3;
-    sA[0][1] = 5e3;
-    Tensor<2, 3> Q  = Q0;
-    Stress       sB = rotate(Q, sA);
+    sA[0][0]               = -100e3;
+    sA[1][1]               = -80e3;
+    sA[2][2]               = -120e3;
+    sA[0][1]               = 5e3;
+    Tensor<2, 3>        Q  = Q0;
+    Stress              sB = rotate(Q, sA);
     std::vector<double> hA(m->n_history()), hB(m->n_history());
     m->initialize_history(sA, ArrayView<double>(hA.data(), hA.size()));
     m->initialize_history(sB, ArrayView<double>(hB.data(), hB.size()));
@@ -78,8 +78,7 @@ namespace
         const double ref      = std::max(sA.norm(), 1.0);
         for (unsigned int i = 0; i < 3; ++i)
           for (unsigned int j = i; j < 3; ++j)
-            ASSERT_NEAR(sB[i][j], expected[i][j], 1e-10 * ref)
-              << c.name << " step " << k << " component " << i << j;
+            ASSERT_NEAR(sB[i][j], expected[i][j], 1e-10 * ref) << c.name << " step " << k << " component " << i << j;
         for (unsigned int h = 0; h < hA.size(); ++h)
           ASSERT_NEAR(hB[h], hA[h], 1e-10 * std::max(std::abs(hA[h]), 1e-12 * ref))
             << c.name << " step " << k << " history " << h;
@@ -93,25 +92,15 @@ namespace
   cases()
   {
     return {
-      {"mohr coulomb",
-       [] { return std::make_unique<MohrCoulomb>(20e6, 0.3, 10e3, 30, 10, 20e3); },
-       1e-3,
+      {"mohr coulomb", [] { return std::make_unique<MohrCoulomb>(20e6, 0.3, 10e3, 30, 10, 20e3); }, 1e-3,
        MohrCoulomb::h_plastic_shear_strain},
-      {"tresca", [] { return std::make_unique<Tresca>(20e6, 0.45, 30e3); }, 1e-3,
-       Tresca::h_plastic_shear_strain},
-      {"modified cam clay",
-       [] { return std::make_unique<ModifiedCamClay>(1.1, 0.2, 0.04, 0.25, 1.0, 1.2); },
-       2e-3,
+      {"tresca", [] { return std::make_unique<Tresca>(20e6, 0.45, 30e3); }, 1e-3, Tresca::h_plastic_shear_strain},
+      {"modified cam clay", [] { return std::make_unique<ModifiedCamClay>(1.1, 0.2, 0.04, 0.25, 1.0, 1.2); }, 2e-3,
        ModifiedCamClay::h_plastic_shear_strain},
-      {"newtonian", [] { return std::make_unique<Newtonian>(2e9, 1e3, -1e9); }, 1e-6,
-       Newtonian::h_volumetric_strain},
-      {"bingham",
-       [] { return std::make_unique<Bingham>(1e7, 0.3, 1e8, 20e3, 10, 1e5, -1e9); },
-       1e-3,
+      {"newtonian", [] { return std::make_unique<Newtonian>(2e9, 1e3, -1e9); }, 1e-6, Newtonian::h_volumetric_strain},
+      {"bingham", [] { return std::make_unique<Bingham>(1e7, 0.3, 1e8, 20e3, 10, 1e5, -1e9); }, 1e-3,
        Bingham::h_effective_viscosity},
-      {"frictional fluid",
-       [] { return std::make_unique<FrictionalFluid>(1e7, 0.3, 1e6, 30, 10, 1e5, -1e9); },
-       1e-3,
+      {"frictional fluid", [] { return std::make_unique<FrictionalFluid>(1e7, 0.3, 1e6, 30, 10, 1e5, -1e9); }, 1e-3,
        FrictionalFluid::h_effective_viscosity},
     };
   }
@@ -120,9 +109,9 @@ namespace
 TEST(ObjectivityRateForm, SuperposedRigidRotation)
 {
   // spin increment about an oblique axis, 0.05 rad per step (3 rad in total)
-  Tensor<2, 3>       W;
-  const double       a[3] = {0.6, -0.48, 0.64}; // unit axis
-  const double       th   = 0.05;
+  Tensor<2, 3> W;
+  const double a[3] = {0.6, -0.48, 0.64}; // unit axis
+  const double th   = 0.05;
   W[0][1] = -th * a[2], W[1][0] = th * a[2];
   W[0][2] = th * a[1], W[2][0] = -th * a[1];
   W[1][2] = -th * a[0], W[2][1] = th * a[0];

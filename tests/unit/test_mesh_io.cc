@@ -52,7 +52,7 @@ namespace
   dealii_reads_talus_grid_file()
   {
     const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 0.5};
-    auto         m     = talus::io::make_box_mesh(dim, lo, hi, std::vector<unsigned int>{4, 3, 2});
+    auto         m = talus::io::make_box_mesh(dim, lo, hi, std::vector<unsigned int>{4, 3, 2});
     for (std::size_t c = 0; c < m.n_cells(); ++c)
       m.cell_material[c] = c % 3 + 1; // some material ids
     const std::string path = "test_mesh_io_" + std::to_string(dim) + ".msh";
@@ -76,16 +76,22 @@ namespace
   }
 } // namespace
 
-TEST(GridFile, DealIIReadsIt2D) { dealii_reads_talus_grid_file<2>(); }
-TEST(GridFile, DealIIReadsIt3D) { dealii_reads_talus_grid_file<3>(); }
+TEST(GridFile, DealIIReadsIt2D)
+{
+  dealii_reads_talus_grid_file<2>();
+}
+TEST(GridFile, DealIIReadsIt3D)
+{
+  dealii_reads_talus_grid_file<3>();
+}
 
 TEST(GridFile, RotatedBoxCellsAreNormalisedAndKeepTheirIds)
 {
   // 2 x 1 unit squares; cell 1 starts at its upper right corner
   talus::io::GridMesh m;
-  m.dim      = 2;
-  m.vertices = {{{0, 0, 0}}, {{1, 0, 0}}, {{2, 0, 0}}, {{0, 1, 0}}, {{1, 1, 0}}, {{2, 1, 0}}};
-  m.cells    = {0, 1, 3, 4, /* rotated by 180 degrees: */ 5, 4, 2, 1};
+  m.dim           = 2;
+  m.vertices      = {{{0, 0, 0}}, {{1, 0, 0}}, {{2, 0, 0}}, {{0, 1, 0}}, {{1, 1, 0}}, {{2, 1, 0}}};
+  m.cells         = {0, 1, 3, 4, /* rotated by 180 degrees: */ 5, 4, 2, 1};
   m.cell_material = {3, 4};
   m.faces         = {0, 1, 1, 2, 2, 5, 5, 4, 4, 3, 3, 0};
   m.face_boundary = {10, 10, 11, 12, 12, 13};
@@ -198,12 +204,12 @@ TEST(MeshPreparation, TetrahedronBodyVolumeAndOutsideCheck3D)
 TEST(ParticleFile, RoundTrip)
 {
   talus::io::ParticleTable t;
-  t.dim      = 2;
-  t.position = {0.1, 0.2, 0.3, 0.4};
-  t.volume   = {0.5, 0.25};
-  t.material = {1, 2};
-  t.body     = {0, 3};
-  t.stress   = {1, 2, 3, 4, 5, 6, 7, 8};
+  t.dim                  = 2;
+  t.position             = {0.1, 0.2, 0.3, 0.4};
+  t.volume               = {0.5, 0.25};
+  t.material             = {1, 2};
+  t.body                 = {0, 3};
+  t.stress               = {1, 2, 3, 4, 5, 6, 7, 8};
   const std::string path = "test_mesh_io_particles.h5";
   talus::io::write_particle_file(path, t, MPI_COMM_WORLD);
   const auto info = talus::io::particle_file_info(path, 2, MPI_COMM_WORLD, "test");

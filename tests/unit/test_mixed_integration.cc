@@ -70,8 +70,8 @@ namespace
   void
   exact_forces(const Linear<dim> &field, const double (&h)[dim], double (&f)[QF<dim>::nv][dim])
   {
-    const double g[3] = {0.5 - 0.5 * std::sqrt(0.6), 0.5, 0.5 + 0.5 * std::sqrt(0.6)};
-    const double w[3] = {5.0 / 18, 8.0 / 18, 5.0 / 18};
+    const double g[3]                         = {0.5 - 0.5 * std::sqrt(0.6), 0.5, 0.5 + 0.5 * std::sqrt(0.6)};
+    const double w[3]                         = {5.0 / 18, 8.0 / 18, 5.0 / 18};
     double       T[dim][QF<dim>::npairs][dim] = {};
     double       volume                       = 1;
     for (unsigned int d = 0; d < dim; ++d)
@@ -97,7 +97,7 @@ namespace
         t[0][1] = t[1][0] = -wt * s[3];
         if constexpr (dim == 3)
           {
-            t[2][2]           = -wt * s[2];
+            t[2][2] = -wt * s[2];
             t[1][2] = t[2][1] = -wt * s[4];
             t[0][2] = t[2][0] = -wt * s[5];
           }
@@ -120,8 +120,8 @@ namespace
       hh[d] = extents[d];
     for (int trial = 0; trial < 20; ++trial)
       {
-        const auto   field = random_linear<dim>(rng);
-        Fit<dim>     fit;
+        const auto field = random_linear<dim>(rng);
+        Fit<dim>   fit;
         // 4 points per direction on a regular sub-grid, jittered, random volumes
         unsigned int n = 1;
         for (unsigned int d = 0; d < dim; ++d)
@@ -270,7 +270,7 @@ namespace
     bool limited = false;
     for (unsigned int q = 0; q < Fit<dim>::nst; ++q)
       {
-        const double r = hi[q] - lo[q];
+        const double r    = hi[q] - lo[q];
         double       vmax = -1e300;
         for (unsigned int gp = 0; gp < QF<dim>::nv; ++gp)
           {
@@ -290,9 +290,27 @@ namespace
   }
 } // namespace
 
-TEST(MixedIntegration, LinearField2D) { check_linear_field<2>(); }
-TEST(MixedIntegration, LinearField3D) { check_linear_field<3>(); }
-TEST(MixedIntegration, Degenerate2D) { check_degenerate<2>(); }
-TEST(MixedIntegration, Degenerate3D) { check_degenerate<3>(); }
-TEST(MixedIntegration, Limiter2D) { check_limiter<2>(); }
-TEST(MixedIntegration, Limiter3D) { check_limiter<3>(); }
+TEST(MixedIntegration, LinearField2D)
+{
+  check_linear_field<2>();
+}
+TEST(MixedIntegration, LinearField3D)
+{
+  check_linear_field<3>();
+}
+TEST(MixedIntegration, Degenerate2D)
+{
+  check_degenerate<2>();
+}
+TEST(MixedIntegration, Degenerate3D)
+{
+  check_degenerate<3>();
+}
+TEST(MixedIntegration, Limiter2D)
+{
+  check_limiter<2>();
+}
+TEST(MixedIntegration, Limiter3D)
+{
+  check_limiter<3>();
+}

@@ -60,13 +60,9 @@ namespace
   template <int dim>
   struct Scene
   {
-    Scene(const MPI_Comm                   comm,
-          const std::vector<double> &      lower,
-          const std::vector<double> &      upper,
-          const std::vector<unsigned int> &cells,
-          const std::vector<Box> &         bodies,
-          const bool                       bspline)
-      : grid(comm)
+    Scene(const MPI_Comm comm, const std::vector<double> &lower, const std::vector<double> &upper,
+          const std::vector<unsigned int> &cells, const std::vector<Box> &bodies, const bool bspline)
+        : grid(comm)
     {
       dealii::Point<dim> lo, hi;
       for (unsigned int d = 0; d < dim; ++d)
@@ -149,7 +145,7 @@ namespace
     const double       corner  = 2.0 / n_cells;
     Scene<dim>         s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
                          {{filled<dim>(0), filled<dim>(corner), 1000, 2}}, is_bspline<K>);
-    NodalSpace<dim> space(s.grid, dim);
+    NodalSpace<dim>    space(s.grid, dim);
     space.setup();
     ActiveSet<dim> active(space);
     active.template reinit<K>(s.set_pointers());
@@ -166,9 +162,9 @@ namespace
 
     // every owned row: an inactive one holds its diagonal only; an active one
     // only couples nodes that share a point's stencil
-    const double       h = 1.0 / n_cells;
+    const double       h             = 1.0 / n_cells;
     unsigned long long inactive_rows = 0, inactive_bad = 0, active_rows = 0, far_entries = 0, active_to_inactive = 0;
-    const auto &       part = *space.partitioner();
+    const auto        &part = *space.partitioner();
     for (const auto i : space.locally_owned_dofs())
       {
         if (!active.is_active(i))
@@ -187,7 +183,7 @@ namespace
                 ++far_entries; // a coupling must stay within the ghost layer
                 continue;
               }
-            const auto &xj   = space.position(part.global_to_local(j));
+            const auto  &xj    = space.position(part.global_to_local(j));
             const double reach = (is_bspline<K> ? 2 : 1) * h * (1 + 1e-9);
             for (unsigned int d = 0; d < dim; ++d)
               far_entries += std::abs(xi[d] - xj[d]) > reach;
@@ -219,7 +215,7 @@ namespace
       {
         // independent count: the cells holding points couple their nodes, plus
         // one diagonal per inactive DoF
-        dealii::DynamicSparsityPattern dsp(space.locally_relevant_dofs());
+        dealii::DynamicSparsityPattern               dsp(space.locally_relevant_dofs());
         std::vector<dealii::types::global_dof_index> dofs(space.dof_handler().get_fe().n_dofs_per_cell());
         for (const auto &cell : space.dof_handler().active_cell_iterators())
           if (cell->is_locally_owned() && cell->center()[0] < corner && cell->center()[1] < corner &&
@@ -275,9 +271,9 @@ namespace
   kept_pattern_detects_window_shift()
   {
     const unsigned int n_cells = 4;
-    Scene<dim> s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
-                 {{filled<dim>(0.25), filled<dim>(0.75), 1000, 1}}, is_bspline<K>);
-    NodalSpace<dim> space(s.grid, 1);
+    Scene<dim>         s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
+                         {{filled<dim>(0.25), filled<dim>(0.75), 1000, 1}}, is_bspline<K>);
+    NodalSpace<dim>    space(s.grid, 1);
     space.setup();
     ActiveSet<dim> active(space);
     EXPECT_FALSE(active.template couplings_covered<K>(s.set_pointers())) << "never built";
@@ -293,8 +289,9 @@ namespace
 
     // move the first point of rank 0 (if it holds one) within its cell, to 0.3
     // of the cell in direction 0 (its window takes in the node below)
-    auto &     set   = *s.sets[0];
-    const bool moves = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0 && set.handler.n_locally_owned_particles() > 0;
+    auto      &set = *s.sets[0];
+    const bool moves =
+      dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0 && set.handler.n_locally_owned_particles() > 0;
     const auto shift = [&](auto it) {
       dealii::Point<dim> ref = it->get_reference_location();
       ref[0]                 = 0.3;
@@ -324,8 +321,8 @@ namespace
     active.template reinit<K>(s.set_pointers(), record);
     EXPECT_TRUE(all_covered());
     // a point of a second set in a cell the pattern was not built for
-    Scene<dim> other(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
-                     {{filled<dim>(0), filled<dim>(0.25), 1000, 1}}, is_bspline<K>);
+    Scene<dim>      other(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells),
+                          {{filled<dim>(0), filled<dim>(0.25), 1000, 1}}, is_bspline<K>);
     NodalSpace<dim> other_space(other.grid, 1);
     other_space.setup();
     ActiveSet<dim> other_active(other_space);
@@ -336,10 +333,22 @@ namespace
       << "points in cells without a kept pattern";
   }
 
-  TEST(ActiveSet, KeptPatternWindowShiftQ1_2D) { kept_pattern_detects_window_shift<2, Q1_2>(); }
-  TEST(ActiveSet, KeptPatternWindowShiftQ1_3D) { kept_pattern_detects_window_shift<3, Q1_3>(); }
-  TEST(ActiveSet, KeptPatternWindowShiftBSpline2D) { kept_pattern_detects_window_shift<2, BS_2>(); }
-  TEST(ActiveSet, KeptPatternWindowShiftBSpline3D) { kept_pattern_detects_window_shift<3, BS_3>(); }
+  TEST(ActiveSet, KeptPatternWindowShiftQ1_2D)
+  {
+    kept_pattern_detects_window_shift<2, Q1_2>();
+  }
+  TEST(ActiveSet, KeptPatternWindowShiftQ1_3D)
+  {
+    kept_pattern_detects_window_shift<3, Q1_3>();
+  }
+  TEST(ActiveSet, KeptPatternWindowShiftBSpline2D)
+  {
+    kept_pattern_detects_window_shift<2, BS_2>();
+  }
+  TEST(ActiveSet, KeptPatternWindowShiftBSpline3D)
+  {
+    kept_pattern_detects_window_shift<3, BS_3>();
+  }
 
   /// transfer::touched_window_slots (the kept-pattern check's touched nodes, no
   /// products) against the filter of point_stencil (value or gradient non-zero)
@@ -351,15 +360,16 @@ namespace
   void
   touched_window_slots_match_point_stencil()
   {
-    using K = shape::BSpline2Box<dim>;
+    using K                    = shape::BSpline2Box<dim>;
     const unsigned int n_cells = 5;
     Scene<dim> s(MPI_COMM_SELF, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, n_cells), {}, true);
-    const std::vector<double> xis = {0.0, 1e-300, 1e-17, 0.25, std::nextafter(0.5, 0.0), 0.5,
-                                     std::nextafter(0.5, 1.0), 0.75, std::nextafter(1.0, 0.0), 1.0};
+    const std::vector<double> xis = {
+      0.0, 1e-300, 1e-17, 0.25, std::nextafter(0.5, 0.0), 0.5, std::nextafter(0.5, 1.0), 0.75, std::nextafter(1.0, 0.0),
+      1.0};
     unsigned long long compared = 0, differ = 0;
     for (unsigned int c = 0; c < s.grid.cells.size(); ++c)
       {
-        const auto cell = K::cell(s.grid, c);
+        const auto                    cell = K::cell(s.grid, c);
         std::array<unsigned int, dim> digit{};
         for (bool more = true; more;)
           {
@@ -374,9 +384,9 @@ namespace
                 from_products[n++] = slot[w];
             typename K::Eval e;
             K::evaluate(cell, xi, e);
-            unsigned int from_factors[K::n_point_nodes];
-            const unsigned int m = transfer::touched_window_slots<dim>(e, from_factors);
-            bool same = m == n, superset = true;
+            unsigned int       from_factors[K::n_point_nodes];
+            const unsigned int m    = transfer::touched_window_slots<dim>(e, from_factors);
+            bool               same = m == n, superset = true;
             for (unsigned int k = 0; same && k < n; ++k)
               same = from_factors[k] == from_products[k];
             for (unsigned int k = 0; k < n; ++k)
@@ -398,13 +408,31 @@ namespace
     EXPECT_EQ(differ, 0u) << "of " << compared;
     EXPECT_GT(compared, 0u);
   }
-  TEST(ActiveSet, TouchedWindowSlotsMatchPointStencil2D) { touched_window_slots_match_point_stencil<2>(); }
-  TEST(ActiveSet, TouchedWindowSlotsMatchPointStencil3D) { touched_window_slots_match_point_stencil<3>(); }
+  TEST(ActiveSet, TouchedWindowSlotsMatchPointStencil2D)
+  {
+    touched_window_slots_match_point_stencil<2>();
+  }
+  TEST(ActiveSet, TouchedWindowSlotsMatchPointStencil3D)
+  {
+    touched_window_slots_match_point_stencil<3>();
+  }
 
-  TEST(ActiveSet, SparsityActiveRegionOnlyQ1_2D) { sparsity_active_region_only<2, Q1_2>(); }
-  TEST(ActiveSet, SparsityActiveRegionOnlyQ1_3D) { sparsity_active_region_only<3, Q1_3>(); }
-  TEST(ActiveSet, SparsityActiveRegionOnlyBSpline2D) { sparsity_active_region_only<2, BS_2>(); }
-  TEST(ActiveSet, SparsityActiveRegionOnlyBSpline3D) { sparsity_active_region_only<3, BS_3>(); }
+  TEST(ActiveSet, SparsityActiveRegionOnlyQ1_2D)
+  {
+    sparsity_active_region_only<2, Q1_2>();
+  }
+  TEST(ActiveSet, SparsityActiveRegionOnlyQ1_3D)
+  {
+    sparsity_active_region_only<3, Q1_3>();
+  }
+  TEST(ActiveSet, SparsityActiveRegionOnlyBSpline2D)
+  {
+    sparsity_active_region_only<2, BS_2>();
+  }
+  TEST(ActiveSet, SparsityActiveRegionOnlyBSpline3D)
+  {
+    sparsity_active_region_only<3, BS_3>();
+  }
 
   // ----------------------------------------------------------- consistent mass
   /// Row sums of the consistent mass of space (nc components) against the
@@ -419,8 +447,8 @@ namespace
     active.template reinit<K>(s.set_pointers());
     dealii::TrilinosWrappers::SparseMatrix M;
     active.reinit_matrix(M);
-    transfer::assemble<dim, K, nc>(s.set_pointers(), active, active.constraints(), transfer::ConsistentMass{},
-                                   &M, nullptr);
+    transfer::assemble<dim, K, nc>(s.set_pointers(), active, active.constraints(), transfer::ConsistentMass{}, &M,
+                                   nullptr);
     Vector one, rows;
     space.reinit_vector(one);
     space.reinit_vector(rows);
@@ -430,7 +458,7 @@ namespace
     // compare node by node through the map kernel node -> space DoF
     double             worst = 0, scale = 0, total = 0;
     unsigned long long compared = 0, inactive_with_mass = 0;
-    const auto &       gp   = *s.grid.partitioner;
+    const auto        &gp   = *s.grid.partitioner;
     const unsigned int n_gl = gp.locally_owned_size() + gp.n_ghost_indices();
     for (unsigned int i = 0; i < n_gl; ++i)
       {
@@ -476,7 +504,7 @@ namespace
     Scene<dim> s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, 8),
                  {{filled<dim>(0), filled<dim>(0.5), 1800, 2}, {filled<dim>(0.25), filled<dim>(0.75), 1000, 3}},
                  is_bspline<K>);
-    Vector M, F;
+    Vector     M, F;
     s.grid.reinit_vector(M);
     s.grid.reinit_vector(F);
     for (auto *set : s.set_pointers())
@@ -490,10 +518,22 @@ namespace
     check_mass_rows<dim, K, 1>(s, M); // a scalar space (pore pressure)
   }
 
-  TEST(ConsistentMass, RowSumsAreLumpedMassQ1_2D) { consistent_mass<2, Q1_2>(); }
-  TEST(ConsistentMass, RowSumsAreLumpedMassQ1_3D) { consistent_mass<3, Q1_3>(); }
-  TEST(ConsistentMass, RowSumsAreLumpedMassBSpline2D) { consistent_mass<2, BS_2>(); }
-  TEST(ConsistentMass, RowSumsAreLumpedMassBSpline3D) { consistent_mass<3, BS_3>(); }
+  TEST(ConsistentMass, RowSumsAreLumpedMassQ1_2D)
+  {
+    consistent_mass<2, Q1_2>();
+  }
+  TEST(ConsistentMass, RowSumsAreLumpedMassQ1_3D)
+  {
+    consistent_mass<3, Q1_3>();
+  }
+  TEST(ConsistentMass, RowSumsAreLumpedMassBSpline2D)
+  {
+    consistent_mass<2, BS_2>();
+  }
+  TEST(ConsistentMass, RowSumsAreLumpedMassBSpline3D)
+  {
+    consistent_mass<3, BS_3>();
+  }
 
   // ------------------------------------------------------------------ distribution
   /// transfer::FixedValueDistributor against deal.II's distribute_local on the
@@ -506,14 +546,14 @@ namespace
   void
   fixed_value_distributor_matches_deal_ii()
   {
-    Scene<dim> s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, 8),
-                 {{filled<dim>(0), filled<dim>(0.5), 1800, 2}}, is_bspline<K>);
+    Scene<dim>      s(MPI_COMM_WORLD, filled<dim>(0), filled<dim>(1), std::vector<unsigned int>(dim, 8),
+                      {{filled<dim>(0), filled<dim>(0.5), 1800, 2}}, is_bspline<K>);
     NodalSpace<dim> space(s.grid, nc);
     space.setup();
     ActiveSet<dim> active(space);
     active.template reinit<K>(s.set_pointers());
     // fix the DoFs of the nodes on x = 0 (to 0) and on y = 0 (to a value)
-    const auto dirichlet = space.constraints_where([](const dealii::Point<dim> &x, unsigned int k, double &v) {
+    const auto dirichlet   = space.constraints_where([](const dealii::Point<dim> &x, unsigned int k, double &v) {
       if (x[0] < 1e-12)
         return v = 0.0, true;
       if (x[1] < 1e-12)
@@ -541,12 +581,11 @@ namespace
     std::vector<double>                          Al, bl;
     for (const unsigned int c : active.cells())
       {
-        const auto   cell = K::cell(s.grid, c);
-        unsigned int used[K::n_nodes] = {}, n_used = 0;
+        const auto                cell             = K::cell(s.grid, c);
+        unsigned int              used[K::n_nodes] = {}, n_used = 0;
         std::vector<unsigned int> slots;
         for (unsigned int sl = 0; sl < K::n_nodes; ++sl)
-          if (cell.dofs[sl * dim] != dealii::numbers::invalid_unsigned_int &&
-              active.node_active(cell.dofs[sl * dim]))
+          if (cell.dofs[sl * dim] != dealii::numbers::invalid_unsigned_int && active.node_active(cell.dofs[sl * dim]))
             used[n_used++] = sl;
         // only pairs that share a point's stencil are in the pattern: for the
         // B-spline take the cell's first-quadrant window (the points at 0.25)
@@ -593,13 +632,13 @@ namespace
     // (one rank: the corner region's extremes); both paths must refuse it
     if (dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
       {
-        const auto &part = *space.partitioner();
+        const auto                     &part = *space.partitioner();
         dealii::types::global_dof_index near = dealii::numbers::invalid_dof_index, far = near;
         double                          rmin = 1e9, rmax = -1;
         for (const auto i : active.active_owned_dofs())
           if (!constraints.is_constrained(i))
             {
-              const auto & x = space.position(part.global_to_local(i));
+              const auto  &x = space.position(part.global_to_local(i));
               const double r = x.norm();
               if (r < rmin)
                 rmin = r, near = i;
@@ -608,49 +647,53 @@ namespace
             }
         ASSERT_NE(near, far);
         ASSERT_GT(rmax - rmin, 0.3);
-        dofs  = {near, far};
-        Al    = {1.0, 1.0, 1.0, 1.0};
-        bl    = {0.0, 0.0};
+        dofs = {near, far};
+        Al   = {1.0, 1.0, 1.0, 1.0};
+        bl   = {0.0, 0.0};
         transfer::FixedValueDistributor fast2(constraints, part, &A_fast, &b_fast);
         EXPECT_ANY_THROW(fast2.distribute(2, Al.data(), bl.data(), 2, dofs));
-        EXPECT_ANY_THROW(transfer::distribute_local(constraints, 2, Al.data(), bl.data(), 2, dofs, &A_dealii, &b_dealii))
+        EXPECT_ANY_THROW(
+          transfer::distribute_local(constraints, 2, Al.data(), bl.data(), 2, dofs, &A_dealii, &b_dealii))
           << "deal.II's distribute_local_to_global into a Trilinos matrix is expected to refuse it too";
       }
   }
 
-  TEST(FixedValueDistributor, MatchesDealIIQ1_2D) { fixed_value_distributor_matches_deal_ii<2, Q1_2, 2>(); }
-  TEST(FixedValueDistributor, MatchesDealIIQ1_3D_Scalar) { fixed_value_distributor_matches_deal_ii<3, Q1_3, 1>(); }
-  TEST(FixedValueDistributor, MatchesDealIIBSpline2D_Scalar) { fixed_value_distributor_matches_deal_ii<2, BS_2, 1>(); }
-  TEST(FixedValueDistributor, MatchesDealIIBSpline3D) { fixed_value_distributor_matches_deal_ii<3, BS_3, 3>(); }
+  TEST(FixedValueDistributor, MatchesDealIIQ1_2D)
+  {
+    fixed_value_distributor_matches_deal_ii<2, Q1_2, 2>();
+  }
+  TEST(FixedValueDistributor, MatchesDealIIQ1_3D_Scalar)
+  {
+    fixed_value_distributor_matches_deal_ii<3, Q1_3, 1>();
+  }
+  TEST(FixedValueDistributor, MatchesDealIIBSpline2D_Scalar)
+  {
+    fixed_value_distributor_matches_deal_ii<2, BS_2, 1>();
+  }
+  TEST(FixedValueDistributor, MatchesDealIIBSpline3D)
+  {
+    fixed_value_distributor_matches_deal_ii<3, BS_3, 3>();
+  }
 
   // ------------------------------------------------------------------ elastic
   /// Solve the static elastic problem K u = f on the points of s with the
   /// Dirichlet conditions `bc` (by node position); returns u with ghosts.
   template <int dim, class K>
   LinearSolveInfo
-  solve_elastic(Scene<dim> &                                                                   s,
-                NodalSpace<dim> &                                                              space,
-                ActiveSet<dim> &                                                               active,
+  solve_elastic(Scene<dim> &s, NodalSpace<dim> &space, ActiveSet<dim> &active,
                 const std::function<bool(const dealii::Point<dim> &, unsigned int, double &)> &bc,
-                const dealii::Tensor<1, dim> &                                                 g,
-                const LinearSolverOptions &                                                    options,
-                const double                                                                   E,
-                const double                                                                   nu,
-                Vector &                                                                       u)
+                const dealii::Tensor<1, dim> &g, const LinearSolverOptions &options, const double E, const double nu,
+                Vector &u)
   {
-    const auto constraints = active.constraints_with(space.constraints_where(bc));
+    const auto                             constraints = active.constraints_with(space.constraints_where(bc));
     dealii::TrilinosWrappers::SparseMatrix A;
     active.reinit_matrix(A);
     Vector b;
     space.reinit_vector(b);
     space.reinit_vector(u);
-    transfer::assemble<dim, K, dim>(s.set_pointers(),
-                                    active,
-                                    constraints,
-                                    transfer::sum(transfer::LinearElasticStiffness::from_E_nu(E, nu),
-                                                  transfer::BodyForce<dim>{g}),
-                                    &A,
-                                    &b);
+    transfer::assemble<dim, K, dim>(
+      s.set_pointers(), active, constraints,
+      transfer::sum(transfer::LinearElasticStiffness::from_E_nu(E, nu), transfer::BodyForce<dim>{g}), &A, &b);
     const auto info = solve_linear(A, u, b, options, space.constant_modes());
     constraints.distribute(u);
     u.update_ghost_values();
@@ -682,7 +725,8 @@ namespace
       return std::abs(x[c]) < tol;
     };
     Vector     u;
-    const auto info = solve_elastic<dim, K>(s, space, active, bc, dealii::Tensor<1, dim>(), LinearSolverOptions(), E, nu, u);
+    const auto info =
+      solve_elastic<dim, K>(s, space, active, bc, dealii::Tensor<1, dim>(), LinearSolverOptions(), E, nu, u);
     EXPECT_LT(info.relative_residual, 1e-12);
 
     const double exx = delta / L;
@@ -692,8 +736,8 @@ namespace
     const auto   C   = transfer::LinearElasticStiffness::from_E_nu(E, nu);
 
     double             strain_err = 0, stress_err = 0;
-    unsigned long long n_points   = 0;
-    auto cb = [&](transfer::PointIterator<dim> &, const double (&)[dim], const double (&grad)[dim][dim]) {
+    unsigned long long n_points = 0;
+    auto               cb = [&](transfer::PointIterator<dim> &, const double(&)[dim], const double(&grad)[dim][dim]) {
       double tr = 0;
       for (unsigned int d = 0; d < dim; ++d)
         tr += grad[d][d];
@@ -719,7 +763,7 @@ namespace
     const auto &part      = *space.partitioner();
     for (const auto i : active.active_owned_dofs())
       {
-        const auto & x = space.position(part.global_to_local(i));
+        const auto  &x = space.position(part.global_to_local(i));
         const auto   c = space.component(part.global_to_local(i));
         const double e = (c == 0 ? exx : eyy) * x[c];
         nodal_err      = std::max(nodal_err, std::abs(u(i) - e) / delta);
@@ -738,10 +782,22 @@ namespace
     EXPECT_LT(nodal_err, 1e-10);
   }
 
-  TEST(LinearElastic, PatchTestQ1_2D) { patch_test<2, Q1_2>(); }
-  TEST(LinearElastic, PatchTestQ1_3D) { patch_test<3, Q1_3>(); }
-  TEST(LinearElastic, PatchTestBSpline2D) { patch_test<2, BS_2>(); }
-  TEST(LinearElastic, PatchTestBSpline3D) { patch_test<3, BS_3>(); }
+  TEST(LinearElastic, PatchTestQ1_2D)
+  {
+    patch_test<2, Q1_2>();
+  }
+  TEST(LinearElastic, PatchTestQ1_3D)
+  {
+    patch_test<3, Q1_3>();
+  }
+  TEST(LinearElastic, PatchTestBSpline2D)
+  {
+    patch_test<2, BS_2>();
+  }
+  TEST(LinearElastic, PatchTestBSpline3D)
+  {
+    patch_test<3, BS_3>();
+  }
 
   // ------------------------------------------------------------------- column
   /// Nodal displacements of the column by (position, component) on all ranks.
@@ -761,10 +817,10 @@ namespace
 
   struct ColumnResult
   {
-    double                  error_vertical = 0, error_lateral = 0, u_max = 0;
-    double                  error_points = 0; ///< |u_z(x_p) - u(z_p)| / u_max over the points
-    LinearSolveInfo         info;
-    unsigned long long      n_active = 0, nnz = 0, min_owned_active = 0;
+    double             error_vertical = 0, error_lateral = 0, u_max = 0;
+    double             error_points = 0; ///< |u_z(x_p) - u(z_p)| / u_max over the points
+    LinearSolveInfo    info;
+    unsigned long long n_active = 0, nnz = 0, min_owned_active = 0;
   };
 
   /// Column [0, W] x (...) x [0, H] in a grid 4/3 as high and (Q1) twice as
@@ -776,13 +832,11 @@ namespace
   /// `coarsen` divides the number of cells per direction.
   template <int dim, class K = shape::Q1Box<dim>>
   ColumnResult
-  column(const MPI_Comm                    comm,
-         const LinearSolverOptions::Method method,
-         NodalValues<dim> &                values,
-         const unsigned int                coarsen = 1)
+  column(const MPI_Comm comm, const LinearSolverOptions::Method method, NodalValues<dim> &values,
+         const unsigned int coarsen = 1)
   {
-    const double H = 3.0, W = 0.5, rho = 2000, gz = 9.81, E = 1e7, nu = 0.25, tol = 1e-12;
-    std::vector<double>       hi = filled<dim>(is_bspline<K> ? W : 1.0), body_hi = filled<dim>(W);
+    const double        H = 3.0, W = 0.5, rho = 2000, gz = 9.81, E = 1e7, nu = 0.25, tol = 1e-12;
+    std::vector<double> hi = filled<dim>(is_bspline<K> ? W : 1.0), body_hi = filled<dim>(W);
     // Q1: 3298 (2D) / 3675 (3D) active DoFs, above ML's coarse size, so AMG
     // is a real multilevel preconditioner here
     std::vector<unsigned int> cells(dim, (dim == 2 ? 32 : 8) / (is_bspline<K> ? 2 : 1) / coarsen);
@@ -812,18 +866,18 @@ namespace
     const auto   C = transfer::LinearElasticStiffness::from_E_nu(E, nu);
     const double M = C.lambda + 2 * C.mu;
     r.u_max        = rho * gz * H * H / (2 * M);
-    auto at_points = [&](transfer::PointIterator<dim> &it, const double (&val)[dim], const double (&)[dim][dim]) {
+    auto at_points = [&](transfer::PointIterator<dim> &it, const double(&val)[dim], const double(&)[dim][dim]) {
       const double z = it->get_location()[dim - 1];
       r.error_points = std::max(r.error_points, std::abs(val[dim - 1] - rho * gz * (z * z / 2 - H * z) / M));
     };
     transfer::InterpolateField<dim, K, dim, decltype(at_points)> op(space, u, at_points);
     for (auto *set : s.set_pointers())
       transfer::for_each_active_cell(*set, op);
-    r.error_points = dealii::Utilities::MPI::max(r.error_points, comm) / r.u_max;
+    r.error_points   = dealii::Utilities::MPI::max(r.error_points, comm) / r.u_max;
     const auto &part = *space.partitioner();
     for (const auto i : active.active_owned_dofs())
       {
-        const auto & x = space.position(part.global_to_local(i));
+        const auto  &x = space.position(part.global_to_local(i));
         const auto   c = space.component(part.global_to_local(i));
         const double z = x[dim - 1];
         if (c + 1 == dim)
@@ -857,19 +911,18 @@ namespace
         amg_vs_direct = std::max(amg_vs_direct, std::abs(amg.at(k) - v));
         ranks         = std::max(ranks, std::abs(serial.at(k) - v));
       }
-    amg_vs_direct = dealii::Utilities::MPI::max(amg_vs_direct, MPI_COMM_WORLD) / rd.u_max;
-    ranks         = dealii::Utilities::MPI::max(ranks, MPI_COMM_WORLD) / rd.u_max;
+    amg_vs_direct              = dealii::Utilities::MPI::max(amg_vs_direct, MPI_COMM_WORLD) / rd.u_max;
+    ranks                      = dealii::Utilities::MPI::max(ranks, MPI_COMM_WORLD) / rd.u_max;
     const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
     if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-      std::cout << "  " << dim << "D column on " << n_ranks << " rank(s): active DoFs " << rd.n_active
-                << ", n_nonzero " << rd.nnz << "; u_max " << rd.u_max << " m\n"
+      std::cout << "  " << dim << "D column on " << n_ranks << " rank(s): active DoFs " << rd.n_active << ", n_nonzero "
+                << rd.nnz << "; u_max " << rd.u_max << " m\n"
                 << "    direct: |u - u(z)|/u_max " << rd.error_vertical << ", lateral " << rd.error_lateral
                 << ", residual " << rd.info.relative_residual << "\n"
                 << "    CG+AMG: " << ra.info.iterations << " iterations, |u - u(z)|/u_max " << ra.error_vertical
-                << ", |u_cg - u_direct|/u_max " << amg_vs_direct << ", residual " << ra.info.relative_residual
-                << "\n"
-                << "    one-rank solve vs this run: " << ranks << "; point error (Q1 interpolation) "
-                << rd.error_points << "\n";
+                << ", |u_cg - u_direct|/u_max " << amg_vs_direct << ", residual " << ra.info.relative_residual << "\n"
+                << "    one-rank solve vs this run: " << ranks << "; point error (Q1 interpolation) " << rd.error_points
+                << "\n";
     // Q1 with the 2-point-per-direction rule: the 1D reduction is the linear FE
     // of M u'' = rho g with exact stiffness and load, nodally exact; only
     // round-off (direct) or the CG tolerance 1e-10 (relative residual) remain
@@ -889,7 +942,10 @@ namespace
       }
   }
 
-  TEST(LinearElastic, ColumnUnderSelfWeight2D) { column_under_self_weight<2>(); }
+  TEST(LinearElastic, ColumnUnderSelfWeight2D)
+  {
+    column_under_self_weight<2>();
+  }
 
   // The B-spline column: not nodally exact (the wall-modified functions at the
   // base reproduce only linear fields, and the point rule is not exact for the
@@ -899,10 +955,10 @@ namespace
   {
     using Method = LinearSolverOptions::Method;
     NodalValues<2> direct, amg, serial, coarse;
-    const auto     rc = column<2, BS_2>(MPI_COMM_WORLD, Method::direct, coarse, 2);
-    const auto     rd = column<2, BS_2>(MPI_COMM_WORLD, Method::direct, direct);
-    const auto     ra = column<2, BS_2>(MPI_COMM_WORLD, Method::cg_amg, amg);
-    const auto     rs = column<2, BS_2>(MPI_COMM_SELF, Method::direct, serial);
+    const auto     rc            = column<2, BS_2>(MPI_COMM_WORLD, Method::direct, coarse, 2);
+    const auto     rd            = column<2, BS_2>(MPI_COMM_WORLD, Method::direct, direct);
+    const auto     ra            = column<2, BS_2>(MPI_COMM_WORLD, Method::cg_amg, amg);
+    const auto     rs            = column<2, BS_2>(MPI_COMM_SELF, Method::direct, serial);
     double         amg_vs_direct = 0, ranks = 0;
     for (const auto &[k, v] : direct)
       {
@@ -930,5 +986,8 @@ namespace
         EXPECT_GT(rd.min_owned_active, 0u) << "every rank must own part of the column";
       }
   }
-  TEST(LinearElastic, ColumnUnderSelfWeight3D) { column_under_self_weight<3>(); }
+  TEST(LinearElastic, ColumnUnderSelfWeight3D)
+  {
+    column_under_self_weight<3>();
+  }
 } // namespace

@@ -28,7 +28,7 @@ namespace
     for (unsigned int j = 0; j < n_side; ++j)
       for (unsigned int i = 0; i < n_side; ++i)
         {
-          const unsigned int row = j * n_side + i;
+          const unsigned int row      = j * n_side + i;
           const double       reaction = amplitude * step * (1 + std::sin(0.37 * row + step));
           A.set(row, row, 4.0 + reaction);
           if (i > 0)
@@ -83,7 +83,7 @@ TEST(ReusedAMGSolver, RebuildsAtItsStepsAndSolvesToTheTolerance)
   ReusedAMGSolver solver;
   solver.set_rebuild_interval(4);
   // steps 0 (first), 4 (interval), 6 (invalidated before), 8 (interval)
-  const unsigned int expected_setups[] = {1, 1, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4};
+  const unsigned int expected_setups[]   = {1, 1, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4};
   unsigned int       max_kept_iterations = 0;
   for (unsigned int step = 0; step < 12; ++step)
     {

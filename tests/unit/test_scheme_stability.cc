@@ -46,7 +46,7 @@ TEST(SchemeStability, CellCrossingGrowth)
   EXPECT_LE(crossing_growth_per_step(2, 0.5, 0.0, 8), 1 + 1e-7);
   // translating at V/c = 0.2, dt c/h = 0.5: parametric growth, the same on 8 and 16 cells
   // (a per-step factor independent of h), and it grows with the step (~ 1 + a C^2)
-  double v = 0;
+  double       v   = 0;
   const double g8  = crossing_growth_per_step(2, 0.5, 0.2, 8, &v);
   const double g16 = crossing_growth_per_step(2, 0.5, 0.2, 16);
   EXPECT_NEAR(v, 0.2, 1e-12);

@@ -56,11 +56,11 @@ TEST(SemiImplicitFbar, DeterminantFollowsTheSmoothedIncrement)
 // principal directions and stretch ratios (an isotropic scaling of b_e)
 TEST(SemiImplicitFbar, ElasticBTakesThePatchMean)
 {
-  const Tensor<2, 3>            F  = compression(0.01, 0.02, 0.03);
-  const dealii::SymmetricTensor<2, 3> b = dealii::symmetrize(F * transpose(F));
-  const double                  Je = std::sqrt(determinant(b));
-  double                        h[6] = {b[0][0], b[1][1], b[2][2], b[0][1], b[1][2], b[0][2]};
-  const double                  Jebar = 1.013;
+  const Tensor<2, 3>                  F     = compression(0.01, 0.02, 0.03);
+  const dealii::SymmetricTensor<2, 3> b     = dealii::symmetrize(F * transpose(F));
+  const double                        Je    = std::sqrt(determinant(b));
+  double                              h[6]  = {b[0][0], b[1][1], b[2][2], b[0][1], b[1][2], b[0][2]};
+  const double                        Jebar = 1.013;
   semi_implicit::scale_elastic_b(h, Jebar / Je);
   dealii::SymmetricTensor<2, 3> bb;
   bb[0][0] = h[0], bb[1][1] = h[1], bb[2][2] = h[2], bb[0][1] = h[3], bb[1][2] = h[4], bb[0][2] = h[5];

@@ -99,8 +99,16 @@ namespace
       N      = spline(r(I)) + c_lo * spline(r(-1)) + c_hi * spline(r(n + 1));
       dN     = (dspline(r(I)) + c_lo * dspline(r(-1)) + c_hi * dspline(r(n + 1))) / h;
     }
-    static std::vector<double> switches(unsigned int) { return {0.5}; }
-    static double              wall_zone(unsigned int) { return 0.5; }
+    static std::vector<double>
+    switches(unsigned int)
+    {
+      return {0.5};
+    }
+    static double
+    wall_zone(unsigned int)
+    {
+      return 0.5;
+    }
     static unsigned int
     nonzero_1d(const unsigned int j, const unsigned int n, const double xi, unsigned int)
     {
@@ -113,7 +121,11 @@ namespace
   {
     using K = shape::GIMP<dim>;
     // l_p/h per direction; 0.5 is one point per cell
-    static double a(const unsigned int d) { return d == 0 ? 0.3 : d == 1 ? 0.2 : 0.5; }
+    static double
+    a(const unsigned int d)
+    {
+      return d == 0 ? 0.3 : d == 1 ? 0.2 : 0.5;
+    }
     static void
     evaluate(const unsigned int (&j)[dim], const unsigned int (&n)[dim], const double (&inv_h)[dim],
              const dealii::Point<dim> &xi, typename K::Eval &e)
@@ -134,8 +146,16 @@ namespace
       auto dh = [&](int J) { return (hat(r(J) + a(d)) - hat(r(J) - a(d))) / (2 * a(d) * h); };
       dN      = dh(I) + c_lo * dh(-1) + c_hi * dh(n + 1);
     }
-    static std::vector<double> switches(const unsigned int d) { return {0.5, a(d), 1 - a(d)}; }
-    static double              wall_zone(const unsigned int d) { return a(d); }
+    static std::vector<double>
+    switches(const unsigned int d)
+    {
+      return {0.5, a(d), 1 - a(d)};
+    }
+    static double
+    wall_zone(const unsigned int d)
+    {
+      return a(d);
+    }
     static unsigned int
     nonzero_1d(const unsigned int j, const unsigned int n, const double xi, const unsigned int d)
     {
@@ -152,7 +172,7 @@ namespace
   template <int dim>
   struct Nodal
   {
-    std::vector<double>                   N;
+    std::vector<double>                  N;
     std::vector<std::array<double, dim>> G;
   };
 
@@ -168,9 +188,7 @@ namespace
 
   template <template <int> class P, int dim>
   Nodal<dim>
-  kernel_by_node(const unsigned int (&n)[dim],
-                 const double (&h)[dim],
-                 const unsigned int (&j)[dim],
+  kernel_by_node(const unsigned int (&n)[dim], const double (&h)[dim], const unsigned int (&j)[dim],
                  const dealii::Point<dim> &xi)
   {
     using K = typename P<dim>::K;
@@ -185,7 +203,7 @@ namespace
     for (unsigned int w = 0; w < K::n_nodes; ++w)
       {
         unsigned int node = 0, m = 1;
-        bool         in   = true;
+        bool         in = true;
         for (unsigned int d = 0; d < dim; ++d)
           {
             const int k = int(j[d]) - 1 + e.first[d] + int(K::digit(w, d));
@@ -247,14 +265,16 @@ namespace
       for (unsigned int d = 0; d < dim; ++d)
         n[d] = nn[d], h[d] = hh[d];
     }
-    unsigned int n_cells() const
+    unsigned int
+    n_cells() const
     {
       unsigned int m = 1;
       for (unsigned int d = 0; d < dim; ++d)
         m *= n[d];
       return m;
     }
-    void cell(unsigned int c, unsigned int (&j)[dim]) const
+    void
+    cell(unsigned int c, unsigned int (&j)[dim]) const
     {
       for (unsigned int d = 0; d < dim; ++d)
         {
@@ -326,9 +346,15 @@ check_analytic(const double tol_value, const double tol_derivative)
     }
 }
 
-TEST(ShapeBSpline2, Analytic1D) { check_analytic<BSplineKernel>(1e-14, 1e-13); }
+TEST(ShapeBSpline2, Analytic1D)
+{
+  check_analytic<BSplineKernel>(1e-14, 1e-13);
+}
 // GIMP reference: exact average of the hats over the point's domain
-TEST(ShapeGIMP, Analytic1D) { check_analytic<GIMPKernel>(1e-14, 1e-13); }
+TEST(ShapeGIMP, Analytic1D)
+{
+  check_analytic<GIMPKernel>(1e-14, 1e-13);
+}
 
 // Partition of unity, sum of gradients = 0, linear reproduction (sum x_I N_I = x,
 // sum x_I (x) grad N_I = identity) at random points of every cell, walls included.
@@ -373,16 +399,34 @@ check_consistency()
   EXPECT_LT(worst_pu, 1e-15) << "partition of unity";
   EXPECT_LT(worst_lin, 1e-14) << "linear reproduction sum x_I N_I = x";
   EXPECT_LT(worst_grad, 1e-14) << "sum grad N_I = 0, sum x_I (x) grad N_I = I";
-  std::cout << "  " << dim << "D: |sum N - 1| " << worst_pu << ", |sum x N - x| " << worst_lin
-            << ", gradients " << worst_grad << "\n";
+  std::cout << "  " << dim << "D: |sum N - 1| " << worst_pu << ", |sum x N - x| " << worst_lin << ", gradients "
+            << worst_grad << "\n";
 }
 
-TEST(ShapeBSpline2, PartitionOfUnityAndLinearReproduction1D) { check_consistency<BSplineKernel, 1>(); }
-TEST(ShapeBSpline2, PartitionOfUnityAndLinearReproduction2D) { check_consistency<BSplineKernel, 2>(); }
-TEST(ShapeBSpline2, PartitionOfUnityAndLinearReproduction3D) { check_consistency<BSplineKernel, 3>(); }
-TEST(ShapeGIMP, PartitionOfUnityAndLinearReproduction1D) { check_consistency<GIMPKernel, 1>(); }
-TEST(ShapeGIMP, PartitionOfUnityAndLinearReproduction2D) { check_consistency<GIMPKernel, 2>(); }
-TEST(ShapeGIMP, PartitionOfUnityAndLinearReproduction3D) { check_consistency<GIMPKernel, 3>(); }
+TEST(ShapeBSpline2, PartitionOfUnityAndLinearReproduction1D)
+{
+  check_consistency<BSplineKernel, 1>();
+}
+TEST(ShapeBSpline2, PartitionOfUnityAndLinearReproduction2D)
+{
+  check_consistency<BSplineKernel, 2>();
+}
+TEST(ShapeBSpline2, PartitionOfUnityAndLinearReproduction3D)
+{
+  check_consistency<BSplineKernel, 3>();
+}
+TEST(ShapeGIMP, PartitionOfUnityAndLinearReproduction1D)
+{
+  check_consistency<GIMPKernel, 1>();
+}
+TEST(ShapeGIMP, PartitionOfUnityAndLinearReproduction2D)
+{
+  check_consistency<GIMPKernel, 2>();
+}
+TEST(ShapeGIMP, PartitionOfUnityAndLinearReproduction3D)
+{
+  check_consistency<GIMPKernel, 3>();
+}
 
 // C1: at every switch of formula (xi = 1/2 for both kernels; xi = a, 1 - a for
 // GIMP) both sides (xi and the next double below) give the same values and
@@ -426,8 +470,14 @@ check_c1()
     }
 }
 
-TEST(ShapeBSpline2, C1Continuity) { check_c1<BSplineKernel>(); }
-TEST(ShapeGIMP, C1Continuity) { check_c1<GIMPKernel>(); }
+TEST(ShapeBSpline2, C1Continuity)
+{
+  check_c1<BSplineKernel>();
+}
+TEST(ShapeGIMP, C1Continuity)
+{
+  check_c1<GIMPKernel>();
+}
 
 // The wall functions are interpolatory: at x = 0 only node 0 is non-zero (= 1),
 // at x = n h only node n; in the wall zone they are the linear hats.
@@ -460,8 +510,14 @@ check_wall_interpolation()
     }
 }
 
-TEST(ShapeBSpline2, WallInterpolation1D) { check_wall_interpolation<BSplineKernel>(); }
-TEST(ShapeGIMP, WallInterpolation1D) { check_wall_interpolation<GIMPKernel>(); }
+TEST(ShapeBSpline2, WallInterpolation1D)
+{
+  check_wall_interpolation<BSplineKernel>();
+}
+TEST(ShapeGIMP, WallInterpolation1D)
+{
+  check_wall_interpolation<GIMPKernel>();
+}
 
 // On every face of the box: wall nodes carry a prescribed linear velocity field
 // (zero = fixed; normal component zero = roller), the other nodes random values.
@@ -488,7 +544,7 @@ check_wall_velocity()
               B[c][d] = u(rng);
           }
         std::vector<std::array<double, dim>> v(nn);
-        auto prescribed = [&](const double *x, const unsigned int c) {
+        auto                                 prescribed = [&](const double *x, const unsigned int c) {
           if (kind == 0 || (kind == 1 && c == normal))
             return 0.0;
           double s = a[c];
@@ -540,10 +596,22 @@ check_wall_velocity()
       }
 }
 
-TEST(ShapeBSpline2, WallVelocity2D) { check_wall_velocity<BSplineKernel, 2>(); }
-TEST(ShapeBSpline2, WallVelocity3D) { check_wall_velocity<BSplineKernel, 3>(); }
-TEST(ShapeGIMP, WallVelocity2D) { check_wall_velocity<GIMPKernel, 2>(); }
-TEST(ShapeGIMP, WallVelocity3D) { check_wall_velocity<GIMPKernel, 3>(); }
+TEST(ShapeBSpline2, WallVelocity2D)
+{
+  check_wall_velocity<BSplineKernel, 2>();
+}
+TEST(ShapeBSpline2, WallVelocity3D)
+{
+  check_wall_velocity<BSplineKernel, 3>();
+}
+TEST(ShapeGIMP, WallVelocity2D)
+{
+  check_wall_velocity<GIMPKernel, 2>();
+}
+TEST(ShapeGIMP, WallVelocity3D)
+{
+  check_wall_velocity<GIMPKernel, 3>();
+}
 
 // Support: strictly inside a cell exactly the expected window nodes are non-zero
 // (B-spline: all 3^dim, except the third node of a wall half cell, which has
@@ -611,12 +679,30 @@ check_support()
   EXPECT_GT(n_points, 20 * g.n_cells());
 }
 
-TEST(ShapeBSpline2, Support1D) { check_support<BSplineKernel, 1>(); }
-TEST(ShapeBSpline2, Support2D) { check_support<BSplineKernel, 2>(); }
-TEST(ShapeBSpline2, Support3D) { check_support<BSplineKernel, 3>(); }
-TEST(ShapeGIMP, Support1D) { check_support<GIMPKernel, 1>(); }
-TEST(ShapeGIMP, Support2D) { check_support<GIMPKernel, 2>(); }
-TEST(ShapeGIMP, Support3D) { check_support<GIMPKernel, 3>(); }
+TEST(ShapeBSpline2, Support1D)
+{
+  check_support<BSplineKernel, 1>();
+}
+TEST(ShapeBSpline2, Support2D)
+{
+  check_support<BSplineKernel, 2>();
+}
+TEST(ShapeBSpline2, Support3D)
+{
+  check_support<BSplineKernel, 3>();
+}
+TEST(ShapeGIMP, Support1D)
+{
+  check_support<GIMPKernel, 1>();
+}
+TEST(ShapeGIMP, Support2D)
+{
+  check_support<GIMPKernel, 2>();
+}
+TEST(ShapeGIMP, Support3D)
+{
+  check_support<GIMPKernel, 3>();
+}
 
 // Gradients against central differences of the values (global node numbering,
 // so the difference may cross a switch or a cell face).
@@ -647,12 +733,30 @@ check_finite_differences()
     }
 }
 
-TEST(ShapeBSpline2, FiniteDifferences1D) { check_finite_differences<BSplineKernel, 1>(); }
-TEST(ShapeBSpline2, FiniteDifferences2D) { check_finite_differences<BSplineKernel, 2>(); }
-TEST(ShapeBSpline2, FiniteDifferences3D) { check_finite_differences<BSplineKernel, 3>(); }
-TEST(ShapeGIMP, FiniteDifferences1D) { check_finite_differences<GIMPKernel, 1>(); }
-TEST(ShapeGIMP, FiniteDifferences2D) { check_finite_differences<GIMPKernel, 2>(); }
-TEST(ShapeGIMP, FiniteDifferences3D) { check_finite_differences<GIMPKernel, 3>(); }
+TEST(ShapeBSpline2, FiniteDifferences1D)
+{
+  check_finite_differences<BSplineKernel, 1>();
+}
+TEST(ShapeBSpline2, FiniteDifferences2D)
+{
+  check_finite_differences<BSplineKernel, 2>();
+}
+TEST(ShapeBSpline2, FiniteDifferences3D)
+{
+  check_finite_differences<BSplineKernel, 3>();
+}
+TEST(ShapeGIMP, FiniteDifferences1D)
+{
+  check_finite_differences<GIMPKernel, 1>();
+}
+TEST(ShapeGIMP, FiniteDifferences2D)
+{
+  check_finite_differences<GIMPKernel, 2>();
+}
+TEST(ShapeGIMP, FiniteDifferences3D)
+{
+  check_finite_differences<GIMPKernel, 3>();
+}
 
 // The hot-loop helpers agree with value()/gradient(): values(),
 // values_and_gradients(), and the sum-factorised interpolate().
@@ -710,10 +814,22 @@ check_helpers()
     }
 }
 
-TEST(ShapeBSpline2, Helpers1D) { check_helpers<BSplineKernel, 1>(); }
-TEST(ShapeBSpline2, Helpers2D) { check_helpers<BSplineKernel, 2>(); }
-TEST(ShapeBSpline2, Helpers3D) { check_helpers<BSplineKernel, 3>(); }
-TEST(ShapeGIMP, Helpers3D) { check_helpers<GIMPKernel, 3>(); }
+TEST(ShapeBSpline2, Helpers1D)
+{
+  check_helpers<BSplineKernel, 1>();
+}
+TEST(ShapeBSpline2, Helpers2D)
+{
+  check_helpers<BSplineKernel, 2>();
+}
+TEST(ShapeBSpline2, Helpers3D)
+{
+  check_helpers<BSplineKernel, 3>();
+}
+TEST(ShapeGIMP, Helpers3D)
+{
+  check_helpers<GIMPKernel, 3>();
+}
 
 // ------------------------------------------------------------------ grid stencil
 namespace
@@ -811,8 +927,14 @@ check_patches(const std::vector<unsigned int> &n)
   EXPECT_GT(dealii::Utilities::MPI::sum(n_checked, MPI_COMM_WORLD), 0u);
 }
 
-TEST(BSplinePatches, SupportPoints2D) { check_patches<2>({6, 4}); }
-TEST(BSplinePatches, SupportPoints3D) { check_patches<3>({4, 3, 6}); }
+TEST(BSplinePatches, SupportPoints2D)
+{
+  check_patches<2>({6, 4});
+}
+TEST(BSplinePatches, SupportPoints3D)
+{
+  check_patches<3>({4, 3, 6});
+}
 
 // P2G with the patches: random points in every owned cell (placed from the cell's
 // global index, so the point set does not depend on the rank count) scatter m N
@@ -857,15 +979,15 @@ check_p2g(const std::vector<unsigned int> &n)
     {
       if (!grid.cells[c].locally_owned)
         continue;
-      const auto & p    = grid.patch(c);
+      const auto  &p    = grid.patch(c);
       unsigned int flat = 0;
       for (unsigned int d = dim; d-- > 0;)
         flat = flat * n[d] + p.i_cell[d];
       for (const Pt &q : points_of(flat))
         {
-          const auto & xi = q.xi;
-          const double m  = q.m;
-          const double *v = q.v;
+          const auto      &xi = q.xi;
+          const double     m  = q.m;
+          const double    *v  = q.v;
           typename K::Eval e;
           K::evaluate(p.i_cell, grid.box.n_cells, grid.box.inv_h, xi, e);
           double N[K::n_nodes];
@@ -917,7 +1039,7 @@ check_p2g(const std::vector<unsigned int> &n)
       for (const Pt &q : points_of(flat))
         {
           dealii::Point<dim> x;
-          unsigned int f = flat;
+          unsigned int       f = flat;
           for (unsigned int d = 0; d < dim; ++d)
             {
               x[d] = (f % n[d] + q.xi[d]) * h[d];
@@ -975,17 +1097,23 @@ check_p2g(const std::vector<unsigned int> &n)
               << "), momentum x diff " << p_grid[0] - p_points[0] << "\n";
 }
 
-TEST(BSplinePatches, P2GConservation2D) { check_p2g<2>({8, 6}); }
-TEST(BSplinePatches, P2GConservation3D) { check_p2g<3>({4, 6, 4}); }
+TEST(BSplinePatches, P2GConservation2D)
+{
+  check_p2g<2>({8, 6});
+}
+TEST(BSplinePatches, P2GConservation3D)
+{
+  check_p2g<3>({4, 6, 4});
+}
 
 // Grids the kernel cannot use are refused with an InputError naming the reason;
 // anisotropic uniform boxes are fine.
 TEST(BSplinePatches, RefusesNonUniformGrids)
 {
   {
-    BackgroundGrid<2>  grid(MPI_COMM_WORLD);
-    dealii::Point<2>   lower;
-    double             h[2];
+    BackgroundGrid<2> grid(MPI_COMM_WORLD);
+    dealii::Point<2>  lower;
+    double            h[2];
     EXPECT_NO_THROW(make_grid<2>(grid, {3, 5}, lower, h));
   }
   {
@@ -1025,7 +1153,7 @@ TEST(BSplinePatches, RefusesNonUniformGrids)
     // a grid file whose vertex lines are off by 1e-9 of the extent (rounded
     // coordinates) is still a uniform box
     const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
-    auto         mesh  = io::make_box_mesh(2, lo, hi, {5, 4});
+    auto         mesh = io::make_box_mesh(2, lo, hi, {5, 4});
     for (auto &v : mesh.vertices)
       if (std::lround(v[0] * 5) % 2 == 1)
         v[0] += 1e-9;
@@ -1038,7 +1166,7 @@ TEST(BSplinePatches, RefusesNonUniformGrids)
   {
     // L-shaped: a uniform lattice that does not fill its bounding box
     const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
-    auto         mesh  = io::make_box_mesh(2, lo, hi, {4, 4});
+    auto         mesh = io::make_box_mesh(2, lo, hi, {4, 4});
     mesh.cells.erase(mesh.cells.end() - 4, mesh.cells.end());
     mesh.cell_material.pop_back();
     mesh.faces.clear();
@@ -1078,9 +1206,9 @@ TEST(BSplinePatches, RebuiltBySetup)
   EXPECT_FALSE(q1.has_patches());
   EXPECT_TRUE(q1.patches.empty());
 
-  BackgroundGrid<2>  grid(MPI_COMM_WORLD);
-  dealii::Point<2>   lower;
-  double             h[2];
+  BackgroundGrid<2> grid(MPI_COMM_WORLD);
+  dealii::Point<2>  lower;
+  double            h[2];
   make_grid<2>(grid, {6, 4}, lower, h);
   ASSERT_TRUE(grid.has_patches());
   const std::vector<BSplinePatch<2>> before = grid.patches;

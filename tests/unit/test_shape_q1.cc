@@ -14,11 +14,11 @@ template <int dim>
 void
 check_kernel()
 {
-  constexpr unsigned int nv = shape::Q1<dim>::n_vertices;
-  std::mt19937           rng(42);
+  constexpr unsigned int                 nv = shape::Q1<dim>::n_vertices;
+  std::mt19937                           rng(42);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double           h[3] = {0.3, 0.7, 1.9};
-  double                 inv_h[dim];
+  const double                           h[3] = {0.3, 0.7, 1.9};
+  double                                 inv_h[dim];
   for (unsigned int d = 0; d < dim; ++d)
     inv_h[d] = 1.0 / h[d];
   dealii::FE_Q<dim> fe(1);
@@ -72,8 +72,14 @@ check_kernel()
     }
 }
 
-TEST(ShapeQ1, Kernel2D) { check_kernel<2>(); }
-TEST(ShapeQ1, Kernel3D) { check_kernel<3>(); }
+TEST(ShapeQ1, Kernel2D)
+{
+  check_kernel<2>();
+}
+TEST(ShapeQ1, Kernel3D)
+{
+  check_kernel<3>();
+}
 
 // The sum-factorised kernel gives the same gradients and internal forces as the
 // direct per-vertex evaluation.
@@ -81,11 +87,11 @@ template <int dim>
 void
 check_factorised()
 {
-  using QF                  = shape::Q1Factorised<dim>;
-  constexpr unsigned int nv = QF::nv;
-  std::mt19937           rng(7);
+  using QF                                  = shape::Q1Factorised<dim>;
+  constexpr unsigned int                 nv = QF::nv;
+  std::mt19937                           rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
-  double                 inv_h[dim];
+  double                                 inv_h[dim];
   for (unsigned int d = 0; d < dim; ++d)
     inv_h[d] = 1.0 / (0.5 + d * 0.3);
   for (int trial = 0; trial < 100; ++trial)
@@ -135,5 +141,11 @@ check_factorised()
     }
 }
 
-TEST(ShapeQ1, Factorised2D) { check_factorised<2>(); }
-TEST(ShapeQ1, Factorised3D) { check_factorised<3>(); }
+TEST(ShapeQ1, Factorised2D)
+{
+  check_factorised<2>();
+}
+TEST(ShapeQ1, Factorised3D)
+{
+  check_factorised<3>();
+}

@@ -24,8 +24,8 @@ template <int dim>
 void
 check_iso()
 {
-  constexpr unsigned int nv = 1u << dim;
-  std::mt19937           rng(7);
+  constexpr unsigned int                 nv = 1u << dim;
+  std::mt19937                           rng(7);
   std::uniform_real_distribution<double> u(-0.2, 0.2), r(0.05, 0.95);
   for (int trial = 0; trial < 20; ++trial)
     {
@@ -49,8 +49,9 @@ check_iso()
       dealii::FE_Q<dim>       fe(1);
       dealii::MappingQ<dim>   mapping(1);
       dealii::Quadrature<dim> q(std::vector<dealii::Point<dim>>{xi}, std::vector<double>{1.0});
-      dealii::FEValues<dim>   fv(mapping, fe, q, dealii::update_values | dealii::update_gradients |
-                                                  dealii::update_JxW_values | dealii::update_quadrature_points);
+      dealii::FEValues<dim>   fv(mapping, fe, q,
+                                 dealii::update_values | dealii::update_gradients | dealii::update_JxW_values |
+                                   dealii::update_quadrature_points);
       fv.reinit(tria.begin_active());
       double N[nv], dN[nv][dim], G[nv][dim];
       shape::IsoQ1<dim>::shape(xi, N, dN);
@@ -78,8 +79,14 @@ check_iso()
     }
 }
 
-TEST(ShapeQ1Iso, DistortedQuad) { check_iso<2>(); }
-TEST(ShapeQ1Iso, DistortedHex) { check_iso<3>(); }
+TEST(ShapeQ1Iso, DistortedQuad)
+{
+  check_iso<2>();
+}
+TEST(ShapeQ1Iso, DistortedHex)
+{
+  check_iso<3>();
+}
 
 // The Q1Iso policy on a distorted cell: the same numbers as IsoQ1; an affine
 // field u = A x + b interpolated with value and gradient exact; the per-cell
@@ -90,9 +97,9 @@ template <int dim>
 void
 check_policy()
 {
-  using K                   = shape::Q1Iso<dim>;
-  constexpr unsigned int nv = K::n_nodes;
-  std::mt19937           rng(11);
+  using K                                   = shape::Q1Iso<dim>;
+  constexpr unsigned int                 nv = K::n_nodes;
+  std::mt19937                           rng(11);
   std::uniform_real_distribution<double> u(-0.2, 0.2), r(0.05, 0.95);
   for (int trial = 0; trial < 10; ++trial)
     {
@@ -200,5 +207,11 @@ check_policy()
     }
 }
 
-TEST(ShapeQ1Iso, PolicyQuad) { check_policy<2>(); }
-TEST(ShapeQ1Iso, PolicyHex) { check_policy<3>(); }
+TEST(ShapeQ1Iso, PolicyQuad)
+{
+  check_policy<2>();
+}
+TEST(ShapeQ1Iso, PolicyHex)
+{
+  check_policy<3>();
+}

@@ -37,7 +37,7 @@ namespace
   struct Scene
   {
     explicit Scene(const bool bspline)
-      : grid(MPI_COMM_WORLD)
+        : grid(MPI_COMM_WORLD)
     {
       std::vector<unsigned int> cells;
       for (unsigned int d = 0; d < dim; ++d)
@@ -72,10 +72,10 @@ namespace
   run_checks(const bool bspline)
   {
     using L = PropertyLayout<dim>;
-    Scene<dim>                scene(bspline);
-    BackgroundGrid<dim> &     grid        = scene.grid;
-    MaterialPointSet<dim> &   set         = *scene.set;
-    const unsigned int        coefficient = scene.coefficient, source = scene.source;
+    Scene<dim>             scene(bspline);
+    BackgroundGrid<dim>   &grid        = scene.grid;
+    MaterialPointSet<dim> &set         = *scene.set;
+    const unsigned int     coefficient = scene.coefficient, source = scene.source;
 
     // a linear velocity field v = a + B x on the points, varying coefficients
     const double a[3] = {0.3, -0.2, 0.1}, B[3][3] = {{0.5, -1.0, 0.2}, {0.7, 0.25, -0.4}, {0.1, 0.3, -0.6}};
@@ -185,7 +185,7 @@ namespace
     space.reinit_vector(b);
     space.reinit_vector(one);
     space.reinit_vector(A_one);
-    transfer::PoissonWithSource                                    terms{coefficient, source};
+    transfer::PoissonWithSource                                      terms{coefficient, source};
     transfer::AssembleSystem<dim, K, 1, transfer::PoissonWithSource> op(active, active.constraints(), terms, &A, &b);
     transfer::for_each_active_cell(set, op);
     transfer::finish_assembly(active, op.diag_sum, op.diag_count, &A, &b);
@@ -218,26 +218,26 @@ namespace
   stencil_cache_follows_the_points(const bool bspline)
   {
     using S = transfer::PointStencil<dim, K>;
-    Scene<dim>             scene(bspline);
-    MaterialPointSet<dim> &set = *scene.set;
-    const MPI_Comm         comm = MPI_COMM_WORLD;
+    Scene<dim>                     scene(bspline);
+    MaterialPointSet<dim>         &set  = *scene.set;
+    const MPI_Comm                 comm = MPI_COMM_WORLD;
     transfer::StencilCache<dim, K> cache;
-    const auto same_bits = [](const S &a, const S &b) {
+    const auto                     same_bits = [](const S &a, const S &b) {
       bool same = a.n == b.n;
       for (unsigned int w = 0; same && w < a.n; ++w)
-        same = std::memcmp(a.dof[w], b.dof[w], sizeof(a.dof[w])) == 0 && std::memcmp(&a.N[w], &b.N[w], sizeof(double)) == 0 &&
-               std::memcmp(a.G[w], b.G[w], sizeof(a.G[w])) == 0;
+        same = std::memcmp(a.dof[w], b.dof[w], sizeof(a.dof[w])) == 0 &&
+               std::memcmp(&a.N[w], &b.N[w], sizeof(double)) == 0 && std::memcmp(a.G[w], b.G[w], sizeof(a.G[w])) == 0;
       return same;
     };
     // the number of stencils the cached walk evaluated; every one checked
     const auto walk = [&](const std::string &after) {
       std::vector<S> fresh;
-      transfer::for_each_point_stencil<dim, K>(scene.grid, set, [&](unsigned int, auto &, const S &s) { fresh.push_back(s); });
+      transfer::for_each_point_stencil<dim, K>(scene.grid, set,
+                                               [&](unsigned int, auto &, const S &s) { fresh.push_back(s); });
       const unsigned long long before = cache.evaluations();
       unsigned int             k = 0, differ = 0;
-      transfer::for_each_point_stencil<dim, K>(scene.grid, set, cache, [&](unsigned int, auto &, const S &s) {
-        differ += !same_bits(s, fresh[k++]);
-      });
+      transfer::for_each_point_stencil<dim, K>(
+        scene.grid, set, cache, [&](unsigned int, auto &, const S &s) { differ += !same_bits(s, fresh[k++]); });
       EXPECT_EQ(dealii::Utilities::MPI::sum(differ, comm), 0u) << after;
       EXPECT_EQ(k, fresh.size());
       return dealii::Utilities::MPI::sum(cache.evaluations() - before, comm);
@@ -290,12 +290,36 @@ namespace
   }
 } // namespace
 
-TEST(StencilCache, FollowsThePointsQ1In2D) { stencil_cache_follows_the_points<2, shape::Q1Box<2>>(false); }
-TEST(StencilCache, FollowsThePointsQ1In3D) { stencil_cache_follows_the_points<3, shape::Q1Box<3>>(false); }
-TEST(StencilCache, FollowsThePointsBSplineIn2D) { stencil_cache_follows_the_points<2, shape::BSpline2Box<2>>(true); }
-TEST(StencilCache, FollowsThePointsBSplineIn3D) { stencil_cache_follows_the_points<3, shape::BSpline2Box<3>>(true); }
+TEST(StencilCache, FollowsThePointsQ1In2D)
+{
+  stencil_cache_follows_the_points<2, shape::Q1Box<2>>(false);
+}
+TEST(StencilCache, FollowsThePointsQ1In3D)
+{
+  stencil_cache_follows_the_points<3, shape::Q1Box<3>>(false);
+}
+TEST(StencilCache, FollowsThePointsBSplineIn2D)
+{
+  stencil_cache_follows_the_points<2, shape::BSpline2Box<2>>(true);
+}
+TEST(StencilCache, FollowsThePointsBSplineIn3D)
+{
+  stencil_cache_follows_the_points<3, shape::BSpline2Box<3>>(true);
+}
 
-TEST(StencilOps, Q1In2D) { run_checks<2, shape::Q1Box<2>>(false); }
-TEST(StencilOps, Q1In3D) { run_checks<3, shape::Q1Box<3>>(false); }
-TEST(StencilOps, BSplineIn2D) { run_checks<2, shape::BSpline2Box<2>>(true); }
-TEST(StencilOps, BSplineIn3D) { run_checks<3, shape::BSpline2Box<3>>(true); }
+TEST(StencilOps, Q1In2D)
+{
+  run_checks<2, shape::Q1Box<2>>(false);
+}
+TEST(StencilOps, Q1In3D)
+{
+  run_checks<3, shape::Q1Box<3>>(false);
+}
+TEST(StencilOps, BSplineIn2D)
+{
+  run_checks<2, shape::BSpline2Box<2>>(true);
+}
+TEST(StencilOps, BSplineIn3D)
+{
+  run_checks<3, shape::BSpline2Box<3>>(true);
+}

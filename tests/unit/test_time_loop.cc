@@ -26,16 +26,33 @@ namespace
     std::vector<double> stage_end       = {1.0};
     std::vector<double> stage_threshold = {0.0};
     double              largest_step    = 1e9; ///< steps above this are refused (cut back)
-    unsigned long long  lost            = 0, lose_at_step = 0;
+    unsigned long long  lost = 0, lose_at_step = 0;
     std::vector<double> vtu_times, checkpoint_times, steps_taken;
-    bool                finished = false;
+    bool                finished          = false;
     unsigned int        diagnostics_steps = 0;
 
-    std::string tool_name() const override { return "talus-test"; }
-    void        describe(std::ostream &out) const override { out << "decay\n"; }
-    unsigned int n_stages() const override { return stage_end.size(); }
-    double      begin_stage(const unsigned int k, const bool, const bool) override { return stage_end[k]; }
-    bool        stage_converged(std::string &message) override
+    std::string
+    tool_name() const override
+    {
+      return "talus-test";
+    }
+    void
+    describe(std::ostream &out) const override
+    {
+      out << "decay\n";
+    }
+    unsigned int
+    n_stages() const override
+    {
+      return stage_end.size();
+    }
+    double
+    begin_stage(const unsigned int k, const bool, const bool) override
+    {
+      return stage_end[k];
+    }
+    bool
+    stage_converged(std::string &message) override
     {
       if (stage_threshold[current_stage] > 0 && y < stage_threshold[current_stage])
         {
@@ -44,8 +61,13 @@ namespace
         }
       return false;
     }
-    void before_step(const double, const bool diagnostics_due) override { diagnostics_steps += diagnostics_due; }
-    StepOutcome advance_by(const double h) override
+    void
+    before_step(const double, const bool diagnostics_due) override
+    {
+      diagnostics_steps += diagnostics_due;
+    }
+    StepOutcome
+    advance_by(const double h) override
     {
       if (h > largest_step * (1 + 1e-12))
         return StepOutcome::cut_back;
@@ -55,36 +77,56 @@ namespace
         lost += 3;
       return StepOutcome::done;
     }
-    void check_stability() const override
+    void
+    check_stability() const override
     {
       if (!std::isfinite(y))
         throw InstabilityError("y is not finite");
     }
-    unsigned long long       lost_points() const override { return lost; }
-    std::vector<std::string> series_columns() const override { return {"y"}; }
-    std::vector<double>      series_values(const bool) override { return {y}; }
-    void        write_vtu(const unsigned int counter) override
+    unsigned long long
+    lost_points() const override
+    {
+      return lost;
+    }
+    std::vector<std::string>
+    series_columns() const override
+    {
+      return {"y"};
+    }
+    std::vector<double>
+    series_values(const bool) override
+    {
+      return {y};
+    }
+    void
+    write_vtu(const unsigned int counter) override
     {
       EXPECT_EQ(counter, vtu_times.size());
       vtu_times.push_back(time);
     }
-    std::string write_checkpoint() override
+    std::string
+    write_checkpoint() override
     {
       checkpoint_times.push_back(time);
       return "checkpoint-" + std::to_string(step_number);
     }
-    void finish(const std::string &series_csv) override
+    void
+    finish(const std::string &series_csv) override
     {
       finished = std::filesystem::exists(series_csv);
     }
-    void summary(const LoopTimings &t) override { EXPECT_GE(t.total, t.output); }
+    void
+    summary(const LoopTimings &t) override
+    {
+      EXPECT_GE(t.total, t.output);
+    }
   };
 
   std::string
   scratch(const std::string &name)
   {
-    const std::string dir = "time_loop_test_" + name + "_" +
-                            std::to_string(dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD));
+    const std::string dir =
+      "time_loop_test_" + name + "_" + std::to_string(dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD));
     std::filesystem::remove_all(dir);
     return dir;
   }
@@ -113,7 +155,7 @@ namespace
 
 TEST(TimeLoop, CadenceOfRowsOutputAndCheckpoints)
 {
-  Decay        f;
+  Decay f;
   f.dt = 0.03; // 1/0.03 is not an integer: the last step is shortened
   LoopSettings s;
   s.end_time            = 1.0;
@@ -211,8 +253,8 @@ TEST(TimeLoop, CutBackHalvesTheStepAndKeepsTheState)
 
   // too many cut-backs: the run stops, series.csv up to the last step stays
   Decay g;
-  g.dt           = 0.1;
-  g.largest_step = 0.001;
+  g.dt               = 0.1;
+  g.largest_step     = 0.001;
   s.output_directory = scratch("cutback_fail");
   s.max_cut_backs    = 3;
   EXPECT_THROW(TimeLoop(g, s, MPI_COMM_SELF).run(), InstabilityError);
@@ -239,8 +281,8 @@ TEST(TimeLoop, LostPointsAndMaxSteps)
   EXPECT_NEAR(f.vtu_times.back(), 0.2, 1e-12); // max steps: the last step writes output
 
   Decay g;
-  g.dt               = 0.01;
-  g.lose_at_step     = 5;
+  g.dt                  = 0.01;
+  g.lose_at_step        = 5;
   s.stop_on_lost_points = true;
   s.output_directory    = scratch("lost_stop");
   EXPECT_THROW(TimeLoop(g, s, MPI_COMM_SELF).run(), RunStopped);

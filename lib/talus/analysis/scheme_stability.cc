@@ -25,8 +25,8 @@ namespace talus::analysis
     dealii::LAPACKFullMatrix<double>
     amplification(const unsigned int n, const unsigned int n_cells, const bool periodic, const double dt)
     {
-      const unsigned int n_nodes = periodic ? n_cells : n_cells + 1;
-      const unsigned int np      = n * n_cells;
+      const unsigned int         n_nodes = periodic ? n_cells : n_cells + 1;
+      const unsigned int         np      = n * n_cells;
       dealii::FullMatrix<double> S(np, n_nodes), B(np, n_nodes); // N_i(x_p), N'_i(x_p)
       for (unsigned int e = 0; e < n_cells; ++e)
         for (unsigned int k = 0; k < n; ++k)
@@ -74,7 +74,7 @@ namespace talus::analysis
             {
               G(p, np + q) = -dt * A(p, q);
               G(np + p, q) = dt * C(p, q);
-              double ca = 0;
+              double ca    = 0;
               for (unsigned int r = 0; r < np; ++r)
                 ca += C(p, r) * A(r, q);
               G(np + p, np + q) -= dt * dt * ca;
@@ -122,7 +122,7 @@ namespace talus::analysis
             {
               G(p, np + q) = -dt * A(p, q);
               G(np + p, q) = dt * C(p, q);
-              double ca = 0;
+              double ca    = 0;
               for (unsigned int r = 0; r < np; ++r)
                 ca += C(p, r) * A(r, q);
               G(np + p, np + q) -= dt * dt * ca;
@@ -167,7 +167,7 @@ namespace talus::analysis
     // distance per step r = v dt / h, rounded to the nearest fraction a / b with b <= 200:
     // after S = b N / gcd(a, N) steps the points have moved a whole number of grid lengths
     // and the configuration repeats exactly
-    const double d = std::max(v_over_c, 0.0) * dt;
+    const double  d = std::max(v_over_c, 0.0) * dt;
     unsigned long a = 0, b = 1;
     double        best = std::numeric_limits<double>::max();
     for (unsigned long q = 1; q <= 200 && d > 0; ++q)
@@ -183,8 +183,8 @@ namespace talus::analysis
     const double v = a > 0 ? double(a) / b / dt : 0.0;
     if (v_over_c_used)
       *v_over_c_used = v;
-    const unsigned int np    = n * n_cells;
-    const unsigned int steps = a > 0 ? b * n_cells / std::gcd(a, static_cast<unsigned long>(n_cells)) : 1;
+    const unsigned int  np    = n * n_cells;
+    const unsigned int  steps = a > 0 ? b * n_cells / std::gcd(a, static_cast<unsigned long>(n_cells)) : 1;
     std::vector<double> x(np);
     for (unsigned int e = 0; e < n_cells; ++e)
       for (unsigned int k = 0; k < n; ++k)
@@ -197,7 +197,7 @@ namespace talus::analysis
       {
         const auto G = step_at(x, n_cells, n, dt);
         G.mmult(T, P);
-        P = T;
+        P                 = T;
         const double norm = P.linfty_norm();
         if (norm > 1e50)
           {
@@ -248,7 +248,7 @@ namespace talus::analysis
       return hi;
     while (hi - lo > 1e-6 * lo)
       {
-        const double mid = 0.5 * (lo + hi);
+        const double mid        = 0.5 * (lo + hi);
         (stable(mid) ? lo : hi) = mid;
       }
     return lo;

@@ -13,8 +13,9 @@ namespace talus
   {
   public:
     explicit InputError(const std::string &what)
-      : std::runtime_error(what)
-    {}
+        : std::runtime_error(what)
+    {
+    }
   };
 
   /// A run went unstable (non-finite state, unbounded energy growth).
@@ -22,8 +23,9 @@ namespace talus
   {
   public:
     explicit InstabilityError(const std::string &what)
-      : std::runtime_error(what)
-    {}
+        : std::runtime_error(what)
+    {
+    }
   };
 
   /// The run met a condition the .prm says must stop it (e.g. material points
@@ -32,8 +34,9 @@ namespace talus
   {
   public:
     explicit RunStopped(const std::string &what)
-      : std::runtime_error(what)
-    {}
+        : std::runtime_error(what)
+    {
+    }
   };
 
   /// Throw InputError with `where: message` when cond is false.

@@ -38,10 +38,10 @@ namespace talus
 #ifdef OPEN_MPI
       for (const char *v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "OMPI_MCA_orte_hnp_uri", "PMI_RANK"})
         if (std::getenv(v))
-          return; // launched by mpirun or another process manager
+          return;                                  // launched by mpirun or another process manager
       if (std::getenv("TALUS_SHARED_MPI_SESSION")) // opt out (diagnosis of the shared case)
         return;
-      const char *      env_base = std::getenv("TMPDIR");
+      const char       *env_base = std::getenv("TMPDIR");
       const std::string base     = env_base && *env_base ? env_base : "/tmp";
       remove_stale(base);
       const std::string templ = base + "/talus-mpi-" + std::to_string(::getpid()) + "-XXXXXX";
@@ -92,7 +92,7 @@ namespace talus
         }
     }
 
-    PrivateMpiSessionBase(const PrivateMpiSessionBase &) = delete;
+    PrivateMpiSessionBase(const PrivateMpiSessionBase &)            = delete;
     PrivateMpiSessionBase &operator=(const PrivateMpiSessionBase &) = delete;
   };
 } // namespace talus

@@ -36,8 +36,8 @@ namespace talus
         while (!has_include && std::getline(in, line))
           {
             const auto b = line.find_first_not_of(" \t");
-            has_include  = b != std::string::npos && (line.compare(b, 8, "include ") == 0 ||
-                                                     line.compare(b, 8, "INCLUDE ") == 0);
+            has_include =
+              b != std::string::npos && (line.compare(b, 8, "include ") == 0 || line.compare(b, 8, "INCLUDE ") == 0);
           }
       }
       if (!has_include)
@@ -62,7 +62,11 @@ namespace talus
 
     struct NullBuffer : public std::streambuf
     {
-      int overflow(int c) override { return c; }
+      int
+      overflow(int c) override
+      {
+        return c;
+      }
     };
     NullBuffer   null_buffer;
     std::ostream null_stream(&null_buffer);
@@ -94,8 +98,7 @@ namespace talus
     {
       const std::string a = "The following parameters ", b = " have not been set";
       const auto        i = text.find(a), j = text.find(b);
-      if (text.find("has_to_be_set") == std::string::npos || i == std::string::npos || j == std::string::npos ||
-          j < i)
+      if (text.find("has_to_be_set") == std::string::npos || i == std::string::npos || j == std::string::npos || j < i)
         return text;
       std::istringstream is(text.substr(i + a.size(), j - i - a.size()));
       std::string        token, list;
@@ -139,9 +142,8 @@ namespace talus
       return fallback;
     const std::string v       = tool_option_value(name, "");
     const std::string allowed = "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
-    const bool digits = !v.empty() && v.size() < 19 && std::all_of(v.begin(), v.end(), [](const char c) {
-      return c >= '0' && c <= '9';
-    });
+    const bool        digits =
+      !v.empty() && v.size() < 19 && std::all_of(v.begin(), v.end(), [](const char c) { return c >= '0' && c <= '9'; });
     if (!digits)
       throw InputError("option " + name + ": '" + v + "' is not " + allowed);
     const unsigned long n = std::stoul(v);
@@ -191,20 +193,17 @@ namespace talus
         p = p.parent_path();
       }
     if (!fs::is_directory(p, ec))
-      throw InputError(where + ": '" + dir + "' cannot be used: '" + p.string() +
-                       "' exists and is not a directory");
+      throw InputError(where + ": '" + dir + "' cannot be used: '" + p.string() + "' exists and is not a directory");
     if (::access(p.c_str(), W_OK | X_OK) != 0)
-      throw InputError(where + ": '" + dir + "' cannot be written: directory '" + p.string() +
-                       "' is not writable");
+      throw InputError(where + ": '" + dir + "' cannot be written: directory '" + p.string() + "' is not writable");
     // access() says yes to root everywhere, also where nothing can be created
     // (/proc, read-only mounts): create and remove a probe directory there
     std::string probe = (p / ".talus-probe-XXXXXX").string();
     if (::mkdtemp(probe.data()) == nullptr)
       {
         const std::string why = std::strerror(errno);
-        throw InputError(where + ": '" + dir + "' cannot be " +
-                         (p == fs::path(dir) ? "written" : "created") + ": nothing can be created in '" +
-                         p.string() + "' (" + why + ")");
+        throw InputError(where + ": '" + dir + "' cannot be " + (p == fs::path(dir) ? "written" : "created") +
+                         ": nothing can be created in '" + p.string() + "' (" + why + ")");
       }
     ::rmdir(probe.c_str());
   }
@@ -290,7 +289,7 @@ namespace talus
         std::string s = trim(os.str());
         // deal.II prefixes messages with "    " and sometimes "The violated
         // condition was:" blocks; keep the text compact.
-        std::string out;
+        std::string        out;
         std::istringstream is(s);
         std::string        line;
         while (std::getline(is, line))
@@ -305,11 +304,8 @@ namespace talus
   }
 
   std::string
-  peek_entry(const std::string &                  prm_file,
-             const std::string &                  subsection_path,
-             const std::string &                  entry,
-             const std::string &                  default_value,
-             const dealii::Patterns::PatternBase &pattern)
+  peek_entry(const std::string &prm_file, const std::string &subsection_path, const std::string &entry,
+             const std::string &default_value, const dealii::Patterns::PatternBase &pattern)
   {
     dealii::ParameterHandler prm;
     std::vector<std::string> path;
@@ -347,15 +343,15 @@ namespace talus
     check_flag = false;
 
     const std::string file_arg = tool.reads_prm ? (tool.prm_optional ? " [FILE.prm]" : " FILE.prm") : "";
-    const auto usage = [&](std::ostream &os) {
-      os << "Usage: " << tool.name << " [--help]" << (tool.reads_prm ? " [--print-parameters]" : "")
-         << " [--check]";
+    const auto        usage    = [&](std::ostream &os) {
+      os << "Usage: " << tool.name << " [--help]" << (tool.reads_prm ? " [--print-parameters]" : "") << " [--check]";
       for (const auto &[o, d] : tool.options)
         os << " [" << o << (o.back() == '=' ? "VALUE" : "") << "]";
       os << file_arg << "\n";
       if (tool.reads_prm)
         os << "       mpirun -np N " << tool.name << file_arg << "\n";
-      os << "\n" << tool.summary << "\n\n"
+      os << "\n"
+         << tool.summary << "\n\n"
          << "  --help               this text\n";
       if (tool.reads_prm)
         os << "  --print-parameters   print a complete, documented default .prm and exit\n"
@@ -391,13 +387,11 @@ namespace talus
           print = true;
         else if (a == "--check")
           check_flag = true;
-        else if (!a.empty() && a[0] == '-' &&
-                 std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
+        else if (!a.empty() && a[0] == '-' && std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
                    return o.first.back() == '=' ? a.rfind(o.first, 0) == 0 : a == o.first;
                  }))
           given_options.push_back(a);
-        else if (!a.empty() && a[0] == '-' &&
-                 std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
+        else if (!a.empty() && a[0] == '-' && std::any_of(tool.options.begin(), tool.options.end(), [&](const auto &o) {
                    return o.first.back() == '=' && a + "=" == o.first;
                  }))
           {
@@ -411,8 +405,7 @@ namespace talus
           }
         else if (!a.empty() && a[0] == '-' && a != "-")
           {
-            err() << tool.name << ": error: unknown option '" << a << "' (allowed: " << allowed_options()
-                  << ")\n";
+            err() << tool.name << ": error: unknown option '" << a << "' (allowed: " << allowed_options() << ")\n";
             return exit_input_error;
           }
         else if (!tool.reads_prm)
@@ -425,8 +418,7 @@ namespace talus
           prm_file = a;
         else
           {
-            err() << tool.name << ": error: more than one parameter file given ('"
-                  << prm_file << "', '" << a << "')\n";
+            err() << tool.name << ": error: more than one parameter file given ('" << prm_file << "', '" << a << "')\n";
             return exit_input_error;
           }
       }
@@ -452,21 +444,21 @@ namespace talus
               }
             std::error_code ec;
             if (!prm_file.empty())
-            {
-            if (!std::filesystem::exists(prm_file, ec))
-              throw InputError("parameter file '" + prm_file + "' does not exist");
-            if (!std::filesystem::is_regular_file(prm_file, ec))
-              throw InputError("parameter file '" + prm_file + "' is not a regular file");
-            try
               {
-                tool.declare(prm, prm_file);
-                parse_prm_file(prm, prm_file, /*skip_undefined=*/false, /*assert_mandatory=*/true);
+                if (!std::filesystem::exists(prm_file, ec))
+                  throw InputError("parameter file '" + prm_file + "' does not exist");
+                if (!std::filesystem::is_regular_file(prm_file, ec))
+                  throw InputError("parameter file '" + prm_file + "' is not a regular file");
+                try
+                  {
+                    tool.declare(prm, prm_file);
+                    parse_prm_file(prm, prm_file, /*skip_undefined=*/false, /*assert_mandatory=*/true);
+                  }
+                catch (const dealii::ExceptionBase &e)
+                  {
+                    throw InputError("in '" + prm_file + "': " + readable_mandatory_message(exception_text(e)));
+                  }
               }
-            catch (const dealii::ExceptionBase &e)
-              {
-                throw InputError("in '" + prm_file + "': " + readable_mandatory_message(exception_text(e)));
-              }
-            }
           }
         try
           {
@@ -562,10 +554,9 @@ namespace talus
   parse_point(const std::string &text, const std::string &where)
   {
     const auto v = parse_doubles(text, where);
-    require(v.size() == dim,
-            where,
-            "needs exactly " + std::to_string(dim) + " comma-separated numbers for dimension " +
-              std::to_string(dim) + " (got '" + text + "')");
+    require(v.size() == dim, where,
+            "needs exactly " + std::to_string(dim) + " comma-separated numbers for dimension " + std::to_string(dim) +
+              " (got '" + text + "')");
     dealii::Point<dim> p;
     for (unsigned int d = 0; d < dim; ++d)
       p[d] = v[d];

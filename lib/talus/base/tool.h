@@ -61,8 +61,7 @@ namespace talus
   bool        tool_option_given(const std::string &name);
   /// Integer value of "--name=VALUE" in [min, max], or `fallback` when absent;
   /// InputError naming the option and the allowed range otherwise.
-  unsigned long tool_option_uint(const std::string &name, unsigned long fallback, unsigned long min,
-                                 unsigned long max);
+  unsigned long tool_option_uint(const std::string &name, unsigned long fallback, unsigned long min, unsigned long max);
   /// True while run_tool() runs with --check (parse and validate only).
   bool check_only();
 
@@ -113,11 +112,8 @@ namespace talus
   /// (everything else in the file is ignored). `subsection_path` is a list of
   /// nested subsections separated by '/', empty for the top level. Returns
   /// `default_value` when the entry is absent.
-  std::string peek_entry(const std::string &prm_file,
-                         const std::string &subsection_path,
-                         const std::string &entry,
-                         const std::string &default_value,
-                         const dealii::Patterns::PatternBase &pattern);
+  std::string peek_entry(const std::string &prm_file, const std::string &subsection_path, const std::string &entry,
+                         const std::string &default_value, const dealii::Patterns::PatternBase &pattern);
 
   /// Rank-0 output streams (silent on other ranks).
   std::ostream &log();

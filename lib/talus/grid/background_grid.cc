@@ -20,19 +20,18 @@ namespace talus
 {
   template <int dim>
   BackgroundGrid<dim>::BackgroundGrid(MPI_Comm comm_, const bool canonical)
-    : comm(comm_)
-    , tria(comm_,
-           dealii::Triangulation<dim>::none,
-           canonical ? dealii::parallel::distributed::Triangulation<dim>::mesh_reconstruction_after_repartitioning :
-                       dealii::parallel::distributed::Triangulation<dim>::default_setting)
-    , fe(dealii::FE_Q<dim>(1), dim)
-    , dof_handler(tria)
-  {}
+      : comm(comm_)
+      , tria(comm_, dealii::Triangulation<dim>::none,
+             canonical ? dealii::parallel::distributed::Triangulation<dim>::mesh_reconstruction_after_repartitioning
+                       : dealii::parallel::distributed::Triangulation<dim>::default_setting)
+      , fe(dealii::FE_Q<dim>(1), dim)
+      , dof_handler(tria)
+  {
+  }
 
   template <int dim>
   void
-  BackgroundGrid<dim>::make_box(const dealii::Point<dim> &       lower,
-                                const dealii::Point<dim> &       upper,
+  BackgroundGrid<dim>::make_box(const dealii::Point<dim> &lower, const dealii::Point<dim> &upper,
                                 const std::vector<unsigned int> &n_cells)
   {
     require(n_cells.size() == dim, "grid/cells", "needs " + std::to_string(dim) + " entries");
@@ -67,12 +66,12 @@ namespace talus
   void
   BackgroundGrid<dim>::make_from_mesh(const io::GridMesh &mesh)
   {
-    require(mesh.dim == dim, "grid/file", "the grid file is " + std::to_string(mesh.dim) + "D, the scene " +
-                                            std::to_string(dim) + "D");
+    require(mesh.dim == dim, "grid/file",
+            "the grid file is " + std::to_string(mesh.dim) + "D, the scene " + std::to_string(dim) + "D");
     constexpr unsigned int nv = dealii::GeometryInfo<dim>::vertices_per_cell;
     constexpr unsigned int nf = dealii::GeometryInfo<dim>::vertices_per_face;
     // keep only the vertices the cells use (deal.II refuses unused ones)
-    std::vector<unsigned int> new_index(mesh.vertices.size(), dealii::numbers::invalid_unsigned_int);
+    std::vector<unsigned int>       new_index(mesh.vertices.size(), dealii::numbers::invalid_unsigned_int);
     std::vector<dealii::Point<dim>> vertices;
     for (const unsigned int v : mesh.cells)
       if (new_index[v] == dealii::numbers::invalid_unsigned_int)
@@ -160,8 +159,8 @@ namespace talus
             {
               const double expected = p0[d] + (((v >> d) & 1u) ? cc.h[d] : 0.0);
               if (std::abs(cell->vertex(v)[d] - expected) > 1e-10 * std::abs(cc.h[d]) || !(cc.h[d] > 0))
-                throw InputError("grid: cell " + cell->id().to_string() + " at " +
-                                 std::to_string(p0[0]) + ",... is not an axis-aligned box with lexicographic "
+                throw InputError("grid: cell " + cell->id().to_string() + " at " + std::to_string(p0[0]) +
+                                 ",... is not an axis-aligned box with lexicographic "
                                  "vertex order; the MPM background grid must consist of axis-aligned quads/hexes");
             }
         cell->get_dof_indices(dof_indices);
@@ -220,10 +219,10 @@ namespace talus
   void
   BackgroundGrid<dim>::setup_bspline_patches()
   {
-    const std::string where  = "grid";
-    const std::string reason = ": quadratic B-spline shape functions need a uniform box grid (equal "
-                               "axis-aligned cells filling the box; every face of the box is a wall)";
-    const char        axis[] = "xyz";
+    const std::string  where   = "grid";
+    const std::string  reason  = ": quadratic B-spline shape functions need a uniform box grid (equal "
+                                 "axis-aligned cells filling the box; every face of the box is a wall)";
+    const char         axis[]  = "xyz";
     const unsigned int invalid = dealii::numbers::invalid_unsigned_int;
 
     // the box from the owned cells of all ranks
@@ -262,8 +261,8 @@ namespace talus
         box.inv_h[d]              = n / extent;
         if (n < shape::BSpline2<dim>::min_cells)
           throw InputError(where + ": quadratic B-spline shape functions need at least " +
-                           std::to_string(shape::BSpline2<dim>::min_cells) + " cells in every direction; the grid has " +
-                           std::to_string(n) + " in " + axis[d]);
+                           std::to_string(shape::BSpline2<dim>::min_cells) +
+                           " cells in every direction; the grid has " + std::to_string(n) + " in " + axis[d]);
         n_box *= n;
       }
     if (n_box != tria.n_global_active_cells())
@@ -307,7 +306,7 @@ namespace talus
                   slot += (index[n][d] + ((v >> d) & 1u) + 1 - index[c][d]) * m;
                 for (unsigned int comp = 0; comp < dim; ++comp)
                   {
-                    unsigned int &dst = p.dofs[slot * dim + comp];
+                    unsigned int      &dst = p.dofs[slot * dim + comp];
                     const unsigned int src = cells[n].dofs[v * dim + comp];
                     if (dst != invalid && dst != src)
                       throw std::logic_error("BackgroundGrid::setup_bspline_patches: two DoFs for one node");
@@ -337,7 +336,7 @@ namespace talus
   std::vector<unsigned char>
   BackgroundGrid<dim>::constrained_dofs(const std::vector<BoundaryCondition> &bcs) const
   {
-    std::vector<unsigned char> flag(partitioner->locally_owned_size() + partitioner->n_ghost_indices(), 0);
+    std::vector<unsigned char>           flag(partitioner->locally_owned_size() + partitioner->n_ghost_indices(), 0);
     std::set<dealii::types::boundary_id> used;
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
@@ -357,7 +356,7 @@ namespace talus
                     for (unsigned int comp = 0; comp < dim; ++comp)
                       if (bc.kind == BoundaryCondition::Kind::fixed || comp == normal_dir)
                         {
-                          const auto gi = cell->face(f)->vertex_dof_index(v, comp);
+                          const auto gi                          = cell->face(f)->vertex_dof_index(v, comp);
                           flag[partitioner->global_to_local(gi)] = 1;
                         }
                 }
@@ -385,7 +384,7 @@ namespace talus
     for (unsigned int k = cc.neighbours_begin; k < cc.neighbours_end; ++k)
       {
         const unsigned int n  = neighbours[k];
-        const auto &       nc = cells[n];
+        const auto        &nc = cells[n];
         bool               in = true;
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -401,13 +400,12 @@ namespace talus
 
   template <int dim>
   unsigned int
-  BackgroundGrid<dim>::find_owned_cell_near(const unsigned int        c,
-                                            const dealii::Point<dim> &x,
-                                            dealii::Point<dim> &      xi) const
+  BackgroundGrid<dim>::find_owned_cell_near(const unsigned int c, const dealii::Point<dim> &x,
+                                            dealii::Point<dim> &xi) const
   {
     const unsigned int n = find_cell_near(c, x, xi);
-    return n != dealii::numbers::invalid_unsigned_int && cells[n].locally_owned ? n :
-                                                                                   dealii::numbers::invalid_unsigned_int;
+    return n != dealii::numbers::invalid_unsigned_int && cells[n].locally_owned ? n
+                                                                                : dealii::numbers::invalid_unsigned_int;
   }
 
   template <int dim>

@@ -50,7 +50,7 @@ namespace talus
     unsigned int dofs[n_vertices * dim];
     /// Range of this cell's vertex neighbours in BackgroundGrid::neighbours.
     unsigned int neighbours_begin = 0, neighbours_end = 0;
-    bool         locally_owned    = false;
+    bool         locally_owned = false;
   };
 
   /// Stencil data of the quadratic B-spline kernel (shape/bspline2.h) for one
@@ -90,8 +90,7 @@ namespace talus
 
     /// Axis-aligned box with n_cells[d] cells per direction; boundary ids
     /// 0..2dim-1 for the faces x-, x+, y-, y+, z-, z+.
-    void make_box(const dealii::Point<dim> &       lower,
-                  const dealii::Point<dim> &       upper,
+    void make_box(const dealii::Point<dim> &lower, const dealii::Point<dim> &upper,
                   const std::vector<unsigned int> &n_cells);
 
     /// Grid read from a file (io::read_msh): the cells must be axis-aligned boxes
@@ -105,26 +104,28 @@ namespace talus
 
     /// Per local DoF (owned + ghost) a flag: 1 if its velocity component is
     /// prescribed zero by one of the conditions.
-    std::vector<unsigned char>
-    constrained_dofs(const std::vector<BoundaryCondition> &bcs) const;
+    std::vector<unsigned char> constrained_dofs(const std::vector<BoundaryCondition> &bcs) const;
 
-    void reinit_vector(Vector &v) const { v.reinit(partitioner); }
+    void
+    reinit_vector(Vector &v) const
+    {
+      v.reinit(partitioner);
+    }
 
     /// Index of the cell (owned, containing x) among cell `c` and its vertex
     /// neighbours; on success also writes the reference coordinates. Returns
     /// numbers::invalid_unsigned_int if x is in none of them or the containing
     /// cell is not locally owned.
-    unsigned int find_owned_cell_near(const unsigned int        c,
-                                      const dealii::Point<dim> &x,
-                                      dealii::Point<dim> &      xi) const;
+    unsigned int find_owned_cell_near(const unsigned int c, const dealii::Point<dim> &x, dealii::Point<dim> &xi) const;
     /// The same for any cached cell (owned or ghost): the index of the cell
     /// among c and its vertex neighbours that contains x, or invalid.
     unsigned int find_cell_near(const unsigned int c, const dealii::Point<dim> &x, dealii::Point<dim> &xi) const;
 
     /// Reference coordinates of x in cell c (box map).
-    dealii::Point<dim> reference_point(const unsigned int c, const dealii::Point<dim> &x) const
+    dealii::Point<dim>
+    reference_point(const unsigned int c, const dealii::Point<dim> &x) const
     {
-      const auto &  cc = cells[c];
+      const auto        &cc = cells[c];
       dealii::Point<dim> xi;
       for (unsigned int d = 0; d < dim; ++d)
         xi[d] = (x[d] - cc.lower[d]) * cc.inv_h[d];
@@ -139,7 +140,11 @@ namespace talus
     /// points) must be packed before and unpacked after by the caller.
     void repartition(const CellWeight &weight);
     /// Smallest cell edge over the whole grid (all ranks).
-    double min_cell_size() const { return global_min_h; }
+    double
+    min_cell_size() const
+    {
+      return global_min_h;
+    }
 
     /// Build the B-spline stencil (box, patches) after setup(); collective. Only a
     /// B-spline run calls it, so a Q1 run keeps its memory. Throws InputError if
@@ -148,21 +153,29 @@ namespace talus
     void setup_bspline_patches();
 
     /// Patch of locally owned cell c (active_cell_index); setup_bspline_patches() first.
-    const BSplinePatch<dim> &patch(const unsigned int c) const { return patches[patch_of_cell[c]]; }
-    bool has_patches() const { return !patch_of_cell.empty(); }
+    const BSplinePatch<dim> &
+    patch(const unsigned int c) const
+    {
+      return patches[patch_of_cell[c]];
+    }
+    bool
+    has_patches() const
+    {
+      return !patch_of_cell.empty();
+    }
 
-    MPI_Comm                                           comm;
-    dealii::parallel::distributed::Triangulation<dim> tria;
-    dealii::FESystem<dim>                              fe;
-    dealii::DoFHandler<dim>                            dof_handler;
-    dealii::MappingCartesian<dim>                      mapping;
-    dealii::IndexSet                                   owned_dofs, relevant_dofs;
+    MPI_Comm                                                   comm;
+    dealii::parallel::distributed::Triangulation<dim>          tria;
+    dealii::FESystem<dim>                                      fe;
+    dealii::DoFHandler<dim>                                    dof_handler;
+    dealii::MappingCartesian<dim>                              mapping;
+    dealii::IndexSet                                           owned_dofs, relevant_dofs;
     std::shared_ptr<const dealii::Utilities::MPI::Partitioner> partitioner;
 
     /// Indexed by active_cell_index().
-    std::vector<CellCache<dim>>                                             cells;
+    std::vector<CellCache<dim>>                                            cells;
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_iterators;
-    std::vector<unsigned int>                                               neighbours;
+    std::vector<unsigned int>                                              neighbours;
 
     /// Filled by setup_bspline_patches(): the box, one patch per locally owned
     /// cell, and per active cell the index of its patch (invalid if not owned).

@@ -7,11 +7,12 @@ namespace talus
 {
   template <int dim>
   NodalSpace<dim>::NodalSpace(const BackgroundGrid<dim> &grid_, const unsigned int n_components)
-    : grid(grid_)
-    , n_comp(n_components)
-    , fe(dealii::FE_Q<dim>(1), n_components)
-    , dofs(grid_.tria)
-  {}
+      : grid(grid_)
+      , n_comp(n_components)
+      , fe(dealii::FE_Q<dim>(1), n_components)
+      , dofs(grid_.tria)
+  {
+  }
 
   template <int dim>
   void
@@ -37,11 +38,11 @@ namespace talus
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
           for (unsigned int k = 0; k < n_comp; ++k)
             {
-              const auto g                              = cell->vertex_dof_index(v, k);
+              const auto g                                          = cell->vertex_dof_index(v, k);
               node_dofs[std::size_t(cc.dofs[v * dim]) * n_comp + k] = g;
-              const unsigned int l                      = part->global_to_local(g);
-              positions[l]                              = cell->vertex(v);
-              components[l]                             = k;
+              const unsigned int l                                  = part->global_to_local(g);
+              positions[l]                                          = cell->vertex(v);
+              components[l]                                         = k;
             }
       }
   }

@@ -32,21 +32,57 @@ namespace talus
     /// Distribute DoFs, build the index sets, the partitioner and the node map.
     void setup();
 
-    unsigned int n_components() const { return n_comp; }
-    const dealii::DoFHandler<dim> &dof_handler() const { return dofs; }
-    const dealii::IndexSet &       locally_owned_dofs() const { return owned; }
-    const dealii::IndexSet &       locally_relevant_dofs() const { return relevant; }
-    const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &partitioner() const { return part; }
-    void reinit_vector(Vector &v) const { v.reinit(part); }
+    unsigned int
+    n_components() const
+    {
+      return n_comp;
+    }
+    const dealii::DoFHandler<dim> &
+    dof_handler() const
+    {
+      return dofs;
+    }
+    const dealii::IndexSet &
+    locally_owned_dofs() const
+    {
+      return owned;
+    }
+    const dealii::IndexSet &
+    locally_relevant_dofs() const
+    {
+      return relevant;
+    }
+    const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &
+    partitioner() const
+    {
+      return part;
+    }
+    void
+    reinit_vector(Vector &v) const
+    {
+      v.reinit(part);
+    }
 
     /// Global DoF of component k at the node whose grid DoF of component 0 has
     /// the local (owned + ghost) index i: grid.cells[c].dofs[v * dim] or a
     /// B-spline patch's dofs[s * dim].
-    size_type node_dof(const unsigned int i, const unsigned int k) const { return node_dofs[i * n_comp + k]; }
+    size_type
+    node_dof(const unsigned int i, const unsigned int k) const
+    {
+      return node_dofs[i * n_comp + k];
+    }
 
     /// Position and component of the DoF with local (owned + ghost) index i.
-    const dealii::Point<dim> &position(const unsigned int i) const { return positions[i]; }
-    unsigned int              component(const unsigned int i) const { return components[i]; }
+    const dealii::Point<dim> &
+    position(const unsigned int i) const
+    {
+      return positions[i];
+    }
+    unsigned int
+    component(const unsigned int i) const
+    {
+      return components[i];
+    }
 
     /// Constraints (on the locally relevant DoFs, closed) u_i = value for every
     /// DoF where `prescribed(x, component, value)` returns true: Dirichlet

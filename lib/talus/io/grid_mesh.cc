@@ -38,7 +38,8 @@ namespace talus::io
       const char *p;
       bool        ok = true;
       template <typename T>
-      Tokens &operator>>(T &x)
+      Tokens &
+      operator>>(T &x)
       {
         char *end = nullptr;
         if constexpr (std::is_floating_point_v<T>)
@@ -70,7 +71,7 @@ namespace talus::io
     corner_jacobians(const GridMesh &m, const std::size_t c, double &scale)
     {
       const unsigned int nv = m.n_cell_vertices();
-      const auto X = [&](const unsigned int v) -> const std::array<double, 3> & {
+      const auto         X  = [&](const unsigned int v) -> const std::array<double, 3>          &{
         return m.vertices[m.cells[c * nv + v]];
       };
       std::vector<double> det(nv);
@@ -173,10 +174,11 @@ namespace talus::io
   }
 
   GridMesh
-  make_box_mesh(const unsigned int dim, const double lower[3], const double upper[3], const std::vector<unsigned int> &n)
+  make_box_mesh(const unsigned int dim, const double lower[3], const double upper[3],
+                const std::vector<unsigned int> &n)
   {
     GridMesh m;
-    m.dim = dim;
+    m.dim              = dim;
     unsigned int nn[3] = {1, 1, 1}, nc[3] = {1, 1, 1};
     for (unsigned int d = 0; d < dim; ++d)
       {
@@ -190,7 +192,7 @@ namespace talus::io
       for (unsigned int j = 0; j < nn[1]; ++j)
         for (unsigned int i = 0; i < nn[0]; ++i)
           {
-            const unsigned int idx[3] = {i, j, k};
+            const unsigned int    idx[3] = {i, j, k};
             std::array<double, 3> x{};
             for (unsigned int d = 0; d < dim; ++d)
               x[d] = idx[d] == nc[d] ? upper[d] : lower[d] + (upper[d] - lower[d]) * idx[d] / nc[d];
@@ -228,9 +230,9 @@ namespace talus::io
   {
     for (std::size_t c = 0; c < m.n_cells(); ++c)
       {
-        double     scale = 0;
-        const auto det   = corner_jacobians(m, c, scale);
-        const double tol = 1e-12 * std::pow(scale, m.dim);
+        double       scale = 0;
+        const auto   det   = corner_jacobians(m, c, scale);
+        const double tol   = 1e-12 * std::pow(scale, m.dim);
         unsigned int n_pos = 0, n_neg = 0;
         for (const double j : det)
           {
@@ -242,7 +244,8 @@ namespace talus::io
         if (n_neg == det.size())
           throw InputError(where + ": " + m.describe_cell(c) +
                            " is inverted (negative Jacobian determinant at every corner: its vertices are "
-                           "ordered clockwise" + (m.dim == 3 ? " / mirrored" : "") + ")");
+                           "ordered clockwise" +
+                           (m.dim == 3 ? " / mirrored" : "") + ")");
         throw InputError(where + ": " + m.describe_cell(c) +
                          " is degenerate (the Jacobian determinant is zero or changes sign between its corners: "
                          "collapsed, non-convex or self-intersecting cell)");
@@ -252,7 +255,7 @@ namespace talus::io
   void
   normalise_boxes(GridMesh &m, const std::string &where)
   {
-    const unsigned int nv = m.n_cell_vertices();
+    const unsigned int        nv = m.n_cell_vertices();
     std::vector<unsigned int> tmp(nv);
     for (std::size_t c = 0; c < m.n_cells(); ++c)
       {
@@ -271,7 +274,7 @@ namespace talus::io
         bool         ok   = true;
         for (unsigned int v = 0; v < nv && ok; ++v)
           {
-            const auto & x    = m.vertices[m.cells[c * nv + v]];
+            const auto  &x    = m.vertices[m.cells[c * nv + v]];
             unsigned int bits = 0;
             for (unsigned int d = 0; d < m.dim && ok; ++d)
               {
@@ -351,10 +354,10 @@ namespace talus::io
       for (std::size_t i = 0; i < m.vertices.size(); ++i)
         f << i + 1 << " " << m.vertices[i][0] << " " << m.vertices[i][1] << " " << m.vertices[i][2] << "\n";
       f << "$EndNodes\n$Elements\n" << m.n_faces() + m.n_cells() << "\n";
-      std::size_t  id         = 1;
-      const int    face_type  = m.dim == 2 ? 1 : 3;
-      const int    cell_type  = m.dim == 2 ? 3 : 5;
-      const unsigned int nf   = m.n_face_vertices(), nv = m.n_cell_vertices();
+      std::size_t        id        = 1;
+      const int          face_type = m.dim == 2 ? 1 : 3;
+      const int          cell_type = m.dim == 2 ? 3 : 5;
+      const unsigned int nf = m.n_face_vertices(), nv = m.n_cell_vertices();
       // physical tag = boundary id / material id; elementary tag = the same + 1
       for (std::size_t k = 0; k < m.n_faces(); ++k)
         {
@@ -400,7 +403,7 @@ namespace talus::io
       return line;
     };
     std::unordered_map<std::uint64_t, unsigned int> node_index;
-    bool                                 have_format = false, have_nodes = false, have_elements = false;
+    bool                                            have_format = false, have_nodes = false, have_elements = false;
     while (std::getline(f, line))
       {
         ++lineno;
@@ -413,7 +416,8 @@ namespace talus::io
             int                type    = -1;
             is >> version >> type;
             if (!is || version < 2 || version >= 3)
-              bad("MSH format '" + line + "' is not supported: talus grid files are MSH 2.2 ASCII (written by "
+              bad("MSH format '" + line +
+                  "' is not supported: talus grid files are MSH 2.2 ASCII (written by "
                   "talus-mesh, or by gmsh with -format msh22)");
             if (type != 0)
               bad("binary MSH is not supported (ASCII MSH 2.2 only)");
@@ -447,16 +451,16 @@ namespace talus::io
             std::istringstream(next()) >> n;
             for (std::size_t i = 0; i < n; ++i)
               {
-                Tokens             is{next().c_str()};
-                std::uint64_t      tag = 0;
-                int                type = 0, n_tags = 0;
+                Tokens        is{next().c_str()};
+                std::uint64_t tag  = 0;
+                int           type = 0, n_tags = 0;
                 is >> tag >> type >> n_tags;
                 std::vector<long> tags(std::max(0, n_tags));
                 for (auto &t : tags)
                   is >> t;
                 if (!is)
                   bad("cannot read element '" + line + "'");
-                unsigned int nn = 0;
+                unsigned int nn   = 0;
                 bool         cell = false;
                 if (type == 15)
                   continue; // point
@@ -471,9 +475,10 @@ namespace talus::io
                 else if (dim == 3 && type == 1)
                   continue; // edges of a 3D mesh carry nothing for talus
                 else
-                  bad("element " + std::to_string(tag) + " has gmsh type " + std::to_string(type) +
-                      ", which a " + std::to_string(dim) + "D talus grid file cannot hold (allowed: first-order " +
-                      (dim == 2 ? "quadrangles (3) and boundary lines (1)" : "hexahedra (5) and boundary quadrangles (3)") +
+                  bad("element " + std::to_string(tag) + " has gmsh type " + std::to_string(type) + ", which a " +
+                      std::to_string(dim) + "D talus grid file cannot hold (allowed: first-order " +
+                      (dim == 2 ? "quadrangles (3) and boundary lines (1)"
+                                : "hexahedra (5) and boundary quadrangles (3)") +
                       "; second-order or simplex elements are not supported)");
                 const long phys = tags.empty() ? 0 : tags[0];
                 if (phys < 0 || phys > 65535)
@@ -506,7 +511,7 @@ namespace talus::io
       }
     {
       // a cell listed twice (gmsh lists an element once per physical group it is in)
-      const unsigned int nv = m.n_cell_vertices();
+      const unsigned int                                               nv = m.n_cell_vertices();
       std::vector<std::pair<std::array<unsigned int, 8>, std::size_t>> keys(m.n_cells());
       for (std::size_t c = 0; c < m.n_cells(); ++c)
         {

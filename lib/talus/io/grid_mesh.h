@@ -27,10 +27,26 @@ namespace talus::io
     std::vector<unsigned int> faces;
     std::vector<unsigned int> face_boundary;
 
-    unsigned int n_cell_vertices() const { return 1u << dim; }
-    unsigned int n_face_vertices() const { return 1u << (dim - 1); }
-    std::size_t  n_cells() const { return cell_material.size(); }
-    std::size_t  n_faces() const { return face_boundary.size(); }
+    unsigned int
+    n_cell_vertices() const
+    {
+      return 1u << dim;
+    }
+    unsigned int
+    n_face_vertices() const
+    {
+      return 1u << (dim - 1);
+    }
+    std::size_t
+    n_cells() const
+    {
+      return cell_material.size();
+    }
+    std::size_t
+    n_faces() const
+    {
+      return face_boundary.size();
+    }
     /// "cell 12 (gmsh element 57) with vertices (0, 0), (1, 0), ..." for messages.
     std::string describe_cell(std::size_t c) const;
     /// Sorted distinct boundary ids / material ids.

@@ -28,13 +28,17 @@ namespace talus::io
 
     H5File(const std::string &path, Mode mode, MPI_Comm comm);
     ~H5File();
-    H5File(const H5File &) = delete;
+    H5File(const H5File &)            = delete;
     H5File &operator=(const H5File &) = delete;
 
     /// Close and (create mode) rename into place. Collective.
     void commit();
 
-    const std::string &path() const { return file_path; }
+    const std::string &
+    path() const
+    {
+      return file_path;
+    }
 
     /// Dataset `name` ("a/b/c": groups created as needed) of shape
     /// (sum over ranks of local rows) x cols.
@@ -52,18 +56,18 @@ namespace talus::io
     std::vector<double>        read_all(const std::string &name) const;
 
     /// Attributes of the root group (all ranks pass the same value).
-    void        set_attribute(const std::string &name, double value);
-    void        set_attribute(const std::string &name, std::int64_t value);
-    void        set_attribute(const std::string &name, const std::string &value);
-    bool        has_attribute(const std::string &name) const;
-    double      get_double(const std::string &name) const;
+    void         set_attribute(const std::string &name, double value);
+    void         set_attribute(const std::string &name, std::int64_t value);
+    void         set_attribute(const std::string &name, const std::string &value);
+    bool         has_attribute(const std::string &name) const;
+    double       get_double(const std::string &name) const;
     std::int64_t get_int(const std::string &name) const;
-    std::string get_string(const std::string &name) const;
+    std::string  get_string(const std::string &name) const;
 
   private:
     std::string  file_path, tmp_path;
     MPI_Comm     comm;
-    std::int64_t file = -1; // hid_t
+    std::int64_t file    = -1; // hid_t
     bool         writing = false;
     void         close();
     void         fail(const std::string &what) const;

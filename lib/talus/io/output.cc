@@ -8,9 +8,9 @@
 namespace talus::io
 {
   AtomicFile::AtomicFile(const std::string &p)
-    : path(p)
-    , tmp(p + ".part")
-    , out(tmp)
+      : path(p)
+      , tmp(p + ".part")
+      , out(tmp)
   {
     if (!out)
       throw std::runtime_error("cannot open '" + tmp + "' for writing");
@@ -42,7 +42,7 @@ namespace talus::io
   write_pvd(const std::string &path, const std::vector<std::pair<double, std::string>> &records)
   {
     AtomicFile f(path);
-    auto &     s = f.stream();
+    auto      &s = f.stream();
     s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
          "  <Collection>\n"
       << std::setprecision(12);

@@ -18,10 +18,14 @@ namespace talus::io
   public:
     explicit AtomicFile(const std::string &path);
     ~AtomicFile();
-    AtomicFile(const AtomicFile &) = delete;
+    AtomicFile(const AtomicFile &)            = delete;
     AtomicFile &operator=(const AtomicFile &) = delete;
 
-    std::ofstream &stream() { return out; }
+    std::ofstream &
+    stream()
+    {
+      return out;
+    }
     /// Flush, close and rename into place. Throws std::runtime_error on I/O failure.
     void commit();
 

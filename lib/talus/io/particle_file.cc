@@ -48,13 +48,12 @@ namespace talus::io
       for (const char *name : {"position", "volume", "material_id", "body_id"})
         if (!f.exists(name))
           throw InputError(w + " has no dataset '" + name + "'");
-      const auto n = f.shape("volume").first;
+      const auto n           = f.shape("volume").first;
       const auto check_shape = [&](const std::string &name, unsigned int cols) {
         const auto s = f.shape(name);
         if (s.first != n || s.second != cols)
           throw InputError(w + ": dataset '" + name + "' has shape " + std::to_string(s.first) + " x " +
-                           std::to_string(s.second) + ", expected " + std::to_string(n) + " x " +
-                           std::to_string(cols));
+                           std::to_string(s.second) + ", expected " + std::to_string(n) + " x " + std::to_string(cols));
       };
       check_shape("position", dim);
       check_shape("material_id", 1);
@@ -70,9 +69,9 @@ namespace talus::io
     H5File f(path, H5File::Mode::read, comm);
     check_header(f, dim, where);
     ParticleFileInfo info;
-    info.dim        = dim;
-    info.n          = f.shape("volume").first;
-    info.has_stress = f.exists("stress");
+    info.dim            = dim;
+    info.n              = f.shape("volume").first;
+    info.has_stress     = f.exists("stress");
     const auto body     = f.read_rows_u64("body_id", 0, info.n);
     const auto material = f.read_rows_u64("material_id", 0, info.n);
     for (const auto b : body)
@@ -100,12 +99,12 @@ namespace talus::io
     H5File f(path, H5File::Mode::read, comm);
     check_header(f, dim, where);
     ParticleTable t;
-    t.dim            = dim;
-    const auto n     = f.shape("volume").first;
-    t.position       = f.read_rows("position", 0, n);
-    t.volume         = f.read_rows("volume", 0, n);
-    t.material       = f.read_rows_u64("material_id", 0, n);
-    t.body           = f.read_rows_u64("body_id", 0, n);
+    t.dim        = dim;
+    const auto n = f.shape("volume").first;
+    t.position   = f.read_rows("position", 0, n);
+    t.volume     = f.read_rows("volume", 0, n);
+    t.material   = f.read_rows_u64("material_id", 0, n);
+    t.body       = f.read_rows_u64("body_id", 0, n);
     if (f.exists("stress"))
       t.stress = f.read_rows("stress", 0, n);
     for (std::uint64_t i = 0; i < n; ++i)

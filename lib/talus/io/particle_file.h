@@ -26,8 +26,16 @@ namespace talus::io
     std::vector<double>        volume;
     std::vector<std::uint64_t> material, body;
     std::vector<double>        stress; ///< empty or n_stress per point
-    std::size_t                size() const { return volume.size(); }
-    unsigned int               n_stress() const { return dim == 2 ? 4 : 6; }
+    std::size_t
+    size() const
+    {
+      return volume.size();
+    }
+    unsigned int
+    n_stress() const
+    {
+      return dim == 2 ? 4 : 6;
+    }
   };
 
   /// Collective: rank 0 passes the complete table, the other ranks an empty one
@@ -38,8 +46,8 @@ namespace talus::io
   /// whether it has stresses, and the number of rows per body id.
   struct ParticleFileInfo
   {
-    unsigned int               dim = 0;
-    std::uint64_t              n   = 0;
+    unsigned int               dim        = 0;
+    std::uint64_t              n          = 0;
     bool                       has_stress = false;
     std::vector<std::uint64_t> rows_per_body;
     std::uint64_t              max_material = 0;
@@ -52,6 +60,5 @@ namespace talus::io
                                       const std::string &where);
 
   /// The complete table on every rank (collective).
-  ParticleTable read_particle_file(const std::string &path, unsigned int dim, MPI_Comm comm,
-                                   const std::string &where);
+  ParticleTable read_particle_file(const std::string &path, unsigned int dim, MPI_Comm comm, const std::string &where);
 } // namespace talus::io

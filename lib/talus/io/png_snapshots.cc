@@ -25,11 +25,27 @@ namespace talus::io
   namespace
   {
     // the field names of talus-plot (tools/talus-plot, FIELDS)
-    const std::vector<std::string> png_fields = {
-      "displacement magnitude", "displacement x", "displacement y", "displacement z", "velocity magnitude",
-      "velocity x", "velocity y", "velocity z", "stress xx", "stress yy", "stress zz", "stress xy", "stress yz",
-      "stress xz", "mean stress", "von mises stress", "pore pressure", "plastic strain", "material id",
-      "body id", "free surface"};
+    const std::vector<std::string> png_fields = {"displacement magnitude",
+                                                 "displacement x",
+                                                 "displacement y",
+                                                 "displacement z",
+                                                 "velocity magnitude",
+                                                 "velocity x",
+                                                 "velocity y",
+                                                 "velocity z",
+                                                 "stress xx",
+                                                 "stress yy",
+                                                 "stress zz",
+                                                 "stress xy",
+                                                 "stress yz",
+                                                 "stress xz",
+                                                 "mean stress",
+                                                 "von mises stress",
+                                                 "pore pressure",
+                                                 "plastic strain",
+                                                 "material id",
+                                                 "body id",
+                                                 "free surface"};
 
     std::filesystem::path
     plot_tool()
@@ -48,7 +64,7 @@ namespace talus::io
       std::string rest = path;
       for (std::size_t b = 0; b <= rest.size();)
         {
-          const std::size_t e = std::min(rest.find(':', b), rest.size());
+          const std::size_t e   = std::min(rest.find(':', b), rest.size());
           const std::string dir = rest.substr(b, e - b);
           if (!dir.empty() && access((dir + "/" + name).c_str(), X_OK) == 0)
             return true;
@@ -113,7 +129,7 @@ namespace talus::io
         prm.leave_subsection();
         // fields.txt: what the generic VTU names (history_k) mean per material
         AtomicFile f(dir + "/fields.txt");
-        auto &     s = f.stream();
+        auto      &s = f.stream();
         s << "# talus: meaning of the particle fields of this run (read by talus-plot)\n"
           << "dimension = " << prm.get("dimension") << "\n";
         // FEM / UL-FEM points are drawn at X + u; families without the entry
@@ -125,7 +141,8 @@ namespace talus::io
             integration = prm.get({"numerics"}, "integration");
           }
         catch (const dealii::ExceptionBase &)
-          {}
+          {
+          }
         if (integration.empty()) // deal.II 9.4 answers "" for an entry a path does not declare
           integration = "mpm";
         s << "integration = " << integration << "\n";
@@ -152,11 +169,10 @@ namespace talus::io
     if (mode == "none" || mode.empty())
       return;
 
-    const std::string tool = plot_tool().string();
+    const std::string        tool = plot_tool().string();
     std::vector<std::string> args = {tool, "--run-directory=" + dir,
-                                     std::string("--frames=") + (mode == "final" ? "last" : "all"),
-                                     "--field=" + field};
-    std::vector<char *> argv;
+                                     std::string("--frames=") + (mode == "final" ? "last" : "all"), "--field=" + field};
+    std::vector<char *>      argv;
     for (auto &a : args)
       argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -167,9 +183,9 @@ namespace talus::io
     int   rc     = posix_spawn(&pid, tool.c_str(), nullptr, nullptr, argv.data(), environ);
     if (rc == 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0)
       return;
-    const std::string why = rc != 0 ? "could not start " + tool + " (" + std::strerror(rc) + ")" :
-                            WIFEXITED(status) ? "talus-plot exited with status " + std::to_string(WEXITSTATUS(status)) :
-                                                std::string("talus-plot was killed");
+    const std::string why = rc != 0             ? "could not start " + tool + " (" + std::strerror(rc) + ")"
+                            : WIFEXITED(status) ? "talus-plot exited with status " + std::to_string(WEXITSTATUS(status))
+                                                : std::string("talus-plot was killed");
     std::cerr << "talus: warning: output/png snapshots = " << mode << ": the pictures were not drawn: " << why
               << ". The run itself is complete (exit 0); its results are in " << dir << "/. Draw them later with "
               << tool << " " << dir << std::endl;

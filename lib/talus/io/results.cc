@@ -59,9 +59,9 @@ namespace talus::io
     if (f.get_int("version") != results_version)
       throw InputError("HDF5 file '" + path + "': results version " + std::to_string(f.get_int("version")) +
                        ", this tool reads version " + std::to_string(results_version));
-    r.dim         = static_cast<unsigned int>(f.get_int("dimension"));
-    r.integration = f.get_string("integration");
-    r.time        = f.get_double("time");
+    r.dim          = static_cast<unsigned int>(f.get_int("dimension"));
+    r.integration  = f.get_string("integration");
+    r.time         = f.get_double("time");
     r.series_names = split(f.get_string("series columns"), ',');
     for (const auto &n : r.series_names)
       r.series.push_back(f.read_all("series/" + n));
@@ -188,8 +188,8 @@ namespace talus::io
       if (Ta.empty() || Tb.empty())
         throw InputError("results file '" + (Ta.empty() ? a.path : b.path) + "': the series is empty");
       Accumulator acc;
-      acc.d.name = name;
-      const std::size_t nc = cols.size();
+      acc.d.name               = name;
+      const std::size_t nc     = cols.size();
       const auto        finish = [&]() {
         Difference d = acc.result();
         if (nc > 1 && d.n > 0) // rms over times of the vector length
@@ -268,8 +268,8 @@ namespace talus::io
       const Table &va = a.grid_vertices, &vb = b.grid_vertices;
       if (a.dim != b.dim || va.rows() != vb.rows())
         throw InputError("mismatched grids: '" + a.path + "' has " + std::to_string(va.rows()) + " nodes (" +
-                         std::to_string(a.dim) + "D), '" + b.path + "' has " + std::to_string(vb.rows()) +
-                         " nodes (" + std::to_string(b.dim) + "D); grid fields can only be compared on the same grid");
+                         std::to_string(a.dim) + "D), '" + b.path + "' has " + std::to_string(vb.rows()) + " nodes (" +
+                         std::to_string(b.dim) + "D); grid fields can only be compared on the same grid");
       double extent = 0;
       for (const double x : va.data)
         extent = std::max(extent, std::abs(x));
@@ -280,7 +280,7 @@ namespace talus::io
         x = std::round(x / tol);
       for (auto &x : rb.data)
         x = std::round(x / tol);
-      const auto pa = sorted_rows(ra), pb = sorted_rows(rb);
+      const auto                                       pa = sorted_rows(ra), pb = sorted_rows(rb);
       std::vector<std::pair<std::size_t, std::size_t>> r;
       for (std::size_t k = 0; k < pa.size(); ++k)
         {
@@ -389,7 +389,7 @@ namespace talus::io
                 if ((q == "probe_displacements" && kind != "u") || (q == "probe_velocities" && kind != "v") ||
                     (q == "probe_stresses" && kind != "stress"))
                   continue;
-                const auto              cols = series_matching(std::regex(pattern));
+                const auto               cols = series_matching(std::regex(pattern));
                 std::vector<std::string> ids;
                 for (const auto &c : cols)
                   {
@@ -416,15 +416,16 @@ namespace talus::io
           {
             const auto [field, comp] = split_component(q.substr(5), {"displacement", "velocity", "stress", "mass"});
             if (field.empty())
-              throw InputError("unknown quantity '" + q + "' (allowed grid fields: grid:displacement, "
+              throw InputError("unknown quantity '" + q +
+                               "' (allowed grid fields: grid:displacement, "
                                "grid:velocity, grid:stress, grid:mass, optionally with a component: "
                                "grid:displacement_y, grid:stress_xx, ...)");
             const auto pairs = match_grids(a, b);
-            const auto pick  = [&](const Results &r) -> const Table & {
-              return field == "displacement" ? r.grid_displacement :
-                     field == "velocity"     ? r.grid_velocity :
-                     field == "stress"       ? r.grid_stress :
-                                               r.grid_mass;
+            const auto pick  = [&](const Results &r) -> const Table  &{
+              return field == "displacement" ? r.grid_displacement
+                      : field == "velocity"   ? r.grid_velocity
+                      : field == "stress"     ? r.grid_stress
+                                              : r.grid_mass;
             };
             int c = -1;
             if (!comp.empty())
@@ -452,7 +453,8 @@ namespace talus::io
             const auto [field, comp] = split_component(
               q.substr(10), {"initial_position", "position", "displacement", "velocity", "stress", "volume"});
             if (field.empty())
-              throw InputError("unknown quantity '" + q + "' (allowed particle fields: particles:position, "
+              throw InputError("unknown quantity '" + q +
+                               "' (allowed particle fields: particles:position, "
                                "particles:initial_position, particles:displacement, particles:velocity, "
                                "particles:stress, particles:volume)");
             if (a.particle_id.size() != b.particle_id.size())
@@ -474,12 +476,12 @@ namespace talus::io
                 pairs.emplace_back(pa[k], pb[k]);
               }
             const auto pick = [&](const Results &r) -> const Table & {
-              return field == "position"         ? r.particle_position :
-                     field == "initial_position" ? r.particle_initial_position :
-                     field == "displacement"     ? r.particle_displacement :
-                     field == "velocity"         ? r.particle_velocity :
-                     field == "stress"           ? r.particle_stress :
-                                                   r.particle_volume;
+              return field == "position"           ? r.particle_position
+                     : field == "initial_position" ? r.particle_initial_position
+                     : field == "displacement"     ? r.particle_displacement
+                     : field == "velocity"         ? r.particle_velocity
+                     : field == "stress"           ? r.particle_stress
+                                                   : r.particle_volume;
             };
             int c = -1;
             if (!comp.empty())
@@ -499,8 +501,8 @@ namespace talus::io
             std::string cols;
             for (const auto &n : a.series_names)
               cols += (cols.empty() ? "" : ", ") + n;
-            throw InputError("unknown quantity '" + q + "' (allowed: " + quantity_help() +
-                             "; series columns of '" + a.path + "': " + cols + ")");
+            throw InputError("unknown quantity '" + q + "' (allowed: " + quantity_help() + "; series columns of '" +
+                             a.path + "': " + cols + ")");
           }
       }
     return out;

@@ -17,7 +17,11 @@ namespace talus::io
   {
     std::vector<double> data;
     unsigned int        cols = 0;
-    std::size_t         rows() const { return cols ? data.size() / cols : 0; }
+    std::size_t
+    rows() const
+    {
+      return cols ? data.size() / cols : 0;
+    }
   };
 
   /// Content of a results file (read completely on the calling rank).
@@ -66,15 +70,15 @@ namespace talus::io
   struct Difference
   {
     std::string name;
-    std::size_t n      = 0;
-    double      l2     = 0; ///< rms(a - b)
-    double      linf   = 0; ///< max |a - b|
-    double      ref_l2 = 0; ///< rms(b)
+    std::size_t n        = 0;
+    double      l2       = 0; ///< rms(a - b)
+    double      linf     = 0; ///< max |a - b|
+    double      ref_l2   = 0; ///< rms(b)
     double      ref_linf = 0; ///< max |b|
     double      relative_l2() const;
     double      relative_linf() const;
     /// the value the tolerance is checked against
-    double      value(CompareOptions::Norm norm) const;
+    double value(CompareOptions::Norm norm) const;
   };
 
   /// Compare a with b (reference). InputError for an unknown quantity (naming

@@ -11,11 +11,8 @@ namespace talus::io
 {
   template <int patch_dim, int spacedim>
   std::string
-  write_vtu_atomic(const dealii::DataOutInterface<patch_dim, spacedim> &out,
-                   const std::string &                                  directory,
-                   const std::string &                                  base,
-                   const unsigned int                                   counter,
-                   MPI_Comm                                             comm)
+  write_vtu_atomic(const dealii::DataOutInterface<patch_dim, spacedim> &out, const std::string &directory,
+                   const std::string &base, const unsigned int counter, MPI_Comm comm)
   {
     const unsigned int rank   = dealii::Utilities::MPI::this_mpi_process(comm);
     const unsigned int n_rank = dealii::Utilities::MPI::n_mpi_processes(comm);

@@ -19,9 +19,6 @@ namespace talus::io
   /// <base>_<counter>.pvtu (same names as deal.II's
   /// write_vtu_with_pvtu_record). Collective. Returns the PVTU file name.
   template <int patch_dim, int spacedim>
-  std::string write_vtu_atomic(const dealii::DataOutInterface<patch_dim, spacedim> &out,
-                               const std::string &directory,
-                               const std::string &base,
-                               const unsigned int counter,
-                               MPI_Comm           comm);
+  std::string write_vtu_atomic(const dealii::DataOutInterface<patch_dim, spacedim> &out, const std::string &directory,
+                               const std::string &base, const unsigned int counter, MPI_Comm comm);
 } // namespace talus::io

@@ -16,12 +16,9 @@ namespace talus::loads
 
   template <int dim>
   dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<dim> &           grid,
-                   const NodalSpace<dim> &               space,
-                   const std::vector<unsigned char> &    flags,
-                   const std::vector<PrescribedNodeDof> *prescribed,
-                   const std::vector<double> *           values,
-                   const std::vector<dealii::types::global_dof_index> *contact)
+  wall_constraints(const BackgroundGrid<dim> &grid, const NodalSpace<dim> &space,
+                   const std::vector<unsigned char> &flags, const std::vector<PrescribedNodeDof> *prescribed,
+                   const std::vector<double> *values, const std::vector<dealii::types::global_dof_index> *contact)
   {
     dealii::AffineConstraints<double> walls;
     walls.reinit(space.locally_relevant_dofs());
@@ -43,7 +40,7 @@ namespace talus::loads
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
           for (unsigned int k = 0; k < dim; ++k)
             {
-              const auto &       cc = grid.cells[cell->active_cell_index()];
+              const auto        &cc = grid.cells[cell->active_cell_index()];
               const unsigned int g  = cc.dofs[v * dim + k];
               if (g == dealii::numbers::invalid_unsigned_int || !flags[g])
                 continue;
@@ -63,9 +60,8 @@ namespace talus::loads
 
   template <int dim>
   std::vector<ContactNode>
-  contact_wall_nodes(const BackgroundGrid<dim> &                     grid,
-                     const std::vector<dealii::types::boundary_id> &ids,
-                     const std::vector<unsigned char> &             wall_flags)
+  contact_wall_nodes(const BackgroundGrid<dim> &grid, const std::vector<dealii::types::boundary_id> &ids,
+                     const std::vector<unsigned char> &wall_flags)
   {
     std::vector<ContactNode> nodes;
     if (ids.empty())
@@ -88,7 +84,7 @@ namespace talus::loads
             const unsigned int axis = f / 2; // box: faces 2d, 2d+1 normal to d
             for (unsigned int v = 0; v < dealii::GeometryInfo<dim>::vertices_per_face; ++v)
               {
-                const unsigned int node = grid.partitioner->global_to_local(cell->face(f)->vertex_dof_index(v, 0));
+                const unsigned int node   = grid.partitioner->global_to_local(cell->face(f)->vertex_dof_index(v, 0));
                 const unsigned int normal = grid.partitioner->global_to_local(cell->face(f)->vertex_dof_index(v, axis));
                 if (seen[node] || wall_flags[normal])
                   continue;
@@ -102,13 +98,12 @@ namespace talus::loads
 
   template <int dim>
   std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<dim> &                 grid,
-                       const std::vector<PrescribedVelocity<dim>> &conditions,
-                       const bool                                  owned_only)
+  prescribed_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<PrescribedVelocity<dim>> &conditions,
+                       const bool owned_only)
   {
-    using Target               = typename PrescribedVelocity<dim>::Target;
-    const unsigned int n_owned = grid.partitioner->locally_owned_size();
-    const unsigned int n_local = owned_only ? n_owned : n_owned + grid.partitioner->n_ghost_indices();
+    using Target                           = typename PrescribedVelocity<dim>::Target;
+    const unsigned int             n_owned = grid.partitioner->locally_owned_size();
+    const unsigned int             n_local = owned_only ? n_owned : n_owned + grid.partitioner->n_ghost_indices();
     std::vector<PrescribedNodeDof> out;
     std::vector<unsigned char>     seen(n_local, 0);
     for (unsigned int j = 0; j < conditions.size(); ++j)
@@ -158,30 +153,26 @@ namespace talus::loads
     return out;
   }
 
-  template std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<2> &, const std::vector<PrescribedVelocity<2>> &, const bool);
-  template std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<3> &, const std::vector<PrescribedVelocity<3>> &, const bool);
-  template std::vector<ContactNode> contact_wall_nodes(const BackgroundGrid<2> &,
-                                                       const std::vector<dealii::types::boundary_id> &,
-                                                       const std::vector<unsigned char> &);
-  template std::vector<ContactNode> contact_wall_nodes(const BackgroundGrid<3> &,
-                                                       const std::vector<dealii::types::boundary_id> &,
-                                                       const std::vector<unsigned char> &);
+  template std::vector<PrescribedNodeDof> prescribed_node_dofs(const BackgroundGrid<2> &,
+                                                               const std::vector<PrescribedVelocity<2>> &, const bool);
+  template std::vector<PrescribedNodeDof> prescribed_node_dofs(const BackgroundGrid<3> &,
+                                                               const std::vector<PrescribedVelocity<3>> &, const bool);
+  template std::vector<ContactNode>       contact_wall_nodes(const BackgroundGrid<2> &,
+                                                             const std::vector<dealii::types::boundary_id> &,
+                                                             const std::vector<unsigned char> &);
+  template std::vector<ContactNode>       contact_wall_nodes(const BackgroundGrid<3> &,
+                                                             const std::vector<dealii::types::boundary_id> &,
+                                                             const std::vector<unsigned char> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<2> &, const std::vector<BoundaryCondition> &);
   template std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<3> &, const std::vector<BoundaryCondition> &);
-  template dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<2> &,
-                   const NodalSpace<2> &,
-                   const std::vector<unsigned char> &,
-                   const std::vector<PrescribedNodeDof> *,
-                   const std::vector<double> *,
-                   const std::vector<dealii::types::global_dof_index> *);
-  template dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<3> &,
-                   const NodalSpace<3> &,
-                   const std::vector<unsigned char> &,
-                   const std::vector<PrescribedNodeDof> *,
-                   const std::vector<double> *,
-                   const std::vector<dealii::types::global_dof_index> *);
+  template dealii::AffineConstraints<double> wall_constraints(const BackgroundGrid<2> &, const NodalSpace<2> &,
+                                                              const std::vector<unsigned char> &,
+                                                              const std::vector<PrescribedNodeDof> *,
+                                                              const std::vector<double> *,
+                                                              const std::vector<dealii::types::global_dof_index> *);
+  template dealii::AffineConstraints<double> wall_constraints(const BackgroundGrid<3> &, const NodalSpace<3> &,
+                                                              const std::vector<unsigned char> &,
+                                                              const std::vector<PrescribedNodeDof> *,
+                                                              const std::vector<double> *,
+                                                              const std::vector<dealii::types::global_dof_index> *);
 } // namespace talus::loads

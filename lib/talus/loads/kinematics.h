@@ -35,8 +35,7 @@ namespace talus::loads
   /// velocity component is prescribed zero by one of the conditions. Throws
   /// InputError naming 'boundary conditions' for a boundary id the grid lacks.
   template <int dim>
-  std::vector<unsigned char>
-  wall_dof_flags(const BackgroundGrid<dim> &grid, const std::vector<BoundaryCondition> &bcs);
+  std::vector<unsigned char> wall_dof_flags(const BackgroundGrid<dim> &grid, const std::vector<BoundaryCondition> &bcs);
 
   /// The flagged DoFs as homogeneous constraints on `space` (a vector space on
   /// the grid's triangulation, whose node_dof maps the grid's DoFs), closed.
@@ -48,11 +47,9 @@ namespace talus::loads
   /// are homogeneous.
   template <int dim>
   dealii::AffineConstraints<double>
-  wall_constraints(const BackgroundGrid<dim> &           grid,
-                   const NodalSpace<dim> &               space,
-                   const std::vector<unsigned char> &    flags,
-                   const std::vector<PrescribedNodeDof> *prescribed = nullptr,
-                   const std::vector<double> *           values     = nullptr,
+  wall_constraints(const BackgroundGrid<dim> &grid, const NodalSpace<dim> &space,
+                   const std::vector<unsigned char> &flags, const std::vector<PrescribedNodeDof> *prescribed = nullptr,
+                   const std::vector<double>                          *values  = nullptr,
                    const std::vector<dealii::types::global_dof_index> *contact = nullptr);
 
   /// One grid node of a unilateral contact wall (talus-implicit's 'boundary
@@ -72,10 +69,9 @@ namespace talus::loads
   /// `wall_flags` (fixed/roller walls: they win at shared corners) is left out.
   /// Throws InputError naming 'boundary conditions/contact' for an id the grid lacks.
   template <int dim>
-  std::vector<ContactNode>
-  contact_wall_nodes(const BackgroundGrid<dim> &                     grid,
-                     const std::vector<dealii::types::boundary_id> &ids,
-                     const std::vector<unsigned char> &             wall_flags);
+  std::vector<ContactNode> contact_wall_nodes(const BackgroundGrid<dim>                     &grid,
+                                              const std::vector<dealii::types::boundary_id> &ids,
+                                              const std::vector<unsigned char>              &wall_flags);
 
   /// The node DoFs reached by the grid-node conditions of `conditions` (target
   /// boundary: the nodes of the faces with that id; region: the nodes inside
@@ -84,8 +80,7 @@ namespace talus::loads
   /// distributed assembly must be known on the ghosts too). Body conditions
   /// (on material points) are skipped. Each node is listed once per condition.
   template <int dim>
-  std::vector<PrescribedNodeDof>
-  prescribed_node_dofs(const BackgroundGrid<dim> &                 grid,
-                       const std::vector<PrescribedVelocity<dim>> &conditions,
-                       const bool                                  owned_only = true);
+  std::vector<PrescribedNodeDof> prescribed_node_dofs(const BackgroundGrid<dim>                  &grid,
+                                                      const std::vector<PrescribedVelocity<dim>> &conditions,
+                                                      const bool                                  owned_only = true);
 } // namespace talus::loads

@@ -24,11 +24,9 @@ namespace talus::loads
 
   template <int dim>
   void
-  PointForces<dim>::assign(const std::vector<Traction<dim>> &       tractions,
-                           MaterialPointSet<dim> &                  points,
-                           const BackgroundGrid<dim> &              grid,
-                           const std::vector<BodyDescription<dim>> &bodies,
-                           MPI_Comm                                 comm)
+  PointForces<dim>::assign(const std::vector<Traction<dim>> &tractions, MaterialPointSet<dim> &points,
+                           const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+                           MPI_Comm comm)
   {
     // Each point gets the share A_p of the loaded area proportional to V_p /
     // spacing normal to the face (regular seeding: the area of its sub-cell
@@ -55,7 +53,7 @@ namespace talus::loads
           return X;
         };
         const auto spacing = [&](const auto &pt) {
-          const auto &       cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+          const auto        &cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
           const unsigned int b  = static_cast<unsigned int>(pt.get_properties()[L::body]);
           return cc.h[t.axis] / bodies[b].particles_per_direction;
         };
@@ -116,10 +114,8 @@ namespace talus::loads
 
   template <int dim>
   void
-  PointForces<dim>::update_factors(const std::vector<Traction<dim>> &tractions,
-                                   const unsigned int                n_global,
-                                   const double                      t,
-                                   const double                      stage_t0)
+  PointForces<dim>::update_factors(const std::vector<Traction<dim>> &tractions, const unsigned int n_global,
+                                   const double t, const double stage_t0)
   {
     const unsigned int nt = tractions.size();
     factor.resize(nt);

@@ -25,9 +25,17 @@ namespace talus::loads
     /// Add `n_slots` blocks of dim doubles (point_force_j) to the layout;
     /// before the ParticleHandler is initialised.
     void extend_layout(PropertyLayout<dim> &layout, const unsigned int n_slots);
-    unsigned int n_slots() const { return slots; }
+    unsigned int
+    n_slots() const
+    {
+      return slots;
+    }
     /// Offset of the first block (slot j at + j dim).
-    unsigned int offset() const { return force_offset; }
+    unsigned int
+    offset() const
+    {
+      return force_offset;
+    }
 
     /// Select the points of every traction by their initial position X = x - u
     /// (the outermost layer of a box body on the face, or the points in a
@@ -36,26 +44,33 @@ namespace talus::loads
     /// exactly traction x area) and store t_j A_p in slot j; other slots 0.
     /// Logs one line per traction; a traction selecting no point is an
     /// InputError. Collective.
-    void assign(const std::vector<Traction<dim>> &      tractions,
-                MaterialPointSet<dim> &                 points,
-                const BackgroundGrid<dim> &             grid,
-                const std::vector<BodyDescription<dim>> &bodies,
-                MPI_Comm                                comm);
+    void assign(const std::vector<Traction<dim>> &tractions, MaterialPointSet<dim> &points,
+                const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies, MPI_Comm comm);
 
     /// Time factors: traction j < n_global at the absolute time t, the others
     /// at the stage time t - stage_t0.
-    void update_factors(const std::vector<Traction<dim>> &tractions,
-                        const unsigned int                n_global,
-                        const double                      t,
-                        const double                      stage_t0);
+    void update_factors(const std::vector<Traction<dim>> &tractions, const unsigned int n_global, const double t,
+                        const double stage_t0);
 
     /// Time factors given by the caller, one per slot (a family that keeps the
     /// tractions of every stage in slots of their own and sets the others to 0).
-    void set_factors(std::vector<double> f) { factor = std::move(f); }
+    void
+    set_factors(std::vector<double> f)
+    {
+      factor = std::move(f);
+    }
 
     /// Whether the tractions of the last assign() were not empty.
-    bool any() const { return have_tractions; }
-    const std::vector<double> &factors() const { return factor; }
+    bool
+    any() const
+    {
+      return have_tractions;
+    }
+    const std::vector<double> &
+    factors() const
+    {
+      return factor;
+    }
 
     /// f_p at the time of the last update_factors (0 without tractions).
     void

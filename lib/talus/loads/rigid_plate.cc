@@ -54,8 +54,8 @@ namespace talus::loads
   RigidPlate<dim>::node_condition() const
   {
     PrescribedVelocity<dim> v;
-    v.target   = target == Target::boundary ? PrescribedVelocity<dim>::Target::boundary
-                                            : PrescribedVelocity<dim>::Target::region;
+    v.target =
+      target == Target::boundary ? PrescribedVelocity<dim>::Target::boundary : PrescribedVelocity<dim>::Target::region;
     v.boundary = boundary;
     v.lower    = lower;
     v.upper    = upper;
@@ -70,16 +70,17 @@ namespace talus::loads
   {
     if (prm_file.empty())
       return 0;
-    return dealii::Utilities::string_to_int(peek_entry(prm_file, "boundary conditions", "number of rigid plates", "0",
-                                                       Integer(0, max_rigid_plates)));
+    return dealii::Utilities::string_to_int(
+      peek_entry(prm_file, "boundary conditions", "number of rigid plates", "0", Integer(0, max_rigid_plates)));
   }
 
   void
   declare_rigid_plate_parameters(dealii::ParameterHandler &prm, const unsigned int dim, const unsigned int n)
   {
-    prm.declare_entry("number of rigid plates", "0", Integer(0, max_rigid_plates),
-                      "Number of 'rigid plate k' subsections: sets of grid nodes that move as one rigid body "
-                      "along one axis, driven by a total force or by a displacement history (docs/boundary-conditions.md).");
+    prm.declare_entry(
+      "number of rigid plates", "0", Integer(0, max_rigid_plates),
+      "Number of 'rigid plate k' subsections: sets of grid nodes that move as one rigid body "
+      "along one axis, driven by a total force or by a displacement history (docs/boundary-conditions.md).");
     for (unsigned int k = 0; k < n; ++k)
       {
         prm.enter_subsection("rigid plate " + std::to_string(k));
@@ -104,9 +105,10 @@ namespace talus::loads
         prm.declare_entry("time function", "constant", Anything(),
                           "Factor f(t) of the force or displacement (absolute time): constant | step T | ramp T1 | "
                           "ramp T0 T1 | table t0:f0, t1:f1, ... | table file NAME.csv.");
-        prm.declare_entry("drainage", "impermeable", Selection("impermeable|permeable"),
-                          "Two-phase families: 'permeable': the pore pressure is zero at the plate's nodes (the "
-                          "water drains through it); 'impermeable': no water crosses the plate. One-phase runs ignore it.");
+        prm.declare_entry(
+          "drainage", "impermeable", Selection("impermeable|permeable"),
+          "Two-phase families: 'permeable': the pore pressure is zero at the plate's nodes (the "
+          "water drains through it); 'impermeable': no water crosses the plate. One-phase runs ignore it.");
         prm.leave_subsection();
       }
   }
@@ -171,7 +173,8 @@ namespace talus::loads
 
   template <int dim>
   std::vector<PrescribedNodeDof>
-  rigid_plate_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<RigidPlate<dim>> &plates, const bool owned_only)
+  rigid_plate_node_dofs(const BackgroundGrid<dim> &grid, const std::vector<RigidPlate<dim>> &plates,
+                        const bool owned_only)
   {
     std::vector<PrescribedVelocity<dim>> conditions;
     for (const auto &p : plates)
@@ -233,7 +236,7 @@ namespace talus::loads
         bool free = true;
         for (unsigned int d = 0; d < dim; ++d)
           {
-            const int n     = static_cast<int>(cells[d]);
+            const int n        = static_cast<int>(cells[d]);
             bool      holds[2] = {false, false}; // the lower / upper face of axis d
             for (const auto &w : walls)
               if (w.id / 2 == d && w.id < 2 * dim)
@@ -297,7 +300,7 @@ namespace talus::loads
     std::vector<RigidPlateNodes> out(n);
     for (unsigned int k = 0; k < n; ++k)
       {
-        const auto &              pl = plates[k];
+        const auto               &pl = plates[k];
         const unsigned long long *c  = &count[k * nc];
         require(c[0] > 0, pl.where, no_node_message(pl));
         require(c[1] == 0, pl.where, shared_message(std::to_string(c[1])));
@@ -342,14 +345,14 @@ namespace talus::loads
 
   template struct RigidPlate<2>;
   template struct RigidPlate<3>;
-  template std::vector<RigidPlate<2>> parse_rigid_plate_parameters<2>(dealii::ParameterHandler &, bool);
-  template std::vector<RigidPlate<3>> parse_rigid_plate_parameters<3>(dealii::ParameterHandler &, bool);
+  template std::vector<RigidPlate<2>>     parse_rigid_plate_parameters<2>(dealii::ParameterHandler &, bool);
+  template std::vector<RigidPlate<3>>     parse_rigid_plate_parameters<3>(dealii::ParameterHandler &, bool);
   template std::vector<PrescribedNodeDof> rigid_plate_node_dofs(const BackgroundGrid<2> &,
                                                                 const std::vector<RigidPlate<2>> &, bool);
   template std::vector<PrescribedNodeDof> rigid_plate_node_dofs(const BackgroundGrid<3> &,
                                                                 const std::vector<RigidPlate<3>> &, bool);
-  template std::vector<std::string> rigid_plate_series_columns(const std::vector<RigidPlate<2>> &);
-  template std::vector<std::string> rigid_plate_series_columns(const std::vector<RigidPlate<3>> &);
+  template std::vector<std::string>       rigid_plate_series_columns(const std::vector<RigidPlate<2>> &);
+  template std::vector<std::string>       rigid_plate_series_columns(const std::vector<RigidPlate<3>> &);
   template void check_rigid_plates_on_box(const std::vector<RigidPlate<2>> &, const dealii::Point<2> &,
                                           const dealii::Point<2> &, const std::vector<unsigned int> &,
                                           const std::vector<BoundaryCondition> &);
@@ -357,13 +360,13 @@ namespace talus::loads
                                           const dealii::Point<3> &, const std::vector<unsigned int> &,
                                           const std::vector<BoundaryCondition> &);
   template std::vector<RigidPlateNodes> check_rigid_plate_nodes(const BackgroundGrid<2> &,
-                                                                 const std::vector<RigidPlate<2>> &,
-                                                                 const std::vector<std::vector<BoundaryCondition>> &,
-                                                                 const std::vector<std::string> &, MPI_Comm);
+                                                                const std::vector<RigidPlate<2>> &,
+                                                                const std::vector<std::vector<BoundaryCondition>> &,
+                                                                const std::vector<std::string> &, MPI_Comm);
   template std::vector<RigidPlateNodes> check_rigid_plate_nodes(const BackgroundGrid<3> &,
-                                                                 const std::vector<RigidPlate<3>> &,
-                                                                 const std::vector<std::vector<BoundaryCondition>> &,
-                                                                 const std::vector<std::string> &, MPI_Comm);
+                                                                const std::vector<RigidPlate<3>> &,
+                                                                const std::vector<std::vector<BoundaryCondition>> &,
+                                                                const std::vector<std::string> &, MPI_Comm);
   template std::string rigid_plate_log_line(const RigidPlate<2> &, unsigned int, const RigidPlateNodes &);
   template std::string rigid_plate_log_line(const RigidPlate<3> &, unsigned int, const RigidPlateNodes &);
   template void refuse_rigid_plates(const std::vector<RigidPlate<2>> &, const std::string &, const std::string &);

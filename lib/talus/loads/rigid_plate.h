@@ -45,8 +45,8 @@ namespace talus::loads
     Target                     target   = Target::boundary;
     dealii::types::boundary_id boundary = 0;
     dealii::Point<dim>         lower, upper;
-    unsigned int               axis  = dim - 1; ///< the plate moves along this grid axis
-    bool                       rough = false;   ///< tangential components held (else free)
+    unsigned int               axis    = dim - 1; ///< the plate moves along this grid axis
+    bool                       rough   = false;   ///< tangential components held (else free)
     Control                    control = Control::force;
     /// force control: the force the plate exerts on the material along +axis
     /// [N; per unit thickness in 2D] at f = 1 (e.g. -1e4 with axis y pushes down)
@@ -59,8 +59,16 @@ namespace talus::loads
     bool        permeable = false;
     std::string where; ///< 'boundary conditions/rigid plate k'
 
-    double force_at(const double t) const { return force * function.value(t); }
-    double displacement_at(const double t) const { return displacement * function.value(t); }
+    double
+    force_at(const double t) const
+    {
+      return force * function.value(t);
+    }
+    double
+    displacement_at(const double t) const
+    {
+      return displacement * function.value(t);
+    }
     /// The plate's nodes as a grid-node velocity condition (the `axis`
     /// component; every component if rough), for prescribed_node_dofs.
     PrescribedVelocity<dim> node_condition() const;
@@ -82,9 +90,9 @@ namespace talus::loads
   /// `PrescribedNodeDof::condition`: owned ones, or with owned_only = false all
   /// locally relevant ones.
   template <int dim>
-  std::vector<PrescribedNodeDof> rigid_plate_node_dofs(const BackgroundGrid<dim> &           grid,
+  std::vector<PrescribedNodeDof> rigid_plate_node_dofs(const BackgroundGrid<dim>          &grid,
                                                        const std::vector<RigidPlate<dim>> &plates,
-                                                       bool                                 owned_only = true);
+                                                       bool                                owned_only = true);
 
   /// The series.csv columns of the plates: plate_k_displacement (along its
   /// axis [m]), plate_k_force (the force the plate exerts on the material along
@@ -100,11 +108,9 @@ namespace talus::loads
   /// the plate's axis component at every node it holds (a wall keeps the
   /// components it holds). A family checks the same on its grid at setup.
   template <int dim>
-  void check_rigid_plates_on_box(const std::vector<RigidPlate<dim>> &       plates,
-                                 const dealii::Point<dim> &                 lower,
-                                 const dealii::Point<dim> &                 upper,
-                                 const std::vector<unsigned int> &          cells,
-                                 const std::vector<BoundaryCondition> &     walls);
+  void check_rigid_plates_on_box(const std::vector<RigidPlate<dim>> &plates, const dealii::Point<dim> &lower,
+                                 const dealii::Point<dim> &upper, const std::vector<unsigned int> &cells,
+                                 const std::vector<BoundaryCondition> &walls);
 
   /// InputError naming the first plate unless `plates` is empty: for a family
   /// (`tool`) that cannot honour a rigid plate, with `reason`.

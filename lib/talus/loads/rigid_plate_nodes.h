@@ -19,8 +19,8 @@ namespace talus::loads
   /// What check_rigid_plate_nodes counted of one plate (over the ranks).
   struct RigidPlateNodes
   {
-    unsigned long long nodes = 0;         ///< grid nodes it holds
-    std::vector<unsigned long long> held; ///< per stage: nodes whose axis component a wall holds
+    unsigned long long              nodes = 0; ///< grid nodes it holds
+    std::vector<unsigned long long> held;      ///< per stage: nodes whose axis component a wall holds
   };
 
   /// InputError naming 'boundary conditions/rigid plate k' when a plate holds
@@ -29,11 +29,10 @@ namespace talus::loads
   /// message when there are several stages) at every one of its nodes. Returns
   /// the counts for the family's log line. Collective.
   template <int dim>
-  std::vector<RigidPlateNodes> check_rigid_plate_nodes(const BackgroundGrid<dim> &                         grid,
-                                                       const std::vector<RigidPlate<dim>> &                plates,
+  std::vector<RigidPlateNodes> check_rigid_plate_nodes(const BackgroundGrid<dim>                         &grid,
+                                                       const std::vector<RigidPlate<dim>>                &plates,
                                                        const std::vector<std::vector<BoundaryCondition>> &stage_walls,
-                                                       const std::vector<std::string> &                   stage_names,
-                                                       MPI_Comm                                            comm);
+                                                       const std::vector<std::string> &stage_names, MPI_Comm comm);
 
   /// One line per plate for the setup log: target, node count (and how many a
   /// wall holds along the axis in the first stage), direction, surface, control.

@@ -19,7 +19,6 @@ namespace talus::loads
   {
 
 
-
     std::vector<dealii::types::boundary_id>
     ids(const std::string &text, const std::string &where, const unsigned int dim)
     {
@@ -42,18 +41,20 @@ namespace talus::loads
     declare_loads(dealii::ParameterHandler &prm, const std::string &prm_file, const std::string &path,
                   const unsigned int dim, const bool with_velocities = true)
     {
-      const unsigned int n_tr = dealii::Utilities::string_to_int(
-        peek_entry(prm_file, path, "number of tractions", "0", Integer(0, 16)));
-      const unsigned int n_v = with_velocities ? dealii::Utilities::string_to_int(peek_entry(
-                                                   prm_file, path, "number of velocity conditions", "0", Integer(0, 16)))
-                                               : 0;
+      const unsigned int n_tr =
+        dealii::Utilities::string_to_int(peek_entry(prm_file, path, "number of tractions", "0", Integer(0, 16)));
+      const unsigned int n_v = with_velocities
+                                 ? dealii::Utilities::string_to_int(
+                                     peek_entry(prm_file, path, "number of velocity conditions", "0", Integer(0, 16)))
+                                 : 0;
       prm.enter_subsection("loads");
       prm.declare_entry("number of tractions", "0", Integer(0, 16),
                         "Number of 'traction k' subsections: surface tractions carried by boundary material "
                         "points (seed 000 §4.3.2, §5.2).");
       if (with_velocities)
-        prm.declare_entry("number of velocity conditions", "0", Integer(0, 16),
-                          "Number of 'velocity k' subsections: prescribed velocities on grid nodes or material points.");
+        prm.declare_entry(
+          "number of velocity conditions", "0", Integer(0, 16),
+          "Number of 'velocity k' subsections: prescribed velocities on grid nodes or material points.");
       for (unsigned int k = 0; k < n_tr; ++k)
         {
           prm.enter_subsection("traction " + std::to_string(k));
@@ -67,7 +68,8 @@ namespace talus::loads
           prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
           prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
           prm.declare_entry("traction", zeros_text(dim), Anything(),
-                            "Traction vector [Pa], force per unit initial area of the face (e.g. 0, -1e4 pushes down); direction and size do not follow the deformation (seed 000 §5.2).");
+                            "Traction vector [Pa], force per unit initial area of the face (e.g. 0, -1e4 pushes down); "
+                            "direction and size do not follow the deformation (seed 000 §5.2).");
           prm.declare_entry("total force", "", Anything(),
                             "Instead of 'traction': the resultant force [N; per unit thickness in 2D] spread over "
                             "the selected points in proportion to their area shares (traction = total force / loaded "
@@ -87,9 +89,9 @@ namespace talus::loads
           prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
           prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
           prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body).");
-          prm.declare_entry("components", "all", Anything(),
-                            "Prescribed components: 'all' or a list of x, y, z.");
-          prm.declare_entry("velocity", zeros_text(dim), Anything(), "Velocity vector [m/s] (unprescribed components ignored).");
+          prm.declare_entry("components", "all", Anything(), "Prescribed components: 'all' or a list of x, y, z.");
+          prm.declare_entry("velocity", zeros_text(dim), Anything(),
+                            "Velocity vector [m/s] (unprescribed components ignored).");
           prm.declare_entry("time function", "constant", Anything(), "Factor f(t), as for tractions.");
           prm.leave_subsection();
         }
@@ -109,8 +111,8 @@ namespace talus::loads
         {
           const std::string where = base + "/traction " + std::to_string(k);
           prm.enter_subsection("traction " + std::to_string(k));
-          Traction<dim>     t;
-          t.where            = where;
+          Traction<dim> t;
+          t.where             = where;
           const std::string f = prm.get("face");
           t.axis              = static_cast<unsigned int>(f[0] - 'x');
           t.side              = f[1] == '+' ? +1 : -1;
@@ -120,11 +122,10 @@ namespace talus::loads
             {
               t.body = prm.get_integer("body");
               require(t.body < bodies.size(), where + "/body",
-                      "body " + std::to_string(t.body) + " is not defined (number of bodies = " +
-                        std::to_string(bodies.size()) + ")");
+                      "body " + std::to_string(t.body) +
+                        " is not defined (number of bodies = " + std::to_string(bodies.size()) + ")");
               require(bodies[t.body].shape == BodyDescription<dim>::Shape::box, where + "/apply to",
-                      "'body face' needs a box body (body " + std::to_string(t.body) +
-                        " is not a box); use 'region'");
+                      "'body face' needs a box body (body " + std::to_string(t.body) + " is not a box); use 'region'");
             }
           else
             {
@@ -156,8 +157,8 @@ namespace talus::loads
           const std::string a = prm.get("apply to");
           if (a == "boundary")
             {
-              v.target                = PrescribedVelocity<dim>::Target::boundary;
-              const unsigned int b    = prm.get_integer("boundary id");
+              v.target             = PrescribedVelocity<dim>::Target::boundary;
+              const unsigned int b = prm.get_integer("boundary id");
               require(b < 2 * dim, where + "/boundary id",
                       "boundary id " + std::to_string(b) + " does not exist (box grid ids 0.." +
                         std::to_string(2 * dim - 1) + ")");
@@ -177,8 +178,8 @@ namespace talus::loads
               v.target = PrescribedVelocity<dim>::Target::body;
               v.body   = prm.get_integer("body");
               require(v.body < bodies.size(), where + "/body",
-                      "body " + std::to_string(v.body) + " is not defined (number of bodies = " +
-                        std::to_string(bodies.size()) + ")");
+                      "body " + std::to_string(v.body) +
+                        " is not defined (number of bodies = " + std::to_string(bodies.size()) + ")");
             }
           const std::string comps = prm.get("components");
           for (unsigned int d = 0; d < dim; ++d)
@@ -220,7 +221,8 @@ namespace talus::loads
                           std::string(stage ? " -1: as the top-level 'mass scaling'." : ""));
       prm.leave_subsection();
       prm.enter_subsection("convergence");
-      prm.declare_entry("enabled", stage ? "inherit" : "false", stage ? Selection("inherit|true|false") : Selection("true|false"),
+      prm.declare_entry("enabled", stage ? "inherit" : "false",
+                        stage ? Selection("inherit|true|false") : Selection("true|false"),
                         "Evaluate the quasi-static convergence ratios of seed 000 §6.4: force ratio "
                         "|f_ext - f_int| / |f_ext| over the free DoFs (Eq. 6.29) and energy ratio KE / W_ext "
                         "(Eq. 6.30, W_ext = work of gravity and loads since the stage start).");
@@ -229,7 +231,8 @@ namespace talus::loads
       prm.declare_entry("check interval", stage ? "0" : "10", Integer(0),
                         "Steps between evaluations (an MPI reduction each)." +
                           std::string(stage ? " 0: inherit." : ""));
-      prm.declare_entry("end stage", stage ? "inherit" : "true", stage ? Selection("inherit|true|false") : Selection("true|false"),
+      prm.declare_entry("end stage", stage ? "inherit" : "true",
+                        stage ? Selection("inherit|true|false") : Selection("true|false"),
                         "End the stage (the run, if it is the last) once both ratios are below their tolerances "
                         "and every load of the stage has reached its final value.");
       prm.leave_subsection();
@@ -259,7 +262,7 @@ namespace talus::loads
         const std::string v = prm.get(e);
         return v == "inherit" ? inherited : v == "true";
       };
-      const Convergence c0 = base ? base->convergence : Convergence();
+      const Convergence c0    = base ? base->convergence : Convergence();
       s.convergence.enabled   = pick("enabled", c0.enabled);
       s.convergence.end_stage = pick("end stage", c0.end_stage);
       const double ft = prm.get_double("force ratio tolerance"), et = prm.get_double("energy ratio tolerance");
@@ -312,8 +315,8 @@ namespace talus::loads
       if (k.enabled)
         return true;
     for (const auto &s : stages)
-      if (!s.friction_ids.empty() || !s.tractions.empty() || !s.velocities.empty() || s.damping > 0 || s.viscous_damping > 0 ||
-          s.mass_scaling != 1.0 || s.convergence.enabled)
+      if (!s.friction_ids.empty() || !s.tractions.empty() || !s.velocities.empty() || s.damping > 0 ||
+          s.viscous_damping > 0 || s.mass_scaling != 1.0 || s.convergence.enabled)
         return true;
     return false;
   }
@@ -326,8 +329,10 @@ namespace talus::loads
     prm.declare_entry("friction", "", Anything(),
                       "Boundary ids with frictional contact (seed 000 §6.2 against a rigid fixed boundary): "
                       "no penetration, free separation, Coulomb friction on the tangential velocity.");
-    prm.declare_entry("friction coefficient", "0", Double(0), "Coulomb friction coefficient mu of the 'friction' boundaries.");
-    prm.declare_entry("adhesion", "0", Double(0), "Adhesion a [Pa] of the 'friction' boundaries (Eq. 6.19: f_adh = a A_k).");
+    prm.declare_entry("friction coefficient", "0", Double(0),
+                      "Coulomb friction coefficient mu of the 'friction' boundaries.");
+    prm.declare_entry("adhesion", "0", Double(0),
+                      "Adhesion a [Pa] of the 'friction' boundaries (Eq. 6.19: f_adh = a A_k).");
     prm.leave_subsection();
     declare_loads(prm, prm_file, "loads", dim);
     declare_switches(prm, false);
@@ -343,7 +348,8 @@ namespace talus::loads
                           "Lateral stress ratio; 'auto' = 1 - sin(phi) for Mohr-Coulomb materials (error otherwise).");
         prm.declare_entry("surface level", "", Anything(),
                           "Level of the free surface along -g [m]; empty = top of this body.");
-        prm.declare_entry("surcharge", "0", Double(0), "Vertical pressure on the surface [Pa] (overburden of layers above).");
+        prm.declare_entry("surcharge", "0", Double(0),
+                          "Vertical pressure on the surface [Pa] (overburden of layers above).");
         prm.leave_subsection();
         prm.leave_subsection();
       }
@@ -352,10 +358,8 @@ namespace talus::loads
   }
 
   void
-  declare_stage_parameters(dealii::ParameterHandler &                            prm,
-                           const std::string &                                   prm_file,
-                           const unsigned int                                    dim,
-                           const bool                                            explicit_entries,
+  declare_stage_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim,
+                           const bool                                             explicit_entries,
                            const std::function<void(dealii::ParameterHandler &)> &family_entries)
   {
     const unsigned int n_stages =
@@ -368,7 +372,8 @@ namespace talus::loads
         const std::string name = "stage " + std::to_string(k);
         prm.enter_subsection(name);
         prm.declare_entry("name", name, Anything(), "Name used in messages.");
-        prm.declare_entry("duration", "1", Double(0), "Simulated duration of the stage [s] (it may end earlier by convergence).");
+        prm.declare_entry("duration", "1", Double(0),
+                          "Simulated duration of the stage [s] (it may end earlier by convergence).");
         prm.enter_subsection("gravity");
         prm.declare_entry("acceleration", "", Anything(), "Gravity of the stage; empty = the top-level gravity.");
         prm.leave_subsection();
@@ -394,10 +399,8 @@ namespace talus::loads
 
   template <int dim>
   std::vector<Stage<dim>>
-  parse_stages(dealii::ParameterHandler &               prm,
-               const Stage<dim> &                       top,
-               const std::vector<BodyDescription<dim>> &bodies,
-               const bool                               explicit_entries)
+  parse_stages(dealii::ParameterHandler &prm, const Stage<dim> &top, const std::vector<BodyDescription<dim>> &bodies,
+               const bool explicit_entries)
   {
     std::vector<Stage<dim>> stages;
     const unsigned int      n_stages = prm.get_integer("number of stages");
@@ -411,7 +414,8 @@ namespace talus::loads
         require(st.duration > 0, where + "/duration", "must be > 0");
         prm.enter_subsection("gravity");
         const std::string g = prm.get("acceleration");
-        st.gravity          = g.empty() ? top.gravity : dealii::Tensor<1, dim>(parse_point<dim>(g, where + "/gravity/acceleration"));
+        st.gravity =
+          g.empty() ? top.gravity : dealii::Tensor<1, dim>(parse_point<dim>(g, where + "/gravity/acceleration"));
         prm.leave_subsection();
         prm.enter_subsection("boundary conditions");
         const auto list = [&](const char *e, const std::vector<dealii::types::boundary_id> &inherited) {
@@ -453,10 +457,8 @@ namespace talus::loads
 
   template <int dim>
   Settings<dim>
-  parse_parameters(dealii::ParameterHandler &               prm,
-                   const double                             end_time,
-                   const dealii::Tensor<1, dim> &           gravity,
-                   const std::vector<BoundaryCondition> &   boundary_conditions,
+  parse_parameters(dealii::ParameterHandler &prm, const double end_time, const dealii::Tensor<1, dim> &gravity,
+                   const std::vector<BoundaryCondition>    &boundary_conditions,
                    const std::vector<BodyDescription<dim>> &bodies)
   {
     Settings<dim> s;
@@ -499,10 +501,10 @@ namespace talus::loads
         const std::string where = "body " + std::to_string(k) + "/initial stress";
         prm.enter_subsection("body " + std::to_string(k));
         prm.enter_subsection("initial stress");
-        K0Stress  z;
-        z.enabled = prm.get_bool("K0 procedure");
+        K0Stress z;
+        z.enabled            = prm.get_bool("K0 procedure");
         const std::string k0 = prm.get("K0"), level = prm.get("surface level");
-        z.surcharge          = prm.get_double("surcharge");
+        z.surcharge = prm.get_double("surcharge");
         if (!level.empty())
           z.surface_level = parse_doubles(level, where + "/surface level").at(0);
         prm.leave_subsection();
@@ -545,19 +547,16 @@ namespace talus::loads
   }
 
   void
-  declare_traction_parameters(dealii::ParameterHandler &prm,
-                              const std::string &       prm_file,
-                              const unsigned int        dim,
-                              const bool                with_velocities)
+  declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim,
+                              const bool with_velocities)
   {
     declare_loads(prm, prm_file, "loads", dim, with_velocities);
   }
 
   template <int dim>
   std::vector<Traction<dim>>
-  parse_traction_parameters(dealii::ParameterHandler &               prm,
-                            const std::vector<BodyDescription<dim>> &bodies,
-                            std::vector<PrescribedVelocity<dim>> *   velocities)
+  parse_traction_parameters(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies,
+                            std::vector<PrescribedVelocity<dim>> *velocities)
   {
     std::vector<Traction<dim>> t;
     parse_loads<dim>(prm, "", bodies, t, velocities);
@@ -570,10 +569,10 @@ namespace talus::loads
   template std::vector<Traction<3>> parse_traction_parameters<3>(dealii::ParameterHandler &,
                                                                  const std::vector<BodyDescription<3>> &,
                                                                  std::vector<PrescribedVelocity<3>> *);
-  template std::vector<Stage<2>> parse_stages<2>(dealii::ParameterHandler &, const Stage<2> &,
-                                                  const std::vector<BodyDescription<2>> &, const bool);
-  template std::vector<Stage<3>> parse_stages<3>(dealii::ParameterHandler &, const Stage<3> &,
-                                                  const std::vector<BodyDescription<3>> &, const bool);
+  template std::vector<Stage<2>>    parse_stages<2>(dealii::ParameterHandler &, const Stage<2> &,
+                                                 const std::vector<BodyDescription<2>> &, const bool);
+  template std::vector<Stage<3>>    parse_stages<3>(dealii::ParameterHandler &, const Stage<3> &,
+                                                 const std::vector<BodyDescription<3>> &, const bool);
   template struct Settings<2>;
   template struct Settings<3>;
   template Settings<2> parse_parameters<2>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 2> &,

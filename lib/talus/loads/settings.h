@@ -64,28 +64,28 @@ namespace talus::loads
 
   struct Convergence
   {
-    bool         enabled            = false;
-    double       force_tolerance    = 1e-3; ///< F = |f_ext - f_int| / |f_ext| (Eq. 6.29)
-    double       energy_tolerance   = 1e-5; ///< E = KE / W_ext (Eq. 6.30)
-    unsigned int interval           = 10;   ///< steps between evaluations
-    bool         end_stage          = true;
+    bool         enabled          = false;
+    double       force_tolerance  = 1e-3; ///< F = |f_ext - f_int| / |f_ext| (Eq. 6.29)
+    double       energy_tolerance = 1e-5; ///< E = KE / W_ext (Eq. 6.30)
+    unsigned int interval         = 10;   ///< steps between evaluations
+    bool         end_stage        = true;
   };
 
   template <int dim>
   struct Stage
   {
-    std::string                              name;
-    double                                   duration = 1.0;
-    dealii::Tensor<1, dim>                   gravity;
-    std::vector<BoundaryCondition>           boundary_conditions;
-    std::vector<dealii::types::boundary_id>  friction_ids;
-    double                                   friction_coefficient = 0, adhesion = 0;
-    std::vector<Traction<dim>>               tractions;   ///< stage loads (stage time)
-    std::vector<PrescribedVelocity<dim>>     velocities;
-    double                                   damping      = 0; ///< local damping alpha
-    double                                   viscous_damping = 0; ///< mass-proportional alpha_v [1/s]
-    double                                   mass_scaling = 1; ///< beta
-    Convergence                              convergence;
+    std::string                             name;
+    double                                  duration = 1.0;
+    dealii::Tensor<1, dim>                  gravity;
+    std::vector<BoundaryCondition>          boundary_conditions;
+    std::vector<dealii::types::boundary_id> friction_ids;
+    double                                  friction_coefficient = 0, adhesion = 0;
+    std::vector<Traction<dim>>              tractions; ///< stage loads (stage time)
+    std::vector<PrescribedVelocity<dim>>    velocities;
+    double                                  damping         = 0; ///< local damping alpha
+    double                                  viscous_damping = 0; ///< mass-proportional alpha_v [1/s]
+    double                                  mass_scaling    = 1; ///< beta
+    Convergence                             convergence;
     /// number of leading tractions/velocities that are global loads (top-level
     /// 'loads', evaluated at the absolute time); the rest use the stage time
     unsigned int n_global_tractions = 0, n_global_velocities = 0;
@@ -103,8 +103,8 @@ namespace talus::loads
   struct Settings
   {
     bool                    staged = false;
-    std::vector<Stage<dim>> stages; ///< at least one
-    std::vector<K0Stress>   k0;     ///< per body
+    std::vector<Stage<dim>> stages;            ///< at least one
+    std::vector<K0Stress>   k0;                ///< per body
     unsigned int            max_tractions = 0; ///< point-force slots needed per material point
 
     /// Whether the run needs the load controller (false: the solver runs its
@@ -120,16 +120,14 @@ namespace talus::loads
   /// Only the 'loads' subsection with its 'traction k' entries and, with
   /// `with_velocities`, its 'velocity k' conditions (families without stages
   /// or damping: talus-implicit).
-  void declare_traction_parameters(dealii::ParameterHandler &prm,
-                                   const std::string &       prm_file,
-                                   unsigned int              dim,
-                                   bool                      with_velocities = false);
+  void declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
+                                   bool with_velocities = false);
   /// The tractions of declare_traction_parameters (global loads, absolute
   /// time) and, if `velocities` is given, the velocity conditions.
   template <int dim>
-  std::vector<Traction<dim>> parse_traction_parameters(dealii::ParameterHandler &               prm,
+  std::vector<Traction<dim>> parse_traction_parameters(dealii::ParameterHandler                &prm,
                                                        const std::vector<BodyDescription<dim>> &bodies,
-                                                       std::vector<PrescribedVelocity<dim>> *   velocities = nullptr);
+                                                       std::vector<PrescribedVelocity<dim>>    *velocities = nullptr);
 
   /// 'number of stages' and the 'stage k' subsections: name, duration, gravity,
   /// fixed/roller boundaries and the stage's own loads; `explicit_entries`
@@ -137,26 +135,21 @@ namespace talus::loads
   /// viscous damping, mass scaling, quasi-static convergence);
   /// `family_entries(prm)`, if given, declares a family's own entries inside
   /// every 'stage k'.
-  void declare_stage_parameters(dealii::ParameterHandler &                            prm,
-                                const std::string &                                   prm_file,
-                                unsigned int                                          dim,
-                                bool                                                  explicit_entries,
+  void declare_stage_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
+                                bool                                                   explicit_entries,
                                 const std::function<void(dealii::ParameterHandler &)> &family_entries = {});
   /// The 'stage k' subsections of declare_stage_parameters (empty when 'number
   /// of stages' is 0). `top`: the top-level stage, whose entries 'inherit' and
   /// -1 stand for and whose loads stay on as global loads in every stage.
   template <int dim>
-  std::vector<Stage<dim>> parse_stages(dealii::ParameterHandler &               prm,
-                                       const Stage<dim> &                       top,
-                                       const std::vector<BodyDescription<dim>> &bodies,
-                                       bool                                     explicit_entries);
+  std::vector<Stage<dim>> parse_stages(dealii::ParameterHandler &prm, const Stage<dim> &top,
+                                       const std::vector<BodyDescription<dim>> &bodies, bool explicit_entries);
 
   /// Parse after the solver has read its own entries (end time, gravity, the
   /// fixed/roller boundaries and the bodies, which are passed in).
   template <int dim>
-  Settings<dim> parse_parameters(dealii::ParameterHandler &               prm,
-                                 const double                             end_time,
-                                 const dealii::Tensor<1, dim> &           gravity,
-                                 const std::vector<BoundaryCondition> &   boundary_conditions,
+  Settings<dim> parse_parameters(dealii::ParameterHandler &prm, const double end_time,
+                                 const dealii::Tensor<1, dim>            &gravity,
+                                 const std::vector<BoundaryCondition>    &boundary_conditions,
                                  const std::vector<BodyDescription<dim>> &bodies);
 } // namespace talus::loads

@@ -24,7 +24,8 @@ namespace talus::loads
             return v;
         }
       catch (const std::exception &)
-        {}
+        {
+        }
       throw InputError(where + ": '" + s + "' is not a number in '" + text + "' (" + forms + ")");
     }
 
@@ -42,7 +43,7 @@ namespace talus::loads
   TimeFunction
   TimeFunction::parse(const std::string &text_in, const std::string &where)
   {
-    TimeFunction f;
+    TimeFunction      f;
     const std::string text = trim(text_in);
     f.source               = text.empty() ? "constant" : text;
     std::istringstream is(text);
@@ -78,7 +79,7 @@ namespace talus::loads
       {
         f.kind = Kind::table;
         std::vector<std::pair<std::string, std::string>> pairs;
-        const std::string rest = trim(text.substr(5));
+        const std::string                                rest = trim(text.substr(5));
         if (rest.rfind("file", 0) == 0 && rest.find(':') == std::string::npos)
           {
             const std::string name = trim(rest.substr(4));
@@ -93,8 +94,7 @@ namespace talus::loads
                   continue;
                 std::replace(line.begin(), line.end(), ';', ',');
                 const auto c = line.find(',');
-                require(c != std::string::npos, where, "table file '" + name + "': line '" + line +
-                                                         "' is not 't,f'");
+                require(c != std::string::npos, where, "table file '" + name + "': line '" + line + "' is not 't,f'");
                 const std::string a = trim(line.substr(0, c)), b = trim(line.substr(c + 1));
                 if (first)
                   {

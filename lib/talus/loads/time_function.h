@@ -27,7 +27,11 @@ namespace talus::loads
     double value(const double t) const;
     /// Time after which f no longer changes (0 for constant).
     double settle_time() const;
-    const std::string &text() const { return source; }
+    const std::string &
+    text() const
+    {
+      return source;
+    }
 
   private:
     enum class Kind
@@ -36,7 +40,7 @@ namespace talus::loads
       step,
       ramp,
       table
-    } kind = Kind::constant;
+    } kind                 = Kind::constant;
     double              t0 = 0, t1 = 0;
     std::vector<double> times, values;
     std::string         source = "constant";

@@ -14,9 +14,9 @@ namespace talus::materials
   class Bingham : public Material
   {
   public:
-    Bingham(const double young, const double poisson, const double bulk_modulus,
-            const double yield_stress, const double viscosity, const double max_viscosity,
-            const double cavitation_pressure, const std::string &where = "bingham");
+    Bingham(const double young, const double poisson, const double bulk_modulus, const double yield_stress,
+            const double viscosity, const double max_viscosity, const double cavitation_pressure,
+            const std::string &where = "bingham");
     Bingham(dealii::ParameterHandler &prm, const std::string &where);
 
     static void declare_parameters(dealii::ParameterHandler &prm);
@@ -25,19 +25,33 @@ namespace talus::materials
     /// recovery", see liquid_common.h)
     bool incremental_cavitation = true;
 
-    std::string  model_name() const override { return "bingham"; }
-    double       constrained_modulus() const override { return K + 4.0 * G / 3.0; }
-    double       dynamic_viscosity() const override { return mu_max; }
-    unsigned int n_history() const override { return 2; }
-    std::vector<std::string> history_names() const override
+    std::string
+    model_name() const override
+    {
+      return "bingham";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return K + 4.0 * G / 3.0;
+    }
+    double
+    dynamic_viscosity() const override
+    {
+      return mu_max;
+    }
+    unsigned int
+    n_history() const override
+    {
+      return 2;
+    }
+    std::vector<std::string>
+    history_names() const override
     {
       return {"volumetric strain", "effective viscosity"};
     }
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
     enum : unsigned int

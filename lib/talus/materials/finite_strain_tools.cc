@@ -58,16 +58,12 @@ namespace talus::materials::fs
     Sym2 r;
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = i; j < 3; ++j)
-        r[i][j] = y[0] * s.e[0][i] * s.e[0][j] + y[1] * s.e[1][i] * s.e[1][j] +
-                  y[2] * s.e[2][i] * s.e[2][j];
+        r[i][j] = y[0] * s.e[0][i] * s.e[0][j] + y[1] * s.e[1][i] * s.e[1][j] + y[2] * s.e[2][i] * s.e[2][j];
     return r;
   }
 
   Tensor4
-  isotropic_derivative(const Spectral &s,
-                       const double    y[3],
-                       const double    dydx[3][3],
-                       const double    rel_tol)
+  isotropic_derivative(const Spectral &s, const double y[3], const double dydx[3][3], const double rel_tol)
   {
     // M_A = e_A e_A^T, S_AB = sym(e_A e_B^T)
     double M[3][3][3];
@@ -78,7 +74,7 @@ namespace talus::materials::fs
     static const unsigned int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
     double                    S[3][3][3];
     double                    theta2[3];
-    const double scale = std::max({std::abs(s.x[0]), std::abs(s.x[1]), std::abs(s.x[2])});
+    const double              scale = std::max({std::abs(s.x[0]), std::abs(s.x[1]), std::abs(s.x[2])});
     for (unsigned int p = 0; p < 3; ++p)
       {
         const unsigned int A = pairs[p][0], B = pairs[p][1];
@@ -123,8 +119,7 @@ namespace talus::materials::fs
       for (unsigned int j = 0; j < 3; ++j)
         for (unsigned int k = 0; k < 3; ++k)
           for (unsigned int l = 0; l < 3; ++l)
-            r[i][j][k][l] =
-              2.0 * (D[i][j][k][0] * G[0][l] + D[i][j][k][1] * G[1][l] + D[i][j][k][2] * G[2][l]);
+            r[i][j][k][l] = 2.0 * (D[i][j][k][0] * G[0][l] + D[i][j][k][1] * G[1][l] + D[i][j][k][2] * G[2][l]);
     return r;
   }
 
@@ -133,16 +128,15 @@ namespace talus::materials::fs
   {
     const Tensor2 Fi  = invert(dF);
     const Tensor2 T   = tau;
-    const Tensor2 FiT = Fi * T;               // (dF^-1 tau)_lj
-    const Tensor2 TFt = T * transpose(Fi);    // (tau dF^-T)_il
+    const Tensor2 FiT = Fi * T;            // (dF^-1 tau)_lj
+    const Tensor2 TFt = T * transpose(Fi); // (tau dF^-T)_il
     Tensor4       r;
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = 0; j < 3; ++j)
         for (unsigned int k = 0; k < 3; ++k)
           for (unsigned int l = 0; l < 3; ++l)
             {
-              double v = c[i][j][k][0] * Fi[l][0] + c[i][j][k][1] * Fi[l][1] +
-                         c[i][j][k][2] * Fi[l][2];
+              double v = c[i][j][k][0] * Fi[l][0] + c[i][j][k][1] * Fi[l][1] + c[i][j][k][2] * Fi[l][2];
               if (i == k)
                 v += FiT[l][j];
               if (j == k)

@@ -26,8 +26,8 @@ namespace talus::materials::fs
   /// descending order: x[0] >= x[1] >= x[2]; e[A] are orthonormal.
   struct Spectral
   {
-    double                 x[3];
-    dealii::Tensor<1, 3>   e[3];
+    double               x[3];
+    dealii::Tensor<1, 3> e[3];
   };
   Spectral spectral_decomposition(const Sym2 &b);
 
@@ -43,10 +43,8 @@ namespace talus::materials::fs
   /// quotient is replaced by its analytic limit for symmetric functions of the
   /// eigenvalues, 1/2 [ (dy_A/dx_A - dy_A/dx_B) + (dy_B/dx_B - dy_B/dx_A) ],
   /// so the tangent is continuous at coincident eigenvalues (error O(rel_tol)).
-  Tensor4 isotropic_derivative(const Spectral &s,
-                               const double    y[3],
-                               const double    dydx[3][3],
-                               const double    rel_tol = 1e-8);
+  Tensor4 isotropic_derivative(const Spectral &s, const double y[3], const double dydx[3][3],
+                               const double rel_tol = 1e-8);
 
   /// For X = dF B dF^T (B fixed, symmetric) and D = dY/dX (symmetric in k,l):
   /// dY_ij / d dF_kl = 2 sum_n D_ijkn (dF B)_nl.

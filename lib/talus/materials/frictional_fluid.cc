@@ -5,22 +5,28 @@ namespace talus::materials
 {
   using namespace internal;
 
-  FrictionalFluid::FrictionalFluid(const double E_, const double nu_, const double K_,
-                                   const double phi_, const double mu_, const double mu_max_,
-                                   const double p_cav_, const std::string &where)
-    : E(E_), nu(nu_), K(K_), phi(phi_), mu(mu_), mu_max(mu_max_), p_cav(p_cav_)
+  FrictionalFluid::FrictionalFluid(const double E_, const double nu_, const double K_, const double phi_,
+                                   const double mu_, const double mu_max_, const double p_cav_,
+                                   const std::string &where)
+      : E(E_)
+      , nu(nu_)
+      , K(K_)
+      , phi(phi_)
+      , mu(mu_)
+      , mu_max(mu_max_)
+      , p_cav(p_cav_)
   {
     setup(where);
   }
 
   FrictionalFluid::FrictionalFluid(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
-    , K(prm.get_double("bulk modulus"))
-    , phi(prm.get_double("friction angle"))
-    , mu(prm.get_double("dynamic viscosity"))
-    , mu_max(prm.get_double("maximum viscosity"))
-    , p_cav(prm.get_double("cavitation threshold"))
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
+      , K(prm.get_double("bulk modulus"))
+      , phi(prm.get_double("friction angle"))
+      , mu(prm.get_double("dynamic viscosity"))
+      , mu_max(prm.get_double("maximum viscosity"))
+      , p_cav(prm.get_double("cavitation threshold"))
   {
     incremental_cavitation = prm.get("cavitation recovery") == "incremental";
     setup(where);
@@ -31,12 +37,10 @@ namespace talus::materials
   {
     check_isotropic_elasticity(E, nu, where);
     check_liquid_pressure_parameters(K, p_cav, where);
-    require(phi >= 0 && phi < 90,
-            where + "/friction angle",
+    require(phi >= 0 && phi < 90, where + "/friction angle",
             "must satisfy 0 <= phi < 90 degrees (got " + std::to_string(phi) + ")");
     require(mu >= 0, where + "/dynamic viscosity", "must be >= 0 (got " + std::to_string(mu) + ")");
-    require(mu_max > 0 && mu_max >= mu,
-            where + "/maximum viscosity",
+    require(mu_max > 0 && mu_max >= mu, where + "/maximum viscosity",
             "must be > 0 and >= the dynamic viscosity (got " + std::to_string(mu_max) + ")");
     G       = E / (2 * (1 + nu));
     sin_phi = std::sin(phi * M_PI / 180.0);
@@ -65,17 +69,14 @@ namespace talus::materials
   }
 
   void
-  FrictionalFluid::update_stress(const Strain &    d_eps,
-                                 const Spin &      d_omega,
-                                 const double      dt,
-                                 Stress &          sigma,
+  FrictionalFluid::update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                                  ArrayView<double> h) const
   {
     const Stress s_old = deviator(apply_jaumann_rotation(sigma, d_omega));
     const double p     = update_liquid_pressure(K, h[h_volumetric_strain], trace(d_eps), p_cav, incremental_cavitation);
     const double tau_y = std::max(p, 0.0) * sin_phi;
     double       mu_eff;
-    sigma = viscoplastic_deviator(s_old, d_eps, dt, G, tau_y, mu, mu_max, !(p > p_cav), mu_eff);
+    sigma                    = viscoplastic_deviator(s_old, d_eps, dt, G, tau_y, mu, mu_max, !(p > p_cav), mu_eff);
     h[h_effective_viscosity] = mu_eff;
     for (unsigned int i = 0; i < 3; ++i)
       sigma[i][i] -= p;

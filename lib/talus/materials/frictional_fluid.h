@@ -13,9 +13,8 @@ namespace talus::materials
   {
   public:
     FrictionalFluid(const double young, const double poisson, const double bulk_modulus,
-                    const double friction_angle_deg, const double viscosity,
-                    const double max_viscosity, const double cavitation_pressure,
-                    const std::string &where = "frictional fluid");
+                    const double friction_angle_deg, const double viscosity, const double max_viscosity,
+                    const double cavitation_pressure, const std::string &where = "frictional fluid");
     FrictionalFluid(dealii::ParameterHandler &prm, const std::string &where);
 
     static void declare_parameters(dealii::ParameterHandler &prm);
@@ -24,19 +23,33 @@ namespace talus::materials
     /// recovery", see liquid_common.h)
     bool incremental_cavitation = true;
 
-    std::string  model_name() const override { return "frictional fluid"; }
-    double       constrained_modulus() const override { return K + 4.0 * G / 3.0; }
-    double       dynamic_viscosity() const override { return mu_max; }
-    unsigned int n_history() const override { return 2; }
-    std::vector<std::string> history_names() const override
+    std::string
+    model_name() const override
+    {
+      return "frictional fluid";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return K + 4.0 * G / 3.0;
+    }
+    double
+    dynamic_viscosity() const override
+    {
+      return mu_max;
+    }
+    unsigned int
+    n_history() const override
+    {
+      return 2;
+    }
+    std::vector<std::string>
+    history_names() const override
     {
       return {"volumetric strain", "effective viscosity"};
     }
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
     enum : unsigned int

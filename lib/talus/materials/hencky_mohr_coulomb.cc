@@ -18,26 +18,23 @@ namespace talus::materials
     }
   } // namespace
 
-  HenckyMohrCoulomb::HenckyMohrCoulomb(const double young,
-                                       const double poisson,
-                                       const double cohesion,
-                                       const double friction_angle_deg,
-                                       const double dilatancy_angle_deg)
-    : E(young)
-    , nu(poisson)
-    , c(cohesion)
-    , phi(friction_angle_deg * M_PI / 180.0)
-    , psi(dilatancy_angle_deg * M_PI / 180.0)
+  HenckyMohrCoulomb::HenckyMohrCoulomb(const double young, const double poisson, const double cohesion,
+                                       const double friction_angle_deg, const double dilatancy_angle_deg)
+      : E(young)
+      , nu(poisson)
+      , c(cohesion)
+      , phi(friction_angle_deg * M_PI / 180.0)
+      , psi(dilatancy_angle_deg * M_PI / 180.0)
   {
     setup("hencky mohr coulomb");
   }
 
   HenckyMohrCoulomb::HenckyMohrCoulomb(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
-    , c(prm.get_double("cohesion"))
-    , phi(prm.get_double("friction angle") * M_PI / 180.0)
-    , psi(prm.get_double("dilatancy angle") * M_PI / 180.0)
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
+      , c(prm.get_double("cohesion"))
+      , phi(prm.get_double("friction angle") * M_PI / 180.0)
+      , psi(prm.get_double("dilatancy angle") * M_PI / 180.0)
   {
     setup(where);
   }
@@ -64,8 +61,7 @@ namespace talus::materials
   {
     prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(),
                       "Young's modulus E of the Hencky law [Pa], > 0.");
-    prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(),
-                      "Poisson's ratio nu [-], -1 < nu < 0.5.");
+    prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(), "Poisson's ratio nu [-], -1 < nu < 0.5.");
     prm.declare_entry("cohesion", "0", dealii::Patterns::Double(), "Cohesion c [Pa], >= 0.");
     prm.declare_entry("friction angle", "30", dealii::Patterns::Double(),
                       "Friction angle phi [degrees], 0 < phi < 90.");
@@ -76,8 +72,7 @@ namespace talus::materials
   std::vector<std::string>
   HenckyMohrCoulomb::history_names() const
   {
-    return {"be_xx", "be_yy", "be_zz", "be_xy", "be_yz", "be_xz", "J",
-            "accumulated plastic strain", "return region"};
+    return {"be_xx", "be_yy", "be_zz", "be_xy", "be_yz", "be_xz", "J", "accumulated plastic strain", "return region"};
   }
 
   double
@@ -134,9 +129,9 @@ namespace talus::materials
         return 1;
       }
     // 2. return to an edge: tau_1 = tau_2 (l1) or tau_2 = tau_3 (l2)
-    const bool   l1     = tp[1] > tp[0];
-    const double rl1[3] = {1, 1, k}, rg1[3] = {1, 1, m};
-    const double rl2[3] = {1, k, k}, rg2[3] = {1, m, m};
+    const bool    l1     = tp[1] > tp[0];
+    const double  rl1[3] = {1, 1, k}, rg1[3] = {1, 1, m};
+    const double  rl2[3] = {1, k, k}, rg2[3] = {1, m, m};
     const double *rl = l1 ? rl1 : rl2, *rg = l1 ? rg1 : rg2;
     double        dt[3], w[3], arl[3];
     for (unsigned int A = 0; A < 3; ++A)
@@ -166,17 +161,14 @@ namespace talus::materials
   }
 
   void
-  HenckyMohrCoulomb::finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                                          ArrayView<const double>     h_old,
-                                          ArrayView<double>           h_new,
-                                          Stress &                    tau,
-                                          dealii::Tensor<4, 3> *      dtau_ddF) const
+  HenckyMohrCoulomb::finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> h_old,
+                                          ArrayView<double> h_new, Stress &tau, dealii::Tensor<4, 3> *dtau_ddF) const
   {
-    const double detf = checked_increment_jacobian(dF, *this);
-    const Stress     b_n  = fs::load_sym(h_old, 0);
-    const Stress     b_tr = symmetrize(dF * dealii::Tensor<2, 3>(b_n) * transpose(dF));
-    const fs::Spectral sp = fs::spectral_decomposition(b_tr);
-    double e_tr[3], t[3], D[3][3];
+    const double       detf = checked_increment_jacobian(dF, *this);
+    const Stress       b_n  = fs::load_sym(h_old, 0);
+    const Stress       b_tr = symmetrize(dF * dealii::Tensor<2, 3>(b_n) * transpose(dF));
+    const fs::Spectral sp   = fs::spectral_decomposition(b_tr);
+    double             e_tr[3], t[3], D[3][3];
     for (unsigned int A = 0; A < 3; ++A)
       e_tr[A] = 0.5 * std::log(sp.x[A]);
     const int region = principal_return(e_tr, t, D);
@@ -224,14 +216,11 @@ namespace talus::materials
   }
 
   void
-  HenckyMohrCoulomb::update_stress(const Strain &    d_eps,
-                                   const Spin &      d_omega,
-                                   const double,
-                                   Stress &          sigma,
+  HenckyMohrCoulomb::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                                    ArrayView<double> history) const
   {
     const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
-    sigma = tau / kirchhoff_jacobian(history);
+    sigma            = tau / kirchhoff_jacobian(history);
   }
 
   double

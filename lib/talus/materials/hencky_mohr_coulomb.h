@@ -23,41 +23,49 @@ namespace talus::materials
   class HenckyMohrCoulomb : public Material
   {
   public:
-    HenckyMohrCoulomb(const double young,
-                      const double poisson,
-                      const double cohesion,
-                      const double friction_angle_deg,
+    HenckyMohrCoulomb(const double young, const double poisson, const double cohesion, const double friction_angle_deg,
                       const double dilatancy_angle_deg);
     HenckyMohrCoulomb(dealii::ParameterHandler &prm, const std::string &where);
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string model_name() const override { return "hencky mohr coulomb"; }
-    double      constrained_modulus() const override { return lambda + 2 * mu; }
+    std::string
+    model_name() const override
+    {
+      return "hencky mohr coulomb";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return lambda + 2 * mu;
+    }
 
-    unsigned int             n_history() const override { return 9; }
+    unsigned int
+    n_history() const override
+    {
+      return 9;
+    }
     std::vector<std::string> history_names() const override;
     /// Elastic pre-strain with tau = sigma; throws InputError if sigma violates f <= 0.
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
 
     /// Rate form: dF = I + d_eps + d_omega, finite-strain update, sigma = tau / J.
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
-    bool has_finite_strain_form() const override { return true; }
+    bool
+    has_finite_strain_form() const override
+    {
+      return true;
+    }
 
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
     /// J^e = sqrt(det b_e) of the history's elastic left Cauchy-Green tensor
     /// (the modified F-bar of the semi-implicit family, seed 002 Eq. 82).
     double elastic_jacobian(ArrayView<const double> history) const;
-    void finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                              ArrayView<const double>     history_old,
-                              ArrayView<double>           history_new,
-                              Stress &                    tau,
-                              dealii::Tensor<4, 3> *      dtau_ddF) const override;
+    void   finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                                ArrayView<double> history_new, Stress &tau,
+                                dealii::Tensor<4, 3> *dtau_ddF) const override;
 
     double elastic_energy_density(const Stress &sigma) const override;
 
@@ -66,8 +74,16 @@ namespace talus::materials
     int principal_return(const double eps_tr[3], double tau[3], double D[3][3]) const;
 
     double yield_function(const double tau_sorted[3]) const;
-    double shear_modulus() const { return mu; }
-    double lame_lambda() const { return lambda; }
+    double
+    shear_modulus() const
+    {
+      return mu;
+    }
+    double
+    lame_lambda() const
+    {
+      return lambda;
+    }
 
   private:
     void   setup(const std::string &where);

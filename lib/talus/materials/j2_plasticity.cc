@@ -21,14 +21,12 @@ namespace talus::materials
     const dealii::SymmetricTensor<2, 3> I2 = dealii::unit_symmetric_tensor<3>();
   } // namespace
 
-  J2Plasticity::J2Plasticity(const double young,
-                             const double poisson,
-                             const double yield_stress,
+  J2Plasticity::J2Plasticity(const double young, const double poisson, const double yield_stress,
                              const double hardening_modulus)
-    : E(young)
-    , nu(poisson)
-    , sigma_y(yield_stress)
-    , H(hardening_modulus)
+      : E(young)
+      , nu(poisson)
+      , sigma_y(yield_stress)
+      , H(hardening_modulus)
   {
     check(E, nu, sigma_y, H, "j2 plasticity");
     mu = E / (2 * (1 + nu));
@@ -36,10 +34,10 @@ namespace talus::materials
   }
 
   J2Plasticity::J2Plasticity(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
-    , sigma_y(prm.get_double("yield stress"))
-    , H(prm.get_double("hardening modulus"))
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
+      , sigma_y(prm.get_double("yield stress"))
+      , H(prm.get_double("hardening modulus"))
   {
     check(E, nu, sigma_y, H, where);
     mu = E / (2 * (1 + nu));
@@ -49,8 +47,7 @@ namespace talus::materials
   void
   J2Plasticity::declare_parameters(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("young modulus", "2e11", dealii::Patterns::Double(),
-                      "Small-strain Young's modulus E [Pa], > 0.");
+    prm.declare_entry("young modulus", "2e11", dealii::Patterns::Double(), "Small-strain Young's modulus E [Pa], > 0.");
     prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(),
                       "Small-strain Poisson's ratio nu [-], -1 < nu < 0.5.");
     prm.declare_entry("yield stress", "2e8", dealii::Patterns::Double(),
@@ -63,8 +60,7 @@ namespace talus::materials
   std::vector<std::string>
   J2Plasticity::history_names() const
   {
-    return {"bebar_xx", "bebar_yy", "bebar_zz", "bebar_xy", "bebar_yz", "bebar_xz", "J",
-            "equivalent plastic strain"};
+    return {"bebar_xx", "bebar_yy", "bebar_zz", "bebar_xy", "bebar_yz", "bebar_xz", "J", "equivalent plastic strain"};
   }
 
   void
@@ -72,8 +68,7 @@ namespace talus::materials
   {
     const std::string where = name.empty() ? "j2 plasticity" : name;
     const Stress      s     = deviator(sigma);
-    require(s.norm() <= std::sqrt(2.0 / 3.0) * sigma_y, where,
-            "initial stress lies outside the yield surface");
+    require(s.norm() <= std::sqrt(2.0 / 3.0) * sigma_y, where, "initial stress lies outside the yield surface");
     const double sm = trace(sigma) / 3.0;
     require(1.0 + 2.0 * sm / K > 0, where, "initial mean stress not reachable");
     const double J = std::sqrt(1.0 + 2.0 * sm / K);
@@ -95,24 +90,21 @@ namespace talus::materials
   }
 
   void
-  J2Plasticity::finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                                     ArrayView<const double>     h_old,
-                                     ArrayView<double>           h_new,
-                                     Stress &                    tau,
-                                     dealii::Tensor<4, 3> *      dtau_ddF) const
+  J2Plasticity::finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> h_old,
+                                     ArrayView<double> h_new, Stress &tau, dealii::Tensor<4, 3> *dtau_ddF) const
   {
-    const double detf = checked_increment_jacobian(dF, *this);
+    const double detf    = checked_increment_jacobian(dF, *this);
     const Stress bbar_n  = fs::load_sym(h_old, 0);
     const double J       = h_old[6] * detf;
     const double alpha_n = h_old[7];
 
-    const dealii::Tensor<2, 3> fbar   = std::pow(detf, -1.0 / 3.0) * dF;
-    const Stress bbar_tr = symmetrize(fbar * dealii::Tensor<2, 3>(bbar_n) * transpose(fbar));
-    const Stress s_tr    = mu * deviator(bbar_tr);
-    const double ns      = s_tr.norm();
-    const double f_tr    = ns - std::sqrt(2.0 / 3.0) * (sigma_y + H * alpha_n);
-    const double Jp      = 0.5 * K * (J * J - 1.0);
-    const double mubar   = mu * trace(bbar_tr) / 3.0;
+    const dealii::Tensor<2, 3> fbar    = std::pow(detf, -1.0 / 3.0) * dF;
+    const Stress               bbar_tr = symmetrize(fbar * dealii::Tensor<2, 3>(bbar_n) * transpose(fbar));
+    const Stress               s_tr    = mu * deviator(bbar_tr);
+    const double               ns      = s_tr.norm();
+    const double               f_tr    = ns - std::sqrt(2.0 / 3.0) * (sigma_y + H * alpha_n);
+    const double               Jp      = 0.5 * K * (J * J - 1.0);
+    const double               mubar   = mu * trace(bbar_tr) / 3.0;
 
     double dgamma = 0.0;
     Stress s      = s_tr;
@@ -147,7 +139,7 @@ namespace talus::materials
         b4                  = (inv_b0 - b1) * ns / mubar;
         dn2                 = deviator(symmetrize(dealii::Tensor<2, 3>(nn) * dealii::Tensor<2, 3>(nn)));
       }
-    const Stress n_tr = ns > 0 ? s_tr / ns : Stress();
+    const Stress         n_tr = ns > 0 ? s_tr / ns : Stress();
     dealii::Tensor<4, 3> c;
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = 0; j < 3; ++j)
@@ -155,7 +147,7 @@ namespace talus::materials
           for (unsigned int l = 0; l < 3; ++l)
             {
               const double dij = (i == j), dkl = (k == l);
-              const double Is  = 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
+              const double Is = 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
               const double cbar =
                 2.0 * mubar * (Is - dij * dkl / 3.0) - 2.0 / 3.0 * ns * (n_tr[i][j] * dkl + dij * n_tr[k][l]);
               double v = K * J * J * dij * dkl - K * (J * J - 1.0) * Is + (1.0 - b1) * cbar;
@@ -167,14 +159,11 @@ namespace talus::materials
   }
 
   void
-  J2Plasticity::update_stress(const Strain &    d_eps,
-                              const Spin &      d_omega,
-                              const double,
-                              Stress &          sigma,
+  J2Plasticity::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                               ArrayView<double> history) const
   {
     const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
-    sigma = tau / kirchhoff_jacobian(history);
+    sigma            = tau / kirchhoff_jacobian(history);
   }
 
   double

@@ -20,53 +20,97 @@ namespace talus::materials
   class J2Plasticity : public Material
   {
   public:
-    J2Plasticity(const double young,
-                 const double poisson,
-                 const double yield_stress,
-                 const double hardening_modulus);
+    J2Plasticity(const double young, const double poisson, const double yield_stress, const double hardening_modulus);
     J2Plasticity(dealii::ParameterHandler &prm, const std::string &where);
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string model_name() const override { return "j2 plasticity"; }
-    double      constrained_modulus() const override { return K + 4.0 * mu / 3.0; }
+    std::string
+    model_name() const override
+    {
+      return "j2 plasticity";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return K + 4.0 * mu / 3.0;
+    }
 
-    unsigned int             n_history() const override { return 8; }
+    unsigned int
+    n_history() const override
+    {
+      return 8;
+    }
     std::vector<std::string> history_names() const override;
     /// Elastic pre-strain such that tau = sigma (must lie inside the yield surface).
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
 
     /// Rate form: dF = I + d_eps + d_omega, finite-strain update, sigma = tau / J.
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
-    bool has_finite_strain_form() const override { return true; }
+    bool
+    has_finite_strain_form() const override
+    {
+      return true;
+    }
 
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
-    void finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                              ArrayView<const double>     history_old,
-                              ArrayView<double>           history_new,
-                              Stress &                    tau,
-                              dealii::Tensor<4, 3> *      dtau_ddF) const override;
+    void   finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                                ArrayView<double> history_new, Stress &tau,
+                                dealii::Tensor<4, 3> *dtau_ddF) const override;
 
     double elastic_energy_density(const Stress &sigma) const override;
 
     /// The split of the mixed u-p driver: J p = K (J^2 - 1)/2, i.e. p(J) = K U'(J)
     /// with the U of the split Neo-Hookean; the yield function depends on s
     /// only and the flow is isochoric (J is the elastic and the total one).
-    bool   has_volumetric_split() const override { return true; }
-    double split_pressure(const double J) const override { return 0.5 * K * (J - 1.0 / J); }
-    double split_dpressure_dJ(const double J) const override { return 0.5 * K * (1.0 + 1.0 / (J * J)); }
-    double split_bulk_modulus() const override { return K; }
-    double split_shear_modulus() const override { return mu; }
+    bool
+    has_volumetric_split() const override
+    {
+      return true;
+    }
+    double
+    split_pressure(const double J) const override
+    {
+      return 0.5 * K * (J - 1.0 / J);
+    }
+    double
+    split_dpressure_dJ(const double J) const override
+    {
+      return 0.5 * K * (1.0 + 1.0 / (J * J));
+    }
+    double
+    split_bulk_modulus() const override
+    {
+      return K;
+    }
+    double
+    split_shear_modulus() const override
+    {
+      return mu;
+    }
 
-    double shear_modulus() const { return mu; }
-    double bulk_modulus() const { return K; }
-    double yield_stress() const { return sigma_y; }
-    double hardening_modulus() const { return H; }
+    double
+    shear_modulus() const
+    {
+      return mu;
+    }
+    double
+    bulk_modulus() const
+    {
+      return K;
+    }
+    double
+    yield_stress() const
+    {
+      return sigma_y;
+    }
+    double
+    hardening_modulus() const
+    {
+      return H;
+    }
 
   private:
     double E, nu, sigma_y, H, mu, K;

@@ -6,8 +6,8 @@
 namespace talus::materials
 {
   LinearElastic::LinearElastic(const double young, const double poisson)
-    : E(young)
-    , nu(poisson)
+      : E(young)
+      , nu(poisson)
   {
     check_isotropic_elasticity(E, nu, "linear elastic");
     two_G       = E / (1 + nu);
@@ -15,8 +15,8 @@ namespace talus::materials
   }
 
   LinearElastic::LinearElastic(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
   {
     check_isotropic_elasticity(E, nu, where);
     two_G       = E / (1 + nu);
@@ -37,10 +37,7 @@ namespace talus::materials
   }
 
   void
-  LinearElastic::update_stress(const Strain &d_eps,
-                               const Spin &  d_omega,
-                               const double,
-                               Stress &sigma,
+  LinearElastic::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                                ArrayView<double>) const
   {
     // sigma <- Q sigma Q^T + 2 G d_eps + lambda tr(d_eps) I, written to sigma once: writing

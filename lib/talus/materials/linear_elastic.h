@@ -13,20 +13,37 @@ namespace talus::materials
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string model_name() const override { return "linear elastic"; }
-    double      constrained_modulus() const override;
-    void        update_stress(const Strain &    d_eps,
-                              const Spin &      d_omega,
-                              const double      dt,
-                              Stress &          sigma,
-                              ArrayView<double> history) const override;
-    void        update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
-    double      elastic_energy_density(const Stress &sigma) const override;
+    std::string
+    model_name() const override
+    {
+      return "linear elastic";
+    }
+    double constrained_modulus() const override;
+    void   update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
+                         ArrayView<double> history) const override;
+    void   update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
+    double elastic_energy_density(const Stress &sigma) const override;
 
-    double young_modulus() const { return E; }
-    double poisson_ratio() const { return nu; }
-    double shear_modulus() const { return E / (2 * (1 + nu)); }
-    double bulk_modulus() const { return E / (3 * (1 - 2 * nu)); }
+    double
+    young_modulus() const
+    {
+      return E;
+    }
+    double
+    poisson_ratio() const
+    {
+      return nu;
+    }
+    double
+    shear_modulus() const
+    {
+      return E / (2 * (1 + nu));
+    }
+    double
+    bulk_modulus() const
+    {
+      return E / (3 * (1 - 2 * nu));
+    }
 
   private:
     double E, nu;

@@ -66,15 +66,9 @@ namespace talus::materials::internal
   /// that in steady simple shear tau = tau_y + mu gamma_dot (until the cap). A
   /// cavitated liquid carries no deviatoric stress. mu_eff is 0 when solid-like.
   inline dealii::SymmetricTensor<2, 3>
-  viscoplastic_deviator(const dealii::SymmetricTensor<2, 3> &s_old,
-                        const dealii::SymmetricTensor<2, 3> &d_eps,
-                        const double                         dt,
-                        const double                         G,
-                        const double                         tau_y,
-                        const double                         mu,
-                        const double                         mu_max,
-                        const bool                           cavitated,
-                        double &                             mu_eff)
+  viscoplastic_deviator(const dealii::SymmetricTensor<2, 3> &s_old, const dealii::SymmetricTensor<2, 3> &d_eps,
+                        const double dt, const double G, const double tau_y, const double mu, const double mu_max,
+                        const bool cavitated, double &mu_eff)
   {
     mu_eff = 0.0;
     if (cavitated)
@@ -85,25 +79,19 @@ namespace talus::materials::internal
       return trial;
     const dealii::SymmetricTensor<2, 3> Ddev = de / dt;
     const double                        gd   = shear_rate(Ddev);
-    mu_eff = (gd > 0) ? std::min(mu + tau_y / gd, mu_max) : mu_max;
+    mu_eff                                   = (gd > 0) ? std::min(mu + tau_y / gd, mu_max) : mu_max;
     return 2.0 * mu_eff * Ddev;
   }
 
   inline void
   declare_liquid_pressure_parameters(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("bulk modulus",
-                      "2.2e9",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("bulk modulus", "2.2e9", dealii::Patterns::Double(),
                       "Bulk modulus of the liquid K_L [Pa], > 0 (dp = -K_L tr(d eps), p compression positive).");
-    prm.declare_entry("cavitation threshold",
-                      "0",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("cavitation threshold", "0", dealii::Patterns::Double(),
                       "Cavitation pressure p_cav [Pa], <= 0 (compression positive): the pressure never "
                       "drops below it; while cavitated the deviatoric stress is zero.");
-    prm.declare_entry("cavitation recovery",
-                      "incremental",
-                      dealii::Patterns::Selection("incremental|volumetric"),
+    prm.declare_entry("cavitation recovery", "incremental", dealii::Patterns::Selection("incremental|volumetric"),
                       "After cavitation: 'incremental' (seed 000 Eq. 7.33: dp = -K_L tr(d eps), p >= p_cav; the "
                       "pressure rises at the first compression) or 'volumetric' (p = max(p_cav, -K_L eps_v) of "
                       "the accumulated volumetric strain: stays at p_cav until the cavitated volume is "
@@ -114,8 +102,7 @@ namespace talus::materials::internal
   check_liquid_pressure_parameters(const double K, const double p_cav, const std::string &where)
   {
     require(K > 0, where + "/bulk modulus", "must be > 0 (got " + std::to_string(K) + ")");
-    require(p_cav <= 0,
-            where + "/cavitation threshold",
+    require(p_cav <= 0, where + "/cavitation threshold",
             "must be <= 0 (compression positive; got " + std::to_string(p_cav) + ")");
   }
 } // namespace talus::materials::internal

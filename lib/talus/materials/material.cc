@@ -22,10 +22,7 @@
 namespace talus::materials
 {
   void
-  Material::finite_strain_update(const dealii::Tensor<2, 3> &,
-                                 ArrayView<const double>,
-                                 ArrayView<double>,
-                                 Stress &,
+  Material::finite_strain_update(const dealii::Tensor<2, 3> &, ArrayView<const double>, ArrayView<double>, Stress &,
                                  dealii::Tensor<4, 3> *) const
   {
     throw InputError("material '" + name + "': model '" + model_name() +
@@ -66,20 +63,17 @@ namespace talus::materials
   }
 
   void
-  Material::split_update(const dealii::Tensor<2, 3> &dF,
-                         ArrayView<const double>     history_old,
-                         ArrayView<double>           history_new,
-                         Stress &                    tau_dev,
-                         double &                    J,
-                         dealii::Tensor<4, 3> *      dtau_dev_ddF) const
+  Material::split_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                         ArrayView<double> history_new, Stress &tau_dev, double &J,
+                         dealii::Tensor<4, 3> *dtau_dev_ddF) const
   {
     if (!has_volumetric_split())
       no_split(*this);
     Stress tau;
     finite_strain_update(dF, history_old, history_new, tau, dtau_dev_ddF);
-    J                    = kirchhoff_jacobian(ArrayView<const double>(history_new.data(), history_new.size()));
-    const double p       = split_pressure(J);
-    tau_dev              = tau - J * p * dealii::unit_symmetric_tensor<3>();
+    J              = kirchhoff_jacobian(ArrayView<const double>(history_new.data(), history_new.size()));
+    const double p = split_pressure(J);
+    tau_dev        = tau - J * p * dealii::unit_symmetric_tensor<3>();
     if (!dtau_dev_ddF)
       return;
     // d (J p(J)) / d dF_kl = (p + J p') dJ / d dF_kl, dJ / d dF_kl = J dF^-1_lk
@@ -122,8 +116,8 @@ namespace talus::materials
   {
     const double detf = determinant(dF);
     if (!(detf > 0))
-      throw InstabilityError("material '" + m.name + "' (" + m.model_name() + "): det dF = " +
-                             std::to_string(detf) + " <= 0");
+      throw InstabilityError("material '" + m.name + "' (" + m.model_name() + "): det dF = " + std::to_string(detf) +
+                             " <= 0");
     return detf;
   }
 
@@ -144,10 +138,8 @@ namespace talus::materials
   {
     struct ModelEntry
     {
-      std::function<void(dealii::ParameterHandler &)> declare;
-      std::function<std::unique_ptr<Material>(dealii::ParameterHandler &,
-                                              const std::string &)>
-        create;
+      std::function<void(dealii::ParameterHandler &)>                                           declare;
+      std::function<std::unique_ptr<Material>(dealii::ParameterHandler &, const std::string &)> create;
     };
 
     const std::map<std::string, ModelEntry> &
@@ -235,14 +227,9 @@ namespace talus::materials
   void
   declare_material_parameters(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("model",
-                      "linear elastic",
-                      dealii::Patterns::Selection(model_list()),
+    prm.declare_entry("model", "linear elastic", dealii::Patterns::Selection(model_list()),
                       "Constitutive model of this material.");
-    prm.declare_entry("density",
-                      "2000",
-                      dealii::Patterns::Double(0.0),
-                      "Mass density [kg/m^3], > 0.");
+    prm.declare_entry("density", "2000", dealii::Patterns::Double(0.0), "Mass density [kg/m^3], > 0.");
     for (const auto &[k, v] : registry())
       {
         prm.enter_subsection(k);
@@ -252,15 +239,11 @@ namespace talus::materials
   }
 
   std::unique_ptr<Material>
-  create_material(dealii::ParameterHandler &prm,
-                  const std::string &       where,
-                  const unsigned int        id)
+  create_material(dealii::ParameterHandler &prm, const std::string &where, const unsigned int id)
   {
     const std::string model = prm.get("model");
     const auto        it    = registry().find(model);
-    require(it != registry().end(),
-            where,
-            "unknown model '" + model + "'; allowed: " + model_list());
+    require(it != registry().end(), where, "unknown model '" + model + "'; allowed: " + model_list());
     const double rho = prm.get_double("density");
     require(rho > 0, where + "/density", "must be > 0 (got " + std::to_string(rho) + ")");
     prm.enter_subsection(model);

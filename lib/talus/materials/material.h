@@ -56,8 +56,16 @@ namespace talus::materials
     virtual std::string model_name() const = 0;
 
     /// Mass density of the material [kg/m^3].
-    double density() const { return rho; }
-    void   set_density(const double r) { rho = r; }
+    double
+    density() const
+    {
+      return rho;
+    }
+    void
+    set_density(const double r)
+    {
+      rho = r;
+    }
 
     /// Constrained (P-wave) modulus E_c [Pa] used by the critical time step
     /// (seed 000 Eq. 4.120). For liquids: the bulk modulus.
@@ -65,29 +73,40 @@ namespace talus::materials
 
     /// Largest dynamic viscosity [Pa s] the model can produce (liquids; 0 for
     /// solids). Drivers use it for the viscous time-step limit dt <= rho h^2 / (2 mu).
-    virtual double dynamic_viscosity() const { return 0.0; }
+    virtual double
+    dynamic_viscosity() const
+    {
+      return 0.0;
+    }
 
     /// Number and names of the history variables stored per material point.
-    virtual unsigned int n_history() const { return 0; }
-    virtual std::vector<std::string> history_names() const { return {}; }
+    virtual unsigned int
+    n_history() const
+    {
+      return 0;
+    }
+    virtual std::vector<std::string>
+    history_names() const
+    {
+      return {};
+    }
     /// Initialise the history for a point with the given initial stress.
-    virtual void initialize_history(const Stress & /*sigma*/,
-                                    ArrayView<double> /*history*/) const
-    {}
+    virtual void
+    initialize_history(const Stress & /*sigma*/, ArrayView<double> /*history*/) const
+    {
+    }
 
     /// Rate-form stress update (explicit driver): updates sigma (Jaumann rotated
     /// then integrated over the strain increment) and history in place.
-    virtual void update_stress(const Strain &    d_eps,
-                               const Spin &      d_omega,
-                               const double      dt,
-                               Stress &          sigma,
+    virtual void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                                ArrayView<double> history) const = 0;
 
     /// The same for n points of one cell (the explicit update pass calls it once
     /// per cell and model instead of once per point). Default: update_stress()
     /// per point; a model overrides it with update_stresses_with() below, which
     /// calls its own update_stress() non-virtually (inlined in the model's file).
-    virtual void update_stresses(RateUpdate *points, const unsigned int n, const double dt) const
+    virtual void
+    update_stresses(RateUpdate *points, const unsigned int n, const double dt) const
     {
       const unsigned int nh = n_history();
       for (unsigned int k = 0; k < n; ++k)
@@ -97,7 +116,11 @@ namespace talus::materials
 
     /// ---- Finite-strain form (implicit updated-Lagrangian and semi-implicit
     /// drivers, seed 001 ch. 3, seed 002 §4.3). Models without it return false.
-    virtual bool has_finite_strain_form() const { return false; }
+    virtual bool
+    has_finite_strain_form() const
+    {
+      return false;
+    }
 
     /// Given the incremental deformation gradient of the step dF = F_{n+1} F_n^{-1}
     /// and the history at the start of the step (converged state), compute the
@@ -105,11 +128,8 @@ namespace talus::materials
     /// null) the consistent tangent d tau_{n+1} / d dF (a full 4th-order tensor,
     /// dtau_ij / d dF_kl). Models that need the total F keep it in their history.
     /// Must not modify history_old; history_new may alias nothing else.
-    virtual void finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                                      ArrayView<const double>     history_old,
-                                      ArrayView<double>           history_new,
-                                      Stress &                    tau,
-                                      dealii::Tensor<4, 3> *      dtau_ddF) const;
+    virtual void finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                                      ArrayView<double> history_new, Stress &tau, dealii::Tensor<4, 3> *dtau_ddF) const;
 
     /// One step of finite_strain_update() with the history updated in place
     /// (from a copy of the old one; no tangent). Returns the Kirchhoff stress;
@@ -120,7 +140,11 @@ namespace talus::materials
     /// det F of the total deformation that the Kirchhoff stress of
     /// finite_strain_update() refers to, read from the history: sigma = tau / J.
     /// (Initial stresses make it differ from the driver's volume ratio.)
-    virtual double kirchhoff_jacobian(ArrayView<const double> /*history*/) const { return 1.0; }
+    virtual double
+    kirchhoff_jacobian(ArrayView<const double> /*history*/) const
+    {
+      return 1.0;
+    }
 
     /// ---- Volumetric/deviatoric split (the mixed u-p driver, seed 001 ch. 5).
     /// A model has it when tau = J p(J) I + tau_dev with p a function of
@@ -129,7 +153,11 @@ namespace talus::materials
     /// pressure (no pressure-dependent yield): then the nodal pressure of u-p can
     /// replace p(J). Neo-Hookean (split energy) and J2 have it; Mohr-Coulomb
     /// (phi > 0) and Nor-Sand do not.
-    virtual bool has_volumetric_split() const { return false; }
+    virtual bool
+    has_volumetric_split() const
+    {
+      return false;
+    }
     /// p(J): the mean Cauchy stress of the volumetric part [Pa] (tension positive)
     virtual double split_pressure(const double J) const;
     /// dp/dJ [Pa]
@@ -144,19 +172,16 @@ namespace talus::materials
     /// every model: the models provide p(J) only. The subtraction loses about
     /// log10(K/G) digits of tau_dev; a model used near incompressibility may
     /// override it with its deviatoric part computed directly (Neo-Hookean).
-    virtual void split_update(const dealii::Tensor<2, 3> &dF,
-                      ArrayView<const double>     history_old,
-                      ArrayView<double>           history_new,
-                      Stress &                    tau_dev,
-                      double &                    J,
-                      dealii::Tensor<4, 3> *      dtau_dev_ddF) const;
+    virtual void split_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                              ArrayView<double> history_new, Stress &tau_dev, double &J,
+                              dealii::Tensor<4, 3> *dtau_dev_ddF) const;
 
     /// Strain energy density increment is computed by the driver from stresses;
     /// this returns the elastic strain energy density of a stress state (for energy
     /// diagnostics), W = 1/2 sigma : C^-1 : sigma. Zero when not meaningful.
     virtual double elastic_energy_density(const Stress &sigma) const;
 
-    std::string name; ///< user-facing name (".prm" subsection), for messages
+    std::string  name; ///< user-facing name (".prm" subsection), for messages
     unsigned int id = 0;
 
   protected:
@@ -197,15 +222,15 @@ namespace talus::materials
     const double c = 2.0 / (1.0 + aa);
     // A = [[0,-a2,a1],[a2,0,-a0],[-a1,a0,0]], A^2 = a a^T - |a|^2 I
     double Q[3][3];
-    Q[0][0] = 1.0 + c * (a0 * a0 - aa);
-    Q[1][1] = 1.0 + c * (a1 * a1 - aa);
-    Q[2][2] = 1.0 + c * (a2 * a2 - aa);
-    Q[0][1] = c * (-a2 + a0 * a1);
-    Q[1][0] = c * (a2 + a0 * a1);
-    Q[0][2] = c * (a1 + a0 * a2);
-    Q[2][0] = c * (-a1 + a0 * a2);
-    Q[1][2] = c * (-a0 + a1 * a2);
-    Q[2][1] = c * (a0 + a1 * a2);
+    Q[0][0]          = 1.0 + c * (a0 * a0 - aa);
+    Q[1][1]          = 1.0 + c * (a1 * a1 - aa);
+    Q[2][2]          = 1.0 + c * (a2 * a2 - aa);
+    Q[0][1]          = c * (-a2 + a0 * a1);
+    Q[1][0]          = c * (a2 + a0 * a1);
+    Q[0][2]          = c * (a1 + a0 * a2);
+    Q[2][0]          = c * (-a1 + a0 * a2);
+    Q[1][2]          = c * (-a0 + a1 * a2);
+    Q[2][1]          = c * (a0 + a1 * a2);
     const double s00 = sigma.access_raw_entry(0), s11 = sigma.access_raw_entry(1), s22 = sigma.access_raw_entry(2),
                  s01 = sigma.access_raw_entry(3), s02 = sigma.access_raw_entry(4), s12 = sigma.access_raw_entry(5);
     const double S[3][3] = {{s00, s01, s02}, {s01, s11, s12}, {s02, s12, s22}};
@@ -213,7 +238,7 @@ namespace talus::materials
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = 0; j < 3; ++j)
         QS[i][j] = Q[i][0] * S[0][j] + Q[i][1] * S[1][j] + Q[i][2] * S[2][j];
-    Stress r;
+    Stress                 r;
     constexpr unsigned int raw[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = i; j < 3; ++j)
@@ -239,9 +264,8 @@ namespace talus::materials
 
   /// Build the material described by the current subsection of prm. `where`
   /// names the subsection for error messages. Throws talus::InputError.
-  std::unique_ptr<Material> create_material(dealii::ParameterHandler &prm,
-                                            const std::string &       where,
-                                            const unsigned int        id);
+  std::unique_ptr<Material> create_material(dealii::ParameterHandler &prm, const std::string &where,
+                                            const unsigned int id);
 
   /// Names of all registered models (for error messages and --help).
   std::vector<std::string> registered_models();

@@ -7,22 +7,27 @@
 
 namespace talus::materials
 {
-  ModifiedCamClay::ModifiedCamClay(const double M_, const double lambda_, const double kappa_,
-                                   const double nu_, const double e0_, const double ocr_,
-                                   const double p_min_, const std::string &where)
-    : M(M_), lam(lambda_), kap(kappa_), nu(nu_), e0(e0_), ocr(ocr_), p_min(p_min_)
+  ModifiedCamClay::ModifiedCamClay(const double M_, const double lambda_, const double kappa_, const double nu_,
+                                   const double e0_, const double ocr_, const double p_min_, const std::string &where)
+      : M(M_)
+      , lam(lambda_)
+      , kap(kappa_)
+      , nu(nu_)
+      , e0(e0_)
+      , ocr(ocr_)
+      , p_min(p_min_)
   {
     setup(where);
   }
 
   ModifiedCamClay::ModifiedCamClay(dealii::ParameterHandler &prm, const std::string &where)
-    : M(prm.get_double("slope of critical state line"))
-    , lam(prm.get_double("compression index"))
-    , kap(prm.get_double("swelling index"))
-    , nu(prm.get_double("poisson ratio"))
-    , e0(prm.get_double("initial void ratio"))
-    , ocr(prm.get_double("overconsolidation ratio"))
-    , p_min(prm.get_double("minimum mean effective stress"))
+      : M(prm.get_double("slope of critical state line"))
+      , lam(prm.get_double("compression index"))
+      , kap(prm.get_double("swelling index"))
+      , nu(prm.get_double("poisson ratio"))
+      , e0(prm.get_double("initial void ratio"))
+      , ocr(prm.get_double("overconsolidation ratio"))
+      , p_min(prm.get_double("minimum mean effective stress"))
   {
     setup(where);
   }
@@ -32,18 +37,14 @@ namespace talus::materials
   {
     require(M > 0, where + "/slope of critical state line", "must be > 0 (got " + std::to_string(M) + ")");
     require(lam > 0, where + "/compression index", "must be > 0 (got " + std::to_string(lam) + ")");
-    require(kap > 0 && kap < lam,
-            where + "/swelling index",
+    require(kap > 0 && kap < lam, where + "/swelling index",
             "must satisfy 0 < kappa < lambda (got kappa = " + std::to_string(kap) +
               ", lambda = " + std::to_string(lam) + ")");
-    require(nu > -1.0 && nu < 0.5,
-            where + "/poisson ratio",
+    require(nu > -1.0 && nu < 0.5, where + "/poisson ratio",
             "must satisfy -1 < nu < 0.5 (got " + std::to_string(nu) + ")");
     require(e0 > 0, where + "/initial void ratio", "must be > 0 (got " + std::to_string(e0) + ")");
     require(ocr >= 1, where + "/overconsolidation ratio", "must be >= 1 (got " + std::to_string(ocr) + ")");
-    require(p_min > 0,
-            where + "/minimum mean effective stress",
-            "must be > 0 (got " + std::to_string(p_min) + ")");
+    require(p_min > 0, where + "/minimum mean effective stress", "must be > 0 (got " + std::to_string(p_min) + ")");
   }
 
   void
@@ -59,8 +60,9 @@ namespace talus::materials
                       "Poisson's ratio nu [-], -1 < nu < 0.5 (shear modulus from the bulk modulus).");
     prm.declare_entry("initial void ratio", "1.0", dealii::Patterns::Double(),
                       "Initial void ratio e0 [-], > 0 (specific volume v0 = 1 + e0).");
-    prm.declare_entry("overconsolidation ratio", "1.0", dealii::Patterns::Double(),
-                      "OCR [-], >= 1: initial p_c = OCR times the p_c that puts the initial stress on the yield surface.");
+    prm.declare_entry(
+      "overconsolidation ratio", "1.0", dealii::Patterns::Double(),
+      "OCR [-], >= 1: initial p_c = OCR times the p_c that puts the initial stress on the yield surface.");
     prm.declare_entry("minimum mean effective stress", "1e3", dealii::Patterns::Double(),
                       "p_min [Pa], > 0: floor of p' used for the elastic stiffness and the initial p_c "
                       "(stress-free or tensile states).");
@@ -78,16 +80,15 @@ namespace talus::materials
   std::vector<std::string>
   ModifiedCamClay::history_names() const
   {
-    return {"preconsolidation pressure", "specific volume", "plastic volumetric strain",
-            "plastic shear strain"};
+    return {"preconsolidation pressure", "specific volume", "plastic volumetric strain", "plastic shear strain"};
   }
 
   void
   ModifiedCamClay::initialize_history(const Stress &sigma, ArrayView<double> h) const
   {
-    const double p  = std::max(-trace(sigma) / 3.0, p_min);
-    const Stress s  = deviator(sigma);
-    const double q2 = 1.5 * scalar_product(s, s);
+    const double p            = std::max(-trace(sigma) / 3.0, p_min);
+    const Stress s            = deviator(sigma);
+    const double q2           = 1.5 * scalar_product(s, s);
     h[h_preconsolidation]     = ocr * (p + q2 / (M * M * p));
     h[h_specific_volume]      = 1 + e0;
     h[h_plastic_vol_strain]   = 0;
@@ -109,7 +110,7 @@ namespace talus::materials
     const double G     = 3 * K * (1 - 2 * nu) / (2 * (1 + nu));
 
     // elastic pressure as a function of the elastic volumetric strain increment
-    auto p_of = [&](const double dee) { return p_n + p_eff * (std::exp(dee / ks) - 1.0); };
+    auto p_of  = [&](const double dee) { return p_n + p_eff * (std::exp(dee / ks) - 1.0); };
     auto dp_of = [&](const double dee) { return p_eff * std::exp(dee / ks) / ks; };
 
     const Stress s_tr = s_n + 2 * G * deviator(d_eps);
@@ -129,9 +130,8 @@ namespace talus::materials
       }
 
     // unknowns x = d eps_v^p (compression positive), y = plastic multiplier
-    const double c6 = 6 * G / M2;
-    auto         residual = [&](const double x, const double y, double &p, double &pc, double &q,
-                        double r[2]) {
+    const double c6       = 6 * G / M2;
+    auto         residual = [&](const double x, const double y, double &p, double &pc, double &q, double r[2]) {
       p    = p_of(dev - x);
       pc   = pc_n * std::exp(x / (ls - ks));
       q    = q_tr / (1 + c6 * y);
@@ -195,10 +195,7 @@ namespace talus::materials
   }
 
   void
-  ModifiedCamClay::update_stress(const Strain &    d_eps,
-                                 const Spin &      d_omega,
-                                 const double,
-                                 Stress &          sigma,
+  ModifiedCamClay::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                                  ArrayView<double> history) const
   {
     sigma = apply_jaumann_rotation(sigma, d_omega);

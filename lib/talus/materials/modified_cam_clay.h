@@ -22,34 +22,43 @@ namespace talus::materials
   {
   public:
     ModifiedCamClay(const double M, const double lambda, const double kappa, const double poisson,
-                    const double initial_void_ratio, const double ocr,
-                    const double min_pressure = 1e3, const std::string &where = "modified cam clay");
+                    const double initial_void_ratio, const double ocr, const double min_pressure = 1e3,
+                    const std::string &where = "modified cam clay");
     ModifiedCamClay(dealii::ParameterHandler &prm, const std::string &where);
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string  model_name() const override { return "modified cam clay"; }
+    std::string
+    model_name() const override
+    {
+      return "modified cam clay";
+    }
     /// Pressure-dependent stiffness: K + 4G/3 evaluated at reference_pressure with
     /// v = 1 + e0 (an upper estimate for the critical time step while p' stays below it).
-    double       constrained_modulus() const override;
-    unsigned int n_history() const override { return 4; }
+    double constrained_modulus() const override;
+    unsigned int
+    n_history() const override
+    {
+      return 4;
+    }
     std::vector<std::string> history_names() const override;
-    void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
-                       ArrayView<double> history) const override;
+    void                     initialize_history(const Stress &sigma, ArrayView<double> history) const override;
+    void                     update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
+                                           ArrayView<double> history) const override;
 
     enum : unsigned int
     {
-      h_preconsolidation   = 0, ///< p_c [Pa], compression positive
-      h_specific_volume    = 1, ///< v = 1 + e [-]
-      h_plastic_vol_strain = 2, ///< accumulated tr(eps^p), dilation positive [-]
-      h_plastic_shear_strain = 3 ///< accumulated plastic deviatoric strain eps_q^p [-]
+      h_preconsolidation     = 0, ///< p_c [Pa], compression positive
+      h_specific_volume      = 1, ///< v = 1 + e [-]
+      h_plastic_vol_strain   = 2, ///< accumulated tr(eps^p), dilation positive [-]
+      h_plastic_shear_strain = 3  ///< accumulated plastic deviatoric strain eps_q^p [-]
     };
 
-    double slope_csl() const { return M; }
+    double
+    slope_csl() const
+    {
+      return M;
+    }
 
     /// Reference pressure for constrained_modulus() [Pa]; drivers can set it to the
     /// largest expected mean effective stress.

@@ -29,30 +29,26 @@ namespace talus::materials
     }
   } // namespace
 
-  MohrCoulomb::MohrCoulomb(const double       young,
-                           const double       poisson,
-                           const double       cohesion,
-                           const double       friction_angle_deg,
-                           const double       dilatancy_angle_deg,
-                           const double       tensile_strength,
-                           const std::string &where)
-    : E(young)
-    , nu(poisson)
-    , c(cohesion)
-    , phi(friction_angle_deg)
-    , psi(dilatancy_angle_deg)
-    , T_in(tensile_strength)
+  MohrCoulomb::MohrCoulomb(const double young, const double poisson, const double cohesion,
+                           const double friction_angle_deg, const double dilatancy_angle_deg,
+                           const double tensile_strength, const std::string &where)
+      : E(young)
+      , nu(poisson)
+      , c(cohesion)
+      , phi(friction_angle_deg)
+      , psi(dilatancy_angle_deg)
+      , T_in(tensile_strength)
   {
     setup(where);
   }
 
   MohrCoulomb::MohrCoulomb(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
-    , c(prm.get_double("cohesion"))
-    , phi(prm.get_double("friction angle"))
-    , psi(prm.get_double("dilatancy angle"))
-    , T_in(prm.get_bool("tension cut-off") ? prm.get_double("tensile strength") : -1.0)
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
+      , c(prm.get_double("cohesion"))
+      , phi(prm.get_double("friction angle"))
+      , psi(prm.get_double("dilatancy angle"))
+      , T_in(prm.get_bool("tension cut-off") ? prm.get_double("tensile strength") : -1.0)
   {
     if (prm.get_bool("tension cut-off"))
       require(T_in >= 0, where + "/tensile strength", "must be >= 0 (got " + std::to_string(T_in) + ")");
@@ -64,23 +60,17 @@ namespace talus::materials
   {
     check_isotropic_elasticity(E, nu, where);
     require(c >= 0, where + "/cohesion", "must be >= 0 (got " + std::to_string(c) + ")");
-    require(phi >= 0 && phi < 90,
-            where + "/friction angle",
+    require(phi >= 0 && phi < 90, where + "/friction angle",
             "must satisfy 0 <= phi < 90 degrees (got " + std::to_string(phi) + ")");
-    require(psi >= 0 && psi <= phi,
-            where + "/dilatancy angle",
-            "must satisfy 0 <= psi <= phi (got psi = " + std::to_string(psi) +
-              ", phi = " + std::to_string(phi) + ")");
-    require(phi > 0 || c > 0,
-            where + "/cohesion",
-            "must be > 0 when the friction angle is 0 (no strength at all)");
-    G        = E / (2 * (1 + nu));
-    K        = E / (3 * (1 - 2 * nu));
-    lambda   = K - 2.0 * G / 3.0;
-    has_apex = phi > 0;
-    const double apex =
-      has_apex ? c / std::tan(phi * deg) : std::numeric_limits<double>::infinity();
-    T = (T_in >= 0) ? std::min(T_in, apex) : apex;
+    require(psi >= 0 && psi <= phi, where + "/dilatancy angle",
+            "must satisfy 0 <= psi <= phi (got psi = " + std::to_string(psi) + ", phi = " + std::to_string(phi) + ")");
+    require(phi > 0 || c > 0, where + "/cohesion", "must be > 0 when the friction angle is 0 (no strength at all)");
+    G                 = E / (2 * (1 + nu));
+    K                 = E / (3 * (1 - 2 * nu));
+    lambda            = K - 2.0 * G / 3.0;
+    has_apex          = phi > 0;
+    const double apex = has_apex ? c / std::tan(phi * deg) : std::numeric_limits<double>::infinity();
+    T                 = (T_in >= 0) ? std::min(T_in, apex) : apex;
   }
 
   void
@@ -89,22 +79,14 @@ namespace talus::materials
     prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(), "Young's modulus E [Pa], > 0.");
     prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(), "Poisson's ratio nu [-], -1 < nu < 0.5.");
     prm.declare_entry("cohesion", "0", dealii::Patterns::Double(), "Effective cohesion c' [Pa], >= 0.");
-    prm.declare_entry("friction angle",
-                      "30",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("friction angle", "30", dealii::Patterns::Double(),
                       "Effective friction angle phi' [degrees], 0 <= phi' < 90.");
-    prm.declare_entry("dilatancy angle",
-                      "0",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("dilatancy angle", "0", dealii::Patterns::Double(),
                       "Dilatancy angle psi [degrees], 0 <= psi <= phi' (psi = phi': associated flow).");
-    prm.declare_entry("tension cut-off",
-                      "false",
-                      dealii::Patterns::Bool(),
+    prm.declare_entry("tension cut-off", "false", dealii::Patterns::Bool(),
                       "Limit the largest principal stress (tension positive) to the tensile strength "
                       "(Rankine surface, associated flow).");
-    prm.declare_entry("tensile strength",
-                      "0",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("tensile strength", "0", dealii::Patterns::Double(),
                       "Tensile strength T [Pa], >= 0, used with 'tension cut-off = true'. Values above "
                       "the apex c' cot(phi') have no effect.");
   }
@@ -116,10 +98,7 @@ namespace talus::materials
   }
 
   void
-  MohrCoulomb::update_stress(const Strain &    d_eps,
-                             const Spin &      d_omega,
-                             const double,
-                             Stress &          sigma,
+  MohrCoulomb::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                              ArrayView<double> history) const
   {
     sigma           = apply_jaumann_rotation(sigma, d_omega);
@@ -162,15 +141,14 @@ namespace talus::materials
       s.b[i] = 1;
       return s;
     };
-    const bool    cutoff = std::isfinite(T) && (!has_apex || T < c / std::tan(phi * deg));
-    PlanarSurface cand[6] = {mc(0, 2), mc(1, 2), mc(0, 1), tension(0), tension(1), tension(2)};
-    const unsigned int n_cand = cutoff ? 6 : 3;
-    PlanarSurface      chk[9] = {mc(0, 2), mc(1, 2), mc(0, 1), mc(2, 0), mc(2, 1), mc(1, 0),
-                            tension(0), tension(1), tension(2)};
-    const unsigned int n_chk  = cutoff ? 9 : 6;
+    const bool         cutoff  = std::isfinite(T) && (!has_apex || T < c / std::tan(phi * deg));
+    PlanarSurface      cand[6] = {mc(0, 2), mc(1, 2), mc(0, 1), tension(0), tension(1), tension(2)};
+    const unsigned int n_cand  = cutoff ? 6 : 3;
+    PlanarSurface      chk[9]  = {mc(0, 2), mc(1, 2),   mc(0, 1),   mc(2, 0),  mc(2, 1),
+                                  mc(1, 0), tension(0), tension(1), tension(2)};
+    const unsigned int n_chk   = cutoff ? 9 : 6;
 
-    PrincipalReturnResult r =
-      return_to_planar_surfaces(sd.values, lambda, G, cand, n_cand, chk, n_chk, tol);
+    PrincipalReturnResult r = return_to_planar_surfaces(sd.values, lambda, G, cand, n_cand, chk, n_chk, tol);
     if (!r.converged)
       {
         // beyond every edge and corner: the stress goes to the apex of the

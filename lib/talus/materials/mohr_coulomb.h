@@ -20,33 +20,50 @@ namespace talus::materials
   {
   public:
     /// Angles in degrees; tensile_strength < 0 means "no tension cut-off".
-    MohrCoulomb(const double young,
-                const double poisson,
-                const double cohesion,
-                const double friction_angle_deg,
-                const double dilatancy_angle_deg,
-                const double tensile_strength = -1.0,
-                const std::string &where      = "mohr coulomb");
+    MohrCoulomb(const double young, const double poisson, const double cohesion, const double friction_angle_deg,
+                const double dilatancy_angle_deg, const double tensile_strength = -1.0,
+                const std::string &where = "mohr coulomb");
     MohrCoulomb(dealii::ParameterHandler &prm, const std::string &where);
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string model_name() const override { return "mohr coulomb"; }
-    double      constrained_modulus() const override { return K + 4.0 * G / 3.0; }
-    unsigned int n_history() const override { return 3; }
+    std::string
+    model_name() const override
+    {
+      return "mohr coulomb";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return K + 4.0 * G / 3.0;
+    }
+    unsigned int
+    n_history() const override
+    {
+      return 3;
+    }
     std::vector<std::string> history_names() const override;
-    void        update_stress(const Strain &    d_eps,
-                              const Spin &      d_omega,
-                              const double      dt,
-                              Stress &          sigma,
-                              ArrayView<double> history) const override;
-    void update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
-    double      elastic_energy_density(const Stress &sigma) const override;
+    void                     update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
+                                           ArrayView<double> history) const override;
+    void                     update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
+    double                   elastic_energy_density(const Stress &sigma) const override;
 
-    double shear_modulus() const { return G; }
-    double bulk_modulus() const { return K; }
+    double
+    shear_modulus() const
+    {
+      return G;
+    }
+    double
+    bulk_modulus() const
+    {
+      return K;
+    }
     /// Active tension limit T [Pa] (tension positive); +inf when there is none.
-    double tension_limit() const { return T; }
+    double
+    tension_limit() const
+    {
+      return T;
+    }
 
     /// History slots.
     enum : unsigned int

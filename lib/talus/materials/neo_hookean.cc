@@ -17,8 +17,7 @@ namespace talus::materials
         return NeoHookean::Energy::coupled;
       if (s == "split")
         return NeoHookean::Energy::split;
-      throw InputError(where + "/volumetric energy: unknown value '" + s +
-                       "'; allowed: coupled|split");
+      throw InputError(where + "/volumetric energy: unknown value '" + s + "'; allowed: coupled|split");
     }
 
     /// Solve det(D + c I) = 1 for c (D symmetric, traceless), Newton from c = 1.
@@ -43,9 +42,9 @@ namespace talus::materials
   } // namespace
 
   NeoHookean::NeoHookean(const double young, const double poisson, const Energy energy)
-    : E(young)
-    , nu(poisson)
-    , energy_form(energy)
+      : E(young)
+      , nu(poisson)
+      , energy_form(energy)
   {
     check_isotropic_elasticity(E, nu, "neo hookean");
     lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
@@ -53,9 +52,9 @@ namespace talus::materials
   }
 
   NeoHookean::NeoHookean(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
-    , energy_form(parse_energy(prm.get("volumetric energy"), where))
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
+      , energy_form(parse_energy(prm.get("volumetric energy"), where))
   {
     check_isotropic_elasticity(E, nu, where);
     lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
@@ -65,8 +64,7 @@ namespace talus::materials
   void
   NeoHookean::declare_parameters(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(),
-                      "Small-strain Young's modulus E [Pa], > 0.");
+    prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(), "Small-strain Young's modulus E [Pa], > 0.");
     prm.declare_entry("poisson ratio", "0.3", dealii::Patterns::Double(),
                       "Small-strain Poisson's ratio nu [-], -1 < nu < 0.5.");
     prm.declare_entry("volumetric energy", "coupled", dealii::Patterns::Selection("coupled|split"),
@@ -155,10 +153,10 @@ namespace talus::materials
   dealii::Tensor<4, 3>
   NeoHookean::deviatoric_spatial_tangent(const Stress &b) const
   {
-    const double J     = std::sqrt(determinant(b));
-    const double trbb  = std::pow(J, -2.0 / 3.0) * trace(b);
-    const Stress tdev  = deviatoric_kirchhoff_stress(b);
-    const double a     = 2.0 / 3.0 * mu * trbb;
+    const double         J    = std::sqrt(determinant(b));
+    const double         trbb = std::pow(J, -2.0 / 3.0) * trace(b);
+    const Stress         tdev = deviatoric_kirchhoff_stress(b);
+    const double         a    = 2.0 / 3.0 * mu * trbb;
     dealii::Tensor<4, 3> c;
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = 0; j < 3; ++j)
@@ -166,8 +164,8 @@ namespace talus::materials
           for (unsigned int l = 0; l < 3; ++l)
             {
               const double dij = (i == j), dkl = (k == l);
-              const double Is  = 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
-              c[i][j][k][l] = a * (Is - dij * dkl / 3.0) - 2.0 / 3.0 * (tdev[i][j] * dkl + dij * tdev[k][l]);
+              const double Is = 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
+              c[i][j][k][l]   = a * (Is - dij * dkl / 3.0) - 2.0 / 3.0 * (tdev[i][j] * dkl + dij * tdev[k][l]);
             }
     return c;
   }
@@ -188,12 +186,9 @@ namespace talus::materials
   }
 
   void
-  NeoHookean::split_update(const dealii::Tensor<2, 3> &dF,
-                           ArrayView<const double>     history_old,
-                           ArrayView<double>           history_new,
-                           Stress &                    tau_dev,
-                           double &                    J,
-                           dealii::Tensor<4, 3> *      dtau_dev_ddF) const
+  NeoHookean::split_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                           ArrayView<double> history_new, Stress &tau_dev, double &J,
+                           dealii::Tensor<4, 3> *dtau_dev_ddF) const
   {
     checked_increment_jacobian(dF, *this);
     const Stress b_n = fs::load_sym(history_old, 0);
@@ -206,11 +201,8 @@ namespace talus::materials
   }
 
   void
-  NeoHookean::finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                                   ArrayView<const double>     history_old,
-                                   ArrayView<double>           history_new,
-                                   Stress &                    tau,
-                                   dealii::Tensor<4, 3> *      dtau_ddF) const
+  NeoHookean::finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                                   ArrayView<double> history_new, Stress &tau, dealii::Tensor<4, 3> *dtau_ddF) const
   {
     checked_increment_jacobian(dF, *this); // throws for det dF <= 0 (an inverted point)
     const Stress b_n = fs::load_sym(history_old, 0);
@@ -220,8 +212,8 @@ namespace talus::materials
     if (!dtau_ddF)
       return;
     // A = d tau / d b (symmetric in k,l), then the chain rule through b = dF b_n dF^T.
-    const double J    = std::sqrt(determinant(b));
-    const Stress binv = invert(b);
+    const double         J    = std::sqrt(determinant(b));
+    const Stress         binv = invert(b);
     dealii::Tensor<4, 3> A;
     if (energy_form == Energy::coupled)
       {
@@ -230,8 +222,8 @@ namespace talus::materials
           for (unsigned int j = 0; j < 3; ++j)
             for (unsigned int k = 0; k < 3; ++k)
               for (unsigned int l = 0; l < 3; ++l)
-                A[i][j][k][l] = 0.5 * lambda * (i == j) * binv[k][l] +
-                                mu * 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
+                A[i][j][k][l] =
+                  0.5 * lambda * (i == j) * binv[k][l] + mu * 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
       }
     else
       {
@@ -254,10 +246,7 @@ namespace talus::materials
   }
 
   void
-  NeoHookean::update_stress(const Strain &    d_eps,
-                            const Spin &      d_omega,
-                            const double,
-                            Stress &          sigma,
+  NeoHookean::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                             ArrayView<double> history) const
   {
     const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);

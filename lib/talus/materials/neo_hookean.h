@@ -30,10 +30,22 @@ namespace talus::materials
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string model_name() const override { return "neo hookean"; }
-    double      constrained_modulus() const override { return lambda + 2 * mu; }
+    std::string
+    model_name() const override
+    {
+      return "neo hookean";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return lambda + 2 * mu;
+    }
 
-    unsigned int             n_history() const override { return 6; }
+    unsigned int
+    n_history() const override
+    {
+      return 6;
+    }
     std::vector<std::string> history_names() const override;
     /// Sets b such that tau(b) = sigma (J = 1 reference, i.e. the given stress is
     /// taken as Kirchhoff stress of a pre-strained state); sigma = 0 gives b = I.
@@ -41,23 +53,22 @@ namespace talus::materials
 
     /// Rate form: dF = I + d_eps + d_omega, then the finite-strain update; the
     /// returned Cauchy stress is tau / J with J = sqrt(det b).
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
-    bool has_finite_strain_form() const override { return true; }
+    bool
+    has_finite_strain_form() const override
+    {
+      return true;
+    }
 
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
     /// J^e = sqrt(det b_e) of the history's elastic left Cauchy-Green tensor
     /// (the modified F-bar of the semi-implicit family, seed 002 Eq. 82).
     double elastic_jacobian(ArrayView<const double> history) const;
-    void finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                              ArrayView<const double>     history_old,
-                              ArrayView<double>           history_new,
-                              Stress &                    tau,
-                              dealii::Tensor<4, 3> *      dtau_ddF) const override;
+    void   finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                                ArrayView<double> history_new, Stress &tau,
+                                dealii::Tensor<4, 3> *dtau_ddF) const override;
 
     double elastic_energy_density(const Stress &sigma) const override;
 
@@ -73,7 +84,11 @@ namespace talus::materials
     /// dp/dJ = K U''(J) [Pa]
     double dpressure_dJ(const double J) const;
     /// Kirchhoff pressure J p = J K U'(J) [Pa]
-    double kirchhoff_pressure(const double J) const { return J * pressure(J); }
+    double
+    kirchhoff_pressure(const double J) const
+    {
+      return J * pressure(J);
+    }
     /// Deviatoric Kirchhoff stress mu dev(J^-2/3 b).
     Stress deviatoric_kirchhoff_stress(const Stress &b) const;
     /// Spatial tangent of the deviatoric part (Eq. 3.52):
@@ -85,25 +100,58 @@ namespace talus::materials
     static dealii::Tensor<4, 3> volumetric_spatial_tangent(const double J, const double p);
     /// The split of the mixed u-p driver (Material::split_update): with the
     /// split energy, p(J) = K U'(J) above.
-    bool   has_volumetric_split() const override { return energy_form == Energy::split; }
-    double split_pressure(const double J) const override { return pressure(J); }
-    double split_dpressure_dJ(const double J) const override { return dpressure_dJ(J); }
-    double split_bulk_modulus() const override { return bulk_modulus(); }
-    double split_shear_modulus() const override { return mu; }
+    bool
+    has_volumetric_split() const override
+    {
+      return energy_form == Energy::split;
+    }
+    double
+    split_pressure(const double J) const override
+    {
+      return pressure(J);
+    }
+    double
+    split_dpressure_dJ(const double J) const override
+    {
+      return dpressure_dJ(J);
+    }
+    double
+    split_bulk_modulus() const override
+    {
+      return bulk_modulus();
+    }
+    double
+    split_shear_modulus() const override
+    {
+      return mu;
+    }
     /// tau_dev = mu dev(J^-2/3 b) and its tangent (Eq. 3.52) computed directly,
     /// not as tau - J p I: at nu = 0.499999 (K/G = 5e5) the difference would
     /// lose 6 digits (the u-p tangent test at that nu sees it: 2e-7 vs 9e-11)
-    void split_update(const dealii::Tensor<2, 3> &dF,
-                      ArrayView<const double>     history_old,
-                      ArrayView<double>           history_new,
-                      Stress &                    tau_dev,
-                      double &                    J,
-                      dealii::Tensor<4, 3> *      dtau_dev_ddF) const override;
+    void split_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                      ArrayView<double> history_new, Stress &tau_dev, double &J,
+                      dealii::Tensor<4, 3> *dtau_dev_ddF) const override;
 
-    double shear_modulus() const { return mu; }
-    double lame_lambda() const { return lambda; }
-    double bulk_modulus() const { return lambda + 2.0 * mu / 3.0; }
-    Energy energy() const { return energy_form; }
+    double
+    shear_modulus() const
+    {
+      return mu;
+    }
+    double
+    lame_lambda() const
+    {
+      return lambda;
+    }
+    double
+    bulk_modulus() const
+    {
+      return lambda + 2.0 * mu / 3.0;
+    }
+    Energy
+    energy() const
+    {
+      return energy_form;
+    }
 
   private:
     double E, nu, lambda, mu;

@@ -6,17 +6,17 @@ namespace talus::materials
   using namespace internal;
 
   Newtonian::Newtonian(const double K_, const double mu_, const double p_cav_, const std::string &where)
-    : K(K_)
-    , mu(mu_)
-    , p_cav(p_cav_)
+      : K(K_)
+      , mu(mu_)
+      , p_cav(p_cav_)
   {
     setup(where);
   }
 
   Newtonian::Newtonian(dealii::ParameterHandler &prm, const std::string &where)
-    : K(prm.get_double("bulk modulus"))
-    , mu(prm.get_double("dynamic viscosity"))
-    , p_cav(prm.get_double("cavitation threshold"))
+      : K(prm.get_double("bulk modulus"))
+      , mu(prm.get_double("dynamic viscosity"))
+      , p_cav(prm.get_double("cavitation threshold"))
   {
     incremental_cavitation = prm.get("cavitation recovery") == "incremental";
     setup(where);
@@ -33,9 +33,7 @@ namespace talus::materials
   Newtonian::declare_parameters(dealii::ParameterHandler &prm)
   {
     declare_liquid_pressure_parameters(prm);
-    prm.declare_entry("dynamic viscosity",
-                      "1e-3",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("dynamic viscosity", "1e-3", dealii::Patterns::Double(),
                       "Dynamic viscosity mu [Pa s], >= 0 (water: 1e-3).");
   }
 
@@ -46,11 +44,7 @@ namespace talus::materials
   }
 
   void
-  Newtonian::update_stress(const Strain &d_eps,
-                           const Spin &,
-                           const double      dt,
-                           Stress &          sigma,
-                           ArrayView<double> h) const
+  Newtonian::update_stress(const Strain &d_eps, const Spin &, const double dt, Stress &sigma, ArrayView<double> h) const
   {
     const double p = update_liquid_pressure(K, h[h_volumetric_strain], trace(d_eps), p_cav, incremental_cavitation);
     if (dt > 0 && p > p_cav)

@@ -22,16 +22,33 @@ namespace talus::materials
     /// recovery", see liquid_common.h)
     bool incremental_cavitation = true;
 
-    std::string  model_name() const override { return "newtonian"; }
-    double       constrained_modulus() const override { return K; }
-    double       dynamic_viscosity() const override { return mu; }
-    unsigned int n_history() const override { return 1; }
-    std::vector<std::string> history_names() const override { return {"volumetric strain"}; }
+    std::string
+    model_name() const override
+    {
+      return "newtonian";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return K;
+    }
+    double
+    dynamic_viscosity() const override
+    {
+      return mu;
+    }
+    unsigned int
+    n_history() const override
+    {
+      return 1;
+    }
+    std::vector<std::string>
+    history_names() const override
+    {
+      return {"volumetric strain"};
+    }
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
     enum : unsigned int

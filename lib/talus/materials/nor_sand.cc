@@ -11,7 +11,7 @@
 namespace talus::materials
 {
   NorSand::NorSand(const Parameters &p)
-    : P(p)
+      : P(p)
   {
     check("nor sand");
   }
@@ -60,8 +60,8 @@ namespace talus::materials
             "must be < 0 (tension-positive convention, D* = alpha psi; got " + std::to_string(P.alpha) + ")");
     require(P.ocr >= 1, w + "/overconsolidation ratio", "must be >= 1 (got " + std::to_string(P.ocr) + ")");
     require(P.cut_start > 0 && P.cut_end > P.cut_start, w + "/dilatancy cutoff end",
-            "must satisfy 0 < start < end (got " + std::to_string(P.cut_start) + ", " +
-              std::to_string(P.cut_end) + ")");
+            "must satisfy 0 < start < end (got " + std::to_string(P.cut_start) + ", " + std::to_string(P.cut_end) +
+              ")");
     require(P.gas_factor > 1, w + "/gas cutoff factor", "must be > 1 (got " + std::to_string(P.gas_factor) + ")");
   }
 
@@ -70,22 +70,37 @@ namespace talus::materials
   {
     using dealii::Patterns::Double;
     prm.declare_entry("shear modulus", "40e6", Double(), "Shear modulus G [Pa], > 0 (seed 002 Table 6: 40 MPa).");
-    prm.declare_entry("swelling index", "0.002", Double(), "Elastic compressibility kappa [-], > 0: p = p_ref exp(-(eps_v - eps_v,ref)/kappa).");
-    prm.declare_entry("compression index", "0.02", Double(), "Slope lambda of the critical state line v_c = v_c0 - lambda ln(p/p_unit) [-], > 0.");
-    prm.declare_entry("reference specific volume", "1.892", Double(), "v_c0, specific volume of the CSL at p = p_unit [-], > 1.");
+    prm.declare_entry("swelling index", "0.002", Double(),
+                      "Elastic compressibility kappa [-], > 0: p = p_ref exp(-(eps_v - eps_v,ref)/kappa).");
+    prm.declare_entry("compression index", "0.02", Double(),
+                      "Slope lambda of the critical state line v_c = v_c0 - lambda ln(p/p_unit) [-], > 0.");
+    prm.declare_entry("reference specific volume", "1.892", Double(),
+                      "v_c0, specific volume of the CSL at p = p_unit [-], > 1.");
     prm.declare_entry("critical state ratio", "1.0", Double(), "Critical state stress ratio M = q/p [-], > 0.");
     prm.declare_entry("yield constant N", "0.1", Double(), "Yield function constant N [-], 0 < N < 1.");
-    prm.declare_entry("potential constant N bar", "0.1", Double(), "Plastic potential constant N bar [-], 0 < N bar < 1.");
+    prm.declare_entry("potential constant N bar", "0.1", Double(),
+                      "Plastic potential constant N bar [-], 0 < N bar < 1.");
     prm.declare_entry("hardening coefficient", "100", Double(), "Hardening coefficient h [-], > 0.");
-    prm.declare_entry("dilatancy multiplier", "-2.0", Double(), "alpha [-], < 0: maximum plastic dilatancy D* = alpha psi_i (dilation positive).");
+    prm.declare_entry("dilatancy multiplier", "-2.0", Double(),
+                      "alpha [-], < 0: maximum plastic dilatancy D* = alpha psi_i (dilation positive).");
     prm.declare_entry("initial specific volume", "2.0", Double(), "Initial specific volume v0 [-], > 1.");
-    prm.declare_entry("reference pressure", "2e3", Double(), "Initial reference mean effective pressure p0, compression positive [Pa], > 0 (seed 002 App. B.4: 2 kPa).");
-    prm.declare_entry("reference elastic volumetric strain", "0", Double(), "Elastic volumetric strain at the reference pressure [-] (tension positive).");
-    prm.declare_entry("overconsolidation ratio", "1", Double(), "OCR [-], >= 1, for the initial image pressure (seed 002 Eq. 113).");
-    prm.declare_entry("critical state pressure unit", "1", Double(), "Pressure unit of the logarithm in the CSL and in psi_i [Pa], > 0 (1 Pa for the Table 6 values).");
-    prm.declare_entry("dilatancy cutoff start", "1.0", Double(), "Accumulated deviatoric plastic strain where the dilatancy cut-off starts [-] (seed 002 Eq. 92).");
-    prm.declare_entry("dilatancy cutoff end", "1.5", Double(), "Accumulated deviatoric plastic strain where psi_i reaches 0 [-], > start.");
-    prm.declare_entry("gas cutoff factor", "1.6", Double(), "Gas-like cut-off: zero stress when v > factor x v0 [-], > 1 (seed 002 Eq. 93).");
+    prm.declare_entry(
+      "reference pressure", "2e3", Double(),
+      "Initial reference mean effective pressure p0, compression positive [Pa], > 0 (seed 002 App. B.4: 2 kPa).");
+    prm.declare_entry("reference elastic volumetric strain", "0", Double(),
+                      "Elastic volumetric strain at the reference pressure [-] (tension positive).");
+    prm.declare_entry("overconsolidation ratio", "1", Double(),
+                      "OCR [-], >= 1, for the initial image pressure (seed 002 Eq. 113).");
+    prm.declare_entry(
+      "critical state pressure unit", "1", Double(),
+      "Pressure unit of the logarithm in the CSL and in psi_i [Pa], > 0 (1 Pa for the Table 6 values).");
+    prm.declare_entry(
+      "dilatancy cutoff start", "1.0", Double(),
+      "Accumulated deviatoric plastic strain where the dilatancy cut-off starts [-] (seed 002 Eq. 92).");
+    prm.declare_entry("dilatancy cutoff end", "1.5", Double(),
+                      "Accumulated deviatoric plastic strain where psi_i reaches 0 [-], > start.");
+    prm.declare_entry("gas cutoff factor", "1.6", Double(),
+                      "Gas-like cut-off: zero stress when v > factor x v0 [-], > 1 (seed 002 Eq. 93).");
   }
 
   double
@@ -97,9 +112,19 @@ namespace talus::materials
   std::vector<std::string>
   NorSand::history_names() const
   {
-    return {"be_xx", "be_yy", "be_zz", "be_xy", "be_yz", "be_xz", "J", "specific volume",
-            "image pressure", "deviatoric plastic strain", "psi at cutoff start",
-            "reference pressure", "reference elastic volumetric strain"};
+    return {"be_xx",
+            "be_yy",
+            "be_zz",
+            "be_xy",
+            "be_yz",
+            "be_xz",
+            "J",
+            "specific volume",
+            "image pressure",
+            "deviatoric plastic strain",
+            "psi at cutoff start",
+            "reference pressure",
+            "reference elastic volumetric strain"};
   }
 
   double
@@ -160,14 +185,14 @@ namespace talus::materials
   {
     const double G = P.G, M = P.M, N = P.N, Nb = P.N_bar, kap = P.kappa;
     const double a = N / (1 - N), ab = Nb / (1 - Nb);
-    s1             = s0;
+    s1                 = s0;
     const double ev_tr = eps[0] + eps[1] + eps[2];
     double       etr[3];
     for (unsigned int A = 0; A < 3; ++A)
       etr[A] = eps[A] - ev_tr / 3.0;
     const double ne    = std::sqrt(etr[0] * etr[0] + etr[1] * etr[1] + etr[2] * etr[2]);
     const double es_tr = std::sqrt(2.0 / 3.0) * ne;
-    auto pres = [&](const double ev) { return s0.p_ref * std::exp(-(ev - s0.ev_ref) / kap); };
+    auto         pres  = [&](const double ev) { return s0.p_ref * std::exp(-(ev - s0.ev_ref) / kap); };
 
     auto set_elastic = [&](const double ev, const double factor) {
       const double p = pres(ev);
@@ -194,9 +219,9 @@ namespace talus::materials
     }
 
     // dilatancy cut-off (seed 002 Eq. 92)
-    const bool   cut = s0.Ed >= P.cut_start;
-    const double dcut = P.cut_end - P.cut_start;
-    auto psi_of = [&](const double pi, const double dl, double &dpsi_dpi, double &dpsi_ddl) {
+    const bool   cut    = s0.Ed >= P.cut_start;
+    const double dcut   = P.cut_end - P.cut_start;
+    auto         psi_of = [&](const double pi, const double dl, double &dpsi_dpi, double &dpsi_ddl) {
       if (!cut)
         {
           dpsi_dpi = P.lambda / pi;
@@ -214,8 +239,8 @@ namespace talus::materials
       return (1 - (E - P.cut_start) / dcut) * s0.psi_start;
     };
 
-    const double sc = std::abs(s0.pi);
-    double       ev = ev_tr, dl = 0, pi = s0.pi;
+    const double    sc = std::abs(s0.pi);
+    double          ev = ev_tr, dl = 0, pi = s0.pi;
     Eigen::Matrix3d Jm;
     bool            ok = false;
     for (int it = 0; it < 60; ++it)
@@ -224,7 +249,7 @@ namespace talus::materials
         // one pow when N = N_bar (the paper's Table 6), the same value to the bit
         const double r = std::pow(p / pi, a), rb = ab == a ? r : std::pow(p / pi, ab);
         const double eta = M / N * (1 - (1 - N) * r);
-        const double Qp = M / Nb * (1 - rb);
+        const double Qp  = M / Nb * (1 - rb);
         const double Qpp = -M / Nb * ab * rb / p, Qppi = M / Nb * ab * rb / pi;
         const double Fp = M / N * (1 - r), Fpi = M * r * p / pi;
         double       dpsi_dpi, dpsi_ddl;
@@ -232,11 +257,10 @@ namespace talus::materials
         const double sg  = 1 - N * P.alpha * psi / M;
         if (!(sg > 0))
           break;
-        const double g   = std::pow(sg, (N - 1) / N);
-        const double gp  = (1 - N) * P.alpha / M * (g / sg); // sg^(-1/N) = sg^((N-1)/N) / sg
-        const double pis = p * g;
-        Eigen::Vector3d R(ev - ev_tr + dl * Qp,
-                          (3 * G * (es_tr - dl) + eta * p) / sc,
+        const double    g   = std::pow(sg, (N - 1) / N);
+        const double    gp  = (1 - N) * P.alpha / M * (g / sg); // sg^(-1/N) = sg^((N-1)/N) / sg
+        const double    pis = p * g;
+        Eigen::Vector3d R(ev - ev_tr + dl * Qp, (3 * G * (es_tr - dl) + eta * p) / sc,
                           (pi - s0.pi - P.h * dl * (pis - pi)) / sc);
         Jm(0, 0) = 1 + dl * Qpp * K;
         Jm(0, 1) = Qp;
@@ -256,7 +280,7 @@ namespace talus::materials
           }
         // 3 x 3: the cofactor inverse (a few dozen flops; Eigen's full-pivot LU
         // was 5 % of a landslide step), the LU only where Jm is near singular
-        const double    det = Jm.determinant();
+        const double    det   = Jm.determinant();
         const double    scale = Jm.row(0).norm() * Jm.row(1).norm() * Jm.row(2).norm();
         Eigen::Vector3d dx    = std::abs(det) > 1e-10 * scale ? Eigen::Vector3d(Jm.inverse() * (-R))
                                                               : Eigen::Vector3d(Jm.fullPivLu().solve(-R));
@@ -282,14 +306,14 @@ namespace talus::materials
             const Eigen::Matrix3d Ji = Jm.inverse();
             // v = v_n det(dF) also depends on the trial strains: dv/d eps_B = v,
             // entering R3 through psi_i (not within the dilatancy cut-off).
-            double dpsi_dpi, dpsi_ddl;
-            const double psi = psi_of(pi, dl, dpsi_dpi, dpsi_ddl);
-            const double gpv = (1 - N) * P.alpha / M * std::pow(1 - N * P.alpha * psi / M, -1.0 / N);
-            const double dR3dv = cut ? 0.0 : -P.h * dl * pres(ev) * gpv * s0.v / sc;
-            const Eigen::Vector3d dv = Ji * Eigen::Vector3d(1, 0, -dR3dv);       // d x / d ev_tr
-            const Eigen::Vector3d ds = Ji * Eigen::Vector3d(0, -3 * G / sc, 0);  // d x / d es_tr
-            const double p = pres(ev), K = -p / kap;
-            const double fac = 1.0 - dl / es_tr;
+            double                dpsi_dpi, dpsi_ddl;
+            const double          psi   = psi_of(pi, dl, dpsi_dpi, dpsi_ddl);
+            const double          gpv   = (1 - N) * P.alpha / M * std::pow(1 - N * P.alpha * psi / M, -1.0 / N);
+            const double          dR3dv = cut ? 0.0 : -P.h * dl * pres(ev) * gpv * s0.v / sc;
+            const Eigen::Vector3d dv    = Ji * Eigen::Vector3d(1, 0, -dR3dv);      // d x / d ev_tr
+            const Eigen::Vector3d ds    = Ji * Eigen::Vector3d(0, -3 * G / sc, 0); // d x / d es_tr
+            const double          p = pres(ev), K = -p / kap;
+            const double          fac = 1.0 - dl / es_tr;
             for (unsigned int B = 0; B < 3; ++B)
               {
                 const double desB = 2.0 / 3.0 * etr[B] / es_tr; // d es_tr / d eps_B
@@ -359,11 +383,8 @@ namespace talus::materials
   }
 
   void
-  NorSand::finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                                ArrayView<const double>     h_old,
-                                ArrayView<double>           h_new,
-                                Stress &                    tau,
-                                dealii::Tensor<4, 3> *      dtau_ddF) const
+  NorSand::finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> h_old, ArrayView<double> h_new,
+                                Stress &tau, dealii::Tensor<4, 3> *dtau_ddF) const
   {
     const double detf = checked_increment_jacobian(dF, *this);
     for (unsigned int i = 0; i < 13; ++i)
@@ -386,7 +407,7 @@ namespace talus::materials
     double             e_tr[3], t[3], D[3][3];
     for (unsigned int A = 0; A < 3; ++A)
       e_tr[A] = 0.5 * std::log(sp.x[A]);
-    State s0{h_old[8], h_old[9], h_old[10], h_old[11], h_old[12], h_new[7]}, s1;
+    State     s0{h_old[8], h_old[9], h_old[10], h_old[11], h_old[12], h_new[7]}, s1;
     const int region = principal_update(e_tr, s0, t, dtau_ddF ? D : nullptr, s1);
     if (region == 1 || region == 2)
       {
@@ -419,14 +440,11 @@ namespace talus::materials
   }
 
   void
-  NorSand::update_stress(const Strain &    d_eps,
-                         const Spin &      d_omega,
-                         const double,
-                         Stress &          sigma,
+  NorSand::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                          ArrayView<double> history) const
   {
     const Stress tau = finite_strain_rate_update(d_eps, d_omega, history);
-    sigma = tau / kirchhoff_jacobian(history);
+    sigma            = tau / kirchhoff_jacobian(history);
   }
 
   double

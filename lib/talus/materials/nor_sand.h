@@ -32,23 +32,23 @@ namespace talus::materials
   public:
     struct Parameters
     {
-      double G           = 40e6;   ///< shear modulus [Pa]
-      double kappa       = 0.002;  ///< elastic compressibility (swelling index) [-]
-      double lambda      = 0.02;   ///< slope of the CSL in v - ln p [-]
-      double v_c0        = 1.892;  ///< CSL specific volume at p = p_unit [-]
-      double M           = 1.0;    ///< critical state stress ratio [-]
-      double N           = 0.1;    ///< yield function constant [-]
-      double N_bar       = 0.1;    ///< plastic potential constant [-]
-      double h           = 100;    ///< hardening coefficient [-]
-      double alpha       = -2.0;   ///< multiplier of the maximum plastic dilatancy [-]
-      double v0          = 2.0;    ///< initial specific volume [-]
-      double p0          = 2e3;    ///< initial reference pressure (compression +) [Pa]
-      double eps_v0      = 0.0;    ///< elastic volumetric strain at p0 [-]
-      double ocr         = 1.0;    ///< overconsolidation ratio [-]
-      double p_unit      = 1.0;    ///< pressure unit of the CSL logarithm [Pa]
-      double cut_start   = 1.0;    ///< dilatancy cut-off start, Ebar_d^p [-]
-      double cut_end     = 1.5;    ///< dilatancy cut-off end, Ebar_d^p [-]
-      double gas_factor  = 1.6;    ///< gas-like cut-off v_crit = gas_factor v0 [-]
+      double G          = 40e6;  ///< shear modulus [Pa]
+      double kappa      = 0.002; ///< elastic compressibility (swelling index) [-]
+      double lambda     = 0.02;  ///< slope of the CSL in v - ln p [-]
+      double v_c0       = 1.892; ///< CSL specific volume at p = p_unit [-]
+      double M          = 1.0;   ///< critical state stress ratio [-]
+      double N          = 0.1;   ///< yield function constant [-]
+      double N_bar      = 0.1;   ///< plastic potential constant [-]
+      double h          = 100;   ///< hardening coefficient [-]
+      double alpha      = -2.0;  ///< multiplier of the maximum plastic dilatancy [-]
+      double v0         = 2.0;   ///< initial specific volume [-]
+      double p0         = 2e3;   ///< initial reference pressure (compression +) [Pa]
+      double eps_v0     = 0.0;   ///< elastic volumetric strain at p0 [-]
+      double ocr        = 1.0;   ///< overconsolidation ratio [-]
+      double p_unit     = 1.0;   ///< pressure unit of the CSL logarithm [Pa]
+      double cut_start  = 1.0;   ///< dilatancy cut-off start, Ebar_d^p [-]
+      double cut_end    = 1.5;   ///< dilatancy cut-off end, Ebar_d^p [-]
+      double gas_factor = 1.6;   ///< gas-like cut-off v_crit = gas_factor v0 [-]
     };
 
     explicit NorSand(const Parameters &p);
@@ -56,14 +56,22 @@ namespace talus::materials
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string model_name() const override { return "nor sand"; }
+    std::string
+    model_name() const override
+    {
+      return "nor sand";
+    }
     /// K + 4/3 G at the reference pressure, K = p0 / kappa.
     double constrained_modulus() const override;
 
-    unsigned int             n_history() const override { return 13; }
+    unsigned int
+    n_history() const override
+    {
+      return 13;
+    }
     /// history slot of the specific volume v (= v0 J unless a caller sets it)
     static constexpr unsigned int specific_volume_slot = 7;
-    std::vector<std::string> history_names() const override;
+    std::vector<std::string>      history_names() const override;
     /// sigma = 0: isotropic state at p0 (reference), eps_v,ref; p_i from Eq. 113
     /// with the OCR. sigma != 0: reference pressure p_ref = tr(sigma)/3, deviatoric
     /// elastic strain dev(sigma)/(2G), p_i = OCR x the image pressure of the yield
@@ -73,27 +81,34 @@ namespace talus::materials
     /// reference, p_i from the OCR (Eq. 113) and v0 <- J v0 (kept in the history).
     void reinitialize_reference(ArrayView<double> history) const;
     /// Elastic only (App. B.4 gravity phase) when false.
-    void set_plasticity(const bool on) { plastic = on; }
+    void
+    set_plasticity(const bool on)
+    {
+      plastic = on;
+    }
 
-    void update_stress(const Strain &    d_eps,
-                       const Spin &      d_omega,
-                       const double      dt,
-                       Stress &          sigma,
+    void update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
                        ArrayView<double> history) const override;
 
-    bool has_finite_strain_form() const override { return true; }
+    bool
+    has_finite_strain_form() const override
+    {
+      return true;
+    }
 
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
     /// J^e = sqrt(det b_e) of the history's elastic left Cauchy-Green tensor
     /// (the modified F-bar of the semi-implicit family, seed 002 Eq. 82).
     double elastic_jacobian(ArrayView<const double> history) const;
-    void finite_strain_update(const dealii::Tensor<2, 3> &dF,
-                              ArrayView<const double>     history_old,
-                              ArrayView<double>           history_new,
-                              Stress &                    tau,
-                              dealii::Tensor<4, 3> *      dtau_ddF) const override;
+    void   finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                                ArrayView<double> history_new, Stress &tau,
+                                dealii::Tensor<4, 3> *dtau_ddF) const override;
 
-    const Parameters &parameters() const { return P; }
+    const Parameters &
+    parameters() const
+    {
+      return P;
+    }
     /// Image pressure on the yield surface through (p, q) (p < 0).
     double image_pressure_through(const double p, const double q) const;
 
@@ -103,8 +118,7 @@ namespace talus::materials
     };
     /// Principal map: sorted trial log strains -> principal tau, d tau/d eps_tr
     /// (if D != nullptr), updated state; returns 0 elastic, 1 plastic, 2 tip.
-    int principal_update(const double eps[3], const State &s0, double tau[3], double (*D)[3],
-                         State &s1) const;
+    int principal_update(const double eps[3], const State &s0, double tau[3], double (*D)[3], State &s1) const;
 
   private:
     void       check(const std::string &where) const;

@@ -83,14 +83,9 @@ namespace talus::materials::internal
   } // namespace
 
   PrincipalReturnResult
-  return_to_planar_surfaces(const Vec3 &         trial,
-                            const double         lambda,
-                            const double         G,
-                            const PlanarSurface *cand,
-                            const unsigned int   n_cand,
-                            const PlanarSurface *check,
-                            const unsigned int   n_check,
-                            const double         tol)
+  return_to_planar_surfaces(const Vec3 &trial, const double lambda, const double G, const PlanarSurface *cand,
+                            const unsigned int n_cand, const PlanarSurface *check, const unsigned int n_check,
+                            const double tol)
   {
     PrincipalReturnResult res;
     Vec3                  Db[6];
@@ -165,9 +160,8 @@ namespace talus::materials::internal
   Spectral
   spectral_decomposition(const dealii::SymmetricTensor<2, 3> &s)
   {
-    const auto ev =
-      dealii::eigenvectors(s, dealii::SymmetricTensorEigenvectorMethod::ql_implicit_shifts);
-    Spectral sd;
+    const auto ev = dealii::eigenvectors(s, dealii::SymmetricTensorEigenvectorMethod::ql_implicit_shifts);
+    Spectral   sd;
     for (unsigned int i = 0; i < 3; ++i)
       {
         sd.values[i]  = ev[i].first;

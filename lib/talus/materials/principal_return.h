@@ -43,15 +43,10 @@ namespace talus::materials::internal
   /// Return the trial principal stresses onto the candidate surfaces. `check`
   /// surfaces are only tested for admissibility (they include the candidates).
   /// lambda, G: Lame constants. tol: absolute tolerance on f [Pa].
-  PrincipalReturnResult
-  return_to_planar_surfaces(const Vec3 &         trial,
-                            const double         lambda,
-                            const double         G,
-                            const PlanarSurface *candidates,
-                            const unsigned int   n_candidates,
-                            const PlanarSurface *check,
-                            const unsigned int   n_check,
-                            const double         tol);
+  PrincipalReturnResult return_to_planar_surfaces(const Vec3 &trial, const double lambda, const double G,
+                                                  const PlanarSurface *candidates, const unsigned int n_candidates,
+                                                  const PlanarSurface *check, const unsigned int n_check,
+                                                  const double tol);
 
   /// Spectral decomposition, eigenvalues in descending order.
   struct Spectral

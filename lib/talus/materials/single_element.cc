@@ -38,16 +38,14 @@ namespace talus::materials
     /// strain d_eps = sym L, d_omega = skew L; finite strain dF = exp(L) (L is
     /// either diagonal or nilpotent in these paths, so exp is exact).
     State
-    advance(const Material &m, const ElementTestSettings &set, const State &s,
-            const dealii::Tensor<2, 3> &L)
+    advance(const Material &m, const ElementTestSettings &set, const State &s, const dealii::Tensor<2, 3> &L)
     {
       State n = s;
       if (!set.finite_strain)
         {
           const Strain d_eps = symmetrize(L);
           const Spin   d_om  = 0.5 * (L - transpose(L));
-          m.update_stress(d_eps, d_om, set.time_increment, n.sigma,
-                          ArrayView<double>(n.h.data(), n.h.size()));
+          m.update_stress(d_eps, d_om, set.time_increment, n.sigma, ArrayView<double>(n.h.data(), n.h.size()));
           n.eps += d_eps;
         }
       else
@@ -64,21 +62,18 @@ namespace talus::materials
           else
             dF += L;
           Stress tau;
-          m.finite_strain_update(dF,
-                                 ArrayView<const double>(s.h.data(), s.h.size()),
-                                 ArrayView<double>(n.h.data(), n.h.size()),
-                                 tau,
-                                 nullptr);
+          m.finite_strain_update(dF, ArrayView<const double>(s.h.data(), s.h.size()),
+                                 ArrayView<double>(n.h.data(), n.h.size()), tau, nullptr);
           n.F            = dF * s.F;
           const double J = determinant(n.F);
           n.sigma        = tau / J;
           // logarithmic strain 1/2 ln(F F^T)
           const dealii::SymmetricTensor<2, 3> B = symmetrize(n.F * transpose(n.F));
           const auto ev = dealii::eigenvectors(B, dealii::SymmetricTensorEigenvectorMethod::jacobi);
-          n.eps = Strain();
+          n.eps         = Strain();
           for (unsigned int k = 0; k < 3; ++k)
-            n.eps += 0.5 * std::log(ev[k].first) *
-                     dealii::symmetrize(dealii::outer_product(ev[k].second, ev[k].second));
+            n.eps +=
+              0.5 * std::log(ev[k].first) * dealii::symmetrize(dealii::outer_product(ev[k].second, ev[k].second));
         }
       n.gamma = s.gamma + L[0][1];
       return n;
@@ -111,24 +106,22 @@ namespace talus::materials
   }
 
   void
-  run_element_test(const Material &                                  m,
-                   const ElementTestSettings &                       set,
+  run_element_test(const Material &m, const ElementTestSettings &set,
                    const std::function<void(const ElementRecord &)> &out)
   {
     require(set.n_increments > 0, "element test/number of increments", "must be > 0");
     require(set.target_strain > 0, "element test/target strain", "must be > 0");
     require(set.time_increment > 0, "element test/time increment", "must be > 0");
     require(set.k0 > 0, "element test/initial stress ratio", "must be > 0");
-    require(!set.finite_strain || m.has_finite_strain_form(),
-            "element test/strain form",
+    require(!set.finite_strain || m.has_finite_strain_form(), "element test/strain form",
             "model '" + m.model_name() + "' has no finite-strain form; use 'small'");
 
     State s;
-    s.F                = dealii::unit_symmetric_tensor<3>();
-    const double sa0   = -3.0 * set.initial_pressure / (1.0 + 2.0 * set.k0);
-    s.sigma[0][0]      = sa0;
-    s.sigma[1][1]      = set.k0 * sa0;
-    s.sigma[2][2]      = set.k0 * sa0;
+    s.F              = dealii::unit_symmetric_tensor<3>();
+    const double sa0 = -3.0 * set.initial_pressure / (1.0 + 2.0 * set.k0);
+    s.sigma[0][0]    = sa0;
+    s.sigma[1][1]    = set.k0 * sa0;
+    s.sigma[2][2]    = set.k0 * sa0;
     s.h.assign(m.n_history(), 0.0);
     m.initialize_history(s.sigma, ArrayView<double>(s.h.data(), s.h.size()));
 
@@ -146,10 +139,10 @@ namespace talus::materials
     emit(s, 0, 0);
 
     const double d = set.target_strain / set.n_increments;
-    const bool   drained = set.path == ElementPath::drained_triaxial_compression ||
-                         set.path == ElementPath::drained_triaxial_extension;
+    const bool   drained =
+      set.path == ElementPath::drained_triaxial_compression || set.path == ElementPath::drained_triaxial_extension;
     const double sigma_lat = s.sigma[1][1];
-    double       guess_y = 0; // lateral strain increment of the previous step
+    double       guess_y   = 0; // lateral strain increment of the previous step
 
     for (unsigned int step = 1; step <= set.n_increments; ++step)
       {
@@ -222,8 +215,7 @@ namespace talus::materials
                 const double Rp = eval(x + h, tmp);
                 const double Rm = eval(x - h, tmp);
                 const double dR = (Rp - Rm) / (2 * h);
-                double       xn = (dR > 0 && std::isfinite(dR)) ? x - R / dR :
-                                                                   x - (R > 0 ? d : -d);
+                double       xn = (dR > 0 && std::isfinite(dR)) ? x - R / dR : x - (R > 0 ? d : -d);
                 if (std::isfinite(lo) && std::isfinite(hi) && !(xn > lo && xn < hi))
                   xn = 0.5 * (lo + hi); // bisection inside the bracket
                 else if (std::isfinite(lo) && xn <= lo)
@@ -237,22 +229,20 @@ namespace talus::materials
               }
             if (ok && std::abs(trial.sigma[1][1] - trial.sigma[2][2]) > 1e3 * tol)
               throw InstabilityError("element test: lateral stresses became unequal in the "
-                                     "drained path at increment " + std::to_string(step) +
-                                     " (the model is not isotropic?)");
+                                     "drained path at increment " +
+                                     std::to_string(step) + " (the model is not isotropic?)");
             if (!ok)
               throw InstabilityError("element test: the drained (mixed-control) Newton loop did not "
                                      "converge at increment " +
-                                     std::to_string(step) + " (lateral stress residual " +
-                                     std::to_string(std::abs(R)) + " Pa, tolerance " +
-                                     std::to_string(tol) + " Pa)");
+                                     std::to_string(step) + " (lateral stress residual " + std::to_string(std::abs(R)) +
+                                     " Pa, tolerance " + std::to_string(tol) + " Pa)");
             guess_y = x;
             s       = trial;
           }
         for (unsigned int i = 0; i < 3; ++i)
           for (unsigned int j = i; j < 3; ++j)
             if (!std::isfinite(s.sigma[i][j]))
-              throw InstabilityError("element test: non-finite stress at increment " +
-                                     std::to_string(step));
+              throw InstabilityError("element test: non-finite stress at increment " + std::to_string(step));
         emit(s, step, its);
       }
   }

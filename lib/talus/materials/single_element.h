@@ -33,17 +33,17 @@ namespace talus::materials
 
   struct ElementTestSettings
   {
-    ElementPath  path          = ElementPath::drained_triaxial_compression;
-    bool         finite_strain = false; ///< use finite_strain_update (dF) instead of update_stress
+    ElementPath path          = ElementPath::drained_triaxial_compression;
+    bool        finite_strain = false; ///< use finite_strain_update (dF) instead of update_stress
     /// Magnitude (> 0) of the controlled strain at the end of the path: axial strain
     /// (triaxial, oedometer), volumetric strain (isotropic), engineering shear strain
     /// gamma (simple shear). Logarithmic strain in the finite-strain form.
-    double       target_strain   = 0.1;
-    unsigned int n_increments    = 1000;
-    double       time_increment  = 1e-3; ///< dt per increment [s]
-    double       initial_pressure = 100e3; ///< initial mean effective stress p0' [Pa], compression positive
-    double       k0               = 1.0;   ///< initial lateral / axial effective stress ratio
-    double       newton_tolerance = 1e-11; ///< relative, on the lateral stresses (drained paths)
+    double       target_strain         = 0.1;
+    unsigned int n_increments          = 1000;
+    double       time_increment        = 1e-3;  ///< dt per increment [s]
+    double       initial_pressure      = 100e3; ///< initial mean effective stress p0' [Pa], compression positive
+    double       k0                    = 1.0;   ///< initial lateral / axial effective stress ratio
+    double       newton_tolerance      = 1e-11; ///< relative, on the lateral stresses (drained paths)
     unsigned int max_newton_iterations = 50;
   };
 
@@ -51,23 +51,34 @@ namespace talus::materials
   {
     unsigned int        step = 0;
     double              time = 0;
-    Strain              eps;   ///< total strain (small) or logarithmic strain (finite), tension positive
+    Strain              eps;       ///< total strain (small) or logarithmic strain (finite), tension positive
     double              gamma = 0; ///< engineering shear strain of the simple-shear path
-    Stress              sigma; ///< Cauchy stress, tension positive
+    Stress              sigma;     ///< Cauchy stress, tension positive
     std::vector<double> history;
     unsigned int        newton_iterations = 0;
 
     // geotechnical invariants (compression positive)
-    double p() const { return -trace(sigma) / 3.0; }
+    double
+    p() const
+    {
+      return -trace(sigma) / 3.0;
+    }
     double q() const; ///< sqrt(3 J2) >= 0
-    double eps_axial() const { return -eps[0][0]; }
-    double eps_vol() const { return -trace(eps); }
+    double
+    eps_axial() const
+    {
+      return -eps[0][0];
+    }
+    double
+    eps_vol() const
+    {
+      return -trace(eps);
+    }
   };
 
   /// Run the path; `out` is called for the initial state (step 0) and after every
   /// increment. Throws talus::InputError for settings that do not make sense and
   /// InstabilityError when the mixed-control Newton loop does not converge.
-  void run_element_test(const Material &                          material,
-                        const ElementTestSettings &               settings,
+  void run_element_test(const Material &material, const ElementTestSettings &settings,
                         const std::function<void(const ElementRecord &)> &out);
 } // namespace talus::materials

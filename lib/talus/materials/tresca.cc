@@ -11,17 +11,17 @@ namespace talus::materials
   using namespace internal;
 
   Tresca::Tresca(const double E_, const double nu_, const double su_, const std::string &where)
-    : E(E_)
-    , nu(nu_)
-    , su(su_)
+      : E(E_)
+      , nu(nu_)
+      , su(su_)
   {
     setup(where);
   }
 
   Tresca::Tresca(dealii::ParameterHandler &prm, const std::string &where)
-    : E(prm.get_double("young modulus"))
-    , nu(prm.get_double("poisson ratio"))
-    , su(prm.get_double("undrained shear strength"))
+      : E(prm.get_double("young modulus"))
+      , nu(prm.get_double("poisson ratio"))
+      , su(prm.get_double("undrained shear strength"))
   {
     setup(where);
   }
@@ -39,14 +39,11 @@ namespace talus::materials
   void
   Tresca::declare_parameters(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(), "Young's modulus E [Pa], > 0 (undrained: E_u).");
-    prm.declare_entry("poisson ratio",
-                      "0.495",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("young modulus", "1e7", dealii::Patterns::Double(),
+                      "Young's modulus E [Pa], > 0 (undrained: E_u).");
+    prm.declare_entry("poisson ratio", "0.495", dealii::Patterns::Double(),
                       "Poisson's ratio nu [-], -1 < nu < 0.5 (undrained: close to 0.5).");
-    prm.declare_entry("undrained shear strength",
-                      "20e3",
-                      dealii::Patterns::Double(),
+    prm.declare_entry("undrained shear strength", "20e3", dealii::Patterns::Double(),
                       "Undrained shear strength s_u = tau_f [Pa], > 0; failure at q = sigma_1 - sigma_3 = 2 s_u.");
   }
 
@@ -57,10 +54,7 @@ namespace talus::materials
   }
 
   void
-  Tresca::update_stress(const Strain &    d_eps,
-                        const Spin &      d_omega,
-                        const double,
-                        Stress &          sigma,
+  Tresca::update_stress(const Strain &d_eps, const Spin &d_omega, const double, Stress &sigma,
                         ArrayView<double> history) const
   {
     sigma           = apply_jaumann_rotation(sigma, d_omega);
@@ -77,18 +71,16 @@ namespace talus::materials
           history[h_yield_state] = 0;
         return;
       }
-    const Spectral sd = spectral_decomposition(sigma);
+    const Spectral sd    = spectral_decomposition(sigma);
     auto           plane = [&](const unsigned int i, const unsigned int j) {
       PlanarSurface s{{{0, 0, 0}}, 2 * su, {{0, 0, 0}}};
       s.a[i] = s.b[i] = 1;
       s.a[j] = s.b[j] = -1;
       return s;
     };
-    const PlanarSurface cand[3] = {plane(0, 2), plane(1, 2), plane(0, 1)};
-    const PlanarSurface chk[6]  = {plane(0, 2), plane(1, 2), plane(0, 1),
-                                  plane(2, 0), plane(2, 1), plane(1, 0)};
-    const PrincipalReturnResult r =
-      return_to_planar_surfaces(sd.values, lambda, G, cand, 3, chk, 6, tol);
+    const PlanarSurface         cand[3] = {plane(0, 2), plane(1, 2), plane(0, 1)};
+    const PlanarSurface         chk[6] = {plane(0, 2), plane(1, 2), plane(0, 1), plane(2, 0), plane(2, 1), plane(1, 0)};
+    const PrincipalReturnResult r      = return_to_planar_surfaces(sd.values, lambda, G, cand, 3, chk, 6, tol);
     if (!r.converged)
       throw InstabilityError("tresca: return mapping found no admissible stress");
     if (r.n_active == 0)

@@ -19,17 +19,26 @@ namespace talus::materials
 
     static void declare_parameters(dealii::ParameterHandler &prm);
 
-    std::string  model_name() const override { return "tresca"; }
-    double       constrained_modulus() const override { return K + 4.0 * G / 3.0; }
-    unsigned int n_history() const override { return 2; }
+    std::string
+    model_name() const override
+    {
+      return "tresca";
+    }
+    double
+    constrained_modulus() const override
+    {
+      return K + 4.0 * G / 3.0;
+    }
+    unsigned int
+    n_history() const override
+    {
+      return 2;
+    }
     std::vector<std::string> history_names() const override;
-    void   update_stress(const Strain &    d_eps,
-                         const Spin &      d_omega,
-                         const double      dt,
-                         Stress &          sigma,
-                         ArrayView<double> history) const override;
-    void update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
-    double elastic_energy_density(const Stress &sigma) const override;
+    void                     update_stress(const Strain &d_eps, const Spin &d_omega, const double dt, Stress &sigma,
+                                           ArrayView<double> history) const override;
+    void                     update_stresses(RateUpdate *points, const unsigned int n, const double dt) const override;
+    double                   elastic_energy_density(const Stress &sigma) const override;
 
     enum : unsigned int
     {

@@ -64,7 +64,8 @@ namespace talus::mesh
   GmshModel::find(const int d, const std::string &ref) const
   {
     const std::string r = normalise_name(ref);
-    bool numeric = !r.empty() && std::all_of(r.begin(), r.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+    bool              numeric =
+      !r.empty() && std::all_of(r.begin(), r.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
     for (const auto &g : groups)
       if (g.dim == d && !g.name.empty() && normalise_name(g.name) == r)
         return &g;
@@ -107,7 +108,8 @@ namespace talus::mesh
           gmsh::logger::getLastError(e);
         }
       catch (...)
-        {}
+        {
+        }
       return e.empty() ? "unknown gmsh error" : e;
     }
   } // namespace
@@ -115,11 +117,11 @@ namespace talus::mesh
   GmshModel
   load_gmsh(const std::string &file, const unsigned int dim, const GmshOptions &opt, const std::string &where)
   {
-    static Session session;
+    static Session    session;
     const std::string w = where + ": '" + file + "'";
     GmshModel         m;
-    m.dim  = dim;
-    m.file = file;
+    m.dim                 = dim;
+    m.file                = file;
     const std::string ext = std::filesystem::path(file).extension().string();
     if (ext != ".geo" && ext != ".msh")
       throw InputError(w + ": unknown extension '" + ext + "' (allowed: .geo, meshed by gmsh; .msh)");
@@ -256,7 +258,9 @@ namespace talus::mesh
       }
     if (m.cells.empty())
       throw InputError(w + " contains no elements of dimension " + std::to_string(dim) +
-                       (ext == ".geo" ? " after meshing (does it define a " + std::string(dim == 2 ? "surface" : "volume") + "?)" : ""));
+                       (ext == ".geo"
+                          ? " after meshing (does it define a " + std::string(dim == 2 ? "surface" : "volume") + "?)"
+                          : ""));
     return m;
   }
 } // namespace talus::mesh

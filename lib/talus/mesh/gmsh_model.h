@@ -13,10 +13,10 @@ namespace talus::mesh
 {
   struct GmshElement
   {
-    int                       type;       ///< gmsh element type (3 = quad, 5 = hex, 2 = triangle, 4 = tet, 1 = line)
-    std::uint64_t             tag;        ///< gmsh element tag
-    int                       entity;     ///< tag of the geometric entity of dimension `dim` it belongs to
-    std::vector<unsigned int> nodes;      ///< indices into GmshModel::nodes, gmsh order
+    int                       type;   ///< gmsh element type (3 = quad, 5 = hex, 2 = triangle, 4 = tet, 1 = line)
+    std::uint64_t             tag;    ///< gmsh element tag
+    int                       entity; ///< tag of the geometric entity of dimension `dim` it belongs to
+    std::vector<unsigned int> nodes;  ///< indices into GmshModel::nodes, gmsh order
   };
 
   struct GmshGroup
@@ -38,7 +38,7 @@ namespace talus::mesh
     std::vector<GmshGroup>             groups; ///< physical groups of every dimension
     /// Elements that repeated an earlier one (same nodes) and were dropped: a MSH
     /// 2.2 file lists an element once per physical group it belongs to.
-    std::size_t                        duplicates = 0;
+    std::size_t duplicates = 0;
     /// Group of dimension d referenced by name (case-insensitive, blanks
     /// collapsed) or, if `ref` is an integer, by tag; nullptr if none.
     const GmshGroup *find(int d, const std::string &ref) const;

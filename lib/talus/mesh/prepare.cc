@@ -35,15 +35,24 @@ namespace talus::mesh
     {
       switch (type)
         {
-          case 1: return "line";
-          case 2: return "triangle";
-          case 3: return "quadrangle";
-          case 4: return "tetrahedron";
-          case 5: return "hexahedron";
-          case 6: return "prism";
-          case 7: return "pyramid";
-          case 15: return "point";
-          default: return "type " + std::to_string(type);
+          case 1:
+            return "line";
+          case 2:
+            return "triangle";
+          case 3:
+            return "quadrangle";
+          case 4:
+            return "tetrahedron";
+          case 5:
+            return "hexahedron";
+          case 6:
+            return "prism";
+          case 7:
+            return "pyramid";
+          case 15:
+            return "point";
+          default:
+            return "type " + std::to_string(type);
         }
     }
 
@@ -69,7 +78,7 @@ namespace talus::mesh
     void
     multilinear(const std::array<double, 3> *X[], const double *xi, double *x, double &det)
     {
-      constexpr unsigned int nv = 1u << dim;
+      constexpr unsigned int nv      = 1u << dim;
       double                 J[3][3] = {};
       for (unsigned int k = 0; k < 3; ++k)
         x[k] = 0;
@@ -91,10 +100,10 @@ namespace talus::mesh
                 J[k][e] += dN[e] * (*X[v])[k];
             }
         }
-      det = dim == 2 ? J[0][0] * J[1][1] - J[0][1] * J[1][0] :
-                       J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
-                         J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
-                         J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+      det = dim == 2
+              ? J[0][0] * J[1][1] - J[0][1] * J[1][0]
+              : J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+                  J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
     }
 
     double
@@ -170,15 +179,15 @@ namespace talus::mesh
     GridBuild
     grid_from_gmsh(const Settings<dim> &s, const GmshModel &m, Summary &summary)
     {
-      const std::string where = "grid/file '" + s.grid_file + "'";
+      const std::string      where = "grid/file '" + s.grid_file + "'";
       constexpr unsigned int nv = 1u << dim, nf = 1u << (dim - 1);
       const int              cell_type = dim == 2 ? 3 : 5, face_type = dim == 2 ? 1 : 3;
       GridBuild              b;
-      auto &                 g = b.mesh;
+      auto                  &g = b.mesh;
       g.dim                    = dim;
       // cells must be quads/hexes
       std::map<int, std::size_t> other;
-      const GmshElement *        first_other = nullptr;
+      const GmshElement         *first_other = nullptr;
       for (const auto &e : m.cells)
         if (e.type != cell_type)
           {
@@ -191,9 +200,9 @@ namespace talus::mesh
           std::string counts;
           for (const auto &[t, n] : other)
             counts += (counts.empty() ? "" : ", ") + std::to_string(n) + " " + element_name(t) + "(s)";
-          throw InputError(where + ": the background grid must consist of " +
-                           (dim == 2 ? "quadrangles" : "hexahedra") + ", but the mesh has " + counts +
-                           " (first: gmsh element " + std::to_string(first_other->tag) +
+          throw InputError(where + ": the background grid must consist of " + (dim == 2 ? "quadrangles" : "hexahedra") +
+                           ", but the mesh has " + counts + " (first: gmsh element " +
+                           std::to_string(first_other->tag) +
                            "). Use Recombine/Transfinite in the .geo, 'recombine = true', or 'subdivide = true'");
         }
       // compact vertex numbering: the nodes the cells use, in first-use order
@@ -220,7 +229,7 @@ namespace talus::mesh
       std::map<int, unsigned int> entity_material;
       for (const auto &[entity, groups] : cell_groups)
         {
-          long id = -1;
+          long             id    = -1;
           const GmshGroup *first = nullptr;
           for (const auto *gr : groups)
             {
@@ -249,9 +258,9 @@ namespace talus::mesh
           for (std::size_t c = 0; c < g.n_cells(); ++c)
             {
               const auto &X0 = g.vertices[g.cells[4 * c]], &X1 = g.vertices[g.cells[4 * c + 1]],
-                         &X2 = g.vertices[g.cells[4 * c + 2]];
+                         &X2   = g.vertices[g.cells[4 * c + 2]];
               const double det = (X1[0] - X0[0]) * (X2[1] - X0[1]) - (X1[1] - X0[1]) * (X2[0] - X0[0]);
-              auto &       p   = cw[b.cell_entity[c]];
+              auto        &p   = cw[b.cell_entity[c]];
               p.first += det < 0;
               ++p.second;
             }
@@ -290,7 +299,7 @@ namespace talus::mesh
               entry.second = f;
             }
       // boundary ids from the groups of dimension dim - 1
-      const auto facet_groups = groups_by_entity(m, dim - 1);
+      const auto          facet_groups = groups_by_entity(m, dim - 1);
       std::map<int, long> entity_boundary;
       for (const auto &[entity, groups] : facet_groups)
         for (const auto *gr : groups)
@@ -299,8 +308,8 @@ namespace talus::mesh
             if (k < 0)
               throw InputError(where + ": physical group " + gr->describe() +
                                " has no boundary id: name it 'boundary <id>' (e.g. 'boundary 3' or 'boundary 3 "
-                               "top'), give it a number only, or map it in grid/boundary groups ('" + gr->name +
-                               " = <id>')");
+                               "top'), give it a number only, or map it in grid/boundary groups ('" +
+                               gr->name + " = <id>')");
             const auto it = entity_boundary.find(entity);
             if (it != entity_boundary.end() && it->second != k)
               throw InputError(where + ": curve/surface " + std::to_string(entity) +
@@ -358,17 +367,17 @@ namespace talus::mesh
       double        x[3];
       double        volume;
       unsigned int  body, material;
-      double        scale;       ///< largest edge of the cell/element it came from
-      double        half_up;     ///< half the point spacing along the vertical axis
-      bool          from_grid;   ///< seeded in a grid cell (else: body-mesh element)
-      std::uint64_t origin;      ///< grid cell index / gmsh element tag
+      double        scale;     ///< largest edge of the cell/element it came from
+      double        half_up;   ///< half the point spacing along the vertical axis
+      bool          from_grid; ///< seeded in a grid cell (else: body-mesh element)
+      std::uint64_t origin;    ///< grid cell index / gmsh element tag
     };
 
     template <int dim>
     std::string
     describe_point(const std::vector<SeedPoint> &pts, const std::size_t i, const Settings<dim> &s)
     {
-      const auto &      p = pts[i];
+      const auto        &p = pts[i];
       std::ostringstream os;
       os << "material point " << i << " at " << fmt_point(p.x, dim) << " (body " << p.body << " '"
          << s.bodies[p.body].name << "', ";
@@ -386,8 +395,8 @@ namespace talus::mesh
     {
     public:
       Locator(const io::GridMesh &g, const bool boxes)
-        : g(g)
-        , boxes(boxes)
+          : g(g)
+          , boxes(boxes)
       {
         constexpr unsigned int nv = 1u << dim;
         lo.assign(g.n_cells() * dim, 0);
@@ -400,12 +409,13 @@ namespace talus::mesh
             {
               double a = std::numeric_limits<double>::max(), b = -a;
               for (unsigned int v = 0; v < nv; ++v)
-                a = std::min(a, g.vertices[g.cells[c * nv + v]][d]), b = std::max(b, g.vertices[g.cells[c * nv + v]][d]);
+                a = std::min(a, g.vertices[g.cells[c * nv + v]][d]),
+                b = std::max(b, g.vertices[g.cells[c * nv + v]][d]);
               lo[c * dim + d] = a, hi[c * dim + d] = b;
               L[d] = std::min(L[d], a), U[d] = std::max(U[d], b);
               h += b - a;
             }
-        size = h / (dim * std::max<std::size_t>(1, g.n_cells()));
+        size              = h / (dim * std::max<std::size_t>(1, g.n_cells()));
         std::size_t total = 1;
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -521,7 +531,7 @@ namespace talus::mesh
         return true;
       }
 
-      const io::GridMesh &                  g;
+      const io::GridMesh                   &g;
       const bool                            boxes;
       std::vector<double>                   lo, hi;
       double                                L[3] = {0, 0, 0}, U[3] = {0, 0, 0}, size = 1;
@@ -543,7 +553,7 @@ namespace talus::mesh
     seed_in_grid(const Settings<dim> &s, const GridBuild &gb, const GmshModel *grid_model, std::vector<SeedPoint> &pts)
     {
       constexpr unsigned int nv = 1u << dim;
-      const auto &           g  = gb.mesh;
+      const auto            &g  = gb.mesh;
       // per grid-region body: the entities it covers (empty set + flag: all cells)
       std::vector<std::set<int>> entities(s.bodies.size());
       std::vector<char>          all(s.bodies.size(), 0);
@@ -574,7 +584,7 @@ namespace talus::mesh
       std::vector<double> rx, rw;
       for (std::size_t c = 0; c < g.n_cells(); ++c)
         {
-          const std::array<double, 3> *X[8];
+          const std::array<double, 3>               *X[8];
           std::vector<const std::array<double, 3> *> Xv;
           for (unsigned int v = 0; v < nv; ++v)
             X[v] = &g.vertices[g.cells[c * nv + v]], Xv.push_back(X[v]);
@@ -598,7 +608,7 @@ namespace talus::mesh
               for (unsigned int k = 0; k < total; ++k)
                 {
                   double       xi[3] = {0, 0, 0}, w = 1, x[3] = {0, 0, 0}, volume;
-                  unsigned int r     = k;
+                  unsigned int r = k;
                   for (unsigned int d = 0; d < dim; ++d)
                     {
                       xi[d] = rx[r % spec.n];
@@ -647,7 +657,7 @@ namespace talus::mesh
     void
     seed_body_mesh(const Settings<dim> &s, const unsigned int b, const GmshModel &m, std::vector<SeedPoint> &pts)
     {
-      const auto &      spec  = s.bodies[b];
+      const auto       &spec  = s.bodies[b];
       const std::string where = "body " + std::to_string(b) + " ('" + spec.name + "')";
       std::set<int>     selected;
       for (const auto &ref : spec.groups)
@@ -694,7 +704,7 @@ namespace talus::mesh
                   }
               }
         }
-      const int simplex_type = dim == 2 ? 2 : 4, cube_type = dim == 2 ? 3 : 5;
+      const int   simplex_type = dim == 2 ? 2 : 4, cube_type = dim == 2 ? 3 : 5;
       std::size_t n_used = 0;
       for (const auto &e : m.cells)
         {
@@ -739,8 +749,8 @@ namespace talus::mesh
               for (unsigned int k = 0; k < dim; ++k)
                 for (unsigned int d = 0; d < dim; ++d)
                   J[k][d] = (*X[d + 1])[k] - (*X[0])[k];
-              const double det = dim == 2 ? J[0][0] * J[1][1] - J[0][1] * J[1][0] :
-                                            J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+              const double det = dim == 2 ? J[0][0] * J[1][1] - J[0][1] * J[1][0]
+                                          : J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
                                               J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
                                               J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
               for (std::size_t q = 0; q < simplex_points.size(); ++q)
@@ -779,7 +789,7 @@ namespace talus::mesh
               for (unsigned int k = 0; k < total; ++k)
                 {
                   double       xi[3] = {0, 0, 0}, w = 1, x[3], det;
-                  unsigned int r     = k;
+                  unsigned int r = k;
                   for (unsigned int d = 0; d < dim; ++d)
                     {
                       xi[d] = rx[r % spec.n];
@@ -829,8 +839,8 @@ namespace talus::mesh
       if (s.bodies[b].source == BodySpec<dim>::Source::gmsh)
         {
           GmshOptions o;
-          o.recombine = false;
-          o.generate  = false;
+          o.recombine  = false;
+          o.generate   = false;
           const auto m = load_gmsh(s.bodies[b].file, dim, o, "body " + std::to_string(b) + "/file");
           for (const auto &ref : s.bodies[b].groups)
             require_group(m, dim, ref, "body " + std::to_string(b) + "/groups");
@@ -842,7 +852,7 @@ namespace talus::mesh
   prepare(const Settings<dim> &s)
   {
     Result<dim> r;
-    auto &      summary = r.summary;
+    auto       &summary = r.summary;
     check_groups(s);
 
     // ---- grid
@@ -912,8 +922,8 @@ namespace talus::mesh
           else if (!s.grid_from_gmsh)
             {
               std::vector<unsigned int> cells(s.cells.begin(), s.cells.end());
-              const auto c = clipped_by_box_grid(spec.shape, lo, hi, cells);
-              std::ostringstream os;
+              const auto                c = clipped_by_box_grid(spec.shape, lo, hi, cells);
+              std::ostringstream        os;
               os.precision(10);
               os << where << ", clip to grid: ";
               if (c.counted)
@@ -933,7 +943,7 @@ namespace talus::mesh
           GmshOptions o;
           o.recombine         = false;
           o.round_coordinates = s.grid_options.round_coordinates;
-          const auto m = load_gmsh(s.bodies[b].file, dim, o, "body " + std::to_string(b) + "/file");
+          const auto m        = load_gmsh(s.bodies[b].file, dim, o, "body " + std::to_string(b) + "/file");
           seed_body_mesh(s, b, m, pts);
           if (m.duplicates)
             summary.notes.push_back("body " + std::to_string(b) + "/file: " + std::to_string(m.duplicates) +
@@ -951,8 +961,8 @@ namespace talus::mesh
         if (!(p.volume > 1e-12 * std::pow(p.scale, dim)) || !std::isfinite(p.volume))
           {
             std::ostringstream os;
-            os << describe_point(pts, i, s) << " has zero volume (" << p.volume
-               << " m^" << dim << "): its cell or element is degenerate";
+            os << describe_point(pts, i, s) << " has zero volume (" << p.volume << " m^" << dim
+               << "): its cell or element is degenerate";
             throw InputError(os.str());
           }
         ++summary.points_per_body[p.body];
@@ -987,13 +997,14 @@ namespace talus::mesh
       const double tol = 1e-9 * gb.mesh.min_edge();
       struct Hash
       {
-        std::size_t operator()(const std::array<long long, 3> &k) const
+        std::size_t
+        operator()(const std::array<long long, 3> &k) const
         {
           return std::hash<long long>()(k[0] * 73856093LL ^ k[1] * 19349663LL ^ k[2] * 83492791LL);
         }
       };
       std::unordered_map<std::array<long long, 3>, std::vector<std::size_t>, Hash> bins;
-      const auto key = [&](const double *x) {
+      const auto                                                                   key = [&](const double *x) {
         std::array<long long, 3> k{};
         for (unsigned int d = 0; d < dim; ++d)
           k[d] = static_cast<long long>(std::floor(x[d] / tol));
@@ -1049,13 +1060,13 @@ namespace talus::mesh
         t.body.push_back(p.body);
         if (!any_k0)
           continue;
-        const auto & spec = s.bodies[p.body];
-        double       sig[6] = {0, 0, 0, 0, 0, 0};
+        const auto &spec   = s.bodies[p.body];
+        double      sig[6] = {0, 0, 0, 0, 0, 0};
         if (spec.k0 > 0)
           {
             const double level = std::isnan(spec.surface_level) ? top[p.body] : spec.surface_level;
-            const auto   k0    = loads::k0_stress(spec.k0_density * spec.k0_gravity,
-                                               std::max(0.0, level - p.x[dim - 1]), 0.0, spec.k0);
+            const auto   k0 =
+              loads::k0_stress(spec.k0_density * spec.k0_gravity, std::max(0.0, level - p.x[dim - 1]), 0.0, spec.k0);
             const double sv = k0.vertical, sh = k0.horizontal;
             sig[0] = sig[1] = sig[2] = sh;
             sig[dim - 1]             = sv;

@@ -31,7 +31,7 @@ namespace talus::mesh
     Source                   source = Source::box;
     BodyDescription<dim>     shape; ///< box / ball / polygon geometry (contains())
     std::vector<std::string> groups;
-    std::string              file; ///< gmsh body mesh (.geo or .msh)
+    std::string              file;         ///< gmsh body mesh (.geo or .msh)
     int                      material = 0; ///< -1: from the "material <id>" groups of the mesh
     unsigned int             n        = 2; ///< points per direction
     bool                     gauss    = false;

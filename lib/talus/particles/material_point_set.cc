@@ -4,9 +4,10 @@ namespace talus
 {
   template <int dim>
   MaterialPointSet<dim>::MaterialPointSet(const BackgroundGrid<dim> &g, const std::string &name)
-    : grid(g)
-    , set_name(name)
-  {}
+      : grid(g)
+      , set_name(name)
+  {
+  }
 
   template <int dim>
   void
@@ -92,14 +93,14 @@ namespace talus
 
   template <int dim>
   void
-  MaterialPointSet<dim>::insert_in_order(const std::vector<unsigned int> &           cell_order,
+  MaterialPointSet<dim>::insert_in_order(const std::vector<unsigned int>            &cell_order,
                                          const std::vector<std::vector<SavedPoint>> &points)
   {
-    const unsigned int n_props = handler.n_properties_per_particle();
+    const unsigned int n_props      = handler.n_properties_per_particle();
     auto               insert_group = [&](const unsigned int k) {
       for (const auto &q : points[k])
         handler.insert_particle(q.x, q.xi, q.id, grid.cell_iterators[cell_order[k]],
-                                dealii::ArrayView<const double>(q.properties, n_props));
+                                              dealii::ArrayView<const double>(q.properties, n_props));
     };
     for (std::size_t k = 0; k < cell_order.size(); ++k)
       insert_group(k);

@@ -36,7 +36,11 @@ namespace talus
     /// Create the storage once `layout` is final (no point may exist yet).
     void initialize();
 
-    const std::string &name() const { return set_name; }
+    const std::string &
+    name() const
+    {
+      return set_name;
+    }
 
     /// The properties every point of this set carries (offsets of the fields).
     PropertyLayout<dim> layout;
@@ -48,7 +52,11 @@ namespace talus
 
     /// Cells with points in storage order, with their counts: the walks move
     /// one particle iterator along this list and never look cells up.
-    const std::vector<ActiveCell> &active_cells() const { return cells; }
+    const std::vector<ActiveCell> &
+    active_cells() const
+    {
+      return cells;
+    }
 
     /// Rebuild the cell list from the storage (after seeding, a deal.II sort,
     /// a restart).
@@ -58,11 +66,8 @@ namespace talus
     /// for the vertex neighbour `entered` (xi: its reference location there) or
     /// for none (invalid_unsigned_int); Relocator::leaving.
     void
-    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
-            const unsigned int                                                          c,
-            const unsigned int                                                          entered,
-            const dealii::Point<dim> &                                                  xi,
-            const bool                                                                  added)
+    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it, const unsigned int c,
+            const unsigned int entered, const dealii::Point<dim> &xi, const bool added)
     {
       relocator_ptr->leaving(it, c, entered, xi, added);
     }
@@ -78,17 +83,29 @@ namespace talus
     /// Whether the last collect or relocate changed the set of cells holding
     /// points (not just their counts): consumers that derive data from the
     /// cell set (active DoFs) may skip their update when it did not.
-    bool cell_set_changed() const { return cells_changed; }
+    bool
+    cell_set_changed() const
+    {
+      return cells_changed;
+    }
 
-    Relocator<dim> &      relocator() { return *relocator_ptr; }
-    const Relocator<dim> &relocator() const { return *relocator_ptr; }
+    Relocator<dim> &
+    relocator()
+    {
+      return *relocator_ptr;
+    }
+    const Relocator<dim> &
+    relocator() const
+    {
+      return *relocator_ptr;
+    }
 
     /// One point of a saved state.
     struct SavedPoint
     {
       dealii::Point<dim>            x, xi;
       dealii::types::particle_index id;
-      const double *                properties;
+      const double                 *properties;
     };
     /// Insert points into the (empty) set so that the storage ends up with the
     /// cell groups in the order given (cells[k] holds points[k]): a bitwise
@@ -100,7 +117,7 @@ namespace talus
     bool check_active_cells();
 
   private:
-    const BackgroundGrid<dim> &     grid;
+    const BackgroundGrid<dim>      &grid;
     std::string                     set_name;
     std::unique_ptr<Relocator<dim>> relocator_ptr;
     std::vector<ActiveCell>         cells;

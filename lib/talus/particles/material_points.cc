@@ -71,13 +71,12 @@ namespace talus
         case Shape::polygon:
           {
             // even-odd rule in the x-y plane (2D bodies only)
-            bool               inside = false;
-            const std::size_t  n      = polygon.size();
+            bool              inside = false;
+            const std::size_t n      = polygon.size();
             for (std::size_t i = 0, j = n - 1; i < n; j = i++)
               {
                 const auto &a = polygon[i], &b = polygon[j];
-                if (((a[1] > x[1]) != (b[1] > x[1])) &&
-                    (x[0] < (b[0] - a[0]) * (x[1] - a[1]) / (b[1] - a[1]) + a[0]))
+                if (((a[1] > x[1]) != (b[1] > x[1])) && (x[0] < (b[0] - a[0]) * (x[1] - a[1]) / (b[1] - a[1]) + a[0]))
                   inside = !inside;
               }
             return inside;
@@ -158,11 +157,11 @@ namespace talus
           if (upper ? x <= hi[d] + tol : x >= lo[d] - tol)
             continue;
           std::ostringstream os;
-          os << (b.shape == S::box    ? (upper ? "upper corner" : "lower corner") :
-                 b.shape == S::ball   ? (upper ? "center + radius" : "center - radius") :
-                                        (upper ? "vertices (largest)" : "vertices (smallest)"))
-             << ": " << axis[d] << " = " << x << " lies outside the grid (" << axis[d] << " from " << lo[d]
-             << " to " << hi[d] << ")";
+          os << (b.shape == S::box    ? (upper ? "upper corner" : "lower corner")
+                 : b.shape == S::ball ? (upper ? "center + radius" : "center - radius")
+                                      : (upper ? "vertices (largest)" : "vertices (smallest)"))
+             << ": " << axis[d] << " = " << x << " lies outside the grid (" << axis[d] << " from " << lo[d] << " to "
+             << hi[d] << ")";
           return os.str();
         }
     return "";
@@ -179,17 +178,17 @@ namespace talus
     dealii::Point<dim> blo, bhi;
     b.bounding_box(blo, bhi);
     // lattice x_k = lo + (k + 1/2) s, k integer (also < 0 and beyond the grid)
-    double s[dim], sub_volume = 1, n_all = 1, n_in = 1, visits = 1;
+    double    s[dim], sub_volume = 1, n_all = 1, n_in = 1, visits = 1;
     long long k0[dim], k1[dim];
     for (unsigned int d = 0; d < dim; ++d)
       {
         s[d] = (hi[d] - lo[d]) / (double(cells[d]) * n);
         sub_volume *= s[d];
-        k0[d] = static_cast<long long>(std::ceil((blo[d] - lo[d]) / s[d] - 0.5 - 1e-12));
-        k1[d] = static_cast<long long>(std::floor((bhi[d] - lo[d]) / s[d] - 0.5 + 1e-12));
+        k0[d]            = static_cast<long long>(std::ceil((blo[d] - lo[d]) / s[d] - 0.5 - 1e-12));
+        k1[d]            = static_cast<long long>(std::floor((bhi[d] - lo[d]) / s[d] - 0.5 + 1e-12));
         const double all = std::max(0.0, double(k1[d] - k0[d] + 1));
-        const double in  = std::max(0.0, double(std::min<long long>(k1[d], (long long)cells[d] * n - 1) -
-                                               std::max<long long>(k0[d], 0) + 1));
+        const double in  = std::max(
+           0.0, double(std::min<long long>(k1[d], (long long)cells[d] * n - 1) - std::max<long long>(k0[d], 0) + 1));
         n_all *= all, n_in *= in, visits *= all;
       }
     if (b.shape == S::box)
@@ -201,19 +200,19 @@ namespace talus
       }
     else
       {
-        long long k[3] = {0, 0, 0};
-        const long long nk = static_cast<long long>(visits);
+        long long       k[3] = {0, 0, 0};
+        const long long nk   = static_cast<long long>(visits);
         for (long long i = 0; i < nk; ++i)
           {
-            long long rem = i;
-            bool      in_grid = true;
+            long long          rem     = i;
+            bool               in_grid = true;
             dealii::Point<dim> x;
             for (unsigned int d = 0; d < dim; ++d)
               {
                 const long long len = k1[d] - k0[d] + 1;
-                k[d] = k0[d] + rem % len;
+                k[d]                = k0[d] + rem % len;
                 rem /= len;
-                x[d] = lo[d] + (k[d] + 0.5) * s[d];
+                x[d]    = lo[d] + (k[d] + 0.5) * s[d];
                 in_grid = in_grid && k[d] >= 0 && k[d] < (long long)cells[d] * n;
               }
             if (!in_grid && b.contains(x))
@@ -226,11 +225,9 @@ namespace talus
 
   template <int dim>
   SeedingResult
-  seed_bodies(const BackgroundGrid<dim> &               grid,
-              const std::vector<BodyDescription<dim>> & bodies,
-              const std::vector<double> &               density_of_material,
-              const PropertyLayout<dim> &               layout,
-              dealii::Particles::ParticleHandler<dim> & particles)
+  seed_bodies(const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+              const std::vector<double> &density_of_material, const PropertyLayout<dim> &layout,
+              dealii::Particles::ParticleHandler<dim> &particles)
   {
     struct NewPoint
     {
@@ -292,19 +289,15 @@ namespace talus
         const auto &p    = points[i];
         const auto &body = bodies[p.body];
         std::fill(props.begin(), props.end(), 0.0);
-        props[layout.mass]     = density_of_material[body.material_id] * p.volume;
-        props[layout.volume]   = p.volume;
-        props[layout.material] = body.material_id;
-        props[layout.body]     = p.body;
-        const dealii::Tensor<1, dim> v =
-          body.velocity_field ? body.velocity_field(p.x) : body.initial_velocity;
+        props[layout.mass]             = density_of_material[body.material_id] * p.volume;
+        props[layout.volume]           = p.volume;
+        props[layout.material]         = body.material_id;
+        props[layout.body]             = p.body;
+        const dealii::Tensor<1, dim> v = body.velocity_field ? body.velocity_field(p.x) : body.initial_velocity;
         for (unsigned int d = 0; d < dim; ++d)
           props[layout.velocity + d] = v[d];
         result.volume_per_body[p.body] += p.volume;
-        particles.insert_particle(p.x,
-                                  p.xi,
-                                  offset + i,
-                                  grid.cell_iterators[p.cell],
+        particles.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
                                   dealii::ArrayView<const double>(props.data(), props.size()));
       }
     particles.update_cached_numbers();
@@ -316,12 +309,9 @@ namespace talus
 
   template <int dim>
   SeedingResult
-  insert_file_bodies(const BackgroundGrid<dim> &               grid,
-                     const std::vector<BodyDescription<dim>> & bodies,
-                     const std::vector<double> &               density_of_material,
-                     const PropertyLayout<dim> &               layout,
-                     dealii::Particles::ParticleHandler<dim> & particles,
-                     const unsigned long long                  first_id)
+  insert_file_bodies(const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+                     const std::vector<double> &density_of_material, const PropertyLayout<dim> &layout,
+                     dealii::Particles::ParticleHandler<dim> &particles, const unsigned long long first_id)
   {
     SeedingResult result;
     result.volume_per_body.assign(bodies.size(), 0.0);
@@ -333,7 +323,7 @@ namespace talus
       return result;
 
     // bucket grid over the locally owned cells (boxes) for the point location
-    double lo[dim], hi[dim], h_sum = 0;
+    double       lo[dim], hi[dim], h_sum = 0;
     unsigned int n_owned = 0;
     for (unsigned int d = 0; d < dim; ++d)
       lo[d] = std::numeric_limits<double>::max(), hi[d] = -lo[d];
@@ -353,7 +343,8 @@ namespace talus
     std::size_t  n_buckets = 1;
     for (unsigned int d = 0; d < dim; ++d)
       {
-        nb[d] = n_owned ? std::max(1u, static_cast<unsigned int>(std::min(1e6, std::ceil((hi[d] - lo[d]) / bucket)))) : 1;
+        nb[d] =
+          n_owned ? std::max(1u, static_cast<unsigned int>(std::min(1e6, std::ceil((hi[d] - lo[d]) / bucket)))) : 1;
         n_buckets *= nb[d];
       }
     const auto bucket_of = [&](const double x, const unsigned int d) {
@@ -369,8 +360,8 @@ namespace talus
           for (unsigned int d = 0; d < dim; ++d)
             {
               const double tol = 1e-10 * cc.h[d];
-              b0[d] = std::max(0, bucket_of(cc.lower[d] - tol, d));
-              b1[d] = std::min(int(nb[d]) - 1, bucket_of(cc.lower[d] + cc.h[d] + tol, d));
+              b0[d]            = std::max(0, bucket_of(cc.lower[d] - tol, d));
+              b1[d]            = std::min(int(nb[d]) - 1, bucket_of(cc.lower[d] + cc.h[d] + tol, d));
             }
           for (int k = (dim == 3 ? b0[dim - 1] : 0); k <= (dim == 3 ? b1[dim - 1] : 0); ++k)
             for (int j = b0[1]; j <= b1[1]; ++j)
@@ -420,7 +411,7 @@ namespace talus
             if (t.body[i] == bodies[b].file_body_id)
               rows.push_back({&t, i, b});
         }
-    const int rank = dealii::Utilities::MPI::this_mpi_process(grid.comm);
+    const int                 rank = dealii::Utilities::MPI::this_mpi_process(grid.comm);
     std::vector<int>          owner(rows.size(), INT_MAX);
     std::vector<unsigned int> cell_of(rows.size(), dealii::numbers::invalid_unsigned_int);
     for (std::size_t k = 0; k < rows.size(); ++k)
@@ -480,11 +471,11 @@ namespace talus
         for (unsigned int d = 0; d < dim; ++d)
           xi[d] = std::min(1.0, std::max(0.0, xi[d]));
         std::fill(props.begin(), props.end(), 0.0);
-        const unsigned int m   = static_cast<unsigned int>(t.material[i]);
-        props[layout.mass]     = density_of_material[m] * t.volume[i];
-        props[layout.volume]   = t.volume[i];
-        props[layout.material] = m;
-        props[layout.body]     = rows[k].body;
+        const unsigned int m           = static_cast<unsigned int>(t.material[i]);
+        props[layout.mass]             = density_of_material[m] * t.volume[i];
+        props[layout.volume]           = t.volume[i];
+        props[layout.material]         = m;
+        props[layout.body]             = rows[k].body;
         const dealii::Tensor<1, dim> v = body.velocity_field ? body.velocity_field(x) : body.initial_velocity;
         for (unsigned int d = 0; d < dim; ++d)
           props[layout.velocity + d] = v[d];
@@ -504,8 +495,8 @@ namespace talus
   // ------------------------------------------------------------ relocation
   template <int dim>
   Relocator<dim>::Relocator(const BackgroundGrid<dim> &g, dealii::Particles::ParticleHandler<dim> &p)
-    : grid(g)
-    , particles(p)
+      : grid(g)
+      , particles(p)
   {
     particles.signals.particle_lost.connect(
       [this](const typename dealii::Particles::ParticleIterator<dim> &,
@@ -514,31 +505,30 @@ namespace talus
 
   template <int dim>
   void
-  Relocator<dim>::finish(
-    RelocationStats &stats,
-    const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved)
+  Relocator<dim>::finish(RelocationStats                                                                     &stats,
+                         const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved)
   {
     const auto t0 = std::chrono::steady_clock::now();
     moves.clear();
     props.clear();
     cell_changes.clear();
-    sorted_last    = false;
-    reordered_last = false;
-    const unsigned int n_props = particles.n_properties_per_particle();
+    sorted_last                  = false;
+    reordered_last               = false;
+    const unsigned int n_props   = particles.n_properties_per_particle();
     bool               need_sort = false;
-    const bool parallel = dealii::Utilities::MPI::n_mpi_processes(grid.comm) > 1;
+    const bool         parallel  = dealii::Utilities::MPI::n_mpi_processes(grid.comm) > 1;
     // per destination rank: the points that entered one of its cells (CellId
     // words, id, x, xi, properties per point); only ranks that get points have an entry
     std::map<unsigned int, std::vector<double>> outgoing;
-    unsigned long long n_sent = 0, n_local_moves = 0;
+    unsigned long long                          n_sent = 0, n_local_moves = 0;
     props.resize(n_props);
     // backwards: pending is in ascending order within each cell, and deal.II
     // removes by moving the cell's last particle into the hole (an insertion
     // appends to its cell, so the iterators still pending stay valid)
     for (std::size_t k = pending.size(); k-- > 0;)
       {
-        const auto &       it = pending[k].it;
-        const auto &       xi = pending[k].xi;
+        const auto        &it = pending[k].it;
+        const auto        &xi = pending[k].xi;
         const auto         x  = it->get_location();
         const unsigned int n  = pending[k].entered; // looked up by the walk
         if (n == dealii::numbers::invalid_unsigned_int)
@@ -565,7 +555,7 @@ namespace talus
         // a neighbour cell of another rank: send the point to its owner
         // (point to point, no collective sort)
         const auto &cell = grid.cell_iterators[n];
-        auto &      buf  = outgoing[cell->subdomain_id()];
+        auto       &buf  = outgoing[cell->subdomain_id()];
         for (const unsigned int w : cell->id().template to_binary<dim>())
           buf.push_back(w);
         buf.push_back(static_cast<double>(it->get_id()));
@@ -587,14 +577,17 @@ namespace talus
         for (const auto &from : received)
           for (std::size_t o = 0; o + stride <= from.second.size(); o += stride)
             {
-              const double *              q = from.second.data() + o;
+              const double               *q = from.second.data() + o;
               dealii::CellId::binary_type key;
               for (unsigned int w = 0; w < 4; ++w)
                 key[w] = static_cast<unsigned int>(q[w]);
               const auto cell = grid.tria.create_cell_iterator(dealii::CellId(key));
               AssertThrow(cell->is_active() && cell->is_locally_owned(),
                           dealii::ExcMessage("a material point was sent to a rank that does not own its cell"));
-              Move m{{}, {}, static_cast<dealii::types::particle_index>(q[4]), cell->active_cell_index(),
+              Move m{{},
+                     {},
+                     static_cast<dealii::types::particle_index>(q[4]),
+                     cell->active_cell_index(),
                      static_cast<unsigned int>(props.size())};
               for (unsigned int d = 0; d < dim; ++d)
                 {
@@ -610,11 +603,8 @@ namespace talus
         if (moved)
           moved(m.cell, m.xi, props.data() + m.prop_offset);
         cell_changes.push_back({m.cell, true});
-        particles.insert_particle(m.x,
-                                m.xi,
-                                m.id,
-                                grid.cell_iterators[m.cell],
-                                dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
+        particles.insert_particle(m.x, m.xi, m.id, grid.cell_iterators[m.cell],
+                                  dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
       }
     stats.moved_locally += n_local_moves + n_sent;
     stats.sent_to_ranks += n_sent;
@@ -622,8 +612,7 @@ namespace talus
     pending.clear();
 
     // one reduction decides both: a needed sort and a memory-order sort
-    double flags[3] = {need_sort ? 1.0 : 0.0, double(moved_since_sort),
-                       double(particles.n_locally_owned_particles())};
+    double flags[3] = {need_sort ? 1.0 : 0.0, double(moved_since_sort), double(particles.n_locally_owned_particles())};
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(flags, 3), grid.comm,
                                 dealii::ArrayView<double>(flags, 3));
     const bool reorder = flags[1] > resort_fraction * flags[2];
@@ -707,10 +696,10 @@ namespace talus
   template class Relocator<2>;
   template std::string outside_extent(const BodyDescription<2> &, const dealii::Point<2> &, const dealii::Point<2> &);
   template std::string outside_extent(const BodyDescription<3> &, const dealii::Point<3> &, const dealii::Point<3> &);
-  template ClipCount   clipped_by_box_grid(const BodyDescription<2> &, const dealii::Point<2> &,
-                                           const dealii::Point<2> &, const std::vector<unsigned int> &);
-  template ClipCount   clipped_by_box_grid(const BodyDescription<3> &, const dealii::Point<3> &,
-                                           const dealii::Point<3> &, const std::vector<unsigned int> &);
+  template ClipCount clipped_by_box_grid(const BodyDescription<2> &, const dealii::Point<2> &, const dealii::Point<2> &,
+                                         const std::vector<unsigned int> &);
+  template ClipCount clipped_by_box_grid(const BodyDescription<3> &, const dealii::Point<3> &, const dealii::Point<3> &,
+                                         const std::vector<unsigned int> &);
   template class Relocator<3>;
   template SeedingResult seed_bodies(const BackgroundGrid<2> &, const std::vector<BodyDescription<2>> &,
                                      const std::vector<double> &, const PropertyLayout<2> &,

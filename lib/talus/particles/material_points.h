@@ -45,12 +45,17 @@ namespace talus
     static constexpr unsigned int history      = stress + n_stress;
 
     unsigned int n_history = 0;
-    unsigned int n_properties() const { return history + n_history + n_extra; }
+    unsigned int
+    n_properties() const
+    {
+      return history + n_history + n_extra;
+    }
 
     /// Optional named block after the history; call after n_history is final
     /// and before the ParticleHandler is initialised. Returns its offset.
     /// `vector`: a dim-sized block shown as a vector in the VTU output.
-    unsigned int add_extra(const std::string &name, const unsigned int size, const bool vector = false)
+    unsigned int
+    add_extra(const std::string &name, const unsigned int size, const bool vector = false)
     {
       extras.push_back({name, history + n_history + n_extra, size, vector});
       n_extra += size;
@@ -66,12 +71,11 @@ namespace talus
     unsigned int       n_extra = 0;
 
     /// Names for output (vectors get dim identical names for ParaView).
-    std::vector<std::string> names() const;
-    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
-    interpretations() const;
+    std::vector<std::string>                                                      names() const;
+    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interpretations() const;
 
     static dealii::SymmetricTensor<2, 3> get_stress(const double *p);
-    static void set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p);
+    static void                          set_stress(const dealii::SymmetricTensor<2, 3> &s, double *p);
   };
 
   // inline: the update pass reads and writes the stress of every point and step
@@ -119,7 +123,7 @@ namespace talus
     t[0][1] = t[1][0] = -V * P[L::stress + 3];
     if constexpr (dim == 3)
       {
-        t[2][2]           = -V * P[L::stress + 2];
+        t[2][2] = -V * P[L::stress + 2];
         t[1][2] = t[2][1] = -V * P[L::stress + 4];
         t[0][2] = t[2][0] = -V * P[L::stress + 5];
       }
@@ -138,22 +142,22 @@ namespace talus
       polygon,
       file ///< the points of a talus particle file (io/particle_file.h)
     };
-    Shape                          shape = Shape::box;
-    dealii::Point<dim>             lower, upper;    // box
-    dealii::Point<dim>             center;          // ball
-    double                         radius = 0;      // ball
-    std::vector<dealii::Point<2>>  polygon;         // polygon (2D)
-    std::string                    particle_file;   // file
-    unsigned int                   file_body_id = 0; // file: rows with this body id
-    unsigned int                   material_id = 0;
-    unsigned int                   particles_per_direction = 2;
-    dealii::Tensor<1, dim>         initial_velocity;
+    Shape                         shape = Shape::box;
+    dealii::Point<dim>            lower, upper;                // box
+    dealii::Point<dim>            center;                      // ball
+    double                        radius = 0;                  // ball
+    std::vector<dealii::Point<2>> polygon;                     // polygon (2D)
+    std::string                   particle_file;               // file
+    unsigned int                  file_body_id            = 0; // file: rows with this body id
+    unsigned int                  material_id             = 0;
+    unsigned int                  particles_per_direction = 2;
+    dealii::Tensor<1, dim>        initial_velocity;
     /// optional velocity field v(x) overriding initial_velocity (empty: none)
     std::function<dealii::Tensor<1, dim>(const dealii::Point<dim> &)> velocity_field;
-    std::string                    name;
+    std::string                                                       name;
     /// 'clip to grid': drop the points outside the grid (logged) instead of
     /// refusing a body that is not wholly inside it
-    bool                           clip_to_grid = false;
+    bool clip_to_grid = false;
 
     bool contains(const dealii::Point<dim> &x) const;
     /// Bounding box of a box, ball or polygon (in 3D polygons do not exist).
@@ -168,8 +172,7 @@ namespace talus
   /// lies outside the grid (y from 0 to 2.3)". An axis-aligned box contains a
   /// box, ball or polygon iff it contains its bounding box.
   template <int dim>
-  std::string outside_extent(const BodyDescription<dim> &b, const dealii::Point<dim> &lo,
-                             const dealii::Point<dim> &hi);
+  std::string outside_extent(const BodyDescription<dim> &b, const dealii::Point<dim> &lo, const dealii::Point<dim> &hi);
 
   /// What clipping a body to a box grid [lo, hi] with `cells` per direction
   /// drops: the seeding positions of the grid's sub-cell lattice (continued
@@ -188,7 +191,7 @@ namespace talus
 
   struct SeedingResult
   {
-    unsigned long long n_particles = 0;
+    unsigned long long  n_particles = 0;
     std::vector<double> volume_per_body;
     /// file bodies with clip_to_grid: points outside the grid left out, and their volume
     std::vector<double> dropped_points, dropped_volume;
@@ -199,11 +202,9 @@ namespace talus
   /// equal shares of the cell volume, masses = density * volume. Particle ids
   /// are global and contiguous. Collective.
   template <int dim>
-  SeedingResult seed_bodies(const BackgroundGrid<dim> &                 grid,
-                            const std::vector<BodyDescription<dim>> &   bodies,
-                            const std::vector<double> &                 density_of_material,
-                            const PropertyLayout<dim> &                 layout,
-                            dealii::Particles::ParticleHandler<dim> &   particles);
+  SeedingResult seed_bodies(const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+                            const std::vector<double> &density_of_material, const PropertyLayout<dim> &layout,
+                            dealii::Particles::ParticleHandler<dim> &particles);
 
   /// Insert the material points of the bodies with shape = file: the rows of
   /// their particle files whose body id is the body's file_body_id, in body and
@@ -214,12 +215,9 @@ namespace talus
   /// contains it (a point on a cell face: the lowest rank). A point in no cell of
   /// the grid is an InputError naming it. Collective.
   template <int dim>
-  SeedingResult insert_file_bodies(const BackgroundGrid<dim> &               grid,
-                                   const std::vector<BodyDescription<dim>> & bodies,
-                                   const std::vector<double> &               density_of_material,
-                                   const PropertyLayout<dim> &               layout,
-                                   dealii::Particles::ParticleHandler<dim> & particles,
-                                   unsigned long long                        first_id);
+  SeedingResult insert_file_bodies(const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+                                   const std::vector<double> &density_of_material, const PropertyLayout<dim> &layout,
+                                   dealii::Particles::ParticleHandler<dim> &particles, unsigned long long first_id);
 
   struct RelocationStats
   {
@@ -251,11 +249,8 @@ namespace talus
     /// full sort places it). `added`: the caller has already added the point to
     /// what finish()'s `moved` callback would add it to.
     void
-    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
-            const unsigned int                                                          c,
-            const unsigned int                                                          entered,
-            const dealii::Point<dim> &                                                  xi,
-            const bool                                                                  added)
+    leaving(const typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it, const unsigned int c,
+            const unsigned int entered, const dealii::Point<dim> &xi, const bool added)
     {
       pending.push_back({it, xi, c, entered, added});
     }
@@ -274,7 +269,7 @@ namespace talus
     /// `moved(c, xi, properties)` is called for every particle moved to a
     /// neighbour cell c (not for those handled by a full sort, nor for those
     /// handed to leaving() with `added`).
-    void finish(RelocationStats &stats,
+    void finish(RelocationStats                                                                     &stats,
                 const std::function<void(unsigned int, const dealii::Point<dim> &, const double *)> &moved = {});
 
     double resort_fraction = 2.0;
@@ -300,8 +295,16 @@ namespace talus
     /// Particles moved (locally) since the last full sort or memory-order
     /// rebuild: part of the state a checkpoint saves, since it decides when the
     /// next rebuild runs.
-    unsigned long long &moves_since_sort() { return moved_since_sort; }
-    unsigned long long  moves_since_sort() const { return moved_since_sort; }
+    unsigned long long &
+    moves_since_sort()
+    {
+      return moved_since_sort;
+    }
+    unsigned long long
+    moves_since_sort() const
+    {
+      return moved_since_sort;
+    }
 
   private:
     /// Rebuild the handler's storage in memory order: every point is copied out
@@ -321,10 +324,10 @@ namespace talus
       unsigned int                                                        cell, entered;
       bool                                                                added;
     };
-    const BackgroundGrid<dim> &              grid;
+    const BackgroundGrid<dim>               &grid;
     dealii::Particles::ParticleHandler<dim> &particles;
     std::vector<Pending>                     pending;
-    unsigned long long                       lost_counter = 0;
+    unsigned long long                       lost_counter     = 0;
     unsigned long long                       moved_since_sort = 0;
     // scratch kept between calls (no per-step allocation)
     struct Move

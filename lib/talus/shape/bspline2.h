@@ -39,13 +39,8 @@ namespace talus::shape
 
     /// One direction: cell j of n, reference coordinate xi in [0,1].
     static inline void
-    evaluate_1d(const unsigned int j,
-                const unsigned int n,
-                const double       inv_h,
-                const double       xi,
-                unsigned char &    first,
-                double (&N)[3],
-                double (&dN)[3])
+    evaluate_1d(const unsigned int j, const unsigned int n, const double inv_h, const double xi, unsigned char &first,
+                double (&N)[3], double (&dN)[3])
     {
       // Which half of the cell is data-dependent and unpredictable for the points of a
       // cell: select it without a branch; only the (rare, predictable) wall test branches.
@@ -55,13 +50,13 @@ namespace talus::shape
           // wall half cell: linear hats on nodes 0, 1 (window 0, 1, 2) resp. n-1, n
           // (window n-2, n-1, n)
           const unsigned int o = upper ? 1 : 0, z = upper ? 0 : 2;
-          first                = upper ? 0 : 1;
-          N[o]                 = 1.0 - xi;
-          N[o + 1]             = xi;
-          N[z]                 = 0.0;
-          dN[o]                = -inv_h;
-          dN[o + 1]            = inv_h;
-          dN[z]                = 0.0;
+          first     = upper ? 0 : 1;
+          N[o]      = 1.0 - xi;
+          N[o + 1]  = xi;
+          N[z]      = 0.0;
+          dN[o]     = -inv_h;
+          dN[o + 1] = inv_h;
+          dN[z]     = 0.0;
           return;
         }
       first          = upper ? 1 : 0;
@@ -78,11 +73,8 @@ namespace talus::shape
     /// i_cell[d]: index of the point's cell per direction among n_cells[d];
     /// inv_h: 1/h per direction; xi: reference coordinates in [0,1]^dim.
     static inline void
-    evaluate(const unsigned int (&i_cell)[dim],
-             const unsigned int (&n_cells)[dim],
-             const double (&inv_h)[dim],
-             const dealii::Point<dim> &xi,
-             Eval &                    e)
+    evaluate(const unsigned int (&i_cell)[dim], const unsigned int (&n_cells)[dim], const double (&inv_h)[dim],
+             const dealii::Point<dim> &xi, Eval &e)
     {
       for (unsigned int d = 0; d < dim; ++d)
         evaluate_1d(i_cell[d], n_cells[d], inv_h[d], xi[d], e.first[d], e.N[d], e.dN[d]);

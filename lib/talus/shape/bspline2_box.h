@@ -23,17 +23,17 @@ namespace talus::shape
   template <int dim>
   struct BSpline2Box
   {
-    using W                               = Window3<dim>;
-    using B                               = BSpline2<dim>;
-    static constexpr unsigned int n_nodes = W::n_patch;
+    using W                                = Window3<dim>;
+    using B                                = BSpline2<dim>;
+    static constexpr unsigned int n_nodes  = W::n_patch;
     static constexpr unsigned int n_window = W::n_nodes;
 
     struct Cell
     {
-      const CellCache<dim> *   cc    = nullptr;
+      const CellCache<dim>    *cc    = nullptr;
       const BSplinePatch<dim> *patch = nullptr;
-      const UniformBox<dim> *  box   = nullptr;
-      const unsigned int *     dofs  = nullptr; // patch slot s, component d at [s * dim + d]
+      const UniformBox<dim>   *box   = nullptr;
+      const unsigned int      *dofs  = nullptr; // patch slot s, component d at [s * dim + d]
     };
     static inline Cell
     cell(const BackgroundGrid<dim> &grid, const unsigned int c)
@@ -99,11 +99,8 @@ namespace talus::shape
     /// gradients (a window node is always inside the grid).
     static constexpr unsigned int n_point_nodes = n_window;
     static inline void
-    point_stencil(const Cell &              c,
-                  const dealii::Point<dim> &xi,
-                  unsigned int (&slot)[n_point_nodes],
-                  double (&N)[n_point_nodes],
-                  double (&G)[n_point_nodes][dim])
+    point_stencil(const Cell &c, const dealii::Point<dim> &xi, unsigned int (&slot)[n_point_nodes],
+                  double (&N)[n_point_nodes], double (&G)[n_point_nodes][dim])
     {
       Eval e;
       evaluate(c, xi, e);
@@ -155,9 +152,8 @@ namespace talus::shape
         for (unsigned int k = 0; k < 3; ++k)
           for (unsigned int b = 0; b < 3; ++b)
             {
-              const double nbc = e.N[1][b] * e.N[2][k], dbc = e.dN[1][b] * e.N[2][k],
-                           nbd = e.N[1][b] * e.dN[2][k];
-              double X[dim], Y[dim];
+              const double nbc = e.N[1][b] * e.N[2][k], dbc = e.dN[1][b] * e.N[2][k], nbd = e.N[1][b] * e.dN[2][k];
+              double       X[dim], Y[dim];
               for (unsigned int c = 0; c < dim; ++c)
                 {
                   X[c] = t[c][0] * nbc;
@@ -185,7 +181,7 @@ namespace talus::shape
       add(const Eval &e, const double m, const double (&t)[dim][dim])
       {
         const unsigned int first = W::first_slot(e);
-        double *           lw    = lm + first;
+        double            *lw    = lm + first;
         double(*fw)[dim]         = f + first;
         for_each_window_force(e, t, [&](const unsigned int o, const double N, const double(&F)[dim]) {
           lw[o] += m * N;
@@ -210,13 +206,8 @@ namespace talus::shape
     /// Mass and force of one point scattered on its window only (a point moved
     /// into another cell: no per-cell sums over the whole patch).
     static inline void
-    scatter_point(const Cell &                  c,
-                  const Eval &                  e,
-                  const double                  m,
-                  const double (&t)[dim][dim],
-                  const dealii::Tensor<1, dim> &g,
-                  double *                      M,
-                  double *                      Fv)
+    scatter_point(const Cell &c, const Eval &e, const double m, const double (&t)[dim][dim],
+                  const dealii::Tensor<1, dim> &g, double *M, double *Fv)
     {
       const unsigned int *dofs = c.dofs + W::first_slot(e) * dim;
       for_each_window_force(e, t, [&](const unsigned int o, const double N, const double(&F)[dim]) {

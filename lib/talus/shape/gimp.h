@@ -60,28 +60,22 @@ namespace talus::shape
     /// One direction: cell j of n, reference coordinate xi, a = l_p/h (clamped
     /// to (0, 1/2]: a domain wider than a cell would reach a 4th node).
     static inline void
-    evaluate_1d(const unsigned int j,
-                const unsigned int n,
-                const double       inv_h,
-                const double       xi,
-                double             a,
-                unsigned char &    first,
-                double (&N)[3],
-                double (&dN)[3])
+    evaluate_1d(const unsigned int j, const unsigned int n, const double inv_h, const double xi, double a,
+                unsigned char &first, double (&N)[3], double (&dN)[3])
     {
       a = std::min(std::max(a, 1e-12), 0.5);
       if ((j == 0 && xi < a) || (j + 1 == n && xi > 1.0 - a))
         {
           // the domain crosses a wall: linear hats (ghost extrapolation)
-          const bool lower = j == 0 && xi < a;
-          first            = lower ? 1 : 0;
+          const bool lower     = j == 0 && xi < a;
+          first                = lower ? 1 : 0;
           const unsigned int o = lower ? 0 : 1;
-          N[o]             = 1.0 - xi;
-          N[o + 1]         = xi;
-          N[lower ? 2 : 0] = 0.0;
-          dN[o]            = -inv_h;
-          dN[o + 1]        = inv_h;
-          dN[lower ? 2 : 0] = 0.0;
+          N[o]                 = 1.0 - xi;
+          N[o + 1]             = xi;
+          N[lower ? 2 : 0]     = 0.0;
+          dN[o]                = -inv_h;
+          dN[o + 1]            = inv_h;
+          dN[lower ? 2 : 0]    = 0.0;
           return;
         }
       // window j-1, j, j+1 (xi < 1/2) or j, j+1, j+2; in a wall cell the node
@@ -99,12 +93,8 @@ namespace talus::shape
 
     /// As BSpline2::evaluate, with a[d] = l_p/h_d of the point.
     static inline void
-    evaluate(const unsigned int (&i_cell)[dim],
-             const unsigned int (&n_cells)[dim],
-             const double (&inv_h)[dim],
-             const dealii::Point<dim> &xi,
-             const double (&a)[dim],
-             Eval &e)
+    evaluate(const unsigned int (&i_cell)[dim], const unsigned int (&n_cells)[dim], const double (&inv_h)[dim],
+             const dealii::Point<dim> &xi, const double (&a)[dim], Eval &e)
     {
       for (unsigned int d = 0; d < dim; ++d)
         evaluate_1d(i_cell[d], n_cells[d], inv_h[d], xi[d], a[d], e.first[d], e.N[d], e.dN[d]);

@@ -33,9 +33,7 @@ namespace talus::shape
     /// Values N_v(xi) and real-space gradients dN_v/dx_d for a box cell with
     /// extents h (inv_h = 1/h per direction).
     static inline void
-    values_and_gradients(const dealii::Point<dim> &xi,
-                         const double (&inv_h)[dim],
-                         double (&N)[n_vertices],
+    values_and_gradients(const dealii::Point<dim> &xi, const double (&inv_h)[dim], double (&N)[n_vertices],
                          double (&G)[n_vertices][dim])
     {
       double f[dim][2], df[dim][2];
@@ -150,9 +148,7 @@ namespace talus::shape
 
     /// grad[c][k] = d u_c / d x_k at the point with pair weights w.
     static inline void
-    gradient(const double (&D)[dim][npairs][dim],
-             const double (&w)[dim][npairs],
-             const double (&inv_h)[dim],
+    gradient(const double (&D)[dim][npairs][dim], const double (&w)[dim][npairs], const double (&inv_h)[dim],
              double (&grad)[dim][dim])
     {
       for (unsigned int k = 0; k < dim; ++k)

@@ -28,13 +28,13 @@ namespace talus::shape
   template <int dim>
   struct Q1Box
   {
-    using F                             = Q1Factorised<dim>;
+    using F                               = Q1Factorised<dim>;
     static constexpr unsigned int n_nodes = F::nv;
 
     struct Cell
     {
       const CellCache<dim> *cc   = nullptr;
-      const unsigned int *  dofs = nullptr;
+      const unsigned int   *dofs = nullptr;
     };
     static inline Cell
     cell(const BackgroundGrid<dim> &grid, const unsigned int c)
@@ -112,11 +112,8 @@ namespace talus::shape
     /// vertices, slot = vertex).
     static constexpr unsigned int n_point_nodes = n_nodes;
     static inline void
-    point_stencil(const Cell &              c,
-                  const dealii::Point<dim> &xi,
-                  unsigned int (&slot)[n_point_nodes],
-                  double (&N)[n_point_nodes],
-                  double (&G)[n_point_nodes][dim])
+    point_stencil(const Cell &c, const dealii::Point<dim> &xi, unsigned int (&slot)[n_point_nodes],
+                  double (&N)[n_point_nodes], double (&G)[n_point_nodes][dim])
     {
       Q1<dim>::values_and_gradients(xi, c.cc->inv_h, N, G);
       for (unsigned int v = 0; v < n_point_nodes; ++v)
@@ -163,13 +160,8 @@ namespace talus::shape
 
     /// Mass and force of one point (a point moved into another cell).
     static inline void
-    scatter_point(const Cell &                  c,
-                  const Eval &                  e,
-                  const double                  m,
-                  const double (&t)[dim][dim],
-                  const dealii::Tensor<1, dim> &g,
-                  double *                      M,
-                  double *                      Fv)
+    scatter_point(const Cell &c, const Eval &e, const double m, const double (&t)[dim][dim],
+                  const dealii::Tensor<1, dim> &g, double *M, double *Fv)
     {
       MassForce sums;
       sums.add(e, m, t);

@@ -56,12 +56,12 @@ namespace talus::shape
       double Ji[dim][dim], det;
       if constexpr (dim == 2)
         {
-          det      = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+          det            = J[0][0] * J[1][1] - J[0][1] * J[1][0];
           const double r = 1.0 / det;
-          Ji[0][0] = J[1][1] * r;
-          Ji[0][1] = -J[0][1] * r;
-          Ji[1][0] = -J[1][0] * r;
-          Ji[1][1] = J[0][0] * r;
+          Ji[0][0]       = J[1][1] * r;
+          Ji[0][1]       = -J[0][1] * r;
+          Ji[1][0]       = -J[1][0] * r;
+          Ji[1][1]       = J[0][0] * r;
         }
       else
         {

@@ -125,8 +125,7 @@ namespace talus::shape
         for (unsigned int c = 0; c < 3; ++c)
           for (unsigned int b = 0; b < 3; ++b)
             {
-              const double nbc = e.N[1][b] * e.N[2][c], dbc = e.dN[1][b] * e.N[2][c],
-                           nbd = e.N[1][b] * e.dN[2][c];
+              const double nbc = e.N[1][b] * e.N[2][c], dbc = e.dN[1][b] * e.N[2][c], nbd = e.N[1][b] * e.dN[2][c];
               for (unsigned int a = 0; a < 3; ++a)
                 {
                   const unsigned int w = a + 3 * b + 9 * c;
@@ -202,9 +201,9 @@ namespace talus::shape
             for (unsigned int c = 0; c < nc; ++c)
               {
                 const unsigned int l = 3 * p;
-                v1[p][c]  = e.N[1][0] * v0[l][c] + e.N[1][1] * v0[l + 1][c] + e.N[1][2] * v0[l + 2][c];
-                dx1[p][c] = e.N[1][0] * d0[l][c] + e.N[1][1] * d0[l + 1][c] + e.N[1][2] * d0[l + 2][c];
-                dy1[p][c] = e.dN[1][0] * v0[l][c] + e.dN[1][1] * v0[l + 1][c] + e.dN[1][2] * v0[l + 2][c];
+                v1[p][c]             = e.N[1][0] * v0[l][c] + e.N[1][1] * v0[l + 1][c] + e.N[1][2] * v0[l + 2][c];
+                dx1[p][c]            = e.N[1][0] * d0[l][c] + e.N[1][1] * d0[l + 1][c] + e.N[1][2] * d0[l + 2][c];
+                dy1[p][c]            = e.dN[1][0] * v0[l][c] + e.dN[1][1] * v0[l + 1][c] + e.dN[1][2] * v0[l + 2][c];
               }
           for (unsigned int c = 0; c < nc; ++c)
             {
@@ -270,8 +269,7 @@ namespace talus::shape
         for (unsigned int c = 0; c < 3; ++c)
           for (unsigned int b = 0; b < 3; ++b)
             {
-              const double nbc = e.N[1][b] * e.N[2][c], dbc = e.dN[1][b] * e.N[2][c],
-                           nbd = e.N[1][b] * e.dN[2][c];
+              const double nbc = e.N[1][b] * e.N[2][c], dbc = e.dN[1][b] * e.N[2][c], nbd = e.N[1][b] * e.dN[2][c];
               for (unsigned int a = 0; a < 3; ++a)
                 {
                   const double g[3] = {e.dN[0][a] * nbc, e.N[0][a] * dbc, e.N[0][a] * nbd};

@@ -28,12 +28,9 @@ namespace talus
     /// tol |b|; returns the iterations
     template <class KrylovSolver>
     unsigned int
-    krylov(const dealii::TrilinosWrappers::SparseMatrix &        A,
-           Vector &                                              x,
-           const Vector &                                        b,
-           const LinearSolverOptions &                           options,
-           const dealii::TrilinosWrappers::PreconditionAMG &     preconditioner,
-           const typename KrylovSolver::AdditionalData &         data = typename KrylovSolver::AdditionalData())
+    krylov(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
+           const LinearSolverOptions &options, const dealii::TrilinosWrappers::PreconditionAMG &preconditioner,
+           const typename KrylovSolver::AdditionalData &data = typename KrylovSolver::AdditionalData())
     {
       // AztecOO's criterion is absolute (|r| <= tol, unscaled)
       dealii::SolverControl control(options.max_iterations, options.relative_tolerance * b.l2_norm());
@@ -43,10 +40,7 @@ namespace talus
     }
 
     unsigned int
-    cg(const dealii::TrilinosWrappers::SparseMatrix &   A,
-       Vector &                                         x,
-       const Vector &                                   b,
-       const LinearSolverOptions &                      options,
+    cg(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b, const LinearSolverOptions &options,
        const dealii::TrilinosWrappers::PreconditionAMG &preconditioner)
     {
       return krylov<dealii::TrilinosWrappers::SolverCG>(A, x, b, options, preconditioner);
@@ -66,10 +60,8 @@ namespace talus
   } // namespace
 
   LinearSolveInfo
-  solve_direct(const dealii::TrilinosWrappers::SparseMatrix &A,
-               std::vector<Vector> &                         xs,
-               const std::vector<Vector> &                   bs,
-               const std::string &                           direct_package)
+  solve_direct(const dealii::TrilinosWrappers::SparseMatrix &A, std::vector<Vector> &xs, const std::vector<Vector> &bs,
+               const std::string &direct_package)
   {
     LinearSolveInfo info;
     info.method = "direct (" + direct_package + ")";
@@ -81,7 +73,7 @@ namespace talus
     for (unsigned int k = 0; k < bs.size(); ++k)
       {
         const Vector &b = bs[k];
-        Vector &      x = xs[k];
+        Vector       &x = xs[k];
         x.reinit(b, true);
         x = 0;
         solver.solve(x, b);
@@ -121,11 +113,8 @@ namespace talus
   }
 
   LinearSolveInfo
-  solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A,
-               Vector &                                      x,
-               const Vector &                                b,
-               const LinearSolverOptions &                   options,
-               const std::vector<std::vector<bool>> &        constant_modes)
+  solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
+               const LinearSolverOptions &options, const std::vector<std::vector<bool>> &constant_modes)
   {
     LinearSolveInfo info;
     if (options.method == LinearSolverOptions::Method::direct)
@@ -167,9 +156,8 @@ namespace talus
   }
 
   void
-  ReusedAMGSolver::build(const dealii::TrilinosWrappers::SparseMatrix &A,
-                         const LinearSolverOptions &                   options,
-                         const std::vector<std::vector<bool>> &        constant_modes)
+  ReusedAMGSolver::build(const dealii::TrilinosWrappers::SparseMatrix &A, const LinearSolverOptions &options,
+                         const std::vector<std::vector<bool>> &constant_modes)
   {
     const auto t0 = std::chrono::steady_clock::now();
     amg.reset(); // free the old hierarchy first (it references A's Epetra matrix)
@@ -182,12 +170,9 @@ namespace talus
   }
 
   LinearSolveInfo
-  ReusedAMGSolver::solve(const dealii::TrilinosWrappers::SparseMatrix &A,
-                         Vector &                                      x,
-                         const Vector &                                b,
-                         const LinearSolverOptions &                   options,
-                         const unsigned long long                      step,
-                         const std::vector<std::vector<bool>> &        constant_modes)
+  ReusedAMGSolver::solve(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
+                         const LinearSolverOptions &options, const unsigned long long step,
+                         const std::vector<std::vector<bool>> &constant_modes)
   {
     rebuilt = false;
     if (stale || !amg || step % interval == 0)

@@ -15,7 +15,7 @@ namespace dealii::TrilinosWrappers
 {
   class SparseMatrix;
   class PreconditionAMG;
-}
+} // namespace dealii::TrilinosWrappers
 
 namespace talus
 {
@@ -23,7 +23,7 @@ namespace talus
   {
     enum class Method
     {
-      direct, ///< TrilinosWrappers::SolverDirect (Amesos_Klu)
+      direct,   ///< TrilinosWrappers::SolverDirect (Amesos_Klu)
       cg_amg,   ///< TrilinosWrappers::SolverCG + PreconditionAMG (ML): symmetric matrices
       gmres_amg ///< TrilinosWrappers::SolverGMRES (restart 100) + PreconditionAMG (ML): non-symmetric ones
     };
@@ -46,27 +46,23 @@ namespace talus
   struct LinearSolveInfo
   {
     std::string  method;
-    unsigned int iterations = 0; ///< CG or GMRES iterations; 1 for the direct solve
+    unsigned int iterations        = 0; ///< CG or GMRES iterations; 1 for the direct solve
     double       relative_residual = 0; ///< |b - A x| / |b| after the solve
   };
 
   /// Solve A x = b (x: initial guess for CG, overwritten). `constant_modes`
   /// (NodalSpace::constant_modes(): one per component) help AMG on vector
   /// problems; empty: a single mode. Collective. Throws on non-convergence.
-  LinearSolveInfo solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A,
-                               Vector &                                      x,
-                               const Vector &                                b,
-                               const LinearSolverOptions &                   options,
-                               const std::vector<std::vector<bool>> &        constant_modes = {});
+  LinearSolveInfo solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
+                               const LinearSolverOptions            &options,
+                               const std::vector<std::vector<bool>> &constant_modes = {});
 
   /// The direct solve of solve_linear (one factorisation of A, with its
   /// iterative refinement) for several right-hand sides: xs[k] from bs[k]
   /// (xs resized like bs). `iterations` counts the right-hand sides,
   /// `relative_residual` is the largest of them. Collective.
-  LinearSolveInfo solve_direct(const dealii::TrilinosWrappers::SparseMatrix &A,
-                               std::vector<Vector> &                         xs,
-                               const std::vector<Vector> &                   bs,
-                               const std::string &                           direct_package);
+  LinearSolveInfo solve_direct(const dealii::TrilinosWrappers::SparseMatrix &A, std::vector<Vector> &xs,
+                               const std::vector<Vector> &bs, const std::string &direct_package);
 
   /// CG + ML AMG whose hierarchy is kept from one solve to the next (the ML
   /// set-up has a fixed cost of ~3 ms per call, most of a small system's
@@ -90,41 +86,69 @@ namespace talus
     ~ReusedAMGSolver();
 
     /// 1: a new hierarchy at every solve (no reuse). >= 1.
-    void         set_rebuild_interval(unsigned int n);
-    unsigned int rebuild_interval() const { return interval; }
+    void set_rebuild_interval(unsigned int n);
+    unsigned int
+    rebuild_interval() const
+    {
+      return interval;
+    }
     /// The next solve builds a new hierarchy.
-    void invalidate() { stale = true; }
+    void
+    invalidate()
+    {
+      stale = true;
+    }
 
     /// Solve A x = b as solve_linear with `options.method` cg_amg. When CG
     /// with a kept hierarchy fails (throws), the hierarchy is rebuilt and the
     /// solve repeated once (counted in n_fallbacks()). Collective.
-    LinearSolveInfo solve(const dealii::TrilinosWrappers::SparseMatrix &A,
-                          Vector &                                      x,
-                          const Vector &                                b,
-                          const LinearSolverOptions &                   options,
-                          unsigned long long                            step,
-                          const std::vector<std::vector<bool>> &        constant_modes = {});
+    LinearSolveInfo solve(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
+                          const LinearSolverOptions &options, unsigned long long step,
+                          const std::vector<std::vector<bool>> &constant_modes = {});
 
     /// Hierarchies built so far (settable: a checkpoint carries the count).
-    unsigned long long n_setups() const { return setups; }
-    void               set_n_setups(const unsigned long long n) { setups = n; }
-    unsigned long long n_fallbacks() const { return fallbacks; }
+    unsigned long long
+    n_setups() const
+    {
+      return setups;
+    }
+    void
+    set_n_setups(const unsigned long long n)
+    {
+      setups = n;
+    }
+    unsigned long long
+    n_fallbacks() const
+    {
+      return fallbacks;
+    }
     /// Solves after which the next one rebuilds because they were slow.
-    unsigned long long n_slow_solves() const { return slow_solves; }
+    unsigned long long
+    n_slow_solves() const
+    {
+      return slow_solves;
+    }
     /// Wall time spent in the ML set-up [s] and whether the last solve built one.
-    double setup_seconds() const { return seconds_setup; }
-    bool   last_solve_rebuilt() const { return rebuilt; }
+    double
+    setup_seconds() const
+    {
+      return seconds_setup;
+    }
+    bool
+    last_solve_rebuilt() const
+    {
+      return rebuilt;
+    }
 
   private:
-    void build(const dealii::TrilinosWrappers::SparseMatrix &A,
-               const LinearSolverOptions &                   options,
-               const std::vector<std::vector<bool>> &        constant_modes);
+    void build(const dealii::TrilinosWrappers::SparseMatrix &A, const LinearSolverOptions &options,
+               const std::vector<std::vector<bool>> &constant_modes);
 
     std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg;
-    unsigned int       interval = 1;
-    bool               stale    = true, rebuilt = false;
-    unsigned long long setups = 0, fallbacks = 0, slow_solves = 0;
-    unsigned int       fresh_iterations = 0; ///< of the first solve with the current hierarchy
-    double             seconds_setup = 0;
+    unsigned int                                               interval = 1;
+    bool                                                       stale = true, rebuilt = false;
+    unsigned long long                                         setups = 0, fallbacks = 0, slow_solves = 0;
+    unsigned int fresh_iterations = 0; ///< of the first solve with the current hierarchy
+    double       seconds_setup    = 0;
   };
 } // namespace talus

@@ -29,7 +29,8 @@ namespace talus
     template <int dim, class K>
     struct PairOffsets
     {
-      static constexpr unsigned int root(const unsigned int n)
+      static constexpr unsigned int
+      root(const unsigned int n)
       {
         unsigned int r = 1;
         while (dim == 1 ? r < n : dim == 2 ? r * r < n : r * r * r < n)
@@ -37,10 +38,12 @@ namespace talus
         return r;
       }
       static constexpr unsigned int B = root(K::n_nodes), W = root(K::n_point_nodes), span = 2 * W - 1;
-      static_assert(dim == 1 ? span <= 128 : dim == 2 ? span * span <= 128 : span * span * span <= 128,
+      static_assert(dim == 1   ? span <= 128
+                    : dim == 2 ? span * span <= 128
+                               : span * span * span <= 128,
                     "ActiveSet: a stencil's offsets must fit 128 bits");
       static constexpr unsigned char far = 255; // never within one point's stencil
-      unsigned char bit[K::n_nodes][K::n_nodes];
+      unsigned char                  bit[K::n_nodes][K::n_nodes];
 
       PairOffsets()
       {
@@ -48,7 +51,7 @@ namespace talus
           for (unsigned int b = 0; b < K::n_nodes; ++b)
             {
               unsigned int index = 0, scale = 1, pa = a, pb = b;
-              bool         near  = true;
+              bool         near = true;
               for (unsigned int d = 0; d < dim; ++d, scale *= span, pa /= B, pb /= B)
                 {
                   const int o = int(pb % B) - int(pa % B);
@@ -148,9 +151,10 @@ namespace talus
 
   template <int dim>
   ActiveSet<dim>::ActiveSet(const NodalSpace<dim> &space_)
-    : space(space_)
-    , pattern(std::make_unique<dealii::TrilinosWrappers::SparsityPattern>())
-  {}
+      : space(space_)
+      , pattern(std::make_unique<dealii::TrilinosWrappers::SparsityPattern>())
+  {
+  }
 
   template <int dim>
   ActiveSet<dim>::~ActiveSet() = default;
@@ -158,13 +162,12 @@ namespace talus
   template <int dim>
   template <class K>
   void
-  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings,
-                         const Reach reach)
+  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings, const Reach reach)
   {
-    const auto &       grid = space.grid;
-    const unsigned int nc   = space.n_components();
-    const auto &       relevant = space.locally_relevant_dofs();
-    const auto &       owned    = space.locally_owned_dofs();
+    const auto        &grid     = space.grid;
+    const unsigned int nc       = space.n_components();
+    const auto        &relevant = space.locally_relevant_dofs();
+    const auto        &owned    = space.locally_owned_dofs();
 
     // rows of all relevant DoFs: a point near the partition touches ghost nodes,
     // whose rows go to their owners (distribute_sparsity_pattern below)
@@ -172,8 +175,8 @@ namespace talus
     Vector                         touched_dofs;
     space.reinit_vector(touched_dofs);
     std::vector<dealii::types::global_dof_index> cols;
-    const PairOffsets<dim, K> &offsets = PairOffsets<dim, K>::table();
-    const bool                 record  = couplings == Couplings::record;
+    const PairOffsets<dim, K>                   &offsets = PairOffsets<dim, K>::table();
+    const bool                                   record  = couplings == Couplings::record;
     cell_holds_points.assign(grid.cells.size(), 0);
     recorded_kernel_nodes           = record ? K::n_nodes : 0;
     const unsigned int n_grid_nodes = grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices();
@@ -186,7 +189,7 @@ namespace talus
           if (!touched[a])
             continue;
           const unsigned int ga   = cell.dofs[a * dim];
-          std::uint64_t *    bits = record ? node_neighbours.data() + std::size_t(ga) * offset_words : nullptr;
+          std::uint64_t     *bits = record ? node_neighbours.data() + std::size_t(ga) * offset_words : nullptr;
           cols.clear();
           for (unsigned int b = 0; b < K::n_nodes; ++b)
             if (reach == Reach::cell ? touched[b] : pairs[a * K::n_nodes + b])
@@ -199,7 +202,7 @@ namespace talus
           std::sort(cols.begin(), cols.end());
           for (unsigned int k = 0; k < nc; ++k)
             {
-              const auto row = space.node_dof(ga, k);
+              const auto row    = space.node_dof(ga, k);
               touched_dofs(row) = 1.0;
               dsp.add_entries(row, cols.begin(), cols.end(), true);
             }
@@ -227,7 +230,7 @@ namespace talus
     active_relevant = dealii::IndexSet(space.dof_handler().n_dofs());
     active_relevant.add_indices(act.begin(), act.end());
     active_relevant.compress();
-    active_owned = active_relevant & owned;
+    active_owned    = active_relevant & owned;
     n_active_global = dealii::Utilities::MPI::sum<unsigned long long>(active_owned.n_elements(), grid.comm);
 
     active_cells.clear();
@@ -270,19 +273,18 @@ namespace talus
     template <int dim, class K>
     struct CheckCouplings
     {
-      CheckCouplings(const BackgroundGrid<dim> &       grid,
-                     const std::vector<unsigned char> &cell_recorded,
-                     const std::vector<std::uint64_t> &node_neighbours,
-                     const PairOffsets<dim, K> &       offsets)
-        : grid(grid)
-        , cell_recorded(cell_recorded)
-        , node_neighbours(node_neighbours)
-        , offsets(offsets)
-      {}
-      const BackgroundGrid<dim> &       grid;
+      CheckCouplings(const BackgroundGrid<dim> &grid, const std::vector<unsigned char> &cell_recorded,
+                     const std::vector<std::uint64_t> &node_neighbours, const PairOffsets<dim, K> &offsets)
+          : grid(grid)
+          , cell_recorded(cell_recorded)
+          , node_neighbours(node_neighbours)
+          , offsets(offsets)
+      {
+      }
+      const BackgroundGrid<dim>        &grid;
       const std::vector<unsigned char> &cell_recorded;
       const std::vector<std::uint64_t> &node_neighbours;
-      const PairOffsets<dim, K> &       offsets;
+      const PairOffsets<dim, K>        &offsets;
       static constexpr bool             prefetch_location = false;
       typename K::Cell                  cell;
       bool                              recorded = false, covered = true;
@@ -306,8 +308,8 @@ namespace talus
       /// test per pair.
       struct WindowMasks
       {
-        std::uint32_t zeros; ///< window_zeros of the windows it describes
-        unsigned int  n;     ///< touched window nodes
+        std::uint32_t zeros;                    ///< window_zeros of the windows it describes
+        unsigned int  n;                        ///< touched window nodes
         unsigned int  offset[K::n_point_nodes]; ///< their patch slots from the first window slot
         std::uint64_t mask[K::n_point_nodes][offset_words];
       };
@@ -323,7 +325,8 @@ namespace talus
         std::uint32_t z = 0;
         for (unsigned int d = 0; d < dim; ++d)
           for (unsigned int a = 0; a < 3; ++a)
-            z |= (std::uint32_t(e.N[d][a] == 0.0) << (6 * d + a)) | (std::uint32_t(e.dN[d][a] == 0.0) << (6 * d + 3 + a));
+            z |=
+              (std::uint32_t(e.N[d][a] == 0.0) << (6 * d + a)) | (std::uint32_t(e.dN[d][a] == 0.0) << (6 * d + 3 + a));
         return z;
       }
       template <class Eval>
@@ -387,7 +390,8 @@ namespace talus
       }
       inline void
       end_cell(const unsigned int)
-      {}
+      {
+      }
     };
   } // namespace
 
@@ -438,15 +442,17 @@ namespace talus
   template class ActiveSet<2>;
   template class ActiveSet<3>;
   template void ActiveSet<2>::reinit<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &,
-                                                            ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
+                                                      ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
   template void ActiveSet<3>::reinit<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &,
-                                                            ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
+                                                      ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
   template void ActiveSet<2>::reinit<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &,
                                                             ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
   template void ActiveSet<3>::reinit<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &,
                                                             ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
   template bool ActiveSet<2>::couplings_covered<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
   template bool ActiveSet<3>::couplings_covered<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
-  template bool ActiveSet<2>::couplings_covered<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
-  template bool ActiveSet<3>::couplings_covered<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
+  template bool
+  ActiveSet<2>::couplings_covered<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
+  template bool
+  ActiveSet<3>::couplings_covered<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
 } // namespace talus

@@ -32,7 +32,7 @@ namespace dealii::TrilinosWrappers
 {
   class SparseMatrix;
   class SparsityPattern;
-}
+} // namespace dealii::TrilinosWrappers
 
 namespace talus
 {
@@ -90,16 +90,40 @@ namespace talus
     bool couplings_covered(const std::vector<MaterialPointSet<dim> *> &sets) const;
 
     /// Locally owned cells holding points of any set (active_cell_index, ascending).
-    const std::vector<unsigned int> &cells() const { return active_cells; }
+    const std::vector<unsigned int> &
+    cells() const
+    {
+      return active_cells;
+    }
     /// Active DoFs among the owned and among the relevant ones.
-    const dealii::IndexSet &active_owned_dofs() const { return active_owned; }
-    const dealii::IndexSet &active_relevant_dofs() const { return active_relevant; }
+    const dealii::IndexSet &
+    active_owned_dofs() const
+    {
+      return active_owned;
+    }
+    const dealii::IndexSet &
+    active_relevant_dofs() const
+    {
+      return active_relevant;
+    }
     /// Whether a locally relevant DoF is active.
-    bool is_active(const size_type i) const { return active_relevant.is_element(i); }
-    size_type n_active_dofs() const { return n_active_global; }
+    bool
+    is_active(const size_type i) const
+    {
+      return active_relevant.is_element(i);
+    }
+    size_type
+    n_active_dofs() const
+    {
+      return n_active_global;
+    }
 
     /// Inactive relevant DoFs pinned to zero (closed).
-    const dealii::AffineConstraints<double> &constraints() const { return inactive; }
+    const dealii::AffineConstraints<double> &
+    constraints() const
+    {
+      return inactive;
+    }
     /// The inactive constraints together with Dirichlet constraints (e.g. from
     /// NodalSpace::constraints_where). Where both constrain a DoF the pin to zero
     /// wins: no point sees an inactive node's value. The sparsity fits any such
@@ -107,21 +131,29 @@ namespace talus
     dealii::AffineConstraints<double> constraints_with(const dealii::AffineConstraints<double> &dirichlet) const;
 
     /// The pattern over the active region (owned rows, compressed).
-    const dealii::TrilinosWrappers::SparsityPattern &sparsity() const { return *pattern; }
+    const dealii::TrilinosWrappers::SparsityPattern &
+    sparsity() const
+    {
+      return *pattern;
+    }
     void reinit_matrix(dealii::TrilinosWrappers::SparseMatrix &A) const;
 
     /// For transfer ops: per grid local index (component-0 DoF of a node) whether
     /// the node is active.
-    bool node_active(const unsigned int grid_local) const { return active_node[grid_local] != 0; }
+    bool
+    node_active(const unsigned int grid_local) const
+    {
+      return active_node[grid_local] != 0;
+    }
 
     const NodalSpace<dim> &space;
 
   private:
-    std::vector<unsigned int>                 active_cells;
-    std::vector<unsigned char>                active_node;
-    dealii::IndexSet                          active_owned, active_relevant;
-    size_type                                 n_active_global = 0;
-    dealii::AffineConstraints<double>         inactive;
+    std::vector<unsigned int>                                  active_cells;
+    std::vector<unsigned char>                                 active_node;
+    dealii::IndexSet                                           active_owned, active_relevant;
+    size_type                                                  n_active_global = 0;
+    dealii::AffineConstraints<double>                          inactive;
     std::unique_ptr<dealii::TrilinosWrappers::SparsityPattern> pattern;
     /// Per cell whether points held it at the last reinit (active_cells are
     /// the owned ones among them).

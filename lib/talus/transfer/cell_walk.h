@@ -24,8 +24,8 @@ namespace talus::transfer
   {
   public:
     Prefetcher(dealii::Particles::ParticleHandler<dim> &ph, const unsigned int distance)
-      : it(ph.begin())
-      , end(ph.end())
+        : it(ph.begin())
+        , end(ph.end())
     {
       for (unsigned int i = 0; i < distance && it != end; ++i)
         ++it;
@@ -146,14 +146,15 @@ namespace talus::transfer
   struct Fused
   {
     Fused(First &first, Second &second)
-      : first(first)
-      , second(second)
-    {}
-    First &                      first;
-    Second &                     second;
-    static constexpr bool        prefetch_location = First::prefetch_location || Second::prefetch_location;
+        : first(first)
+        , second(second)
+    {
+    }
+    First                &first;
+    Second               &second;
+    static constexpr bool prefetch_location = First::prefetch_location || Second::prefetch_location;
     /// a first op that walks whole cells runs second on the points that stayed
-    static constexpr bool        whole_cells       = walks_whole_cells<First>(0);
+    static constexpr bool whole_cells = walks_whole_cells<First>(0);
     template <class It, class Ahead>
     inline void
     whole_cell(const unsigned int c, const unsigned int n, It &it, Ahead &ahead)
@@ -181,12 +182,14 @@ namespace talus::transfer
       return false;
     }
     template <class Op>
-    static constexpr auto moves_points(int) -> decltype(Op::moves_points, bool())
+    static constexpr auto
+    moves_points(int) -> decltype(Op::moves_points, bool())
     {
       return Op::moves_points;
     }
     template <class Op>
-    static constexpr bool moves_points(long)
+    static constexpr bool
+    moves_points(long)
     {
       return false;
     }

@@ -19,14 +19,10 @@
 namespace talus::transfer
 {
   void
-  distribute_local(const dealii::AffineConstraints<double> &           constraints,
-                   const unsigned int                                  m,
-                   const double *                                      A_local,
-                   const double *                                      b_local,
-                   const unsigned int                                  stride,
-                   const std::vector<dealii::types::global_dof_index> &dofs,
-                   dealii::TrilinosWrappers::SparseMatrix *            A,
-                   Vector *                                            b)
+  distribute_local(const dealii::AffineConstraints<double> &constraints, const unsigned int m, const double *A_local,
+                   const double *b_local, const unsigned int stride,
+                   const std::vector<dealii::types::global_dof_index> &dofs, dealii::TrilinosWrappers::SparseMatrix *A,
+                   Vector *b)
   {
     // scratch kept between calls (the walk is serial)
     static thread_local dealii::FullMatrix<double> Am;
@@ -58,18 +54,18 @@ namespace talus::transfer
 
   struct FixedValueDistributor::Impl
   {
-    const dealii::AffineConstraints<double> &   constraints;
+    const dealii::AffineConstraints<double>   &constraints;
     const dealii::Utilities::MPI::Partitioner &part;
-    dealii::TrilinosWrappers::SparseMatrix *    A;
-    Vector *                                    b;
-    const Epetra_CrsMatrix *                    E = nullptr;
-    bool                                        usable = false, wrote = false;
+    dealii::TrilinosWrappers::SparseMatrix    *A;
+    Vector                                    *b;
+    const Epetra_CrsMatrix                    *E      = nullptr;
+    bool                                       usable = false, wrote = false;
     /// per partitioner-local index: 0 free, 1 fixed to 0, 2 fixed to value[l]
     std::vector<unsigned char> state;
     std::vector<double>        value;
     // scratch per cell
     std::vector<unsigned int> local, free_rows, fixed_rows, inhomogeneous, order;
-    std::vector<int>                                   column;
+    std::vector<int>          column;
     /// Epetra local row and column index of each partitioner-local DoF, looked
     /// up at its first use in this assembly (-2: not yet, -1: not in the map):
     /// a map's LID is a hash look-up, and a DoF comes up in every cell of its
@@ -84,17 +80,15 @@ namespace talus::transfer
         id = map.LID(static_cast<int>(g));
       return id;
     }
-    std::vector<dealii::types::global_dof_index>       cols;
-    std::vector<double>                                vals;
+    std::vector<dealii::types::global_dof_index> cols;
+    std::vector<double>                          vals;
 
-    Impl(const dealii::AffineConstraints<double> &c,
-         const dealii::Utilities::MPI::Partitioner &p,
-         dealii::TrilinosWrappers::SparseMatrix *   A,
-         Vector *                                   b)
-      : constraints(c)
-      , part(p)
-      , A(A)
-      , b(b)
+    Impl(const dealii::AffineConstraints<double> &c, const dealii::Utilities::MPI::Partitioner &p,
+         dealii::TrilinosWrappers::SparseMatrix *A, Vector *b)
+        : constraints(c)
+        , part(p)
+        , A(A)
+        , b(b)
     {
       if (A == nullptr)
         return;
@@ -127,8 +121,8 @@ namespace talus::transfer
     /// column l is valid for the row being filled when its stamp is current
     /// (no clearing between rows). Filled by open_row, read by position.
     std::vector<unsigned long long> slot; // (stamp << 32) | position
-    unsigned long long              stamp = 0;
-    double *                        row_values = nullptr;
+    unsigned long long              stamp      = 0;
+    double                         *row_values = nullptr;
 
     inline void
     open_row(const int lr)
@@ -171,10 +165,7 @@ namespace talus::transfer
     }
 
     void
-    distribute(const unsigned int                                  m,
-               const double *                                      Al,
-               const double *                                      bl,
-               const unsigned int                                  stride,
+    distribute(const unsigned int m, const double *Al, const double *bl, const unsigned int stride,
                const std::vector<dealii::types::global_dof_index> &dofs)
     {
       local.resize(m);
@@ -193,7 +184,7 @@ namespace talus::transfer
           (state[local[i]] == 0 ? free_rows : fixed_rows).push_back(i);
         }
       const Epetra_Map &row_map = E->RowMap(), &col_map = E->ColMap();
-      const auto        row_of  = [&](const unsigned int i) { return cached_lid(row_lid, row_map, local[i], dofs[i]); };
+      const auto        row_of = [&](const unsigned int i) { return cached_lid(row_lid, row_map, local[i], dofs[i]); };
 
       // Epetra column index of every local DoF (-1: not in the column map, in
       // no pattern row here)
@@ -226,9 +217,8 @@ namespace talus::transfer
               vals.clear();
               order.assign(free_rows.begin(), free_rows.end());
               const unsigned int k = order.size();
-              std::sort(order.begin(), order.end(), [&](const unsigned int x, const unsigned int y) {
-                return dofs[x] < dofs[y];
-              });
+              std::sort(order.begin(), order.end(),
+                        [&](const unsigned int x, const unsigned int y) { return dofs[x] < dofs[y]; });
               for (unsigned int q = 0; q < k; ++q)
                 if (row[order[q]] != 0.0)
                   {
@@ -306,12 +296,12 @@ namespace talus::transfer
     }
   };
 
-  FixedValueDistributor::FixedValueDistributor(const dealii::AffineConstraints<double> &constraints,
+  FixedValueDistributor::FixedValueDistributor(const dealii::AffineConstraints<double>   &constraints,
                                                const dealii::Utilities::MPI::Partitioner &partitioner,
-                                               dealii::TrilinosWrappers::SparseMatrix *A,
-                                               Vector *                                b)
-    : impl(std::make_unique<Impl>(constraints, partitioner, A, b))
-  {}
+                                               dealii::TrilinosWrappers::SparseMatrix *A, Vector *b)
+      : impl(std::make_unique<Impl>(constraints, partitioner, A, b))
+  {
+  }
   FixedValueDistributor::~FixedValueDistributor() = default;
   bool
   FixedValueDistributor::usable() const
@@ -319,30 +309,24 @@ namespace talus::transfer
     return impl->usable;
   }
   void
-  FixedValueDistributor::distribute(const unsigned int                                  m,
-                                    const double *                                      A_local,
-                                    const double *                                      b_local,
-                                    const unsigned int                                  stride,
-                                    const std::vector<dealii::types::global_dof_index> &dofs)
+  FixedValueDistributor::distribute(const unsigned int m, const double *A_local, const double *b_local,
+                                    const unsigned int stride, const std::vector<dealii::types::global_dof_index> &dofs)
   {
     impl->distribute(m, A_local, b_local, stride, dofs);
   }
 
   template <int dim>
   void
-  finish_assembly(const ActiveSet<dim> &                  active,
-                  const double                            diag_sum,
-                  const double                            diag_count,
-                  dealii::TrilinosWrappers::SparseMatrix *A,
-                  Vector *                                b)
+  finish_assembly(const ActiveSet<dim> &active, const double diag_sum, const double diag_count,
+                  dealii::TrilinosWrappers::SparseMatrix *A, Vector *b)
   {
     const MPI_Comm comm = active.space.grid.comm;
     if (A != nullptr)
       {
         A->compress(dealii::VectorOperation::add);
-        const double s = dealii::Utilities::MPI::sum(diag_sum, comm);
-        const double n = dealii::Utilities::MPI::sum(diag_count, comm);
-        const double d = s > 0 ? s / n : 1.0;
+        const double     s        = dealii::Utilities::MPI::sum(diag_sum, comm);
+        const double     n        = dealii::Utilities::MPI::sum(diag_count, comm);
+        const double     d        = s > 0 ? s / n : 1.0;
         dealii::IndexSet inactive = active.space.locally_owned_dofs();
         inactive.subtract_set(active.active_owned_dofs());
         for (const auto i : inactive)
@@ -353,28 +337,26 @@ namespace talus::transfer
       b->compress(dealii::VectorOperation::add);
   }
 
-  template void finish_assembly(const ActiveSet<2> &, double, double, dealii::TrilinosWrappers::SparseMatrix *, Vector *);
-  template void finish_assembly(const ActiveSet<3> &, double, double, dealii::TrilinosWrappers::SparseMatrix *, Vector *);
+  template void finish_assembly(const ActiveSet<2> &, double, double, dealii::TrilinosWrappers::SparseMatrix *,
+                                Vector *);
+  template void finish_assembly(const ActiveSet<3> &, double, double, dealii::TrilinosWrappers::SparseMatrix *,
+                                Vector *);
 
   // the common assemblies for both kernels
   template <int dim>
   using ElasticAndGravity = Sum<LinearElasticStiffness, BodyForce<dim>>;
-#define TALUS_ASSEMBLE(dim, K, nc, Integrand)                                                                   \
-  template void assemble<dim, K, nc, Integrand>(const std::vector<MaterialPointSet<dim> *> &,                  \
-                                                const ActiveSet<dim> &,                                         \
-                                                const dealii::AffineConstraints<double> &,                      \
-                                                const Integrand &,                                              \
-                                                dealii::TrilinosWrappers::SparseMatrix *,                       \
-                                                Vector *,                                                       \
-                                                const Vector *);
-#define TALUS_MATRIX_OPS(dim, K)                                                                                \
-  template struct AssembleSystem<dim, K, dim, ConsistentMass>;                                                \
-  template struct AssembleSystem<dim, K, 1, ConsistentMass>;                                                  \
-  template struct AssembleSystem<dim, K, dim, LinearElasticStiffness>;                                        \
-  template struct AssembleSystem<dim, K, dim, BodyForce<dim>>;                                                \
-  template struct AssembleSystem<dim, K, dim, ElasticAndGravity<dim>>;                                        \
-  TALUS_ASSEMBLE(dim, K, dim, ConsistentMass)                                                                 \
-  TALUS_ASSEMBLE(dim, K, 1, ConsistentMass)                                                                   \
+#define TALUS_ASSEMBLE(dim, K, nc, Integrand)                                                                         \
+  template void assemble<dim, K, nc, Integrand>(const std::vector<MaterialPointSet<dim> *> &, const ActiveSet<dim> &, \
+                                                const dealii::AffineConstraints<double> &, const Integrand &,         \
+                                                dealii::TrilinosWrappers::SparseMatrix *, Vector *, const Vector *);
+#define TALUS_MATRIX_OPS(dim, K)                                       \
+  template struct AssembleSystem<dim, K, dim, ConsistentMass>;         \
+  template struct AssembleSystem<dim, K, 1, ConsistentMass>;           \
+  template struct AssembleSystem<dim, K, dim, LinearElasticStiffness>; \
+  template struct AssembleSystem<dim, K, dim, BodyForce<dim>>;         \
+  template struct AssembleSystem<dim, K, dim, ElasticAndGravity<dim>>; \
+  TALUS_ASSEMBLE(dim, K, dim, ConsistentMass)                          \
+  TALUS_ASSEMBLE(dim, K, 1, ConsistentMass)                            \
   TALUS_ASSEMBLE(dim, K, dim, ElasticAndGravity<dim>)
 
   TALUS_MATRIX_OPS(2, shape::Q1Box<2>)

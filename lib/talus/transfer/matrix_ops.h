@@ -90,17 +90,18 @@ namespace talus::transfer
   struct CollectCouplings
   {
     CollectCouplings(const BackgroundGrid<dim> &grid, Sink &sink)
-      : grid(grid)
-      , sink(sink)
-    {}
+        : grid(grid)
+        , sink(sink)
+    {
+    }
     const BackgroundGrid<dim> &grid;
-    Sink &                     sink;
+    Sink                      &sink;
 
-    static constexpr unsigned int                  n_nodes           = K::n_nodes;
-    static constexpr bool                          prefetch_location = false;
-    typename K::Cell                               cell;
-    std::bitset<n_nodes>                           touched;
-    std::bitset<n_nodes * n_nodes>                 pairs;
+    static constexpr unsigned int  n_nodes           = K::n_nodes;
+    static constexpr bool          prefetch_location = false;
+    typename K::Cell               cell;
+    std::bitset<n_nodes>           touched;
+    std::bitset<n_nodes * n_nodes> pairs;
 
     inline void
     begin_cell(const unsigned int c)
@@ -139,10 +140,10 @@ namespace talus::transfer
   struct PointNodes
   {
     static constexpr unsigned int capacity = max_nodes;
-    unsigned int n = 0;
-    unsigned int local[max_nodes];
-    double       N[max_nodes];
-    double       G[max_nodes][dim];
+    unsigned int                  n        = 0;
+    unsigned int                  local[max_nodes];
+    double                        N[max_nodes];
+    double                        G[max_nodes][dim];
   };
 
   /// A cell's local matrix (row-major, `stride` columns) and vector; row of
@@ -150,11 +151,15 @@ namespace talus::transfer
   /// assembly gathers (AssembleSystem's `field`) at the same indices, or null.
   struct LocalSystem
   {
-    double *       A;
-    double *       b;
-    unsigned int   stride;
-    const double * u = nullptr;
-    double &     a(const unsigned int i, const unsigned int j) { return A[i * stride + j]; }
+    double       *A;
+    double       *b;
+    unsigned int  stride;
+    const double *u = nullptr;
+    double &
+    a(const unsigned int i, const unsigned int j)
+    {
+      return A[i * stride + j];
+    }
   };
 
   // ------------------------------------------------------------------ integrands
@@ -251,10 +256,12 @@ namespace talus::transfer
   /// projection onto cell means of the mixed u-p stabilisation).
   template <class T, class = void>
   struct has_cell_terms : std::false_type
-  {};
+  {
+  };
   template <class T>
   struct has_cell_terms<T, std::void_t<decltype(T::cell_terms)>> : std::bool_constant<T::cell_terms>
-  {};
+  {
+  };
 
   /// The sum of integrands.
   template <class... T>
@@ -281,14 +288,10 @@ namespace talus::transfer
   /// Distribute a local system (m x m, row-major with `stride`) with the
   /// constraints into A and/or b (either may be null); global indices `dofs`.
   /// (Out of line: keeps deal.II's Trilinos and constraint templates in a .cc.)
-  void distribute_local(const dealii::AffineConstraints<double> &       constraints,
-                        const unsigned int                              m,
-                        const double *                                  A_local,
-                        const double *                                  b_local,
-                        const unsigned int                              stride,
+  void distribute_local(const dealii::AffineConstraints<double> &constraints, const unsigned int m,
+                        const double *A_local, const double *b_local, const unsigned int stride,
                         const std::vector<dealii::types::global_dof_index> &dofs,
-                        dealii::TrilinosWrappers::SparseMatrix *        A,
-                        Vector *                                        b);
+                        dealii::TrilinosWrappers::SparseMatrix *A, Vector *b);
 
   /// distribute_local for constraints that only fix values (u_i = g_i: every
   /// line without entries, e.g. ActiveSet::constraints_with(Dirichlet)) into a
@@ -305,20 +308,16 @@ namespace talus::transfer
   class FixedValueDistributor
   {
   public:
-    FixedValueDistributor(const dealii::AffineConstraints<double> &           constraints,
-                          const dealii::Utilities::MPI::Partitioner &         partitioner,
-                          dealii::TrilinosWrappers::SparseMatrix *            A,
-                          Vector *                                            b);
+    FixedValueDistributor(const dealii::AffineConstraints<double>   &constraints,
+                          const dealii::Utilities::MPI::Partitioner &partitioner,
+                          dealii::TrilinosWrappers::SparseMatrix *A, Vector *b);
     ~FixedValueDistributor();
     /// Whether the fast path applies: A given, filled, with sorted local
     /// indices; every constraint line without entries and on a DoF of the
     /// partitioner; b null or on the partitioner. Otherwise use distribute_local.
     bool usable() const;
     /// As distribute_local (A_local given; b_local may be null when b is).
-    void distribute(unsigned int                                        m,
-                    const double *                                      A_local,
-                    const double *                                      b_local,
-                    unsigned int                                        stride,
+    void distribute(unsigned int m, const double *A_local, const double *b_local, unsigned int stride,
                     const std::vector<dealii::types::global_dof_index> &dofs);
 
   private:
@@ -331,11 +330,8 @@ namespace talus::transfer
   /// over all ranks), so that the system stays regular and well scaled.
   /// Collective.
   template <int dim>
-  void finish_assembly(const ActiveSet<dim> &                  active,
-                       double                                  diag_sum,
-                       double                                  diag_count,
-                       dealii::TrilinosWrappers::SparseMatrix *A,
-                       Vector *                                b);
+  void finish_assembly(const ActiveSet<dim> &active, double diag_sum, double diag_count,
+                       dealii::TrilinosWrappers::SparseMatrix *A, Vector *b);
 
   /// Assembly of A and/or b over a cell's points (the integrand's sums),
   /// distributed at end_cell with `constraints` (ActiveSet::constraints() or
@@ -348,22 +344,19 @@ namespace talus::transfer
   {
     static constexpr unsigned int max_rows = K::n_nodes * nc;
 
-    AssembleSystem(const ActiveSet<dim> &                   active,
-                   const dealii::AffineConstraints<double> &constraints,
-                   const Integrand &                        integrand,
-                   dealii::TrilinosWrappers::SparseMatrix * A,
-                   Vector *                                 b,
-                   const Vector *                           field = nullptr)
-      : grid(active.space.grid)
-      , space(active.space)
-      , constraints(constraints)
-      , integrand(integrand)
-      , A(A)
-      , b(b)
-      , field(field)
-      , Al(max_rows * max_rows)
-      , bl(max_rows)
-      , ul(field ? max_rows : 0)
+    AssembleSystem(const ActiveSet<dim> &active, const dealii::AffineConstraints<double> &constraints,
+                   const Integrand &integrand, dealii::TrilinosWrappers::SparseMatrix *A, Vector *b,
+                   const Vector *field = nullptr)
+        : grid(active.space.grid)
+        , space(active.space)
+        , constraints(constraints)
+        , integrand(integrand)
+        , A(A)
+        , b(b)
+        , field(field)
+        , Al(max_rows * max_rows)
+        , bl(max_rows)
+        , ul(field ? max_rows : 0)
     {
       if (space.n_components() != nc)
         throw std::logic_error("transfer::AssembleSystem: nc differs from the space's number of components");
@@ -376,14 +369,14 @@ namespace talus::transfer
             fast.reset();
         }
     }
-    const BackgroundGrid<dim> &              grid;
-    const NodalSpace<dim> &                  space;
+    const BackgroundGrid<dim>               &grid;
+    const NodalSpace<dim>                   &space;
     const dealii::AffineConstraints<double> &constraints;
     /// (not const: a walk over several sets, for_each_cell_of_sets, switches it per set)
-    Integrand                                integrand;
-    dealii::TrilinosWrappers::SparseMatrix * A;
-    Vector *                                 b;
-    const Vector *                           field;
+    Integrand                               integrand;
+    dealii::TrilinosWrappers::SparseMatrix *A;
+    Vector                                 *b;
+    const Vector                           *field;
 
     static constexpr bool prefetch_location = false;
     typename K::Cell      cell;
@@ -414,9 +407,9 @@ namespace talus::transfer
     {
       if (local_of_slot[s] != dealii::numbers::invalid_unsigned_int)
         return local_of_slot[s];
-      const unsigned int a = n_local++;
-      local_of_slot[s]     = a;
-      slot_of_local[a]     = s;
+      const unsigned int a  = n_local++;
+      local_of_slot[s]      = a;
+      slot_of_local[a]      = s;
       const unsigned int r0 = a * nc, r1 = r0 + nc;
       for (unsigned int i = 0; i < r1; ++i)
         for (unsigned int j = (i < r0 ? r0 : 0); j < r1; ++j) // new columns; new rows in full
@@ -470,14 +463,9 @@ namespace talus::transfer
       if (fast)
         fast->distribute(m, Al.data(), Integrand::vector ? bl.data() : nullptr, max_rows, dofs);
       else
-        distribute_local(constraints,
-                       m,
-                       Integrand::matrix ? Al.data() : nullptr,
-                       Integrand::vector ? bl.data() : nullptr,
-                       max_rows,
-                       dofs,
-                       Integrand::matrix ? A : nullptr,
-                       Integrand::vector ? b : nullptr);
+        distribute_local(constraints, m, Integrand::matrix ? Al.data() : nullptr,
+                         Integrand::vector ? bl.data() : nullptr, max_rows, dofs, Integrand::matrix ? A : nullptr,
+                         Integrand::vector ? b : nullptr);
     }
   };
 
@@ -563,13 +551,9 @@ namespace talus::transfer
   /// AssembleSystem. Collective.
   template <int dim, class K, unsigned int nc, class Integrand>
   void
-  assemble(const std::vector<MaterialPointSet<dim> *> &sets,
-           const ActiveSet<dim> &                      active,
-           const dealii::AffineConstraints<double> &   constraints,
-           const Integrand &                           integrand,
-           dealii::TrilinosWrappers::SparseMatrix *    A,
-           Vector *                                    b,
-           const Vector *                              field = nullptr)
+  assemble(const std::vector<MaterialPointSet<dim> *> &sets, const ActiveSet<dim> &active,
+           const dealii::AffineConstraints<double> &constraints, const Integrand &integrand,
+           dealii::TrilinosWrappers::SparseMatrix *A, Vector *b, const Vector *field = nullptr)
   {
     AssembleSystem<dim, K, nc, Integrand> op(active, constraints, integrand, A, b, field);
     for (auto *set : sets)
@@ -598,15 +582,16 @@ namespace talus::transfer
   struct InterpolateField
   {
     InterpolateField(const NodalSpace<dim> &space, const Vector &u, Callback &callback)
-      : grid(space.grid)
-      , space(space)
-      , u(u)
-      , callback(callback)
-    {}
+        : grid(space.grid)
+        , space(space)
+        , u(u)
+        , callback(callback)
+    {
+    }
     const BackgroundGrid<dim> &grid;
-    const NodalSpace<dim> &    space;
-    const Vector &             u;
-    Callback &                 callback;
+    const NodalSpace<dim>     &space;
+    const Vector              &u;
+    Callback                  &callback;
 
     static constexpr bool prefetch_location = false;
     typename K::Cell      cell;
@@ -638,6 +623,7 @@ namespace talus::transfer
     }
     inline void
     end_cell(const unsigned int)
-    {}
+    {
+    }
   };
 } // namespace talus::transfer

@@ -20,8 +20,7 @@ namespace talus::transfer
   inline bool
   place_moved_point(MaterialPointSet<dim> &set, const BackgroundGrid<dim> &grid, const unsigned int c,
                     typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
-                    const dealii::Point<dim> &x, dealii::Point<dim> &xi, unsigned int &add_to,
-                    const bool caller_adds)
+                    const dealii::Point<dim> &x, dealii::Point<dim> &xi, unsigned int &add_to, const bool caller_adds)
   {
     const auto &cc     = grid.cells[c];
     bool        inside = true;
@@ -37,8 +36,8 @@ namespace talus::transfer
         return true;
       }
     const unsigned int entered = grid.find_cell_near(c, x, xi);
-    const bool         added   = caller_adds && entered != dealii::numbers::invalid_unsigned_int &&
-                       grid.cells[entered].locally_owned;
+    const bool         added =
+      caller_adds && entered != dealii::numbers::invalid_unsigned_int && grid.cells[entered].locally_owned;
     add_to = added ? entered : dealii::numbers::invalid_unsigned_int;
     set.leaving(it, c, entered, xi, added);
     return false;

@@ -24,8 +24,9 @@ namespace talus::transfer
   struct CellSums
   {
     explicit CellSums(const BackgroundGrid<dim> &grid)
-      : grid(grid)
-    {}
+        : grid(grid)
+    {
+    }
     const BackgroundGrid<dim> &grid;
 
     static constexpr bool prefetch_location = false;
@@ -50,11 +51,12 @@ namespace talus::transfer
     using Base::grid;
     using Base::sums;
     ScatterMassForce(const BackgroundGrid<dim> &grid, const dealii::Tensor<1, dim> &g, double *M, double *F)
-      : Base(grid)
-      , g(g)
-      , M(M)
-      , F(F)
-    {}
+        : Base(grid)
+        , g(g)
+        , M(M)
+        , F(F)
+    {
+    }
     const dealii::Tensor<1, dim> g;
     double *const                M;
     double *const                F;
@@ -114,11 +116,12 @@ namespace talus::transfer
   struct UpdateVelocityScatterMomentum
   {
     UpdateVelocityScatterMomentum(const BackgroundGrid<dim> &grid, const double *A, double *Pn, const double h)
-      : grid(grid)
-      , A(A)
-      , Pn(Pn)
-      , h(h)
-    {}
+        : grid(grid)
+        , A(A)
+        , Pn(Pn)
+        , h(h)
+    {
+    }
     const BackgroundGrid<dim> &grid;
     const double *const        A;
     double *const              Pn;
@@ -139,8 +142,8 @@ namespace talus::transfer
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
     {
-      using L   = PropertyLayout<dim>;
-      double *P = it->get_properties().data();
+      using L              = PropertyLayout<dim>;
+      double            *P = it->get_properties().data();
       typename K::Values N;
       K::values(cell, it->get_reference_location(), N);
       double ap[dim];
@@ -167,15 +170,16 @@ namespace talus::transfer
     using Base::cell;
     using Base::sums;
     ScatterMomentum(const BackgroundGrid<dim> &grid, double *Pn)
-      : Base(grid)
-      , Pn(Pn)
-    {}
+        : Base(grid)
+        , Pn(Pn)
+    {
+    }
     double *const Pn;
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
     {
-      using L         = PropertyLayout<dim>;
-      const double *P = it->get_properties().data();
+      using L              = PropertyLayout<dim>;
+      const double      *P = it->get_properties().data();
       typename K::Values N;
       K::values(cell, it->get_reference_location(), N);
       sums.add(N, P[L::mass], P + L::velocity);
@@ -197,12 +201,13 @@ namespace talus::transfer
   struct ScatterPointVectors
   {
     ScatterPointVectors(const BackgroundGrid<dim> &grid, Source &source, const std::array<double *, n_out> &out)
-      : grid(grid)
-      , source(source)
-      , out(out)
-    {}
-    const BackgroundGrid<dim> &     grid;
-    Source &                        source;
+        : grid(grid)
+        , source(source)
+        , out(out)
+    {
+    }
+    const BackgroundGrid<dim>        &grid;
+    Source                           &source;
     const std::array<double *, n_out> out;
 
     static constexpr bool prefetch_location = false;
@@ -247,7 +252,10 @@ namespace talus::transfer
   struct NoOp
   {
     static constexpr bool prefetch_location = false;
-    inline void           begin_cell(unsigned int) {}
+    inline void
+    begin_cell(unsigned int)
+    {
+    }
     template <class It>
     inline bool
     point(unsigned int, It &)
@@ -260,7 +268,10 @@ namespace talus::transfer
     {
       return true;
     }
-    inline void end_cell(unsigned int) {}
+    inline void
+    end_cell(unsigned int)
+    {
+    }
   };
   /// The update of the points from the nodal velocity V over a step h: the
   /// displacement increment du = h V is interpolated (Eq. 4.51) and its
@@ -283,22 +294,20 @@ namespace talus::transfer
   template <int dim, class K, class Physics>
   struct UpdateAndMove
   {
-    UpdateAndMove(const BackgroundGrid<dim> &grid,
-                  MaterialPointSet<dim> &    set,
-                  const double *             V,
-                  const double               h,
-                  Physics &                  physics)
-      : grid(grid)
-      , set(set)
-      , V(V)
-      , h(h)
-      , physics(physics)
-    {}
+    UpdateAndMove(const BackgroundGrid<dim> &grid, MaterialPointSet<dim> &set, const double *V, const double h,
+                  Physics &physics)
+        : grid(grid)
+        , set(set)
+        , V(V)
+        , h(h)
+        , physics(physics)
+    {
+    }
     const BackgroundGrid<dim> &grid;
-    MaterialPointSet<dim> &    set;
+    MaterialPointSet<dim>     &set;
     const double *const        V;
     const double               h;
-    Physics &                  physics;
+    Physics                   &physics;
 
     static constexpr bool prefetch_location = true;
     /// this op moves points: a fused second op gets the new reference location
@@ -316,8 +325,8 @@ namespace talus::transfer
     inline bool
     point(const unsigned int c, PointIterator<dim> &it)
     {
-      using L    = PropertyLayout<dim>;
-      double *P  = it->get_properties().data();
+      using L            = PropertyLayout<dim>;
+      double          *P = it->get_properties().data();
       typename K::Eval e;
       K::evaluate(cell, it->get_reference_location(), e);
       double gu[dim][dim], dx[dim];
@@ -335,7 +344,8 @@ namespace talus::transfer
     }
     inline void
     end_cell(const unsigned int)
-    {}
+    {
+    }
 
     /// Physics with `static constexpr bool updates_whole_cells = true` and
     /// update_cell(c, cell, n, points) (points[k].P, .gu, .state) update the
@@ -378,7 +388,7 @@ namespace talus::transfer
     {
       double                       gu[dim][dim];
       double                       dx[dim];
-      double *                     P;
+      double                      *P;
       typename Physics::PointState state;
     };
     std::vector<CellPoint>          scratch;
@@ -407,7 +417,7 @@ namespace talus::transfer
       for (unsigned int k = 0; k < n; ++k)
         {
           CellPoint &q = scratch[k];
-          auto &     p = iterators[k];
+          auto      &p = iterators[k];
           auto       x = p->get_location();
           for (unsigned int d = 0; d < dim; ++d)
             {
@@ -441,11 +451,8 @@ namespace talus::transfer
   /// value of the cell's displacement-increment field.
   template <int dim, class K>
   inline void
-  default_increments(const typename K::Cell & cell,
-                     const typename K::Eval & e,
-                     const typename K::Field &du,
-                     double (&gu)[dim][dim],
-                     double (&dx)[dim])
+  default_increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du,
+                     double (&gu)[dim][dim], double (&dx)[dim])
   {
     K::value_and_gradient(cell, du, e, dx, gu);
   }
@@ -459,20 +466,19 @@ namespace talus::transfer
   template <int dim>
   struct MinDisplacementAwayFromWalls
   {
-    MinDisplacementAwayFromWalls(const BackgroundGrid<dim> &       grid,
-                                 const std::vector<unsigned char> &faces,
-                                 double *                          lift)
-      : grid(grid)
-      , faces(faces)
-      , lift(lift)
-    {}
-    const BackgroundGrid<dim> &       grid;
+    MinDisplacementAwayFromWalls(const BackgroundGrid<dim> &grid, const std::vector<unsigned char> &faces, double *lift)
+        : grid(grid)
+        , faces(faces)
+        , lift(lift)
+    {
+    }
+    const BackgroundGrid<dim>        &grid;
     const std::vector<unsigned char> &faces;
     double *const                     lift;
 
     static constexpr bool prefetch_location = false;
     unsigned char         cell_faces        = 0;
-    const unsigned int *  dofs              = nullptr;
+    const unsigned int   *dofs              = nullptr;
 
     inline void
     begin_cell(const unsigned int c)
@@ -494,7 +500,7 @@ namespace talus::transfer
             for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)
               {
                 const unsigned int v = dealii::GeometryInfo<dim>::face_to_cell_vertices(f, i);
-                double &           l = lift[dofs[v * dim + axis]];
+                double            &l = lift[dofs[v * dim + axis]];
                 l                    = std::min(l, away);
               }
           }
@@ -502,7 +508,8 @@ namespace talus::transfer
     }
     inline void
     end_cell(const unsigned int)
-    {}
+    {
+    }
   };
 
 } // namespace talus::transfer

@@ -144,11 +144,8 @@ namespace talus::transfer
   /// position beyond the grid (no such cell) is clamped into c.
   template <int dim, class K>
   inline void
-  offset_stencil(const BackgroundGrid<dim> &grid,
-                 const unsigned int         c,
-                 const dealii::Point<dim> & x,
-                 const double *             offset,
-                 PointStencil<dim, K> &     s)
+  offset_stencil(const BackgroundGrid<dim> &grid, const unsigned int c, const dealii::Point<dim> &x,
+                 const double *offset, PointStencil<dim, K> &s)
   {
     dealii::Point<dim> y = x, xi;
     for (unsigned int d = 0; d < dim; ++d)
@@ -169,7 +166,7 @@ namespace talus::transfer
   struct VisitStencils
   {
     const BackgroundGrid<dim> &grid;
-    Visit &                    visit;
+    Visit                     &visit;
     static constexpr bool      prefetch_location = false;
     typename K::Cell           cell;
     PointStencil<dim, K>       stencil;
@@ -188,7 +185,8 @@ namespace talus::transfer
     }
     inline void
     end_cell(const unsigned int)
-    {}
+    {
+    }
   };
 
   /// One walk over `set` calling visit(c, it, stencil) per point.
@@ -252,20 +250,21 @@ namespace talus::transfer
   struct VisitCachedStencils
   {
     const BackgroundGrid<dim> &grid;
-    Visit &                    visit;
-    StencilCache<dim, K> &     cache;
+    Visit                     &visit;
+    StencilCache<dim, K>      &cache;
     static constexpr bool      prefetch_location = false;
-    unsigned int               index = 0; ///< the point's place in the walk
-    typename K::Cell           cell{};    ///< of cell `cell_of`, made at its first miss
+    unsigned int               index             = 0; ///< the point's place in the walk
+    typename K::Cell           cell{};                ///< of cell `cell_of`, made at its first miss
     unsigned int               cell_of = dealii::numbers::invalid_unsigned_int;
 
     inline void
     begin_cell(const unsigned int)
-    {}
+    {
+    }
     inline bool
     point(const unsigned int c, PointIterator<dim> &it)
     {
-      auto &                    e  = cache.entries[index++];
+      auto                     &e  = cache.entries[index++];
       const dealii::Point<dim> &xi = it->get_reference_location();
       // the same bits, not the same value: -0.0 == 0.0, but the stencil's
       // derivatives keep the sign of a zero xi, and a restarted run evaluates
@@ -286,7 +285,8 @@ namespace talus::transfer
     }
     inline void
     end_cell(const unsigned int)
-    {}
+    {
+    }
   };
 
   /// for_each_point_stencil with the stencils kept in `cache` for the next walk.
@@ -307,13 +307,8 @@ namespace talus::transfer
   /// the same stencil (it may be a no-op).
   template <int dim, class K, class Also>
   inline void
-  scatter_weak_gradient(const BackgroundGrid<dim> &grid,
-                        MaterialPointSet<dim> &    set,
-                        StencilCache<dim, K> &     cache,
-                        const double *             phi,
-                        const unsigned int         volume_slot,
-                        double *                   f,
-                        Also &&                    also)
+  scatter_weak_gradient(const BackgroundGrid<dim> &grid, MaterialPointSet<dim> &set, StencilCache<dim, K> &cache,
+                        const double *phi, const unsigned int volume_slot, double *f, Also &&also)
   {
     for_each_point_stencil<dim, K>(grid, set, cache,
                                    [&](unsigned int, PointIterator<dim> &it, const PointStencil<dim, K> &s) {
@@ -325,12 +320,8 @@ namespace talus::transfer
   }
   template <int dim, class K>
   inline void
-  scatter_weak_gradient(const BackgroundGrid<dim> &grid,
-                        MaterialPointSet<dim> &    set,
-                        StencilCache<dim, K> &     cache,
-                        const double *             phi,
-                        const unsigned int         volume_slot,
-                        double *                   f)
+  scatter_weak_gradient(const BackgroundGrid<dim> &grid, MaterialPointSet<dim> &set, StencilCache<dim, K> &cache,
+                        const double *phi, const unsigned int volume_slot, double *f)
   {
     scatter_weak_gradient<dim, K>(grid, set, cache, phi, volume_slot, f,
                                   [](PointIterator<dim> &, const PointStencil<dim, K> &) {});

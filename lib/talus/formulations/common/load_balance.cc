@@ -9,15 +9,14 @@
 namespace talus
 {
   template <int dim>
-  LoadBalance<dim>::LoadBalance(BackgroundGrid<dim> &                grid_,
-                                const Settings &                     settings_,
-                                std::vector<MaterialPointSet<dim> *> sets_,
-                                std::function<void()>                grid_changed_)
-    : grid(grid_)
-    , settings(settings_)
-    , sets(std::move(sets_))
-    , grid_changed(std::move(grid_changed_))
-  {}
+  LoadBalance<dim>::LoadBalance(BackgroundGrid<dim> &grid_, const Settings &settings_,
+                                std::vector<MaterialPointSet<dim> *> sets_, std::function<void()> grid_changed_)
+      : grid(grid_)
+      , settings(settings_)
+      , sets(std::move(sets_))
+      , grid_changed(std::move(grid_changed_))
+  {
+  }
 
   template <int dim>
   bool
@@ -103,8 +102,8 @@ namespace talus
       return false;
     const double before = imbalance();
     rebalance();
-    log() << "  load balancing: points per rank max/mean " << std::setprecision(4) << before << " -> "
-          << imbalance() << std::endl;
+    log() << "  load balancing: points per rank max/mean " << std::setprecision(4) << before << " -> " << imbalance()
+          << std::endl;
     return true;
   }
 
@@ -120,8 +119,8 @@ namespace talus
     rebalance();
     const double after = imbalance();
     if (progress)
-      log() << "  step " << step_number << ": rebalanced, points per rank max/mean " << std::setprecision(4)
-            << before << " -> " << after << std::endl;
+      log() << "  step " << step_number << ": rebalanced, points per rank max/mean " << std::setprecision(4) << before
+            << " -> " << after << std::endl;
     return true;
   }
 
@@ -137,7 +136,8 @@ namespace talus
   bool
   LoadBalance<dim>::restore(const io::H5File &f)
   {
-    const bool same = f.get_int("ranks") == static_cast<std::int64_t>(dealii::Utilities::MPI::n_mpi_processes(grid.comm));
+    const bool same =
+      f.get_int("ranks") == static_cast<std::int64_t>(dealii::Utilities::MPI::n_mpi_processes(grid.comm));
     if (!same || !f.exists("balance/weights"))
       return false;
     // the partition of the saved run: the same weights give the same cells per rank

@@ -35,13 +35,15 @@ namespace talus
     /// `sets`: every point set on the grid (their points are counted together
     /// and all move with their cells). `grid_changed`: the family's rebuild of
     /// its partition-dependent data, called after every repartition.
-    LoadBalance(BackgroundGrid<dim> &                       grid,
-                const Settings &                            settings,
-                std::vector<MaterialPointSet<dim> *>        sets,
-                std::function<void()>                       grid_changed);
+    LoadBalance(BackgroundGrid<dim> &grid, const Settings &settings, std::vector<MaterialPointSet<dim> *> sets,
+                std::function<void()> grid_changed);
 
     /// 'load balancing/interval' > 0
-    bool enabled() const { return settings.enabled(); }
+    bool
+    enabled() const
+    {
+      return settings.enabled();
+    }
     /// enabled and more than one rank
     bool active() const;
 
@@ -79,8 +81,8 @@ namespace talus
     /// from them weigh 'cell weight').
     void repartition_with(const std::vector<double> &rows);
 
-    BackgroundGrid<dim> &                grid;
-    const Settings &                     settings;
+    BackgroundGrid<dim>                 &grid;
+    const Settings                      &settings;
     std::vector<MaterialPointSet<dim> *> sets;
     std::function<void()>                grid_changed;
     /// (CellId words, weight) of this rank's cells with points at the last

@@ -17,11 +17,16 @@ namespace talus
 {
   namespace
   {
-    bool is_root(MPI_Comm comm) { return dealii::Utilities::MPI::this_mpi_process(comm) == 0; }
+    bool
+    is_root(MPI_Comm comm)
+    {
+      return dealii::Utilities::MPI::this_mpi_process(comm) == 0;
+    }
 
     /// checkpoint-<step>.h5 files in dir, newest first (names carry the
     /// zero-padded step: lexicographic order is chronological).
-    std::vector<std::string> sorted_checkpoints(const std::string &dir)
+    std::vector<std::string>
+    sorted_checkpoints(const std::string &dir)
     {
       std::vector<std::string> files;
       if (std::filesystem::is_directory(dir))
@@ -235,10 +240,10 @@ namespace talus
   read_points(const io::H5File &f, MaterialPointSet<dim> &points, const BackgroundGrid<dim> &grid,
               const std::string &where, const std::string &group)
   {
-    MPI_Comm           comm    = grid.comm;
-    const auto         n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
-    const auto         rank    = dealii::Utilities::MPI::this_mpi_process(comm);
-    const unsigned int n_props = points.layout.n_properties();
+    MPI_Comm           comm               = grid.comm;
+    const auto         n_ranks            = dealii::Utilities::MPI::n_mpi_processes(comm);
+    const auto         rank               = dealii::Utilities::MPI::this_mpi_process(comm);
+    const unsigned int n_props            = points.layout.n_properties();
     points.relocation_stats.moved_locally = f.get_int(group + " moved locally");
     points.relocation_stats.global_sorts  = f.get_int(group + " global sorts");
     points.relocation_stats.storage_sorts = f.get_int(group + " storage sorts");
@@ -257,7 +262,7 @@ namespace talus
         const auto          ref   = f.read_rows(group + "/reference", begin, end);
         const auto          props = f.read_rows(group + "/properties", begin, end);
         // the points cell group by cell group, in the saved storage order
-        std::vector<unsigned int>                                             cell_order;
+        std::vector<unsigned int>                                            cell_order;
         std::vector<std::vector<typename MaterialPointSet<dim>::SavedPoint>> groups;
         for (std::size_t i = 0; i < ids.size(); ++i)
           {
@@ -289,10 +294,10 @@ namespace talus
     // cell's points are re-inserted in the saved order with their saved ids
     // and reference coordinates, cells in the order of their first saved row
     // (the storage order of the run, as far as a new partition allows).
-    const std::uint64_t n   = f.shape(group + "/id").first;
-    const auto [b, e]       = io::block_range(n, rank, n_ranks);
-    const auto          loc = f.read_rows(group + "/location", b, e);
-    const auto          pr  = f.read_rows(group + "/properties", b, e);
+    const std::uint64_t n                          = f.shape(group + "/id").first;
+    const auto [b, e]                              = io::block_range(n, rank, n_ranks);
+    const auto                                 loc = f.read_rows(group + "/location", b, e);
+    const auto                                 pr  = f.read_rows(group + "/properties", b, e);
     std::vector<dealii::Point<dim>>            x(e - b);
     std::vector<std::vector<double>>           props(e - b);
     std::vector<dealii::types::particle_index> row(e - b);
@@ -344,8 +349,8 @@ namespace talus
         const unsigned int c = cell_order[g];
         for (const unsigned int k : in_cell_rows[c])
           {
-            const auto &       q  = local[k];
-            dealii::Point<dim> xi = grid.reference_point(c, q.x), saved;
+            const auto        &q    = local[k];
+            dealii::Point<dim> xi   = grid.reference_point(c, q.x), saved;
             double             dist = 0;
             for (unsigned int d = 0; d < dim; ++d)
               {
@@ -354,8 +359,8 @@ namespace talus
               }
             // the saved coordinates unless deal.II put the point into the
             // neighbour of its old cell (a point on a face)
-            groups[g].push_back(
-              {q.x, dist < 1e-10 ? saved : xi, static_cast<dealii::types::particle_index>(all_ids[q.row]), q.props.data()});
+            groups[g].push_back({q.x, dist < 1e-10 ? saved : xi,
+                                 static_cast<dealii::types::particle_index>(all_ids[q.row]), q.props.data()});
           }
       }
     points.insert_in_order(cell_order, groups);
@@ -389,12 +394,12 @@ namespace talus
                                                                  int, const std::vector<double> &, MPI_Comm);
   template std::unique_ptr<io::H5File> open_newest_checkpoint<3>(const std::vector<std::string> &, const std::string &,
                                                                  int, const std::vector<double> &, MPI_Comm);
-  template std::vector<double> scene_signature<2>(const SceneParameters<2> &, unsigned int);
-  template std::vector<double> scene_signature<3>(const SceneParameters<3> &, unsigned int);
-  template std::string         describe_scene_signature<2>(const std::vector<double> &);
-  template std::string         describe_scene_signature<3>(const std::vector<double> &);
-  template void write_points<2>(io::H5File &, const MaterialPointSet<2> &, const std::string &);
-  template void write_points<3>(io::H5File &, const MaterialPointSet<3> &, const std::string &);
+  template std::vector<double>         scene_signature<2>(const SceneParameters<2> &, unsigned int);
+  template std::vector<double>         scene_signature<3>(const SceneParameters<3> &, unsigned int);
+  template std::string                 describe_scene_signature<2>(const std::vector<double> &);
+  template std::string                 describe_scene_signature<3>(const std::vector<double> &);
+  template void                        write_points<2>(io::H5File &, const MaterialPointSet<2> &, const std::string &);
+  template void                        write_points<3>(io::H5File &, const MaterialPointSet<3> &, const std::string &);
   template void read_points<2>(const io::H5File &, MaterialPointSet<2> &, const BackgroundGrid<2> &,
                                const std::string &, const std::string &);
   template void read_points<3>(const io::H5File &, MaterialPointSet<3> &, const BackgroundGrid<3> &,

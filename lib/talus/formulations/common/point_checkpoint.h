@@ -78,7 +78,8 @@ namespace talus
 
   /// Times of the VTU records written so far (the records are named
   /// <prefix>_<counter>.pvtu), to rewrite a PVD file after a restart.
-  void write_pvd_times(io::H5File &f, const std::string &name, const std::vector<std::pair<double, std::string>> &records);
+  void                                        write_pvd_times(io::H5File &f, const std::string &name,
+                                                              const std::vector<std::pair<double, std::string>> &records);
   std::vector<std::pair<double, std::string>> read_pvd_records(const io::H5File &f, const std::string &name,
                                                                const std::string &prefix);
 

@@ -13,8 +13,8 @@ namespace talus
   template <int dim>
   void
   write_point_vtu(const MaterialPointSet<dim> &set, const std::string &directory, const std::string &name,
-                  const unsigned int counter, const double time,
-                  std::vector<std::pair<double, std::string>> &records, MPI_Comm comm)
+                  const unsigned int counter, const double time, std::vector<std::pair<double, std::string>> &records,
+                  MPI_Comm comm)
   {
     dealii::Particles::DataOut<dim> out;
     out.build_patches(set.handler, set.layout.names(), set.layout.interpretations());
@@ -61,7 +61,7 @@ namespace talus
       merged.insert(merged.end(), r.begin(), r.end());
     std::sort(merged.begin(), merged.end());
     std::vector<std::string> header = {"id"};
-    const char *             ax[]   = {"x", "y", "z"};
+    const char              *ax[]   = {"x", "y", "z"};
     for (unsigned int d = 0; d < dim; ++d)
       header.push_back(std::string("pos_") + ax[d]);
     for (unsigned int d = 0; d < dim; ++d)
@@ -74,9 +74,10 @@ namespace talus
     header.push_back("volume");
     for (const auto &e : set.layout.extras)
       for (unsigned int i = 0; i < e.size; ++i)
-        header.push_back(e.size == 1         ? e.name :
-                         e.size == dim * dim ? e.name + "_" + ax[i / dim] + ax[i % dim] : // a matrix (APIC C_p)
-                                               e.name + "_" + std::string(ax[i < 3 ? i : 0]));
+        header.push_back(e.size == 1           ? e.name
+                         : e.size == dim * dim ? e.name + "_" + ax[i / dim] + ax[i % dim]
+                                               : // a matrix (APIC C_p)
+                           e.name + "_" + std::string(ax[i < 3 ? i : 0]));
     io::AtomicFile f(directory + "/particles_final.csv");
     for (unsigned int k = 0; k < header.size(); ++k)
       f.stream() << (k ? "," : "") << header[k];

@@ -36,8 +36,7 @@ namespace talus
   /// The dimension dispatch of a family's tool; returns the exit code.
   template <template <int> class Solver, class Parameters2, class Parameters3>
   int
-  run_formulation(dealii::ParameterHandler &prm,
-                  Parameters2 (*parse_2d)(dealii::ParameterHandler &),
+  run_formulation(dealii::ParameterHandler &prm, Parameters2 (*parse_2d)(dealii::ParameterHandler &),
                   Parameters3 (*parse_3d)(dealii::ParameterHandler &))
   {
     if (prm.get_integer("dimension") == 2)
@@ -53,8 +52,7 @@ namespace talus
   /// restart) are checked.
   template <class Parameters2, class Parameters3>
   void
-  check_formulation(dealii::ParameterHandler &prm,
-                    Parameters2 (*parse_2d)(dealii::ParameterHandler &),
+  check_formulation(dealii::ParameterHandler &prm, Parameters2 (*parse_2d)(dealii::ParameterHandler &),
                     Parameters3 (*parse_3d)(dealii::ParameterHandler &))
   {
     if (prm.get_integer("dimension") == 2)
@@ -66,10 +64,10 @@ namespace talus
 
 /// Explicit instantiation of a family's Solver and Parameters for dim 2 and 3
 /// (in the family's one .cc that defines them; inside its namespace).
-#define TALUS_INSTANTIATE_FORMULATION(SolverKind)                                   \
-  template struct Parameters<2>;                                                  \
-  template struct Parameters<3>;                                                  \
-  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);          \
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);          \
-  template SolverKind Solver<2>;                                                  \
-  template SolverKind Solver<3>
+#define TALUS_INSTANTIATE_FORMULATION(SolverKind)                         \
+  template struct Parameters<2>;                                          \
+  template struct Parameters<3>;                                          \
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &); \
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &); \
+  template SolverKind    Solver<2>;                                       \
+  template SolverKind    Solver<3>

@@ -84,13 +84,14 @@ namespace talus
   {
     if (p.grid_mesh)
       {
-        const auto ids = p.grid_mesh->boundary_ids();
+        const auto  ids = p.grid_mesh->boundary_ids();
         std::string list;
         for (const auto i : ids)
           list += (list.empty() ? "" : ", ") + std::to_string(i);
         for (const auto &bc : p.boundary_conditions)
           require(std::find(ids.begin(), ids.end(), bc.id) != ids.end(),
-                  std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
+                  std::string("boundary conditions/") +
+                    (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
                   "boundary id " + std::to_string(bc.id) + " does not exist in the grid file '" + p.grid_file +
                     "' (ids present: " + (list.empty() ? "none" : list) + ")");
         for (const auto &plate : p.rigid_plates)
@@ -145,10 +146,10 @@ namespace talus
       int size = 1;
       MPI_Comm_size(MPI_COMM_WORLD, &size);
       // ranks sharing this node: Open MPI says; otherwise assume all (the conservative case)
-      const char *  local  = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+      const char        *local   = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
       const unsigned int on_node = local ? std::max(1, std::atoi(local)) : size;
-      const double need  = estimated_memory_bytes(n_cells, n_points_estimate, dim, on_node) * on_node / size;
-      const double avail = available_memory_bytes();
+      const double       need    = estimated_memory_bytes(n_cells, n_points_estimate, dim, on_node) * on_node / size;
+      const double       avail   = available_memory_bytes();
       require(avail < 0 || need <= avail, "grid/cells",
               fmt(n_cells) + " cells and about " + fmt(n_points_estimate) + " material points need about " +
                 fmt_bytes(need) + " on this node" + (on_node > 1 ? " (" + std::to_string(on_node) + " ranks)" : "") +
@@ -156,19 +157,17 @@ namespace talus
                 " are available (MemAvailable of /proc/meminfo, or the cgroup limit); use fewer cells or "
                 "particles per direction, or a machine with more memory");
     }
-    require(n_cells <= max_grid_cells,
-            "grid/cells",
+    require(n_cells <= max_grid_cells, "grid/cells",
             fmt(n_cells) + " cells in total exceed the limit of " + fmt(max_grid_cells) +
               " (check the numbers per direction)");
-    require(cell_volume > 0 && std::isfinite(cell_volume),
-            "grid",
+    require(cell_volume > 0 && std::isfinite(cell_volume), "grid",
             "the cells have zero or non-finite size (corners " + fmt_point(p.grid_lower) + ", " +
               fmt_point(p.grid_upper) + ")");
 
     double n_points = 0;
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
       {
-        const auto &      b     = p.bodies[k];
+        const auto       &b     = p.bodies[k];
         const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
         if (b.shape == BodyDescription<dim>::Shape::file)
           {
@@ -181,8 +180,7 @@ namespace talus
         double overlap = 1;
         for (unsigned int d = 0; d < dim; ++d)
           overlap *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
-        require(overlap > 0,
-                where,
+        require(overlap > 0, where,
                 "contains no material point: it lies entirely outside the grid (body " + fmt_point(lo) + " to " +
                   fmt_point(hi) + ", grid " + fmt_point(p.grid_lower) + " to " + fmt_point(p.grid_upper) + ")");
         if (!b.clip_to_grid)
@@ -190,14 +188,15 @@ namespace talus
             // silently clipped bodies were a trap: the grid must hold the whole body
             const std::string out = outside_extent(b, p.grid_lower, p.grid_upper);
             require(out.empty(), where,
-                    out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
-                          "the grid, or set 'clip to grid = true' in '" + "body " + std::to_string(k) +
-                          "' to drop the points outside)");
+                    out +
+                      "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                      "the grid, or set 'clip to grid = true' in '" +
+                      "body " + std::to_string(k) + "' to drop the points outside)");
             if (p.grid_mesh && b.shape == BodyDescription<dim>::Shape::box)
               {
                 // a grid file need not fill its bounding box: the cells must cover the box body
-                const auto &       m  = *p.grid_mesh;
-                const unsigned int nv = m.n_cell_vertices();
+                const auto        &m       = *p.grid_mesh;
+                const unsigned int nv      = m.n_cell_vertices();
                 double             covered = 0, body_volume = 1;
                 for (unsigned int d = 0; d < dim; ++d)
                   body_volume *= hi[d] - lo[d];
@@ -218,20 +217,15 @@ namespace talus
           }
         if (b.shape == BodyDescription<dim>::Shape::box && !p.grid_mesh)
           for (unsigned int d = 0; d < dim; ++d)
-            require(interval_has_seed(p.grid_lower[d],
-                                      p.grid_upper[d],
-                                      p.grid_cells[d],
-                                      b.particles_per_direction,
-                                      b.lower[d],
-                                      b.upper[d]),
+            require(interval_has_seed(p.grid_lower[d], p.grid_upper[d], p.grid_cells[d], b.particles_per_direction,
+                                      b.lower[d], b.upper[d]),
                     where,
                     "contains no material point: it is thinner than one sub-cell (cell size / particles per "
                     "direction) in direction " +
                       std::to_string(d) + " and holds no seeding position");
         n_points += overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
       }
-    require(n_points <= max_material_points,
-            "bodies",
+    require(n_points <= max_material_points, "bodies",
             "about " + fmt(n_points) + " material points would be seeded, more than the limit of " +
               fmt(max_material_points) + " (check 'cells' and 'particles per direction')");
   }
@@ -267,7 +261,7 @@ namespace talus
   FileBodyRows
   check_file_body(const SceneParameters<dim> &p, const unsigned int k)
   {
-    const auto &        b     = p.bodies[k];
+    const auto         &b     = p.bodies[k];
     const std::string   entry = "body " + std::to_string(k);
     const auto          info  = io::particle_file_info(b.particle_file, dim, MPI_COMM_WORLD, entry + "/particle file");
     const std::uint64_t rows  = b.file_body_id < info.rows_per_body.size() ? info.rows_per_body[b.file_body_id] : 0;
@@ -312,10 +306,10 @@ namespace talus
 
   template FileBodyRows check_file_body(const SceneParameters<2> &, unsigned int);
   template FileBodyRows check_file_body(const SceneParameters<3> &, unsigned int);
-  template double smallest_cell_edge(const SceneParameters<2> &);
-  template double smallest_cell_edge(const SceneParameters<3> &);
-  template void check_run_files(const RunParameters<2> &);
-  template void check_run_files(const RunParameters<3> &);
-  template void check_scene_consistency(const SceneParameters<2> &);
-  template void check_scene_consistency(const SceneParameters<3> &);
+  template double       smallest_cell_edge(const SceneParameters<2> &);
+  template double       smallest_cell_edge(const SceneParameters<3> &);
+  template void         check_run_files(const RunParameters<2> &);
+  template void         check_run_files(const RunParameters<3> &);
+  template void         check_scene_consistency(const SceneParameters<2> &);
+  template void         check_scene_consistency(const SceneParameters<3> &);
 } // namespace talus

@@ -41,7 +41,8 @@ namespace talus
 
   /// Where checkpoints go: checkpoint/directory, or <output>/checkpoints.
   template <int dim>
-  std::string checkpoint_directory_of(const RunParameters<dim> &p)
+  std::string
+  checkpoint_directory_of(const RunParameters<dim> &p)
   {
     return p.checkpoint_directory.empty() ? p.output_directory + "/checkpoints" : p.checkpoint_directory;
   }

@@ -117,7 +117,8 @@ namespace talus
     prm.leave_subsection();
 
     prm.enter_subsection("gravity");
-    prm.declare_entry("acceleration", zeros_text(dim, "-9.81"), Anything(), "Gravitational acceleration vector [m/s^2].");
+    prm.declare_entry("acceleration", zeros_text(dim, "-9.81"), Anything(),
+                      "Gravitational acceleration vector [m/s^2].");
     prm.leave_subsection();
 
     prm.declare_entry("number of materials", "1", Integer(1, 64), "Number of 'material k' subsections (k = 0..n-1).");
@@ -220,7 +221,8 @@ namespace talus
 
     prm.enter_subsection("checkpoint");
     {
-      prm.declare_entry("interval", "0", Double(0), "Simulated time between checkpoints (HDF5, complete state); 0 = off.");
+      prm.declare_entry("interval", "0", Double(0),
+                        "Simulated time between checkpoints (HDF5, complete state); 0 = off.");
       prm.declare_entry("wall clock interval", "0", Double(0),
                         "Wall-clock seconds between checkpoints (for batch time limits); 0 = off.");
       prm.declare_entry("keep", "2", Integer(1, 1000), "Number of newest checkpoints kept.");
@@ -329,7 +331,8 @@ namespace talus
             b.lower = parse_point<dim>(prm.get("lower corner"), where + "/lower corner");
             b.upper = parse_point<dim>(prm.get("upper corner"), where + "/upper corner");
             for (unsigned int d = 0; d < dim; ++d)
-              require(b.upper[d] > b.lower[d], where + "/upper corner", "must exceed 'lower corner' in every direction");
+              require(b.upper[d] > b.lower[d], where + "/upper corner",
+                      "must exceed 'lower corner' in every direction");
           }
         else if (shape == "ball")
           {
@@ -373,7 +376,7 @@ namespace talus
             // deal.II 9.4 prints muparser's diagnosis to std::cerr before it
             // throws: keep it out of the tool's stderr (the InputError below
             // carries the same text, naming the entry)
-            std::ostringstream   parser_noise;
+            std::ostringstream    parser_noise;
             std::streambuf *const cerr_buffer = std::cerr.rdbuf(parser_noise.rdbuf());
             try
               {
@@ -439,7 +442,7 @@ namespace talus
     p.checkpoint_directory     = prm.get("directory");
     {
       const std::string r = prm.get("restart");
-      p.restart = r == "true" ? Restart::yes : r == "if available" ? Restart::if_available : Restart::no;
+      p.restart           = r == "true" ? Restart::yes : r == "if available" ? Restart::if_available : Restart::no;
     }
     if (tool_option_given("--restart"))
       p.restart = Restart::yes;
@@ -474,10 +477,10 @@ namespace talus
   template struct SceneParameters<3>;
   template struct RunParameters<2>;
   template struct RunParameters<3>;
-  template void parse_scene_parameters<2>(dealii::ParameterHandler &, SceneParameters<2> &);
-  template void parse_scene_parameters<3>(dealii::ParameterHandler &, SceneParameters<3> &);
-  template void parse_run_parameters<2>(dealii::ParameterHandler &, RunParameters<2> &);
-  template void parse_run_parameters<3>(dealii::ParameterHandler &, RunParameters<3> &);
+  template void         parse_scene_parameters<2>(dealii::ParameterHandler &, SceneParameters<2> &);
+  template void         parse_scene_parameters<3>(dealii::ParameterHandler &, SceneParameters<3> &);
+  template void         parse_run_parameters<2>(dealii::ParameterHandler &, RunParameters<2> &);
+  template void         parse_run_parameters<3>(dealii::ParameterHandler &, RunParameters<3> &);
   template LoopSettings loop_settings<2>(const RunParameters<2> &);
   template LoopSettings loop_settings<3>(const RunParameters<3> &);
 } // namespace talus

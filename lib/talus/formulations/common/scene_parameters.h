@@ -36,20 +36,24 @@ namespace talus
     std::shared_ptr<const io::GridMesh> grid_mesh;
     std::vector<BoundaryCondition>      boundary_conditions;
     /// 'boundary conditions/rigid plate k' (loads/rigid_plate.h)
-    std::vector<loads::RigidPlate<dim>> rigid_plates;
-    dealii::Tensor<1, dim>              gravity;
+    std::vector<loads::RigidPlate<dim>>                     rigid_plates;
+    dealii::Tensor<1, dim>                                  gravity;
     std::vector<std::shared_ptr<const materials::Material>> materials;
-    std::vector<BodyDescription<dim>>                        bodies;
-    ShapeFunction shape_function = ShapeFunction::linear;
-    bool          bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
+    std::vector<BodyDescription<dim>>                       bodies;
+    ShapeFunction                                           shape_function = ShapeFunction::linear;
+    bool
+    bspline() const
+    {
+      return shape_function == ShapeFunction::quadratic_bspline;
+    }
   };
 
   /// End time, step limit, lost points, output and checkpoint settings.
   template <int dim>
   struct RunParameters
   {
-    double       end_time  = 1.0;
-    unsigned int max_steps = 0; ///< 0: no limit
+    double       end_time               = 1.0;
+    unsigned int max_steps              = 0;     ///< 0: no limit
     bool         stop_on_lost_particles = false; ///< else: remove them, count, go on
     // output
     std::string                     output_directory    = "output";
@@ -75,11 +79,15 @@ namespace talus
     // load balancing by material points (subsection 'load balancing')
     struct Balance
     {
-      unsigned int interval    = 0;    ///< steps between imbalance checks, 0: off
-      double       threshold   = 1.1;  ///< rebalance when max/mean points per rank exceeds it
+      unsigned int interval     = 0;   ///< steps between imbalance checks, 0: off
+      double       threshold    = 1.1; ///< rebalance when max/mean points per rank exceeds it
       unsigned int point_weight = 100; ///< partition weight of a material point
       unsigned int cell_weight  = 1;   ///< partition weight of a cell (with or without points)
-      bool         enabled() const { return interval > 0; }
+      bool
+      enabled() const
+      {
+        return interval > 0;
+      }
     };
     Balance balance;
   };
@@ -110,7 +118,7 @@ namespace talus
   /// talus-plot fields the family's VTU files never hold (e.g. {"pore pressure"}),
   /// refused in 'output/png field'. Returns the counts.
   SceneCounts declare_common_parameters(dealii::ParameterHandler &prm, const std::string &prm_file,
-                                        const std::string &time_step_doc,
+                                        const std::string              &time_step_doc,
                                         const std::vector<std::string> &png_fields_not_written = {});
 
   template <int dim>

@@ -30,9 +30,9 @@ namespace talus
   template <int dim>
   SeedingResult
   seed_scene_bodies(const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
-                    const std::vector<double> &density_of_material, MaterialPointSet<dim> &set,
-                    const std::string &what, const SceneParameters<dim> *scene,
-                    const std::vector<unsigned int> &body_index, const bool allow_empty)
+                    const std::vector<double> &density_of_material, MaterialPointSet<dim> &set, const std::string &what,
+                    const SceneParameters<dim> *scene, const std::vector<unsigned int> &body_index,
+                    const bool allow_empty)
   {
     SeedingResult seeded = seed_bodies(grid, bodies, density_of_material, set.layout, set.handler);
     const auto    filed =
@@ -57,7 +57,8 @@ namespace talus
         auto        P = pt.get_properties();
         const auto &m = *materials[static_cast<unsigned int>(P[L::material])];
         if (m.n_history() > 0)
-          m.initialize_history(L::get_stress(P.data()), dealii::ArrayView<double>(P.data() + history_offset, m.n_history()));
+          m.initialize_history(L::get_stress(P.data()),
+                               dealii::ArrayView<double>(P.data() + history_offset, m.n_history()));
       }
   }
 
@@ -78,8 +79,7 @@ namespace talus
           {
             const double n = k < filed.dropped_points.size() ? filed.dropped_points[k] : 0;
             const double v = k < filed.dropped_volume.size() ? filed.dropped_volume[k] : 0;
-            os << n << " material points of '" << b.particle_file << "' outside the grid dropped, volume lost "
-               << v;
+            os << n << " material points of '" << b.particle_file << "' outside the grid dropped, volume lost " << v;
           }
         else if (!p.grid_mesh)
           {
@@ -100,16 +100,16 @@ namespace talus
       }
   }
 
-#define TALUS_SEEDING(dim)                                                                                         \
-  template SeedingResult seed_scene_bodies(const BackgroundGrid<dim> &, const std::vector<BodyDescription<dim>> &, \
-                                           const std::vector<double> &, MaterialPointSet<dim> &, const std::string &, \
-                                           const SceneParameters<dim> *, const std::vector<unsigned int> &, bool);   \
-  template std::vector<double> material_densities(const SceneParameters<dim> &);                                  \
-  template void require_seeded(const std::vector<BodyDescription<dim>> &, const std::vector<double> &,             \
-                               const std::string &, const std::vector<unsigned int> &);                            \
-  template void initialize_point_histories(const std::vector<std::shared_ptr<const materials::Material>> &,        \
-                                           MaterialPointSet<dim> &, unsigned int);                                 \
-  template void log_clipping(const SceneParameters<dim> &, const std::vector<BodyDescription<dim>> &,              \
+#define TALUS_SEEDING(dim)                                                                                                  \
+  template SeedingResult       seed_scene_bodies(const BackgroundGrid<dim> &, const std::vector<BodyDescription<dim>> &,    \
+                                                 const std::vector<double> &, MaterialPointSet<dim> &, const std::string &, \
+                                                 const SceneParameters<dim> *, const std::vector<unsigned int> &, bool);    \
+  template std::vector<double> material_densities(const SceneParameters<dim> &);                                            \
+  template void                require_seeded(const std::vector<BodyDescription<dim>> &, const std::vector<double> &,       \
+                                              const std::string &, const std::vector<unsigned int> &);                      \
+  template void initialize_point_histories(const std::vector<std::shared_ptr<const materials::Material>> &,                 \
+                                           MaterialPointSet<dim> &, unsigned int);                                          \
+  template void log_clipping(const SceneParameters<dim> &, const std::vector<BodyDescription<dim>> &,                       \
                              const SeedingResult &, const SeedingResult &, const std::vector<unsigned int> &)
   TALUS_SEEDING(2);
   TALUS_SEEDING(3);

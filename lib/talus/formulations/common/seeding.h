@@ -24,14 +24,10 @@ namespace talus
   /// 'clip to grid' left out of each body is logged. Returns the volumes per
   /// body (shape + file) and the counts. Collective.
   template <int dim>
-  SeedingResult seed_scene_bodies(const BackgroundGrid<dim> &               grid,
-                                  const std::vector<BodyDescription<dim>> & bodies,
-                                  const std::vector<double> &               density_of_material,
-                                  MaterialPointSet<dim> &                   set,
-                                  const std::string &                       what,
-                                  const SceneParameters<dim> *              scene      = nullptr,
-                                  const std::vector<unsigned int> &         body_index = {},
-                                  bool                                      allow_empty = false);
+  SeedingResult seed_scene_bodies(const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+                                  const std::vector<double> &density_of_material, MaterialPointSet<dim> &set,
+                                  const std::string &what, const SceneParameters<dim> *scene = nullptr,
+                                  const std::vector<unsigned int> &body_index = {}, bool allow_empty = false);
 
   /// The density of every material of the scene (the point masses of seeding).
   template <int dim>

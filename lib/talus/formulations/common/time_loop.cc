@@ -29,10 +29,11 @@ namespace talus
   } // namespace
 
   TimeLoop::TimeLoop(Formulation &formulation, const LoopSettings &s, MPI_Comm c)
-    : f(formulation)
-    , settings(s)
-    , comm(c)
-  {}
+      : f(formulation)
+      , settings(s)
+      , comm(c)
+  {
+  }
 
   double
   TimeLoop::step(const double h_wanted)
@@ -173,30 +174,29 @@ namespace talus
       return due;
     };
 
-    LoopTimings  timings;
-    const auto   t_start  = Clock::now();
-    auto         t_report = t_start;
-    bool         failed   = false; // unstable or stopped: the run ends after series.csv is closed
-    bool         unstable = false;
-    std::string  failure;
+    LoopTimings timings;
+    const auto  t_start  = Clock::now();
+    auto        t_report = t_start;
+    bool        failed   = false; // unstable or stopped: the run ends after series.csv is closed
+    bool        unstable = false;
+    std::string failure;
     // stages (one without a staged .prm); a restarted run resumes in current_stage
     const unsigned int n_stages    = f.n_stages();
     bool               run_stopped = false; // max steps reached
     bool               first_stage = true;
     for (; f.current_stage < n_stages && !failed && !run_stopped; ++f.current_stage)
       {
-        const double end_time = f.begin_stage(f.current_stage, first_stage, restored && first_stage);
-        first_stage           = false;
-        const double eps_t    = 1e-9 * f.dt;
+        const double end_time   = f.begin_stage(f.current_stage, first_stage, restored && first_stage);
+        first_stage             = false;
+        const double eps_t      = 1e-9 * f.dt;
         bool         stage_done = false;
         while (!stage_done && f.time < end_time - eps_t &&
                (settings.max_steps == 0 || f.step_number < settings.max_steps))
           {
             const double h = std::min(f.dt, end_time - f.time);
-            bool last_step = !(f.time + h < end_time - eps_t) ||
-                             (settings.max_steps && f.step_number + 1 >= settings.max_steps);
-            bool series_due =
-              settings.series_interval == 0 || f.time + h >= counters.next_series - eps_t || last_step;
+            bool         last_step =
+              !(f.time + h < end_time - eps_t) || (settings.max_steps && f.step_number + 1 >= settings.max_steps);
+            bool series_due = settings.series_interval == 0 || f.time + h >= counters.next_series - eps_t || last_step;
             f.before_step(h, series_due);
             try
               {
@@ -225,8 +225,8 @@ namespace talus
             if (f.stage_converged(converged))
               {
                 stage_done = last_step = series_due = true;
-                log() << std::setprecision(6) << "  stage " << f.current_stage << " converged at step "
-                      << f.step_number << " (t = " << f.time << " s): " << converged << std::endl;
+                log() << std::setprecision(6) << "  stage " << f.current_stage << " converged at step " << f.step_number
+                      << " (t = " << f.time << " s): " << converged << std::endl;
               }
             auto t0 = Clock::now();
             if (series_due)

@@ -29,7 +29,7 @@ namespace talus
     double step(const double h);
     void   report_lost_points();
 
-    Formulation &       f;
+    Formulation        &f;
     const LoopSettings &settings;
     MPI_Comm            comm;
   };

@@ -96,14 +96,8 @@ namespace talus::transfer
   /// point, sets v_p = dx / h and C_p (row-major, C[c * dim + k] = C_ck).
   template <int dim, class K>
   inline void
-  apic_point_velocity(const typename K::Cell & cell,
-                      const typename K::Eval & e,
-                      const typename K::Field &du,
-                      const double             h,
-                      const double (&gu)[dim][dim],
-                      const double (&dx)[dim],
-                      double *vel,
-                      double *C)
+  apic_point_velocity(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du,
+                      const double h, const double (&gu)[dim][dim], const double (&dx)[dim], double *vel, double *C)
   {
     const double inv_h = 1.0 / h;
     for (unsigned int d = 0; d < dim; ++d)
@@ -136,7 +130,7 @@ namespace talus::transfer
             const double hk = cell.cc->h[k];
             // D_kk = 0 only for a point exactly on a wall (wall half cell, linear
             // hats): the limit of B D^-1 there is the gradient
-            const bool   singular = !(D[k] > 1e-14 * hk * hk);
+            const bool singular = !(D[k] > 1e-14 * hk * hk);
             for (unsigned int c = 0; c < dim; ++c)
               C[c * dim + k] = (singular ? gu[c][k] : B[c][k] / D[k]) * inv_h;
           }
@@ -147,12 +141,8 @@ namespace talus::transfer
   /// per-cell momentum sums: lp[slot] += N m (v + C r).
   template <int dim, class K>
   inline void
-  add_affine_momentum(const typename K::Cell &cell,
-                      const typename K::Eval &e,
-                      const double            mass,
-                      const double *          vel,
-                      const double *          C,
-                      double (*lp)[dim])
+  add_affine_momentum(const typename K::Cell &cell, const typename K::Eval &e, const double mass, const double *vel,
+                      const double *C, double (*lp)[dim])
   {
     double m[dim], D[dim];
     stencil_moments<dim, K>(cell, e, m, D);
@@ -181,17 +171,18 @@ namespace talus::transfer
     using Base::cell;
     using Base::sums;
     ScatterAffineMomentum(const BackgroundGrid<dim> &grid, double *Pn, const unsigned int affine)
-      : Base(grid)
-      , Pn(Pn)
-      , affine(affine)
-    {}
+        : Base(grid)
+        , Pn(Pn)
+        , affine(affine)
+    {
+    }
     double *const      Pn;
     const unsigned int affine;
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
     {
-      using L         = PropertyLayout<dim>;
-      const double *P = it->get_properties().data();
+      using L            = PropertyLayout<dim>;
+      const double    *P = it->get_properties().data();
       typename K::Eval e;
       K::evaluate(cell, it->get_reference_location(), e);
       add_affine_momentum<dim, K>(cell, e, P[L::mass], P + L::velocity, P + affine, sums.lp);
@@ -209,13 +200,8 @@ namespace talus::transfer
   /// (out[0]); 3D: the three components. For conservation checks.
   template <int dim, class K>
   inline void
-  affine_angular_momentum(const typename K::Cell &  cell,
-                          const dealii::Point<dim> &xi,
-                          const dealii::Point<dim> &x,
-                          const double              mass,
-                          const double *            vel,
-                          const double *            C,
-                          double *                  out)
+  affine_angular_momentum(const typename K::Cell &cell, const dealii::Point<dim> &xi, const dealii::Point<dim> &x,
+                          const double mass, const double *vel, const double *C, double *out)
   {
     typename K::Eval e;
     K::evaluate(cell, xi, e);

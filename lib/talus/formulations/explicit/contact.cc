@@ -13,8 +13,8 @@ namespace talus::explicit_mpm
 {
   template <int dim>
   Contact<dim>::Contact(const BackgroundGrid<dim> &g, const NumericsOptions &o, const unsigned int nb)
-    : grid(g)
-    , n_bodies(nb)
+      : grid(g)
+      , n_bodies(nb)
   {
     fields.resize(n_bodies);
     for (auto &f : fields)
@@ -127,7 +127,7 @@ namespace talus::explicit_mpm
         const auto &cc = grid.cells[ac.cell];
         for (auto &f : fields)
           {
-            const double *M    = f.mass.begin();
+            const double *M = f.mass.begin();
             double        m[nv], any = 0;
             for (unsigned int v = 0; v < nv; ++v)
               any += (m[v] = M[cc.dofs[v * dim]]);
@@ -152,11 +152,8 @@ namespace talus::explicit_mpm
 
   template <int dim>
   bool
-  Contact<dim>::correct_node(const std::array<unsigned int, dim> &dofs,
-                             const std::vector<unsigned char> &   constrained,
-                             std::vector<double> &                mb,
-                             std::vector<std::array<double, dim>> &vb,
-                             const double                          dt)
+  Contact<dim>::correct_node(const std::array<unsigned int, dim> &dofs, const std::vector<unsigned char> &constrained,
+                             std::vector<double> &mb, std::vector<std::array<double, dim>> &vb, const double dt)
   {
     double m = 0;
     for (unsigned int b = 0; b < n_bodies; ++b)
@@ -183,7 +180,7 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           v[d] += mb[b] * vb[b][d] / m;
     std::vector<std::array<double, dim>> out(vb);
-    bool corrected = false;
+    bool                                 corrected = false;
     for (unsigned int g = 0; g < n_bodies; ++g)
       {
         if (!(mb[g] > 0))
@@ -205,8 +202,8 @@ namespace talus::explicit_mpm
         // the partner, so that both bodies of a node use exactly opposite normals
         std::array<double, dim> n;
         double                  ng = 0, np = 0, nn = 0;
-        const double *          Gg = fields[g].gradient.begin();
-        const double *          Gp = fields[partner].gradient.begin();
+        const double           *Gg = fields[g].gradient.begin();
+        const double           *Gp = fields[partner].gradient.begin();
         for (unsigned int d = 0; d < dim; ++d)
           {
             ng += Gg[dofs[d]] * Gg[dofs[d]];
@@ -223,7 +220,7 @@ namespace talus::explicit_mpm
             out[g] = v;
             continue;
           }
-        nn = std::sqrt(nn);
+        nn        = std::sqrt(nn);
         double dn = 0; // (v_g - v) . n > 0: approaching
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -323,9 +320,9 @@ namespace talus::explicit_mpm
   void
   Contact<dim>::g2p_velocity_p2g_momentum(Solver<dim> &s, const double h)
   {
-    using L                   = PropertyLayout<dim>;
-    constexpr unsigned int nv = 1u << dim;
-    double *const          Pn = s.nodal_p.begin();
+    using L                     = PropertyLayout<dim>;
+    constexpr unsigned int nv   = 1u << dim;
+    double *const          Pn   = s.nodal_p.begin();
     const auto             zero = [&](Vector &x) {
       x.zero_out_ghost_values();
       double *p = x.begin();
@@ -335,31 +332,31 @@ namespace talus::explicit_mpm
     zero(s.nodal_p);
     for (auto &f : fields)
       zero(f.momentum);
-    const CellCache<dim> *cell = nullptr;
+    const CellCache<dim> *cell     = nullptr;
     const auto            at_point = [&](const unsigned int, auto &pt) {
-            const auto &       cc = *cell;
-            double *           P = pt->get_properties().data();
-            const unsigned int b = static_cast<unsigned int>(P[L::body]);
-            const double *     A = fields[b].force.begin();
-            double *           Pb = fields[b].momentum.begin();
-            double             N[nv];
-            shape::Q1<dim>::values(pt->get_reference_location(), N);
-            double *vel = P + L::velocity;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                double sum = 0;
-                for (unsigned int v = 0; v < nv; ++v)
-                  sum += N[v] * A[cc.dofs[v * dim + d]];
-                vel[d] += h * sum; // Eq. 4.46 with the corrected acceleration
-              }
-            const double m = P[L::mass];
-            for (unsigned int v = 0; v < nv; ++v)
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  const double q = m * N[v] * vel[d];
-                  Pn[cc.dofs[v * dim + d]] += q;
-                  Pb[cc.dofs[v * dim + d]] += q;
-                }
+      const auto        &cc = *cell;
+      double            *P  = pt->get_properties().data();
+      const unsigned int b  = static_cast<unsigned int>(P[L::body]);
+      const double      *A  = fields[b].force.begin();
+      double            *Pb = fields[b].momentum.begin();
+      double             N[nv];
+      shape::Q1<dim>::values(pt->get_reference_location(), N);
+      double *vel = P + L::velocity;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          double sum = 0;
+          for (unsigned int v = 0; v < nv; ++v)
+            sum += N[v] * A[cc.dofs[v * dim + d]];
+          vel[d] += h * sum; // Eq. 4.46 with the corrected acceleration
+        }
+      const double m = P[L::mass];
+      for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double q = m * N[v] * vel[d];
+            Pn[cc.dofs[v * dim + d]] += q;
+            Pb[cc.dofs[v * dim + d]] += q;
+          }
     };
     transfer::for_each_active_cell(
       s.points, [&](const unsigned int c) { cell = &s.grid.cells[c]; }, at_point, [](const unsigned int) {});

@@ -50,7 +50,8 @@ namespace talus::explicit_mpm
     /// coordinates and component (the vertices of the box grid are computed
     /// identically on any number of ranks). Index: local DoF index.
     template <int dim>
-    std::vector<std::array<double, dim + 1>> owned_dof_keys(const BackgroundGrid<dim> &grid, const unsigned int n_owned)
+    std::vector<std::array<double, dim + 1>>
+    owned_dof_keys(const BackgroundGrid<dim> &grid, const unsigned int n_owned)
     {
       std::vector<std::array<double, dim + 1>> keys(n_owned);
       std::vector<unsigned char>               seen(n_owned, 0);
@@ -64,7 +65,7 @@ namespace talus::explicit_mpm
                 const unsigned int i = grid.cells[c].dofs[v * dim + d];
                 if (i >= n_owned || seen[i])
                   continue;
-                seen[i] = 1;
+                seen[i]      = 1;
                 const auto x = grid.cell_iterators[c]->vertex(v);
                 for (unsigned int e = 0; e < dim; ++e)
                   keys[i][e] = x[e];
@@ -75,7 +76,8 @@ namespace talus::explicit_mpm
     }
 
     /// Raw local elements (owned + ghost) of a distributed vector.
-    std::vector<double> local_elements(const Vector &v)
+    std::vector<double>
+    local_elements(const Vector &v)
     {
       const unsigned int n = v.locally_owned_size() + v.get_partitioner()->n_ghost_indices();
       return std::vector<double>(v.begin(), v.begin() + n);
@@ -172,17 +174,17 @@ namespace talus::explicit_mpm
     const std::string file  = f.path();
     const std::string where = "checkpoint " + file;
     read_run_state(f, *this, prm.checkpoint_interval);
-    external_work            = f.get_double("external work");
-    energy_scale             = f.get_double("energy scale");
-    initial_energies         = {f.get_double("initial kinetic"), f.get_double("initial strain"),
+    external_work    = f.get_double("external work");
+    energy_scale     = f.get_double("energy scale");
+    initial_energies = {f.get_double("initial kinetic"), f.get_double("initial strain"),
                         f.get_double("initial potential"), f.get_double("initial external work")};
-    const bool         same      = f.get_int("ranks") == static_cast<std::int64_t>(n_ranks);
+    const bool same  = f.get_int("ranks") == static_cast<std::int64_t>(n_ranks);
     balance.restore(f); // same ranks: the saved partition (grid_changed() called)
     if (same)
       {
         read_points(f, points, grid, where);
         // the nodal sums of the next step, exactly as the run left them
-        const auto ndofs = f.read_rows_u64("ranks/n_dofs", 0, n_ranks);
+        const auto    ndofs     = f.read_rows_u64("ranks/n_dofs", 0, n_ranks);
         std::uint64_t dof_begin = 0;
         for (unsigned int r = 0; r < rank; ++r)
           dof_begin += ndofs[r];
@@ -208,7 +210,7 @@ namespace talus::explicit_mpm
         p2g_ready = false;
         if (f.exists("nodal/by_vertex") && f.get_int("p2g ready"))
           {
-            const auto  table = f.read_all("nodal/by_vertex");
+            const auto                                                       table = f.read_all("nodal/by_vertex");
             std::map<std::array<double, dim + 1>, std::pair<double, double>> sums;
             for (std::size_t r = 0; r + dim + 3 <= table.size(); r += dim + 3)
               {
@@ -246,17 +248,18 @@ namespace talus::explicit_mpm
     probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
     if (!prm.rigid_plates.empty())
       {
-        require(f.exists("plates/state"), where, "has no rigid plate state ('plates/state'), but the scene has rigid plates");
+        require(f.exists("plates/state"), where,
+                "has no rigid plate state ('plates/state'), but the scene has rigid plates");
         control->restore_rigid_plate_state(f.read_all("plates/state"));
       }
     restored_from = file;
     return true;
   }
 
-  template std::string Solver<2>::write_checkpoint();
-  template std::string Solver<3>::write_checkpoint();
-  template bool        Solver<2>::restore_checkpoint();
-  template bool        Solver<3>::restore_checkpoint();
+  template std::string              Solver<2>::write_checkpoint();
+  template std::string              Solver<3>::write_checkpoint();
+  template bool                     Solver<2>::restore_checkpoint();
+  template bool                     Solver<3>::restore_checkpoint();
   template std::vector<std::string> Solver<2>::list_checkpoints() const;
   template std::vector<std::string> Solver<3>::list_checkpoints() const;
   template std::string              Solver<2>::checkpoint_directory() const;

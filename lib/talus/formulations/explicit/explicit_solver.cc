@@ -140,13 +140,13 @@ namespace talus::explicit_mpm
                 "step was measured unstable (granular column collapse, Courant 0.5 and 0.2; "
                 "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration_name()) +
-                  why + "mpm, or velocity transfer = flip");
+                std::string(p.numerics.integration_name()) + why + "mpm, or velocity transfer = flip");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + why + "none, or velocity transfer = flip");
         require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
-                "coupled 2-phase materials and body tractions" + why + "1-phase materials, or velocity transfer = flip");
+                "coupled 2-phase materials and body tractions" + why +
+                  "1-phase materials, or velocity transfer = flip");
         require(!p.balance.enabled(), "load balancing/interval",
                 "load balancing" + why + "interval = 0, or velocity transfer = flip");
         for (const auto &st : p.loads.stages)
@@ -167,8 +167,7 @@ namespace talus::explicit_mpm
         const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
                                 "(its particle passes use linear shape functions); allowed: ";
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration_name()) +
-                  why + "mpm");
+                std::string(p.numerics.integration_name()) + why + "mpm");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + why + "none");
         require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
@@ -211,8 +210,9 @@ namespace talus::explicit_mpm
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing is not available with numerics/integration = " + mode + "; allowed: none");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/integration",
-                "'" + mode + "' runs the 1-phase step only: coupled 2-phase materials and body tractions are "
-                "refused (allowed with them: mpm)");
+                "'" + mode +
+                  "' runs the 1-phase step only: coupled 2-phase materials and body tractions are "
+                  "refused (allowed with them: mpm)");
         require(p.numerics.integration == NumericsOptions::Integration::fem ||
                   (p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
                    p.restart == Parameters<dim>::Restart::no),
@@ -227,13 +227,14 @@ namespace talus::explicit_mpm
   // ================================================================ solver
   template <int dim>
   Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
-    : prm(p)
-    , comm(c)
-    , grid(c, p.balance.enabled())
-    , points(grid, "points")
-    , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
-    , gravity(p.gravity)
-  {}
+      : prm(p)
+      , comm(c)
+      , grid(c, p.balance.enabled())
+      , points(grid, "points")
+      , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
+      , gravity(p.gravity)
+  {
+  }
 
   template <int dim>
   Solver<dim>::~Solver() = default;
@@ -291,7 +292,7 @@ namespace talus::explicit_mpm
     points.layout.n_history = n_history;
     if (prm.loads.active() || !prm.rigid_plates.empty())
       {
-        control                    = std::make_unique<loads::LoadControl<dim>>(prm.loads);
+        control = std::make_unique<loads::LoadControl<dim>>(prm.loads);
         control->extend_layout(points.layout);
         control->setup_rigid_plates(*this); // node checks (exit 2) and log lines, before any output
       }
@@ -312,8 +313,8 @@ namespace talus::explicit_mpm
       affine_offset = points.layout.add_extra("affine_velocity", dim * dim);
     points.initialize();
     if (prm.numerics.fem())
-      fem = std::make_unique<FemIntegration<dim>>(*this, prm.numerics.integration ==
-                                                           NumericsOptions::Integration::ul_fem);
+      fem =
+        std::make_unique<FemIntegration<dim>>(*this, prm.numerics.integration == NumericsOptions::Integration::ul_fem);
     require(!two_phase || (!prm.numerics.extended_p2g() && prm.numerics.smoothing == NumericsOptions::Smoothing::none),
             "numerics/integration, numerics/strain smoothing, contact/pairs",
             "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
@@ -326,20 +327,20 @@ namespace talus::explicit_mpm
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
       {
-      const std::vector<double> density = material_densities(prm);
-      // FEM: the cells these points occupy get Gauss points instead (fem.h)
-      auto seeded = seed_scene_bodies(grid, prm.bodies, density, points, "material point", &prm, {}, fem != nullptr);
-      if (fem)
-        {
-          seeded = fem->seed(density);
-          require_seeded(prm.bodies, seeded.volume_per_body, "material point");
-        }
-      if (control)
-        control->initial_state(*this); // K0 stresses, stage 0 (gravity, boundaries, mass scaling)
-      if (points.layout.n_history)
-        initialize_point_histories(prm.materials, points, points.layout.history);
-      if (two_phase)
-        two_phase->initialize_particles(); // restored points carry their 2-phase state
+        const std::vector<double> density = material_densities(prm);
+        // FEM: the cells these points occupy get Gauss points instead (fem.h)
+        auto seeded = seed_scene_bodies(grid, prm.bodies, density, points, "material point", &prm, {}, fem != nullptr);
+        if (fem)
+          {
+            seeded = fem->seed(density);
+            require_seeded(prm.bodies, seeded.volume_per_body, "material point");
+          }
+        if (control)
+          control->initial_state(*this); // K0 stresses, stage 0 (gravity, boundaries, mass scaling)
+        if (points.layout.n_history)
+          initialize_point_histories(prm.materials, points, points.layout.history);
+        if (two_phase)
+          two_phase->initialize_particles(); // restored points carry their 2-phase state
       }
 
     const double dt_cr = critical_time_step();
@@ -465,7 +466,7 @@ namespace talus::explicit_mpm
     collect_active_cells();
     if (control)
       control->grid_changed(*this); // nodes of prescribed velocities and friction
-    p2g_ready = false;               // the next step starts with a full P2G
+    p2g_ready = false;              // the next step starts with a full P2G
   }
 
   template <int dim>
@@ -523,7 +524,7 @@ namespace talus::explicit_mpm
     if (control)
       control->nodal_forces(*this); // tractions, convergence ratios, damping, mass scaling
     const double *M = nodal_mass.begin();
-    double *      A = nodal_a.begin();
+    double       *A = nodal_a.begin();
     for (const unsigned int i : active_dofs)
       A[i] = (M[i] > 0 && !constrained[i]) ? A[i] / M[i] : 0.0;
     if (control)
@@ -574,7 +575,7 @@ namespace talus::explicit_mpm
     scatter_point_momentum(nodal_p);
     const double *M = nodal_mass.begin();
     const double *A = nodal_a.begin();
-    double *      V = nodal_p.begin();
+    double       *V = nodal_p.begin();
     for (const unsigned int i : active_dofs)
       V[i] = (M[i] > 0 && !constrained[i]) ? V[i] / M[i] + h * A[i] : 0.0;
     if (control)
@@ -587,7 +588,7 @@ namespace talus::explicit_mpm
   Solver<dim>::nodal_velocity()
   {
     const double *M = nodal_mass.begin();
-    double *      V = nodal_p.begin();
+    double       *V = nodal_p.begin();
     for (const unsigned int i : active_dofs)
       V[i] = (M[i] > 0 && !constrained[i]) ? V[i] / M[i] : 0.0; // Eq. 4.48
     if (control)
@@ -610,12 +611,12 @@ namespace talus::explicit_mpm
       const unsigned int                                             history;
       const double                                                   h;
       const dealii::Tensor<1, dim>                                   g;
-      Contact<dim> *                                                 contact;
-      const StrainSmoothing<dim> *                                   smoothing;
+      Contact<dim>                                                  *contact;
+      const StrainSmoothing<dim>                                    *smoothing;
       const bool                                                     need_strain_energy;
-      const std::vector<dealii::types::particle_index> &             probe_ids;
-      std::vector<double> &                                          probe_values;
-      std::vector<double> &                                          probe_stress;
+      const std::vector<dealii::types::particle_index>              &probe_ids;
+      std::vector<double>                                           &probe_values;
+      std::vector<double>                                           &probe_stress;
 
       Energies               e        = {};
       dealii::Tensor<1, dim> momentum = {};
@@ -624,16 +625,12 @@ namespace talus::explicit_mpm
       struct PointState
       {
         dealii::SymmetricTensor<2, 3> sigma;
-        const materials::Material *   material;
+        const materials::Material    *material;
       };
 
       inline void
-      increments(const typename K::Cell & cell,
-                 const typename K::Eval & ev,
-                 const typename K::Field &du,
-                 const double *           P,
-                 double (&gu)[dim][dim],
-                 double (&dx)[dim])
+      increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, const double *P,
+                 double (&gu)[dim][dim], double (&dx)[dim])
       {
         if constexpr (std::is_same_v<K, shape::Q1Box<dim>>)
           if (contact) // the body's own nodal velocities (§6.2)
@@ -660,8 +657,8 @@ namespace talus::explicit_mpm
         auto                       sigma = L::get_stress(P);
         m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + history, m.n_history()));
         L::set_stress(sigma, P);
-        state.sigma    = sigma;
-        state.material = &m;
+        state.sigma       = sigma;
+        state.material    = &m;
         const double dvol = trace(d_eps);
         P[L::volume] *= (1.0 + dvol); // Eq. 4.50 (density follows as m / V)
         // A point never integrates more than the volume of its cell. Without
@@ -680,7 +677,7 @@ namespace talus::explicit_mpm
       /// same arithmetic per point, with one update_stresses() call per run of
       /// points of one model instead of a virtual call per point.
       static constexpr bool              updates_whole_cells = true;
-      std::vector<materials::RateUpdate> batch = {};
+      std::vector<materials::RateUpdate> batch               = {};
       template <class CellPoint>
       inline void
       update_cell(const unsigned int c, const typename K::Cell &cell, const unsigned int n, CellPoint *points)
@@ -728,10 +725,8 @@ namespace talus::explicit_mpm
       }
 
       inline void
-      moved(const transfer::PointIterator<dim> &it,
-            const double *                      P,
-            const dealii::Point<dim> &          x,
-            const PointState &                  state)
+      moved(const transfer::PointIterator<dim> &it, const double *P, const dealii::Point<dim> &x,
+            const PointState &state)
       {
         const double mass = P[L::mass];
         double       v2 = 0, gx = 0;
@@ -771,15 +766,11 @@ namespace talus::explicit_mpm
     template <int dim, class K>
     struct ApicPointUpdate : ExplicitPointUpdate<dim, K>
     {
-      using L = PropertyLayout<dim>;
+      using L             = PropertyLayout<dim>;
       unsigned int affine = 0;
       inline void
-      increments(const typename K::Cell & cell,
-                 const typename K::Eval & ev,
-                 const typename K::Field &du,
-                 double *                 P,
-                 double (&gu)[dim][dim],
-                 double (&dx)[dim])
+      increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, double *P,
+                 double (&gu)[dim][dim], double (&dx)[dim])
       {
         transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
         transfer::apic_point_velocity<dim, K>(cell, ev, du, this->h, gu, dx, P + L::velocity, P + affine);
@@ -801,9 +792,8 @@ namespace talus::explicit_mpm
   {
     std::fill(probe_values.begin(), probe_values.end(), 0.0);
     std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
-    ExplicitPointUpdate<dim, K> physics{prm.materials, points.layout.history, h, gravity,
-                                        contact.get(), smoothing.get(), need_strain_energy,
-                                        probe_ids, probe_values, probe_stress};
+    ExplicitPointUpdate<dim, K> physics{prm.materials,   points.layout.history, h,         gravity,      contact.get(),
+                                        smoothing.get(), need_strain_energy,    probe_ids, probe_values, probe_stress};
     // the mass and force of the next step are accumulated here, at the updated
     // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
     // the next cycle fused into this pass) and for every particle that entered
@@ -816,8 +806,7 @@ namespace talus::explicit_mpm
     // cells that receive moved particles below start from zero.
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
-    transfer::UpdateAndMove<dim, K, ExplicitPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h,
-                                                                         physics};
+    transfer::UpdateAndMove<dim, K, ExplicitPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h, physics};
     if (prm.numerics.extended_p2g()) // a full P2G pass follows
       transfer::for_each_active_cell(points, update);
     else
@@ -845,8 +834,8 @@ namespace talus::explicit_mpm
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
     transfer::UpdateAndMove<dim, K, ApicPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h, physics};
-    transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-    transfer::Fused                    fused{update, p2g};
+    transfer::ScatterMassForce<dim, K>                       p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+    transfer::Fused                                          fused{update, p2g};
     transfer::for_each_active_cell(points, fused);
     local_energies = physics.e;
     local_momentum = physics.momentum;
@@ -864,9 +853,8 @@ namespace talus::explicit_mpm
     bool sorted = false;
     with_kernel([&](auto kernel) {
       transfer::ScatterMassForce<dim, decltype(kernel)> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-      sorted = points.relocate([&](const unsigned int c, const dealii::Point<dim> &xi, const double *P) {
-        p2g.scatter_one(c, xi, P);
-      });
+      sorted = points.relocate(
+        [&](const unsigned int c, const dealii::Point<dim> &xi, const double *P) { p2g.scatter_one(c, xi, P); });
     });
     p2g_ready = !sorted && !prm.numerics.extended_p2g();
     // recompute the active DoFs only when the set of cells with points changed:
@@ -959,8 +947,8 @@ namespace talus::explicit_mpm
     const bool fixed_points = fem && !fem->updated_lagrangian(); // at their Gauss points: x = X + u
     for (const auto &pt : points.handler)
       {
-        const auto  P = pt.get_properties();
-        const auto &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+        const auto  P  = pt.get_properties();
+        const auto &m  = *prm.materials[static_cast<unsigned int>(P[L::material])];
         double      v2 = 0, gx = 0;
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -985,8 +973,7 @@ namespace talus::explicit_mpm
     dealii::Tensor<1, dim> p;
     for (const auto &pt : points.handler)
       for (unsigned int d = 0; d < dim; ++d)
-        p[d] += pt.get_properties()[PropertyLayout<dim>::mass] *
-                pt.get_properties()[PropertyLayout<dim>::velocity + d];
+        p[d] += pt.get_properties()[PropertyLayout<dim>::mass] * pt.get_properties()[PropertyLayout<dim>::velocity + d];
     return dealii::Utilities::MPI::sum(p, comm);
   }
 
@@ -1011,7 +998,7 @@ namespace talus::explicit_mpm
     const unsigned int  n = nodal_mass.locally_owned_size() + grid.partitioner->n_ghost_indices();
     std::vector<double> m0(nodal_mass.begin(), nodal_mass.begin() + n), f0(nodal_a.begin(), nodal_a.begin() + n);
     p2g_mass_and_force();
-    double scale_m = 0, scale_f = 0, dm = 0, df = 0;
+    double                     scale_m = 0, scale_f = 0, dm = 0, df = 0;
     std::vector<unsigned char> check(n, 0);
     for (const unsigned int i : active_dofs)
       check[i] = 1;
@@ -1036,7 +1023,7 @@ namespace talus::explicit_mpm
     // P2G of mass and of momentum of the current particle velocities (a = 0)
     p2g_mass_and_force();
     nodal_mass.compress(dealii::VectorOperation::add);
-    nodal_a = 0.0;
+    nodal_a   = 0.0;
     p2g_ready = false;
     g2p_velocity_p2g_momentum(0.0);
     double                 m = 0;
@@ -1064,8 +1051,7 @@ namespace talus::explicit_mpm
   Solver<dim>::check_stability() const
   {
     double v[5] = {local_energies.kinetic, need_strain_energy ? local_energies.strain : 0.0,
-                   local_energies.gravity_potential,
-                   local_bad ? 1.0 : 0.0, 0.0};
+                   local_energies.gravity_potential, local_bad ? 1.0 : 0.0, 0.0};
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 5), comm, dealii::ArrayView<double>(v, 5));
     std::ostringstream os;
     os << std::setprecision(4);
@@ -1088,9 +1074,8 @@ namespace talus::explicit_mpm
     const double floor = 1e-12 * energy_scale + 1e-4 * total_mass_setup * gravity.norm() * std::sqrt(diagonal);
     if (now > prm.energy_growth_limit * available + floor)
       {
-        os << "step " << step_number << " (t = " << time << " s, dt = " << dt
-           << " s): kinetic + strain energy grew to " << now << " J, more than " << prm.energy_growth_limit
-           << " x the energy available (" << available
+        os << "step " << step_number << " (t = " << time << " s, dt = " << dt << " s): kinetic + strain energy grew to "
+           << now << " J, more than " << prm.energy_growth_limit << " x the energy available (" << available
            << " J: initial kinetic + strain, released potential, external work). "
               "The time step is above the stability limit or the material data are inconsistent.";
         throw InstabilityError(os.str());
@@ -1110,8 +1095,10 @@ namespace talus::explicit_mpm
         dout.attach_dof_handler(grid.dof_handler);
         std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interp(
           dim, dealii::DataComponentInterpretation::component_is_part_of_vector);
-        dout.add_data_vector(nodal_mass, std::vector<std::string>(dim, "nodal_mass"), dealii::DataOut<dim>::type_dof_data, interp);
-        dout.add_data_vector(nodal_p, std::vector<std::string>(dim, "nodal_velocity"), dealii::DataOut<dim>::type_dof_data, interp);
+        dout.add_data_vector(nodal_mass, std::vector<std::string>(dim, "nodal_mass"),
+                             dealii::DataOut<dim>::type_dof_data, interp);
+        dout.add_data_vector(nodal_p, std::vector<std::string>(dim, "nodal_velocity"),
+                             dealii::DataOut<dim>::type_dof_data, interp);
         dout.build_patches();
         const std::string gname = io::write_vtu_atomic(dout, prm.output_directory, "grid", counter, comm);
         grid_pvd_records.emplace_back(time, gname);
@@ -1137,11 +1124,11 @@ namespace talus::explicit_mpm
     const double dt_cr = critical_time_step();
     out << "talus-explicit: " << dim << "D, " << grid.tria.n_global_active_cells() << " cells, "
         << grid.dof_handler.n_dofs() << " DoFs, " << n_particles()
-        << (fem ? (fem->updated_lagrangian() ? " Gauss points (ul-fem), " : " Gauss points (fem), ") :
-                  " material points, ")
+        << (fem ? (fem->updated_lagrangian() ? " Gauss points (ul-fem), " : " Gauss points (fem), ")
+                : " material points, ")
         << dealii::Utilities::MPI::n_mpi_processes(comm) << " rank(s)\n"
-        << "  critical time step " << dt_cr << " s (L_min " << grid.min_cell_size() << " m), dt = " << dt
-        << " s (" << dt / dt_cr << " x critical), end time " << prm.end_time << " s\n";
+        << "  critical time step " << dt_cr << " s (L_min " << grid.min_cell_size() << " m), dt = " << dt << " s ("
+        << dt / dt_cr << " x critical), end time " << prm.end_time << " s\n";
   }
 
   template <int dim>
@@ -1170,8 +1157,7 @@ namespace talus::explicit_mpm
     if (!control || !control->stage_converged())
       return false;
     std::ostringstream os;
-    os << std::setprecision(6) << "force ratio " << control->force_ratio << ", energy ratio "
-       << control->energy_ratio;
+    os << std::setprecision(6) << "force ratio " << control->force_ratio << ", energy ratio " << control->energy_ratio;
     message = os.str();
     return true;
   }
@@ -1217,9 +1203,9 @@ namespace talus::explicit_mpm
   std::vector<std::string>
   Solver<dim>::series_columns() const
   {
-    const char *             ax[] = {"x", "y", "z"};
-    std::vector<std::string> c    = {"kinetic_energy", "strain_energy", "gravity_potential_energy",
-                                     "external_work",  "total_energy"};
+    const char              *ax[] = {"x", "y", "z"};
+    std::vector<std::string> c    = {"kinetic_energy", "strain_energy", "gravity_potential_energy", "external_work",
+                                     "total_energy"};
     for (unsigned int d = 0; d < dim; ++d)
       c.push_back(std::string("momentum_") + ax[d]);
     c.push_back("n_particles");
@@ -1344,19 +1330,18 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::summary(const LoopTimings &loop_timings)
   {
-    timings.output = loop_timings.output;
-    timings.total  = loop_timings.total;
+    timings.output  = loop_timings.output;
+    timings.total   = loop_timings.total;
     const double ns = 1e9 * timings.total / std::max(1.0, double(step_number) * double(n_particles()));
-    const auto & rs = points.relocation_stats;
+    const auto  &rs = points.relocation_stats;
     // moves are counted per rank: the totals
     const unsigned long long moved = dealii::Utilities::MPI::sum(rs.moved_locally, comm),
                              sent  = dealii::Utilities::MPI::sum(rs.sent_to_ranks, comm);
     log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid
-          << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves "
-          << rs.seconds_moves << ", sorts " << rs.seconds_sorts << "), output " << timings.output
-          << "; particles moved cell " << moved << " (to other ranks " << sent
-          << "), full sorts " << rs.global_sorts
-          << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost;
+          << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves " << rs.seconds_moves
+          << ", sorts " << rs.seconds_sorts << "), output " << timings.output << "; particles moved cell " << moved
+          << " (to other ranks " << sent << "), full sorts " << rs.global_sorts << ", memory-order sorts "
+          << rs.storage_sorts << ", lost " << rs.lost;
     log() << balance.summary();
     log() << "\n";
     log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "

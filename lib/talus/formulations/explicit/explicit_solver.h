@@ -68,7 +68,11 @@ namespace talus::explicit_mpm
   struct Energies
   {
     double kinetic = 0, strain = 0, gravity_potential = 0, external_work = 0;
-    double total() const { return kinetic + strain + gravity_potential - external_work; }
+    double
+    total() const
+    {
+      return kinetic + strain + gravity_potential - external_work;
+    }
   };
 
   /// The explicit formulation: its step, diagnostics and files; the time loop
@@ -94,13 +98,21 @@ namespace talus::explicit_mpm
     double critical_time_step() const;
     /// Per material: phase, formula and step (seed 000 §4.6.1-4.6.3).
     std::vector<CriticalStep> critical_time_steps() const;
-    double time_step() const { return dt; }
+    double
+    time_step() const
+    {
+      return dt;
+    }
 
     /// Global sums over particles (collective).
-    Energies                  energies() const;
-    dealii::Tensor<1, dim>    total_momentum() const;
-    double                    total_mass() const;
-    unsigned long long        n_particles() const { return points.handler.n_global_particles(); }
+    Energies               energies() const;
+    dealii::Tensor<1, dim> total_momentum() const;
+    double                 total_mass() const;
+    unsigned long long
+    n_particles() const
+    {
+      return points.handler.n_global_particles();
+    }
 
     /// For tests: after step(), the mass/force accumulated by the fused update
     /// pass and the relocation must equal a fresh P2G of the new state, and the
@@ -121,21 +133,21 @@ namespace talus::explicit_mpm
     /// (for tests): returns global sums sum_i m_i and sum_i p_i.
     std::pair<double, dealii::Tensor<1, dim>> grid_mass_and_momentum();
 
-    const Parameters<dim> &                       prm;
-    MPI_Comm                                      comm;
-    BackgroundGrid<dim>                           grid;
+    const Parameters<dim> &prm;
+    MPI_Comm               comm;
+    BackgroundGrid<dim>    grid;
     /// The material points (one set; its layout, cell list and relocation).
-    MaterialPointSet<dim>                         points;
-    std::vector<unsigned char>                    constrained;
+    MaterialPointSet<dim>      points;
+    std::vector<unsigned char> constrained;
     /// Nodal lumped mass; nodal_a holds the force until nodal_acceleration()
     /// divides it, then the acceleration; nodal_p the momentum until
     /// nodal_velocity(), then the velocity.
-    Vector                                        nodal_mass, nodal_a, nodal_p;
+    Vector nodal_mass, nodal_a, nodal_p;
     /// Locally owned DoFs (local indices) of the active cells plus those other
     /// ranks contribute to: the only nodes the grid update visits.
-    std::vector<unsigned int>                     active_dofs;
-    Timings                                       timings;
-    Energies                                      initial_energies;
+    std::vector<unsigned int> active_dofs;
+    Timings                   timings;
+    Energies                  initial_energies;
 
     /// Write the complete state to <checkpoint dir>/checkpoint-<step>.h5
     /// (written as .part, renamed when complete; older ones beyond `keep`
@@ -147,15 +159,23 @@ namespace talus::explicit_mpm
     LoadBalance<dim> balance;
 
     // ---- the Formulation interface (the time loop's view)
-    std::string              tool_name() const override { return "talus-explicit"; }
-    void                     describe(std::ostream &out) const override;
-    unsigned int             n_stages() const override;
-    double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
-    bool                     stage_converged(std::string &message) override;
-    void                     before_step(const double h, const bool diagnostics_due) override;
-    StepOutcome              advance_by(const double h) override;
-    void                     check_stability() const override;
-    unsigned long long       lost_points() const override { return points.relocation_stats.lost; }
+    std::string
+    tool_name() const override
+    {
+      return "talus-explicit";
+    }
+    void         describe(std::ostream &out) const override;
+    unsigned int n_stages() const override;
+    double       begin_stage(const unsigned int k, const bool first, const bool resumed) override;
+    bool         stage_converged(std::string &message) override;
+    void         before_step(const double h, const bool diagnostics_due) override;
+    StepOutcome  advance_by(const double h) override;
+    void         check_stability() const override;
+    unsigned long long
+    lost_points() const override
+    {
+      return points.relocation_stats.lost;
+    }
     void                     prepare_output() override;
     std::vector<std::string> series_columns() const override;
     std::vector<double>      series_values(const bool after_step) override;
@@ -169,28 +189,28 @@ namespace talus::explicit_mpm
     std::vector<std::string> list_checkpoints() const;
     /// Strain energy is summed in the update pass only when a series row or a
     /// stability check needs it (set by the time loop).
-    bool                                          need_strain_energy = true;
-    double                                        energy_scale = 0;
+    bool   need_strain_energy = true;
+    double energy_scale       = 0;
     /// total mass of the points at setup (for the floor of the stability check)
-    double                                        total_mass_setup = 0;
+    double total_mass_setup = 0;
     /// Gravity of the running stage (prm.gravity without stages).
-    dealii::Tensor<1, dim>                        gravity;
+    dealii::Tensor<1, dim> gravity;
     /// Mass scaling factor beta of the running stage (seed 000 §6.5): nodal
     /// accelerations f / (beta m); critical_time_step() includes sqrt(beta).
-    double                                        mass_scaling = 1.0;
+    double mass_scaling = 1.0;
     /// Loads/friction/damping/convergence/K0/stages; null when none is used.
-    std::unique_ptr<loads::LoadControl<dim>>      control;
+    std::unique_ptr<loads::LoadControl<dim>> control;
 
     /// chapter-6 numerics, null when switched off (numerics.h)
-    std::unique_ptr<Contact<dim>>                 contact;
-    std::unique_ptr<StrainSmoothing<dim>>         smoothing;
+    std::unique_ptr<Contact<dim>>         contact;
+    std::unique_ptr<StrainSmoothing<dim>> smoothing;
     /// 2-phase / traction step (separate passes; null: the fused 1-phase step)
-    std::unique_ptr<TwoPhase<dim>>                two_phase;
+    std::unique_ptr<TwoPhase<dim>> two_phase;
     /// free-surface detection at output times (null: off)
-    std::unique_ptr<FreeSurface<dim>>             free_surface;
+    std::unique_ptr<FreeSurface<dim>> free_surface;
     /// FEM / UL-FEM on the same grid (numerics/integration = fem | ul-fem;
     /// null for MPM): Gauss-point seeding and its own update pass (fem.h)
-    std::unique_ptr<FemIntegration<dim>>          fem;
+    std::unique_ptr<FemIntegration<dim>> fem;
 
     /// Write the results file (output/results file, HDF5): series, probes,
     /// final particle fields and fields mapped to the grid nodes. Collective.
@@ -200,7 +220,7 @@ namespace talus::explicit_mpm
     friend class loads::LoadControl<dim>;
     /// Read the newest valid checkpoint into the (empty) particle handler and
     /// the solver state; returns false if there is none. Collective.
-    bool restore_checkpoint();
+    bool        restore_checkpoint();
     std::string checkpoint_directory() const;
     friend class TwoPhase<dim>;
     friend class FreeSurface<dim>;
@@ -212,7 +232,7 @@ namespace talus::explicit_mpm
     void zero_on_active(Vector &v) const;
     /// After the partition changed: boundary flags, nodal vectors, cell lists,
     /// active DoFs and the features' grid data.
-    void grid_changed();
+    void                       grid_changed();
     std::vector<unsigned char> dof_marker;
     /// Call f(kernel) with the shape kernel of the run (numerics/shape
     /// function): the walks of the step are templates on it.
@@ -238,11 +258,11 @@ namespace talus::explicit_mpm
 
     bool p2g_ready = false; ///< nodal mass/force of the current state accumulated
     // local energy/stability sums from the last update pass
-    Energies               local_energies;
-    dealii::Tensor<1, dim> local_momentum;
-    bool     local_bad = false;
-    std::string bad_what;
-    double   external_work = 0;
+    Energies                                    local_energies;
+    dealii::Tensor<1, dim>                      local_momentum;
+    bool                                        local_bad = false;
+    std::string                                 bad_what;
+    double                                      external_work = 0;
     std::vector<std::pair<double, std::string>> pvd_records, grid_pvd_records;
     std::vector<dealii::types::particle_index>  probe_ids;
     std::vector<double>                         probe_values; // local, (u, v) per probe

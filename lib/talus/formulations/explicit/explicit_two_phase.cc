@@ -61,43 +61,62 @@ namespace talus::explicit_mpm
     {
     public:
       UndrainedEffectiveStress(std::shared_ptr<const materials::Material> s, const double K_L, const double n)
-        : skeleton(std::move(s))
-        , K_eq(K_L / n)
+          : skeleton(std::move(s))
+          , K_eq(K_L / n)
       {
         name = skeleton->name;
         id   = skeleton->id;
         set_density(skeleton->density());
       }
-      std::string model_name() const override { return skeleton->model_name() + " (undrained)"; }
-      double constrained_modulus() const override { return skeleton->constrained_modulus() + K_eq; }
-      double dynamic_viscosity() const override { return skeleton->dynamic_viscosity(); }
-      unsigned int n_history() const override { return 1 + skeleton->n_history(); }
-      std::vector<std::string> history_names() const override
+      std::string
+      model_name() const override
+      {
+        return skeleton->model_name() + " (undrained)";
+      }
+      double
+      constrained_modulus() const override
+      {
+        return skeleton->constrained_modulus() + K_eq;
+      }
+      double
+      dynamic_viscosity() const override
+      {
+        return skeleton->dynamic_viscosity();
+      }
+      unsigned int
+      n_history() const override
+      {
+        return 1 + skeleton->n_history();
+      }
+      std::vector<std::string>
+      history_names() const override
       {
         std::vector<std::string> n = {"excess pore pressure"};
         for (const auto &s : skeleton->history_names())
           n.push_back(s);
         return n;
       }
-      void initialize_history(const materials::Stress &sigma, materials::ArrayView<double> h) const override
+      void
+      initialize_history(const materials::Stress &sigma, materials::ArrayView<double> h) const override
       {
         h[0] = 0.0; // the initial stress is effective, no excess pore pressure
         skeleton->initialize_history(sigma, materials::ArrayView<double>(h.data() + 1, h.size() - 1));
       }
-      void update_stress(const materials::Strain &d_eps, const materials::Spin &d_omega, const double dt,
-                         materials::Stress &sigma, materials::ArrayView<double> h) const override
+      void
+      update_stress(const materials::Strain &d_eps, const materials::Spin &d_omega, const double dt,
+                    materials::Stress &sigma, materials::ArrayView<double> h) const override
       {
         materials::Stress eff = sigma;
         for (unsigned int i = 0; i < 3; ++i)
           eff[i][i] += h[0];
-        skeleton->update_stress(d_eps, d_omega, dt, eff,
-                                materials::ArrayView<double>(h.data() + 1, h.size() - 1));
+        skeleton->update_stress(d_eps, d_omega, dt, eff, materials::ArrayView<double>(h.data() + 1, h.size() - 1));
         h[0] -= K_eq * trace(d_eps);
         sigma = eff;
         for (unsigned int i = 0; i < 3; ++i)
           sigma[i][i] -= h[0];
       }
-      double elastic_energy_density(const materials::Stress &sigma) const override
+      double
+      elastic_energy_density(const materials::Stress &sigma) const override
       {
         // the split into sigma' and p is not known from sigma alone: the skeleton's
         // energy of the total stress (a diagnostic only)
@@ -132,7 +151,8 @@ namespace talus::explicit_mpm
     prm.declare_entry("liquid density", "1000", Double(0), "Density of the pore liquid rho_L [kg/m^3] (coupled).");
     prm.declare_entry("liquid bulk modulus", "2.2e9", Double(0),
                       "Bulk modulus of the pore liquid K_L [Pa] (undrained, coupled).");
-    prm.declare_entry("liquid viscosity", "1e-3", Double(0), "Dynamic viscosity of the pore liquid mu_d [Pa s] (coupled).");
+    prm.declare_entry("liquid viscosity", "1e-3", Double(0),
+                      "Dynamic viscosity of the pore liquid mu_d [Pa s] (coupled).");
     prm.declare_entry("intrinsic permeability", "1e-10", Double(0),
                       "Intrinsic permeability kappa [m^2] (coupled); the Darcy permeability is "
                       "k = kappa rho_L g / mu_d (Eq. 3.25).");
@@ -153,11 +173,11 @@ namespace talus::explicit_mpm
     const std::string where = where_m + "/pore liquid";
     PoreLiquid        p;
     const std::string d = prm.get("drainage");
-    p.drainage = d == "coupled" ? Drainage::coupled : d == "undrained" ? Drainage::undrained : Drainage::drained;
-    p.porosity               = prm.get_double("porosity");
-    p.density                = prm.get_double("liquid density");
-    p.bulk_modulus           = prm.get_double("liquid bulk modulus");
-    p.viscosity              = prm.get_double("liquid viscosity");
+    p.drainage     = d == "coupled" ? Drainage::coupled : d == "undrained" ? Drainage::undrained : Drainage::drained;
+    p.porosity     = prm.get_double("porosity");
+    p.density      = prm.get_double("liquid density");
+    p.bulk_modulus = prm.get_double("liquid bulk modulus");
+    p.viscosity    = prm.get_double("liquid viscosity");
     p.intrinsic_permeability = prm.get_double("intrinsic permeability");
     p.gravity                = prm.get_double("permeability gravity");
     const double k           = prm.get_double("hydraulic conductivity");
@@ -204,7 +224,7 @@ namespace talus::explicit_mpm
     const std::string f = prm.get("traction face");
     if (f == "none")
       return t;
-    t.face = 2 * (f[0] - 'x') + (f[1] == '+' ? 1 : 0);
+    t.face       = 2 * (f[0] - 'x') + (f[1] == '+' ? 1 : 0);
     const auto v = dealii::Utilities::split_string_list(prm.get("traction"), ',');
     require(v.size() == dim, where + "/traction", "needs exactly " + std::to_string(dim) + " numbers");
     for (unsigned int d = 0; d < dim; ++d)
@@ -265,9 +285,9 @@ namespace talus::explicit_mpm
     std::vector<CriticalStep> r;
     for (std::size_t k = 0; k < materials.size(); ++k)
       {
-        const auto &      m  = *materials[k];
-        const PoreLiquid  pl = k < pore_liquid.size() ? pore_liquid[k] : PoreLiquid();
-        CriticalStep      c;
+        const auto      &m  = *materials[k];
+        const PoreLiquid pl = k < pore_liquid.size() ? pore_liquid[k] : PoreLiquid();
+        CriticalStep     c;
         c.material = m.name;
         c.model    = m.model_name();
         if (pl.drainage == Drainage::coupled)
@@ -275,13 +295,13 @@ namespace talus::explicit_mpm
             // seed 000 §4.6.3. rho_S = 'density', E_c of the skeleton.
             const double n = pl.porosity, rS = m.density(), rL = pl.density, KL = pl.bulk_modulus;
             const double Ec = m.constrained_modulus(), g = pl.gravity, k_d = pl.darcy_permeability();
-            const double rho = (1 - n) * rS + n * rL;                       // Eq. 4.127
-            const double Ecu = Ec + KL / n;                                 // Eq. 4.126
-            c.wave_speed     = std::sqrt(Ecu / rho);                        // Eq. 4.125
-            c.dt_wave        = L / c.wave_speed;                            // Eq. 4.123 (m = 1)
-            const double rt  = rho + (1.0 / n - 2.0) * rL;                  // Eq. 4.128
-            c.dt_other       = 2 * rt * k_d / (rL * g);                     // Eq. 4.124
-            c.dt_4_122       = std::min(c.dt_wave, c.dt_other);             // Eq. 4.122
+            const double rho = (1 - n) * rS + n * rL;           // Eq. 4.127
+            const double Ecu = Ec + KL / n;                     // Eq. 4.126
+            c.wave_speed     = std::sqrt(Ecu / rho);            // Eq. 4.125
+            c.dt_wave        = L / c.wave_speed;                // Eq. 4.123 (m = 1)
+            const double rt  = rho + (1.0 / n - 2.0) * rL;      // Eq. 4.128
+            c.dt_other       = 2 * rt * k_d / (rL * g);         // Eq. 4.124
+            c.dt_4_122       = std::min(c.dt_wave, c.dt_other); // Eq. 4.122
             // Eq. 4.129-4.132. The manual prints L_min in b and c; the dimensions
             // (b in 1/s^2, c in 1/s^4) and the limit k -> infinity (dt -> 2/omega_max
             // with omega_max = 2 c / L for E_c -> 0) need L_min^2 and L_min^4.
@@ -295,9 +315,9 @@ namespace talus::explicit_mpm
           }
         else
           {
-            c.wave_speed = std::sqrt(m.constrained_modulus() / m.density());
-            c.dt_wave    = L / c.wave_speed; // Eq. 4.120 / 4.121
-            c.dt         = c.dt_wave;
+            c.wave_speed    = std::sqrt(m.constrained_modulus() / m.density());
+            c.dt_wave       = L / c.wave_speed; // Eq. 4.120 / 4.121
+            c.dt            = c.dt_wave;
             const double mu = m.dynamic_viscosity();
             if (is_liquid_model(m))
               {
@@ -328,7 +348,7 @@ namespace talus::explicit_mpm
   // ================================================================ 2-phase
   template <int dim>
   TwoPhase<dim>::TwoPhase(Solver<dim> &solver)
-    : s(solver)
+      : s(solver)
   {
     coupled = s.prm.liquid.any_coupled();
   }
@@ -369,11 +389,11 @@ namespace talus::explicit_mpm
   void
   TwoPhase<dim>::initialize_particles()
   {
-    using L          = PropertyLayout<dim>;
-    const auto &pl   = s.prm.liquid.pore_liquid;
+    using L        = PropertyLayout<dim>;
+    const auto &pl = s.prm.liquid.pore_liquid;
     for (auto &pt : s.points.handler)
       {
-        double *           P   = pt.get_properties().data();
+        double            *P   = pt.get_properties().data();
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
         if (coupled && pl[mat].drainage == Drainage::coupled)
           {
@@ -397,7 +417,7 @@ namespace talus::explicit_mpm
       {
         const auto         P   = pt.get_properties();
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-        const auto &       m   = *s.prm.materials[mat];
+        const auto        &m   = *s.prm.materials[mat];
         double             v2 = 0, gx = 0, vl2 = 0, mL = 0;
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -425,16 +445,15 @@ namespace talus::explicit_mpm
   dealii::Tensor<1, dim>
   TwoPhase<dim>::total_momentum() const
   {
-    using L        = PropertyLayout<dim>;
-    const auto &pl = s.prm.liquid.pore_liquid;
+    using L                   = PropertyLayout<dim>;
+    const auto            &pl = s.prm.liquid.pore_liquid;
     dealii::Tensor<1, dim> p;
     for (const auto &pt : s.points.handler)
       {
         const auto         P   = pt.get_properties();
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-        const double       mL  = (coupled && pl[mat].drainage == Drainage::coupled) ?
-                                   P[porosity] * pl[mat].density * P[L::volume] :
-                                   0.0;
+        const double       mL =
+          (coupled && pl[mat].drainage == Drainage::coupled) ? P[porosity] * pl[mat].density * P[L::volume] : 0.0;
         for (unsigned int d = 0; d < dim; ++d)
           p[d] += P[L::mass] * P[L::velocity + d] + (mL > 0 ? mL * P[liquid_velocity + d] : 0.0);
       }
@@ -453,13 +472,13 @@ namespace talus::explicit_mpm
   void
   TwoPhase<dim>::step_with(const double h)
   {
-    using L                   = PropertyLayout<dim>;
+    using L = PropertyLayout<dim>;
     // each point reads and writes the nodes of its kernel stencil (Q1: the
     // cell's vertices; B-spline: its 3^dim window), slot[v] in the cell's list
-    constexpr unsigned int nv = K::n_point_nodes;
-    const auto &           pl = s.prm.liquid.pore_liquid;
-    const auto             g  = s.gravity; // of the running stage
-    const auto             t0 = std::chrono::steady_clock::now();
+    constexpr unsigned int nv      = K::n_point_nodes;
+    const auto            &pl      = s.prm.liquid.pore_liquid;
+    const auto             g       = s.gravity; // of the running stage
+    const auto             t0      = std::chrono::steady_clock::now();
     auto *const            control = s.control.get();
 
     // ---- 1. P2G at time t: masses, drag, forces, momenta of both phases
@@ -479,7 +498,7 @@ namespace talus::explicit_mpm
     double *const T = control ? control->begin_traction_scatter(s) : nullptr;
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
       const auto         kc  = K::cell(s.grid, c);
-      const double *     P   = pt->get_properties().data();
+      const double      *P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       unsigned int       slot[nv];
       double             N[nv], G[nv][dim];
@@ -548,7 +567,7 @@ namespace talus::explicit_mpm
 
     // ---- 2-3. nodal accelerations: liquid (Eq. 4.106), then solid (4.107)
     {
-      const auto & con   = s.constrained;
+      const auto  &con   = s.constrained;
       const double alpha = control ? control->local_damping() : 0.0;
       const double av    = control ? control->viscous_damping() : 0.0;
       const double beta  = s.mass_scaling;
@@ -580,9 +599,9 @@ namespace talus::explicit_mpm
               AL_[i] = aL;
             }
           const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS) - av * MS[i] * vS;
-          FS[i]           = (MS[i] > 0 && !con[i]) ?
-                              (FS[i] - (coupled ? beta * mLn_[i] * aL : 0.0) + dS + n_i * dL) / (beta * MS[i]) :
-                              0.0;
+          FS[i]           = (MS[i] > 0 && !con[i])
+                              ? (FS[i] - (coupled ? beta * mLn_[i] * aL : 0.0) + dS + n_i * dL) / (beta * MS[i])
+                              : 0.0;
         }
       if (control) // prescribed velocities and rigid-wall friction, both phases
         control->nodal_accelerations(s);
@@ -597,7 +616,7 @@ namespace talus::explicit_mpm
       s.zero_on_active(p_liquid);
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
       const auto         kc  = K::cell(s.grid, c);
-      double *           P   = pt->get_properties().data();
+      double            *P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
       unsigned int       slot[nv];
@@ -645,11 +664,11 @@ namespace talus::explicit_mpm
     s.timings.p2g += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // ---- 6-11. strains, effective stress, pore pressure, volume, porosity, positions
-    const auto t1 = std::chrono::steady_clock::now();
+    const auto             t1 = std::chrono::steady_clock::now();
     Energies               e;
     dealii::Tensor<1, dim> momentum;
-    bool                   bad  = false;
-    double                 work = 0; // of the tractions over this step
+    bool                   bad    = false;
+    double                 work   = 0; // of the tractions over this step
     const bool             loaded = control && control->any_traction();
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
@@ -658,7 +677,7 @@ namespace talus::explicit_mpm
       double      cell_volume = 1.0;
       for (unsigned int d = 0; d < dim; ++d)
         cell_volume *= cc.h[d];
-      double *           P   = pt->get_properties().data();
+      double            *P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       const bool         cp  = coupled && pl[mat].drainage == Drainage::coupled;
       const auto         kc  = K::cell(s.grid, c);
@@ -688,8 +707,7 @@ namespace talus::explicit_mpm
           }
       const materials::Material &m     = *s.prm.materials[mat];
       auto                       sigma = L::get_stress(P);
-      m.update_stress(d_eps, d_omega, h, sigma,
-                      dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
+      m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
       L::set_stress(sigma, P);
       const double dvS = trace(d_eps);
       double       mL = 0, vl2 = 0;
@@ -772,9 +790,10 @@ namespace talus::explicit_mpm
   // ================================================================ free surface
   template <int dim>
   FreeSurface<dim>::FreeSurface(Solver<dim> &solver, const double f)
-    : s(solver)
-    , factor(f)
-  {}
+      : s(solver)
+      , factor(f)
+  {
+  }
 
   template <int dim>
   void
@@ -801,8 +820,8 @@ namespace talus::explicit_mpm
     constexpr unsigned int nv = Q::n_vertices;
     // nodal density (Eq. 6.38) on the x-component DoFs: mass share over the
     // volume share of the non-empty cells around the node
-    mass   = 0.0;
-    volume = 0.0;
+    mass             = 0.0;
+    volume           = 0.0;
     double *const Mn = mass.begin(), *const Vn = volume.begin();
     transfer::for_each_active_cell(
       s.points,
@@ -833,18 +852,17 @@ namespace talus::explicit_mpm
     std::vector<double> lo(dim, std::numeric_limits<double>::max()), hi(dim, -std::numeric_limits<double>::max());
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
       const auto &cc = s.grid.cells[c];
-      double N[nv];
+      double      N[nv];
       Q::values(pt->get_reference_location(), N);
       double rho = 0;
       for (unsigned int v = 0; v < nv; ++v)
         rho += N[v] * Mn[cc.dofs[v * dim]]; // Eq. 6.39
-      double *           P   = pt->get_properties().data();
+      double            *P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       // reference density: that of the material, or of the solid mass per
       // volume of a coupled point (its P[mass] is the solid mass)
       double rho0 = s.prm.materials[mat]->density();
-      if (s.two_phase && s.two_phase->coupled &&
-          s.prm.liquid.pore_liquid[mat].drainage == Drainage::coupled)
+      if (s.two_phase && s.two_phase->coupled && s.prm.liquid.pore_liquid[mat].drainage == Drainage::coupled)
         rho0 *= 1 - s.prm.liquid.pore_liquid[mat].porosity;
       const bool on = rho <= factor * rho0; // Eq. 6.40
       P[flag]       = on ? 1.0 : 0.0;
@@ -866,8 +884,8 @@ namespace talus::explicit_mpm
 
   template struct LiquidParameters<2>;
   template struct LiquidParameters<3>;
-  template void parse_liquid_output<2>(dealii::ParameterHandler &, LiquidParameters<2> &);
-  template void parse_liquid_output<3>(dealii::ParameterHandler &, LiquidParameters<3> &);
+  template void            parse_liquid_output<2>(dealii::ParameterHandler &, LiquidParameters<2> &);
+  template void            parse_liquid_output<3>(dealii::ParameterHandler &, LiquidParameters<3> &);
   template BodyTraction<2> parse_body_traction<2>(dealii::ParameterHandler &, const std::string &);
   template BodyTraction<3> parse_body_traction<3>(dealii::ParameterHandler &, const std::string &);
   template class TwoPhase<2>;

@@ -35,14 +35,18 @@ namespace talus::explicit_mpm
   struct PoreLiquid
   {
     Drainage drainage               = Drainage::drained;
-    double   porosity               = 0.3;    ///< n_0 [-]
-    double   density                = 1000;   ///< rho_L [kg/m^3]
-    double   bulk_modulus           = 2.2e9;  ///< K_L [Pa]
-    double   viscosity              = 1e-3;   ///< mu_d [Pa s]
-    double   intrinsic_permeability = 1e-10;  ///< kappa [m^2]
-    double   gravity                = 9.81;   ///< g of Eq. 3.25 [m/s^2]
+    double   porosity               = 0.3;   ///< n_0 [-]
+    double   density                = 1000;  ///< rho_L [kg/m^3]
+    double   bulk_modulus           = 2.2e9; ///< K_L [Pa]
+    double   viscosity              = 1e-3;  ///< mu_d [Pa s]
+    double   intrinsic_permeability = 1e-10; ///< kappa [m^2]
+    double   gravity                = 9.81;  ///< g of Eq. 3.25 [m/s^2]
     /// Darcy permeability k = kappa rho_L g / mu_d (Eq. 3.25) [m/s]
-    double darcy_permeability() const { return intrinsic_permeability * density * gravity / viscosity; }
+    double
+    darcy_permeability() const
+    {
+      return intrinsic_permeability * density * gravity / viscosity;
+    }
   };
 
   /// "body k/traction face", "body k/traction": an alias of a constant global
@@ -58,10 +62,10 @@ namespace talus::explicit_mpm
   template <int dim>
   struct LiquidParameters
   {
-    std::vector<PoreLiquid>        pore_liquid; ///< per material
-    std::vector<BodyTraction<dim>> tractions;   ///< per body
+    std::vector<PoreLiquid>        pore_liquid;             ///< per material
+    std::vector<BodyTraction<dim>> tractions;               ///< per body
     double                         free_surface_factor = 0; ///< F_FreeSurf of Eq. 6.40; 0: off
-    double                         local_damping       = 0; ///< 'two phase/local damping' (alias of damping/local damping)
+    double                         local_damping = 0; ///< 'two phase/local damping' (alias of damping/local damping)
     bool                           any_coupled() const;
     bool                           any_traction() const;
   };
@@ -74,8 +78,7 @@ namespace talus::explicit_mpm
 
   /// Read "pore liquid" of the current material subsection. For undrained
   /// materials `material` is replaced by the effective-stress wrapper.
-  PoreLiquid parse_pore_liquid(dealii::ParameterHandler &                  prm,
-                               const std::string &                         where,
+  PoreLiquid parse_pore_liquid(dealii::ParameterHandler &prm, const std::string &where,
                                std::shared_ptr<const materials::Material> &material);
   template <int dim>
   BodyTraction<dim> parse_body_traction(dealii::ParameterHandler &prm, const std::string &where);
@@ -86,12 +89,12 @@ namespace talus::explicit_mpm
   /// Critical time step of one material (seed 000 §4.6).
   struct CriticalStep
   {
-    std::string material, model, phase; ///< phase: solid | liquid | undrained | coupled
-    std::string formula;                ///< the equation used
-    double      wave_speed = 0;         ///< c (c_1 of Eq. 4.125 for coupled) [m/s]
-    double      dt         = 0;         ///< the step used [s]
+    std::string material, model, phase;    ///< phase: solid | liquid | undrained | coupled
+    std::string formula;                   ///< the equation used
+    double      wave_speed = 0;            ///< c (c_1 of Eq. 4.125 for coupled) [m/s]
+    double      dt         = 0;            ///< the step used [s]
     double      dt_wave = 0, dt_other = 0; ///< L/c; viscous (liquids) or Eq. 4.124 (coupled)
-    double      dt_4_122 = 0;           ///< coupled: min(4.123, 4.124)
+    double      dt_4_122 = 0;              ///< coupled: min(4.123, 4.124)
   };
 
   /// Per material, for the smallest cell edge L_min.
@@ -117,7 +120,7 @@ namespace talus::explicit_mpm
     void step(const double dt);
     /// step() with the shape kernel K of the run (numerics/shape function).
     template <class K>
-    void step_with(const double dt);
+    void     step_with(const double dt);
     Energies energies() const;
     /// sum m_S v_S + m_L v_L (collective)
     dealii::Tensor<1, dim> total_momentum() const;
@@ -148,7 +151,7 @@ namespace talus::explicit_mpm
     void grid_changed();
     /// Flags the points (property "free_surface") and sums the count and the
     /// extent of the particles (collective). Returns {count, extent (min, max per axis)}.
-    void update();
+    void                update();
     unsigned long long  count = 0;
     std::vector<double> extent; ///< x_min, x_max, y_min, y_max (, z_min, z_max)
     unsigned int        flag = 0;

@@ -13,8 +13,8 @@ namespace talus::explicit_mpm
 {
   template <int dim>
   FemIntegration<dim>::FemIntegration(Solver<dim> &solver, const bool updated_lagrangian)
-    : s(solver)
-    , ul(updated_lagrangian)
+      : s(solver)
+      , ul(updated_lagrangian)
   {
     collect_vertices();
     if (ul)
@@ -53,7 +53,7 @@ namespace talus::explicit_mpm
         X[v][d] = X0[v * dim + d];
     if (ul)
       {
-        const auto &  cc = s.grid.cells[c];
+        const auto   &cc = s.grid.cells[c];
         const double *U  = nodal_u.begin();
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)
@@ -65,11 +65,11 @@ namespace talus::explicit_mpm
   SeedingResult
   FemIntegration<dim>::seed(const std::vector<double> &density_of_material)
   {
-    using L                = PropertyLayout<dim>;
-    const auto &grid       = s.grid;
-    const auto &bodies     = s.prm.bodies;
-    const double gauss     = 0.5 / std::sqrt(3.0);
-    const double weight    = 1.0 / nv; // Gauss weights on the unit cell
+    using L             = PropertyLayout<dim>;
+    const auto  &grid   = s.grid;
+    const auto  &bodies = s.prm.bodies;
+    const double gauss  = 0.5 / std::sqrt(3.0);
+    const double weight = 1.0 / nv; // Gauss weights on the unit cell
     struct NewPoint
     {
       dealii::Point<dim> x, xi;
@@ -128,16 +128,16 @@ namespace talus::explicit_mpm
         const auto &p    = points[i];
         const auto &body = bodies[p.body];
         std::fill(props.begin(), props.end(), 0.0);
-        props[L::mass]     = density_of_material[p.material] * p.volume;
-        props[L::volume]   = p.volume;
-        props[L::material] = p.material;
-        props[L::body]     = p.body;
+        props[L::mass]                 = density_of_material[p.material] * p.volume;
+        props[L::volume]               = p.volume;
+        props[L::material]             = p.material;
+        props[L::body]                 = p.body;
         const dealii::Tensor<1, dim> v = body.velocity_field ? body.velocity_field(p.x) : body.initial_velocity;
         for (unsigned int d = 0; d < dim; ++d)
           props[L::velocity + d] = v[d];
         result.volume_per_body[p.body] += p.volume;
         s.points.handler.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
-                                    dealii::ArrayView<const double>(props.data(), props.size()));
+                                         dealii::ArrayView<const double>(props.data(), props.size()));
       }
     s.points.handler.update_cached_numbers();
     result.n_particles = dealii::Utilities::MPI::sum(n_local, grid.comm);
@@ -166,13 +166,13 @@ namespace talus::explicit_mpm
   void
   FemIntegration<dim>::p2g_mass_and_force()
   {
-    using L                = PropertyLayout<dim>;
-    double *const M        = s.nodal_mass.begin();
-    double *const F        = s.nodal_a.begin();
-    const auto    g        = s.gravity;
+    using L         = PropertyLayout<dim>;
+    double *const M = s.nodal_mass.begin();
+    double *const F = s.nodal_a.begin();
+    const auto    g = s.gravity;
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
-    typename Kernel::Cell               cell;
+    typename Kernel::Cell      cell;
     typename Kernel::MassForce sums;
     const auto                 begin_cell = [&](const unsigned int c) {
       current_vertices(c, cell.X);
@@ -180,7 +180,7 @@ namespace talus::explicit_mpm
       sums.clear();
     };
     const auto at_point = [&](const unsigned int, auto &pt) {
-      const double *        P = pt->get_properties().data();
+      const double         *P = pt->get_properties().data();
       typename Kernel::Eval e;
       Kernel::evaluate(cell, pt->get_reference_location(), e);
       double t[dim][dim];
@@ -195,12 +195,12 @@ namespace talus::explicit_mpm
   void
   FemIntegration<dim>::update(const double h)
   {
-    using L                     = PropertyLayout<dim>;
-    constexpr unsigned int nst  = L::n_stress;
-    const double *const    Vn   = s.nodal_p.begin();
-    const auto             g    = s.gravity;
-    double *const          M    = s.nodal_mass.begin();
-    double *const          F    = s.nodal_a.begin();
+    using L                    = PropertyLayout<dim>;
+    constexpr unsigned int nst = L::n_stress;
+    const double *const    Vn  = s.nodal_p.begin();
+    const auto             g   = s.gravity;
+    double *const          M   = s.nodal_mass.begin();
+    double *const          F   = s.nodal_a.begin();
     Energies               e;
     dealii::Tensor<1, dim> momentum;
     bool                   bad          = false;
@@ -211,7 +211,7 @@ namespace talus::explicit_mpm
     s.zero_on_active(s.nodal_a);
     // the cell's vertices at the start and end of the step, the nodal
     // displacement increments, and the next step's mass and force sums
-    typename Kernel::Cell               cell; // at the start of the step
+    typename Kernel::Cell      cell;        // at the start of the step
     double                     X1[nv][dim]; // its vertices at the end
     typename Kernel::Field     du;
     typename Kernel::MassForce sums;
@@ -225,74 +225,74 @@ namespace talus::explicit_mpm
       sums.clear();
     };
     const auto at_point = [&](const unsigned int, auto &pt) {
-            double *              P = pt->get_properties().data();
-            typename Kernel::Eval at;
-            Kernel::evaluate(cell, pt->get_reference_location(), at);
-            const double det0 = at.det;
-            double       gu[dim][dim], dx[dim];
-            Kernel::value_and_gradient(du, at, dx, gu);
-            materials::Strain d_eps;
-            materials::Spin   d_omega; // zero for small strain (fem)
-            for (unsigned int a = 0; a < dim; ++a)
-              for (unsigned int b = 0; b < dim; ++b)
-                {
-                  if (b >= a)
-                    d_eps[a][b] = 0.5 * (gu[a][b] + gu[b][a]);
-                  if (ul)
-                    d_omega[a][b] = 0.5 * (gu[a][b] - gu[b][a]);
-                }
-            const unsigned int         mat   = static_cast<unsigned int>(P[L::material]);
-            const materials::Material &m     = *s.prm.materials[mat];
-            auto                       sigma = L::get_stress(P);
-            m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
-            L::set_stress(sigma, P);
-
-            dealii::Point<dim> x = pt->get_location();
-            for (unsigned int d = 0; d < dim; ++d)
-              P[L::displacement + d] += dx[d];
-            double det1 = det0;
+      double               *P = pt->get_properties().data();
+      typename Kernel::Eval at;
+      Kernel::evaluate(cell, pt->get_reference_location(), at);
+      const double det0 = at.det;
+      double       gu[dim][dim], dx[dim];
+      Kernel::value_and_gradient(du, at, dx, gu);
+      materials::Strain d_eps;
+      materials::Spin   d_omega; // zero for small strain (fem)
+      for (unsigned int a = 0; a < dim; ++a)
+        for (unsigned int b = 0; b < dim; ++b)
+          {
+            if (b >= a)
+              d_eps[a][b] = 0.5 * (gu[a][b] + gu[b][a]);
             if (ul)
-              {
-                // the point follows its cell: x_p = sum N_i x_i, V_p = det J w
-                det1 = Kernel::move_vertices(X1, at);
-                P[L::volume] *= det1 / det0;
-                for (unsigned int d = 0; d < dim; ++d)
-                  x[d] += dx[d];
-                pt->set_location(x);
-              }
-            const double mass = P[L::mass];
-            double       v2 = 0, gx = 0;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                v2 += P[L::velocity + d] * P[L::velocity + d];
-                // fem: the current position is the Gauss point plus the displacement
-                gx += g[d] * (ul ? x[d] : x[d] + P[L::displacement + d]);
-                momentum[d] += mass * P[L::velocity + d];
-              }
-            e.kinetic += 0.5 * mass * v2;
-            e.gravity_potential -= mass * gx;
-            if (s.need_strain_energy)
-              e.strain += P[L::volume] * m.elastic_energy_density(sigma);
-            if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
-                !(P[L::volume] > 0) || !(det1 > 0))
-              bad = true;
-            if (track_probes)
-              for (unsigned int q = 0; q < s.probe_ids.size(); ++q)
-                if (pt->get_id() == s.probe_ids[q])
-                  {
-                    for (unsigned int d = 0; d < dim; ++d)
-                      {
-                        s.probe_values[q * 2 * dim + d]       = P[L::displacement + d];
-                        s.probe_values[q * 2 * dim + dim + d] = P[L::velocity + d];
-                      }
-                    for (unsigned int j = 0; j < nst; ++j)
-                      s.probe_stress[q * nst + j] = P[L::stress + j];
-                  }
+              d_omega[a][b] = 0.5 * (gu[a][b] - gu[b][a]);
+          }
+      const unsigned int         mat   = static_cast<unsigned int>(P[L::material]);
+      const materials::Material &m     = *s.prm.materials[mat];
+      auto                       sigma = L::get_stress(P);
+      m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
+      L::set_stress(sigma, P);
 
-            // next step's mass and internal force at the updated state
-            double t[dim][dim];
-            minus_V_sigma<dim>(P, P[L::volume], t);
-            sums.add(at, mass, t);
+      dealii::Point<dim> x = pt->get_location();
+      for (unsigned int d = 0; d < dim; ++d)
+        P[L::displacement + d] += dx[d];
+      double det1 = det0;
+      if (ul)
+        {
+          // the point follows its cell: x_p = sum N_i x_i, V_p = det J w
+          det1 = Kernel::move_vertices(X1, at);
+          P[L::volume] *= det1 / det0;
+          for (unsigned int d = 0; d < dim; ++d)
+            x[d] += dx[d];
+          pt->set_location(x);
+        }
+      const double mass = P[L::mass];
+      double       v2 = 0, gx = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          v2 += P[L::velocity + d] * P[L::velocity + d];
+          // fem: the current position is the Gauss point plus the displacement
+          gx += g[d] * (ul ? x[d] : x[d] + P[L::displacement + d]);
+          momentum[d] += mass * P[L::velocity + d];
+        }
+      e.kinetic += 0.5 * mass * v2;
+      e.gravity_potential -= mass * gx;
+      if (s.need_strain_energy)
+        e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+      if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
+          !(P[L::volume] > 0) || !(det1 > 0))
+        bad = true;
+      if (track_probes)
+        for (unsigned int q = 0; q < s.probe_ids.size(); ++q)
+          if (pt->get_id() == s.probe_ids[q])
+            {
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  s.probe_values[q * 2 * dim + d]       = P[L::displacement + d];
+                  s.probe_values[q * 2 * dim + dim + d] = P[L::velocity + d];
+                }
+              for (unsigned int j = 0; j < nst; ++j)
+                s.probe_stress[q * nst + j] = P[L::stress + j];
+            }
+
+      // next step's mass and internal force at the updated state
+      double t[dim][dim];
+      minus_V_sigma<dim>(P, P[L::volume], t);
+      sums.add(at, mass, t);
     };
     transfer::for_each_active_cell(s.points, begin_cell, at_point,
                                    [&](const unsigned int) { sums.scatter(cell, g, M, F); });

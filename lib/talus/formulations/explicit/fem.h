@@ -57,22 +57,30 @@ namespace talus::explicit_mpm
     /// the Gauss points, which moved with their cells.
     void grid_changed();
 
-    bool updated_lagrangian() const { return ul; }
+    bool
+    updated_lagrangian() const
+    {
+      return ul;
+    }
     /// ul-fem: accumulated nodal displacements (owned + ghost entries of the
     /// cells that hold points are kept current without communication).
-    const Vector &nodal_displacement() const { return nodal_u; }
+    const Vector &
+    nodal_displacement() const
+    {
+      return nodal_u;
+    }
 
   private:
-    Solver<dim> &             s;
-    const bool                ul;
+    Solver<dim>                  &s;
+    const bool                    ul;
     static constexpr unsigned int nv = 1u << dim;
     using Kernel                     = shape::Q1Iso<dim>; ///< the cells may be deformed (ul-fem)
     /// reference vertex coordinates per active cell index: [c][v][d]
-    std::vector<double>       vertices;
-    Vector                    nodal_u;
+    std::vector<double> vertices;
+    Vector              nodal_u;
     /// local DoF indices (owned + ghost) of the cells that hold points
     std::vector<unsigned int> moving_dofs;
-    void collect_moving_dofs();
+    void                      collect_moving_dofs();
     /// the reference vertex table from the triangulation
     void collect_vertices();
     /// current vertex coordinates of cell c

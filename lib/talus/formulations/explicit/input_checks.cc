@@ -21,8 +21,8 @@ namespace talus::explicit_mpm
   double
   critical_time_step_of(const Parameters<dim> &p)
   {
-    const double h = smallest_cell_edge(p);
-    double dt = std::numeric_limits<double>::infinity();
+    const double h  = smallest_cell_edge(p);
+    double       dt = std::numeric_limits<double>::infinity();
     for (const auto &c : critical_time_steps(p.materials, p.liquid.pore_liquid, h))
       dt = std::min(dt, c.dt);
     // mass scaling (seed 000 Eq. 6.31): the step must suit the stage with the
@@ -49,8 +49,7 @@ namespace talus::explicit_mpm
           throw InputError("body " + std::to_string(k) +
                            "/traction face: tractions are supported on box bodies only (this body is "
                            "read from a file; allowed here: none)");
-        require(b.shape == BodyDescription<dim>::Shape::box,
-                "body " + std::to_string(k) + "/traction face",
+        require(b.shape == BodyDescription<dim>::Shape::box, "body " + std::to_string(k) + "/traction face",
                 "tractions are supported on box bodies only (this body is a " +
                   std::string(b.shape == BodyDescription<dim>::Shape::ball ? "ball" : "polygon") +
                   "; allowed here: none)");
@@ -67,7 +66,8 @@ namespace talus::explicit_mpm
     if (p.liquid.any_coupled())
       for (unsigned int k = 0; k < p.loads.stages.size(); ++k)
         require(p.loads.stages[k].mass_scaling >= 1.0,
-                p.loads.staged ? "stage " + std::to_string(k) + "/mass scaling/factor" : std::string("mass scaling/factor"),
+                p.loads.staged ? "stage " + std::to_string(k) + "/mass scaling/factor"
+                               : std::string("mass scaling/factor"),
                 "must be >= 1 with coupled 2-phase materials: a factor beta < 1 shortens the drag relaxation time of "
                 "the seepage by beta, and the time step sqrt(beta) x critical (Eq. 6.31) would be unstable "
                 "(allowed: >= 1)");
@@ -79,7 +79,7 @@ namespace talus::explicit_mpm
             std::ostringstream os;
             os << "time/time step: " << p.time_step << " s exceeds the critical time step " << dt_cr;
             throw InputError(os.str() +
-                           " s (seed 000 §4.6, smallest cell edge over the fastest wave speed); lower it, or set "
+                             " s (seed 000 §4.6, smallest cell edge over the fastest wave speed); lower it, or set "
                              "'force time step = true' to run anyway");
           }
       }

@@ -23,8 +23,9 @@ namespace talus::loads
 {
   template <int dim>
   LoadControl<dim>::LoadControl(const Settings<dim> &s)
-    : settings(s)
-  {}
+      : settings(s)
+  {
+  }
 
   template <int dim>
   void
@@ -74,7 +75,7 @@ namespace talus::loads
           continue;
         const auto  &cc = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
         const double z  = pt.get_location() * e;
-        top[b] = std::max(top[b], z + 0.5 * cc.h[up_axis] / s.prm.bodies[b].particles_per_direction);
+        top[b]          = std::max(top[b], z + 0.5 * cc.h[up_axis] / s.prm.bodies[b].particles_per_direction);
       }
     {
       std::vector<double> all(top.size());
@@ -87,7 +88,7 @@ namespace talus::loads
         const unsigned int b = static_cast<unsigned int>(P[L::body]);
         if (b >= n_bodies || !settings.k0[b].enabled)
           continue;
-        const auto &k      = settings.k0[b];
+        const auto  &k     = settings.k0[b];
         const double level = std::isnan(k.surface_level) ? top[b] : k.surface_level;
         double       rho   = P[L::mass] / P[L::volume];
         const double depth = std::max(0.0, level - pt.get_location() * e);
@@ -99,18 +100,18 @@ namespace talus::loads
         if (s.two_phase && s.two_phase->coupled &&
             s.prm.liquid.pore_liquid[mat].drainage == explicit_mpm::Drainage::coupled)
           {
-            const auto &pl = s.prm.liquid.pore_liquid[mat];
-            rho            = (1 - pl.porosity) * (s.prm.materials[mat]->density() - pl.density);
+            const auto &pl                = s.prm.liquid.pore_liquid[mat];
+            rho                           = (1 - pl.porosity) * (s.prm.materials[mat]->density() - pl.density);
             P[s.two_phase->pore_pressure] = pl.density * gn * depth;
           }
-        const auto   k0    = k0_stress(rho * gn, depth, k.surcharge, k.K0);
-        const double sv = k0.vertical, sh = k0.horizontal;
+        const auto                    k0 = k0_stress(rho * gn, depth, k.surcharge, k.K0);
+        const double                  sv = k0.vertical, sh = k0.horizontal;
         dealii::SymmetricTensor<2, 3> sigma;
         for (unsigned int i = 0; i < 3; ++i)
           for (unsigned int j = i; j < 3; ++j)
             {
               const double ei = i < dim ? e[i] : 0.0, ej = j < dim ? e[j] : 0.0;
-              sigma[i][j]     = (i == j ? sh : 0.0) + (sv - sh) * ei * ej;
+              sigma[i][j] = (i == j ? sh : 0.0) + (sv - sh) * ei * ej;
             }
         L::set_stress(sigma, P.data());
       }
@@ -144,19 +145,19 @@ namespace talus::loads
   LoadControl<dim>::begin_stage(Solver &s, const unsigned int k, const bool resume)
   {
     AssertThrow(k < settings.stages.size(), dealii::ExcInternalError());
-    current       = &settings.stages[k];
-    stage_index   = k;
+    current         = &settings.stages[k];
+    stage_index     = k;
     s.current_stage = k;
     if (!resume)
       s.stage_start_time = s.time;
-    stage_t0     = s.stage_start_time;
-    stage_step0  = s.step_number;
-    converged    = false;
-    force_ratio  = energy_ratio = std::numeric_limits<double>::quiet_NaN();
-    s.gravity      = current->gravity;
-    s.mass_scaling = current->mass_scaling;
-    s.constrained  = wall_dof_flags(s.grid, current->boundary_conditions);
-    s.p2g_ready    = false; // gravity may have changed: redo the mass/force P2G
+    stage_t0    = s.stage_start_time;
+    stage_step0 = s.step_number;
+    converged   = false;
+    force_ratio = energy_ratio = std::numeric_limits<double>::quiet_NaN();
+    s.gravity                  = current->gravity;
+    s.mass_scaling             = current->mass_scaling;
+    s.constrained              = wall_dof_flags(s.grid, current->boundary_conditions);
+    s.p2g_ready                = false; // gravity may have changed: redo the mass/force P2G
     if (!resume)
       set_time_step(s); // a restart continues with the checkpointed step
 
@@ -180,7 +181,7 @@ namespace talus::loads
     if (!resume)
       s.initial_energies = s.energies(); // baseline of the stability check (restored on restart)
     potential0 = s.energies().gravity_potential;
-    work_loads         = s.external_work;
+    work_loads = s.external_work;
 
     std::ostringstream os;
     os << "  stage " << k << " '" << current->name << "': t = " << s.time << " s, duration " << current->duration
@@ -265,13 +266,13 @@ namespace talus::loads
                     FrictionNode n;
                     for (unsigned int d = 0; d < dim; ++d)
                       n.dofs[d] = cc.dofs[v * dim + d];
-                    n.axis  = axis;
-                    n.side  = (f % 2) ? +1 : -1;
-                    n.area  = 0;
-                    n.h     = cc.h[axis];
-                    n.state = 0;
+                    n.axis           = axis;
+                    n.side           = (f % 2) ? +1 : -1;
+                    n.area           = 0;
+                    n.h              = cc.h[axis];
+                    n.state          = 0;
                     n.liquid_stopped = false;
-                    it      = node_of.emplace(key, friction_nodes.size()).first;
+                    it               = node_of.emplace(key, friction_nodes.size()).first;
                     friction_nodes.push_back(n);
                   }
                 friction_nodes[it->second].area += area / dealii::GeometryInfo<dim>::vertices_per_face;
@@ -330,13 +331,13 @@ namespace talus::loads
   void
   LoadControl<dim>::before_nodal_solve(Solver &s, const double step, const Vector *momentum_t)
   {
-    using L                   = PropertyLayout<dim>;
-    h                         = step;
-    const bool vt_now         = need_vt || check_step(s);
+    using L           = PropertyLayout<dim>;
+    h                 = step;
+    const bool vt_now = need_vt || check_step(s);
     if (vt_now && momentum_t) // the caller's nodal momentum at t (owned entries)
       {
         const double *src = momentum_t->begin();
-        double *      dst = vt.begin();
+        double       *dst = vt.begin();
         for (const unsigned int i : s.active_dofs)
           dst[i] = src[i];
       }
@@ -347,7 +348,7 @@ namespace talus::loads
     const bool scatter = forces.any() && !momentum_t;
     if (!scatter && !any_friction)
       return;
-    double *const T   = scatter ? trac.begin() : nullptr;
+    double *const T = scatter ? trac.begin() : nullptr;
     if (scatter)
       {
         s.zero_on_active(trac);
@@ -359,7 +360,7 @@ namespace talus::loads
       return;
     // Eq. 5.3: f_trac,i = sum_p N_i(x_p) f_p, with the shape functions of the run
     double work   = 0;
-    auto   source = [&](const double *P, double (&w)[1], double (&f)[1][dim]) {
+    auto   source = [&](const double *P, double(&w)[1], double(&f)[1][dim]) {
       if (!forces.force_if_loaded(P, f[0]))
         return false;
       w[0] = 1.0;
@@ -431,7 +432,7 @@ namespace talus::loads
     // quasi-static convergence (seed 000 §6.4), on the unbalanced force before damping
     if (check_step(s))
       {
-        const double *T  = forces.any() ? trac.begin() : nullptr;
+        const double *T    = forces.any() ? trac.begin() : nullptr;
         double        v[4] = {0, 0, 0, 0};
         for (const unsigned int i : s.active_dofs)
           if (!excluded[i] && component[i] >= 0)
@@ -496,10 +497,10 @@ namespace talus::loads
   {
     const auto &conv = current->convergence;
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 4), s.comm, dealii::ArrayView<double>(v, 4));
-    const double w_ext = (potential0 - v[3]) + (s.external_work - work_loads) + 0.0;
-    force_ratio        = std::sqrt(v[0]) / std::max(std::sqrt(v[1]), 1e-300);
-    const double ke    = current->mass_scaling * v[2]; // of the scaled inertia
-    energy_ratio       = w_ext > 0 ? ke / w_ext : (ke > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+    const double w_ext   = (potential0 - v[3]) + (s.external_work - work_loads) + 0.0;
+    force_ratio          = std::sqrt(v[0]) / std::max(std::sqrt(v[1]), 1e-300);
+    const double ke      = current->mass_scaling * v[2]; // of the scaled inertia
+    energy_ratio         = w_ext > 0 ? ke / w_ext : (ke > 0 ? std::numeric_limits<double>::infinity() : 0.0);
     const double t_stage = s.time - stage_t0;
     if (conv.end_stage && t_stage >= settle_time - 1e-9 * s.dt && force_ratio < conv.force_tolerance &&
         energy_ratio < conv.energy_tolerance)
@@ -532,7 +533,7 @@ namespace talus::loads
     // undrained equilibrium, long before the excess pore pressure has gone.
     // f_w enters with the nodal porosity n = Mbar_L / M_L (force on the liquid
     // mass itself), its external part is the liquid's weight Mbar_L g.
-    const auto *  tp  = s.two_phase.get();
+    const auto   *tp  = s.two_phase.get();
     const bool    cp  = tp->coupled;
     const double *T   = forces.any() ? trac.begin() : nullptr;
     const double *mLt = cp ? tp->m_liquid.begin() : nullptr, *mLn = cp ? tp->m_liquid_n.begin() : nullptr;
@@ -562,7 +563,7 @@ namespace talus::loads
         if (cp && mLn[i] > 0)
           v[2] += 0.5 * PL[i] * PL[i] / mLn[i];
       }
-    v[3] = s.local_energies.gravity_potential; // of both masses (TwoPhase::step)
+    v[3] = s.local_energies.gravity_potential;                 // of both masses (TwoPhase::step)
     if (dealii::Utilities::MPI::this_mpi_process(s.comm) == 0) // rigid plates, as in nodal_forces
       for (unsigned int k = 0; k < plate_run.size(); ++k)
         {
@@ -583,9 +584,9 @@ namespace talus::loads
     // base velocity hung on 2 ranks)
     if (!any_friction && !any_prescribed && !any_plate)
       return;
-    double *const       A  = s.nodal_a.begin();
-    const double *const M  = s.nodal_mass.begin();
-    const double *const Pm = vt.begin();
+    double *const       A    = s.nodal_a.begin();
+    const double *const M    = s.nodal_mass.begin();
+    const double *const Pm   = vt.begin();
     const double        beta = current->mass_scaling;
     // frictional contact with a rigid fixed boundary: seed 000 Eqs. 6.4-6.21
     // with the other body at rest (v = 0): predicted v* = v^t + dt a; if it
@@ -614,8 +615,8 @@ namespace talus::loads
         // drift away from the wall (a block sliding on the floor rose 3.8 mm).
         if (lift.local_element(n.dofs[n.axis]) > lift_tolerance * n.h)
           continue;
-        vs[n.axis]  = 0;
-        double vt2  = 0;
+        vs[n.axis] = 0;
+        double vt2 = 0;
         for (unsigned int d = 0; d < dim; ++d)
           vt2 += vs[d] * vs[d];
         const double vtan   = std::sqrt(vt2);
@@ -647,7 +648,7 @@ namespace talus::loads
     // carries no shear stress); where the material has lifted off, nothing
     for (auto &n : friction_nodes)
       {
-        n.liquid_stopped = false;
+        n.liquid_stopped     = false;
         const unsigned int i = n.dofs[n.axis];
         if (!cp || !(mLn[i] > 0) || s.constrained[i])
           continue;
@@ -663,8 +664,8 @@ namespace talus::loads
     double work = 0;
     for (const auto &p : prescribed_dofs)
       {
-        const double m = M[p.dof];
-        const auto & pv   = current->velocities[p.condition];
+        const double m    = M[p.dof];
+        const auto  &pv   = current->velocities[p.condition];
         const double t    = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
         const double vbar = pv.velocity[p.component] * pv.function.value(t);
         if (cp && mLn[p.dof] > 0)
@@ -693,14 +694,13 @@ namespace talus::loads
         for (const auto &p : plate_dofs)
           if (plate_active[p.dof] && M[p.dof] > 0 && mLn[p.dof] > 0)
             liquid[p.condition * dim + p.component] += beta * mLn[p.dof] * AL[p.dof];
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(liquid), s.comm,
-                                    dealii::ArrayView<double>(liquid));
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(liquid), s.comm, dealii::ArrayView<double>(liquid));
         rigid_plate_velocities(s, liquid.data());
       }
     for (const auto &p : plate_dofs)
       if (plate_active[p.dof] && M[p.dof] > 0)
         {
-          const auto & pl = s.prm.rigid_plates[p.condition];
+          const auto  &pl      = s.prm.rigid_plates[p.condition];
           const bool   on_axis = p.component == pl.axis;
           const double V       = on_axis ? plate_run[p.condition].velocity : 0.0;
           A[p.dof]             = (V - Pm[p.dof] / M[p.dof]) / h;
@@ -716,16 +716,16 @@ namespace talus::loads
   {
     if (particle_conditions.empty())
       return;
-    using L              = PropertyLayout<dim>;
-    const bool        cp = s.two_phase && s.two_phase->coupled;
-    double            work = 0;
+    using L         = PropertyLayout<dim>;
+    const bool cp   = s.two_phase && s.two_phase->coupled;
+    double     work = 0;
     // the velocity change of the points of a conditioned body, and its momentum
     // m_p dv_p (solid) and m_L dv_L (pore liquid) added to the nodal momentum
-    auto source = [&](double *P, double (&w)[2], double (&dv)[2][dim]) {
+    auto source = [&](double *P, double(&w)[2], double(&dv)[2][dim]) {
       const unsigned int b   = static_cast<unsigned int>(P[L::body]);
       bool               hit = false;
-      w[0] = P[L::mass];
-      w[1] = 0.0;
+      w[0]                   = P[L::mass];
+      w[1]                   = 0.0;
       for (unsigned int d = 0; d < dim; ++d)
         dv[0][d] = dv[1][d] = 0.0;
       for (const unsigned int j : particle_conditions)
@@ -750,7 +750,7 @@ namespace talus::loads
               w[1] = mL;
               for (unsigned int d = 0; d < dim; ++d)
                 {
-                  double &     vl     = P[s.two_phase->liquid_velocity + d];
+                  double      &vl     = P[s.two_phase->liquid_velocity + d];
                   const double change = pv.component[d] ? pv.velocity[d] * f - vl : 0.0;
                   vl += change;
                   dv[1][d] += change;
@@ -793,7 +793,7 @@ namespace talus::loads
           VL[n.dofs[n.axis]] = 0; // no flow into the wall
     for (const auto &p : prescribed_dofs)
       {
-        const auto & pv = current->velocities[p.condition];
+        const auto  &pv = current->velocities[p.condition];
         const double t  = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
         V[p.dof]        = pv.velocity[p.component] * pv.function.value(t);
         if (VL)
@@ -829,8 +829,8 @@ namespace talus::loads
     for (unsigned int k = 0; k < plates.size(); ++k)
       {
         const auto &pl = plates[k];
-        PlateRun &r = plate_run[k];
-        r.force     = pl.control == RigidPlate<dim>::Control::force ? pl.force_at(s.time) : 0.0;
+        PlateRun   &r  = plate_run[k];
+        r.force        = pl.control == RigidPlate<dim>::Control::force ? pl.force_at(s.time) : 0.0;
         log() << rigid_plate_log_line(pl, k, counts[k]) << std::endl;
       }
   }
@@ -839,7 +839,7 @@ namespace talus::loads
   void
   LoadControl<dim>::rigid_plate_balance(Solver &s, const double *F, const double *M)
   {
-    const auto &       plates  = s.prm.rigid_plates;
+    const auto        &plates  = s.prm.rigid_plates;
     const unsigned int n_owned = s.nodal_mass.locally_owned_size();
     // the nodes of this step (a DoF off the active list may hold a stale mass)
     plate_active.assign(n_owned, 0);
@@ -884,11 +884,11 @@ namespace talus::loads
   void
   LoadControl<dim>::rigid_plate_velocities(Solver &s, const double *liquid)
   {
-    const auto & plates = s.prm.rigid_plates;
+    const auto  &plates = s.prm.rigid_plates;
     const double beta = current->mass_scaling, alpha = current->damping, av = current->viscous_damping;
     for (unsigned int k = 0; k < plates.size(); ++k)
       {
-        const auto &  pl = plates[k];
+        const auto   &pl = plates[k];
         const double *q  = &plate_sum[k * plate_sum_size];
         // the plate's inertia and its force: the solid alone (1-phase; a
         // permeable plate, through which the liquid flows with its own

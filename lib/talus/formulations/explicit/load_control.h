@@ -76,14 +76,30 @@ namespace talus::loads
     using Solver = explicit_mpm::Solver<dim>;
     explicit LoadControl(const Settings<dim> &settings);
 
-    unsigned int n_stages() const { return settings.stages.size(); }
-    unsigned int n_point_force_slots() const { return settings.max_tractions; }
+    unsigned int
+    n_stages() const
+    {
+      return settings.stages.size();
+    }
+    unsigned int
+    n_point_force_slots() const
+    {
+      return settings.max_tractions;
+    }
     /// Add the traction point-force blocks (dim doubles per traction slot) to
     /// the property layout; before the ParticleHandler is initialised.
     void extend_layout(PropertyLayout<dim> &layout);
     /// Offset of the first point-force block (slot j at + j dim).
-    unsigned int point_force_offset() const { return forces.offset(); }
-    const Stage<dim> &stage(const unsigned int k) const { return settings.stages[k]; }
+    unsigned int
+    point_force_offset() const
+    {
+      return forces.offset();
+    }
+    const Stage<dim> &
+    stage(const unsigned int k) const
+    {
+      return settings.stages[k];
+    }
     bool has_convergence() const;
 
     /// After seeding, before the history initialisation: K0 stresses, and
@@ -110,14 +126,30 @@ namespace talus::loads
     void    end_traction_scatter();
     /// Traction force of a point at the time of the last before_nodal_solve
     /// (0 without tractions).
-    void point_force(const double *P, double (&f)[dim]) const { forces.force(P, f); }
-    bool any_traction() const { return forces.any(); }
+    void
+    point_force(const double *P, double (&f)[dim]) const
+    {
+      forces.force(P, f);
+    }
+    bool
+    any_traction() const
+    {
+      return forces.any();
+    }
     void nodal_forces(Solver &s);
     /// 2-phase form of nodal_forces (see above), before the 2-phase nodal solve.
     void nodal_forces_two_phase(Solver &s);
     /// Local damping alpha and viscous damping alpha_v of the running stage.
-    double local_damping() const { return current->damping; }
-    double viscous_damping() const { return current->viscous_damping; }
+    double
+    local_damping() const
+    {
+      return current->damping;
+    }
+    double
+    viscous_damping() const
+    {
+      return current->viscous_damping;
+    }
     void nodal_accelerations(Solver &s);
     void particle_velocities(Solver &s);
     void nodal_velocities(Solver &s);
@@ -132,15 +164,20 @@ namespace talus::loads
     std::vector<double> rigid_plate_series() const;
     /// Checkpointed plate state: per plate (displacement, velocity, force,
     /// tangential force), identical on every rank; and its restore.
-    std::vector<double> rigid_plate_state() const;
-    void                restore_rigid_plate_state(const std::vector<double> &state);
+    std::vector<double>           rigid_plate_state() const;
+    void                          restore_rigid_plate_state(const std::vector<double> &state);
     static constexpr unsigned int rigid_plate_state_size = 4;
 
     /// The convergence criterion of the stage was met (and ends the stage).
-    bool stage_converged() const { return converged; }
+    bool
+    stage_converged() const
+    {
+      return converged;
+    }
     /// After a repartition of the grid (load balancing): the nodal vectors and
     /// node lists on the new partition.
-    void grid_changed(Solver &s)
+    void
+    grid_changed(Solver &s)
     {
       for (Vector *v : {&trac, &vt, &lift})
         if (v->size() > 0)
@@ -155,19 +192,19 @@ namespace talus::loads
   private:
     const Settings<dim> &settings;
     PointForces<dim>     forces; ///< the traction slots of the points and their time factors
-    const Stage<dim> *   current = nullptr;
+    const Stage<dim>    *current     = nullptr;
     unsigned int         stage_index = 0;
-    double               h = 0; ///< size of the running step
-    double               stage_t0 = 0;
+    double               h           = 0; ///< size of the running step
+    double               stage_t0    = 0;
     unsigned int         stage_step0 = 0;
     double               settle_time = 0; ///< stage time after which all loads are constant
-    bool                 converged = false;
+    bool                 converged   = false;
     double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
 
-    bool need_vt = false;
-    Vector trac, vt;
-    std::vector<int> component; ///< of each local DoF (-1: none)
-    std::vector<unsigned char> excluded; ///< DoFs left out of the force ratio
+    bool                       need_vt = false;
+    Vector                     trac, vt;
+    std::vector<int>           component; ///< of each local DoF (-1: none)
+    std::vector<unsigned char> excluded;  ///< DoFs left out of the force ratio
 
     struct FrictionNode
     {
@@ -175,8 +212,8 @@ namespace talus::loads
       unsigned int  axis;
       int           side;
       double        area;
-      double        h; ///< cell size normal to the wall
-      unsigned char state; ///< 0 free/separating, 1 stick, 2 slip
+      double        h;              ///< cell size normal to the wall
+      unsigned char state;          ///< 0 free/separating, 1 stick, 2 slip
       bool          liquid_stopped; ///< 2-phase: liquid normal velocity into the wall removed
     };
     std::vector<FrictionNode> friction_nodes;
@@ -186,14 +223,15 @@ namespace talus::loads
     /// displacement away from that wall of the points in the adjacent cells,
     /// sum over ranks by min. A node whose material has moved away from the
     /// wall by more than `lift_tolerance` x the cell size is free (no contact).
-    Vector       lift;
-    static constexpr double lift_tolerance = 1e-3;
-    bool         any_friction = false;
+    Vector                         lift;
+    static constexpr double        lift_tolerance = 1e-3;
+    bool                           any_friction   = false;
     std::vector<PrescribedNodeDof> prescribed_dofs;
-    bool                       any_prescribed = false; ///< on any rank
-    std::vector<unsigned int>  particle_conditions; ///< indices of body velocity conditions
+    bool                           any_prescribed = false; ///< on any rank
+    std::vector<unsigned int>      particle_conditions;    ///< indices of body velocity conditions
 
-    double load_time(const unsigned int index, const bool global, const double t_abs) const
+    double
+    load_time(const unsigned int index, const bool global, const double t_abs) const
     {
       (void)index;
       return global ? t_abs : t_abs - stage_t0;
@@ -208,10 +246,10 @@ namespace talus::loads
       double unbalanced   = 0; ///< force control: F_P + F_plate before damping (convergence ratio)
     };
     const std::vector<RigidPlate<dim>> *plates = nullptr; ///< the scene's (set by setup_rigid_plates)
-    std::vector<PlateRun>          plate_run;
-    std::vector<PrescribedNodeDof> plate_dofs;   ///< owned plate DoFs that no wall of the stage holds
-    std::vector<unsigned char>     plate_active; ///< per owned DoF: active in this step
-    bool                           any_plate = false; ///< the scene has rigid plates
+    std::vector<PlateRun>               plate_run;
+    std::vector<PrescribedNodeDof>      plate_dofs;        ///< owned plate DoFs that no wall of the stage holds
+    std::vector<unsigned char>          plate_active;      ///< per owned DoF: active in this step
+    bool                                any_plate = false; ///< the scene has rigid plates
     /// Sum the plate nodes' mass, force and momentum over the ranks and set
     /// each plate's velocity V^{t+h}, force/reaction and displacement; F: the
     /// nodal force before damping, M: the nodal mass (solid).
@@ -221,7 +259,7 @@ namespace talus::loads
     /// plate and component sum beta Mbar_L a_L over its nodes; a permeable
     /// plate moves the solid only (the liquid flows through with its own a_L),
     /// an impermeable one the solid and the liquid together along its axis.
-    void rigid_plate_velocities(Solver &s, const double *liquid);
+    void                          rigid_plate_velocities(Solver &s, const double *liquid);
     static constexpr unsigned int plate_sum_size = 5 + 2 * dim;
     std::vector<double>           plate_sum; ///< per plate, summed over the ranks
 

@@ -35,12 +35,12 @@ namespace talus::explicit_mpm
   template <int dim>
   struct CellStressFit
   {
-    using F                              = shape::Q1Factorised<dim>;
-    static constexpr unsigned int nst    = dim == 2 ? 4 : 6;
-    static constexpr double       min_variance = 1.0 / 144.0; ///< (1/12 of the cell width)^2
+    using F                                        = shape::Q1Factorised<dim>;
+    static constexpr unsigned int nst              = dim == 2 ? 4 : 6;
+    static constexpr double       min_variance     = 1.0 / 144.0; ///< (1/12 of the cell width)^2
     static constexpr double       limiter_widening = 0.5;
 
-    unsigned int n = 0;
+    unsigned int n  = 0;
     double       sV = 0, sVx[dim], sVxx[dim][dim], sVs[nst], sVsx[nst][dim], smin[nst], smax[nst];
 
     void
@@ -113,7 +113,7 @@ namespace talus::explicit_mpm
             A[a][b] = C[active[a]][active[b]];
           diag *= A[a][a];
         }
-      double inv[dim][dim];
+      double       inv[dim][dim];
       const double det = invert(A, na, inv);
       if (!(det > 1e-2 * diag)) // nearly collinear positions: constant stress
         return 0;
@@ -202,7 +202,7 @@ namespace talus::explicit_mpm
           t[0][1] = t[1][0] = -wq * s[3];
           if constexpr (dim == 3)
             {
-              t[2][2]           = -wq * s[2];
+              t[2][2] = -wq * s[2];
               t[1][2] = t[2][1] = -wq * s[4];
               t[0][2] = t[2][0] = -wq * s[5];
             }

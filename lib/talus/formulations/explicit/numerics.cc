@@ -24,14 +24,15 @@ namespace talus::explicit_mpm
     // quadratic B-splines need integration = mpm, without strain smoothing,
     // contact, 2-phase materials, tractions, friction or prescribed velocities
     // of bodies (refused by parse_parameters in explicit_solver.cc)
-    prm.declare_entry("velocity transfer", "flip", Selection("flip|apic"),
-                      "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
-                      "velocity from the points' momentum) or 'apic' (affine particle-in-cell, Jiang et al. 2015: "
-                      "nodal momentum sum N m_p (v_p + C_p (x_i - x_p)), v_p and the affine matrix C_p from the "
-                      "updated nodal velocity; conserves linear and angular momentum in the transfers, "
-                      "docs/shape-functions.md). 'apic' needs shape function = quadratic bspline (measured unstable with linear "
-                      "shape functions), integration = mpm and 1-phase materials, without "
-                      "strain smoothing, contact, tractions, prescribed body velocities or load balancing.");
+    prm.declare_entry(
+      "velocity transfer", "flip", Selection("flip|apic"),
+      "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
+      "velocity from the points' momentum) or 'apic' (affine particle-in-cell, Jiang et al. 2015: "
+      "nodal momentum sum N m_p (v_p + C_p (x_i - x_p)), v_p and the affine matrix C_p from the "
+      "updated nodal velocity; conserves linear and angular momentum in the transfers, "
+      "docs/shape-functions.md). 'apic' needs shape function = quadratic bspline (measured unstable with linear "
+      "shape functions), integration = mpm and 1-phase materials, without "
+      "strain smoothing, contact, tractions, prescribed body velocities or load balancing.");
     prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
                       "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
                       "UL-FEM): 'mpm' at the material points; "
@@ -72,28 +73,28 @@ namespace talus::explicit_mpm
   {
     NumericsOptions o;
     prm.enter_subsection("numerics");
-    o.shape_function = prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline
-                                                                           : ShapeFunction::linear;
-    o.velocity_transfer = prm.get("velocity transfer") == "apic" ? NumericsOptions::VelocityTransfer::apic :
-                                                                     NumericsOptions::VelocityTransfer::flip;
+    o.shape_function =
+      prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline : ShapeFunction::linear;
+    o.velocity_transfer = prm.get("velocity transfer") == "apic" ? NumericsOptions::VelocityTransfer::apic
+                                                                 : NumericsOptions::VelocityTransfer::flip;
     {
       const std::string i = prm.get("integration");
-      o.integration       = i == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed :
-                            i == "fem"       ? NumericsOptions::Integration::fem :
-                            i == "ul-fem"    ? NumericsOptions::Integration::ul_fem :
-                                               NumericsOptions::Integration::mpm;
+      o.integration       = i == "mpm-mixed" ? NumericsOptions::Integration::mpm_mixed
+                            : i == "fem"     ? NumericsOptions::Integration::fem
+                            : i == "ul-fem"  ? NumericsOptions::Integration::ul_fem
+                                             : NumericsOptions::Integration::mpm;
     }
-    o.fill_factor = prm.get_double("fill factor");
+    o.fill_factor  = prm.get_double("fill factor");
     o.mixed_linear = prm.get("mixed stress field") == "linear";
     require(o.fill_factor > 0, "numerics/fill factor", "must be > 0 (the manual uses 0.9)");
     const std::string s = prm.get("strain smoothing");
-    o.smoothing = s == "cell" ? NumericsOptions::Smoothing::cell :
-                  s == "nodal" ? NumericsOptions::Smoothing::nodal :
-                                 NumericsOptions::Smoothing::none;
+    o.smoothing         = s == "cell"    ? NumericsOptions::Smoothing::cell
+                          : s == "nodal" ? NumericsOptions::Smoothing::nodal
+                                         : NumericsOptions::Smoothing::none;
     prm.leave_subsection();
 
     prm.enter_subsection("contact");
-    const std::string where = "contact/pairs";
+    const std::string                               where = "contact/pairs";
     std::set<std::pair<unsigned int, unsigned int>> seen;
     for (const auto &item : dealii::Utilities::split_string_list(prm.get("pairs"), ';'))
       {
@@ -170,22 +171,22 @@ namespace talus::explicit_mpm
   void
   p2g_extended(Solver<dim> &s)
   {
-    using L                    = PropertyLayout<dim>;
-    using F                    = shape::Q1Factorised<dim>;
-    constexpr unsigned int nv  = F::nv;
-    const bool   mixed         = s.prm.numerics.integration == NumericsOptions::Integration::mpm_mixed;
-    const double fill          = s.prm.numerics.fill_factor;
-    const bool   linear_stress = s.prm.numerics.mixed_linear;
-    Contact<dim> *contact      = s.contact.get();
-    const auto    g            = s.gravity; // of the running stage
+    using L                              = PropertyLayout<dim>;
+    using F                              = shape::Q1Factorised<dim>;
+    constexpr unsigned int nv            = F::nv;
+    const bool             mixed         = s.prm.numerics.integration == NumericsOptions::Integration::mpm_mixed;
+    const double           fill          = s.prm.numerics.fill_factor;
+    const bool             linear_stress = s.prm.numerics.mixed_linear;
+    Contact<dim>          *contact       = s.contact.get();
+    const auto             g             = s.gravity; // of the running stage
 
     double *const M  = s.nodal_mass.begin();
     double *const Fv = s.nodal_a.begin();
     zero_on(s.nodal_mass, s.active_dofs);
     zero_on(s.nodal_a, s.active_dofs);
-    const unsigned int n_bodies = contact ? contact->n_bodies : 0;
-    std::vector<BodyAcc<dim>> bacc(n_bodies);
-    std::vector<unsigned int> touched;
+    const unsigned int         n_bodies = contact ? contact->n_bodies : 0;
+    std::vector<BodyAcc<dim>>  bacc(n_bodies);
+    std::vector<unsigned int>  touched;
     std::vector<unsigned char> in_cell(n_bodies, 0);
     if (contact)
       for (auto &f : contact->fields)
@@ -196,7 +197,7 @@ namespace talus::explicit_mpm
         }
     CellStressFit<dim> stress_fit; // MPM-MIXED: linear cell stress (mixed_integration.h)
 
-    double lm[nv], T[dim][F::npairs][dim]; // the cell's sums
+    double     lm[nv], T[dim][F::npairs][dim]; // the cell's sums
     const auto begin_cell = [&](const unsigned int) {
       std::fill(lm, lm + nv, 0.0);
       std::fill(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, 0.0);
@@ -205,91 +206,91 @@ namespace talus::explicit_mpm
       touched.clear();
     };
     const auto at_point = [&](const unsigned int, auto &pt) {
-            const double *P  = pt->get_properties().data();
-            const auto    xi = pt->get_reference_location();
-            double        N[nv], w[dim][F::npairs];
-            F::weights(xi, N, w);
-            const double m = P[L::mass], V = P[L::volume];
-            for (unsigned int v = 0; v < nv; ++v)
-              lm[v] += m * N[v];
-            double t[dim][dim];
-            minus_V_sigma<dim>(P, V, t);
-            F::add_moments(t, w, T);
-            if (mixed)
-              stress_fit.add(xi, V, P + L::stress);
-            if (contact)
-              {
-                const unsigned int b = static_cast<unsigned int>(P[L::body]);
-                auto &             a = bacc[b];
-                if (!in_cell[b])
-                  {
-                    in_cell[b] = 1;
-                    touched.push_back(b);
-                    a.clear();
-                  }
-                for (unsigned int v = 0; v < nv; ++v)
-                  {
-                    a.lm[v] += m * N[v];
-                    a.lvol[v] += V * N[v];
-                    for (unsigned int d = 0; d < dim; ++d)
-                      a.lp[v][d] += m * N[v] * P[L::velocity + d];
-                  }
-                F::add_moments(t, w, a.T);
-              }
+      const double *P  = pt->get_properties().data();
+      const auto    xi = pt->get_reference_location();
+      double        N[nv], w[dim][F::npairs];
+      F::weights(xi, N, w);
+      const double m = P[L::mass], V = P[L::volume];
+      for (unsigned int v = 0; v < nv; ++v)
+        lm[v] += m * N[v];
+      double t[dim][dim];
+      minus_V_sigma<dim>(P, V, t);
+      F::add_moments(t, w, T);
+      if (mixed)
+        stress_fit.add(xi, V, P + L::stress);
+      if (contact)
+        {
+          const unsigned int b = static_cast<unsigned int>(P[L::body]);
+          auto              &a = bacc[b];
+          if (!in_cell[b])
+            {
+              in_cell[b] = 1;
+              touched.push_back(b);
+              a.clear();
+            }
+          for (unsigned int v = 0; v < nv; ++v)
+            {
+              a.lm[v] += m * N[v];
+              a.lvol[v] += V * N[v];
+              for (unsigned int d = 0; d < dim; ++d)
+                a.lp[v][d] += m * N[v] * P[L::velocity + d];
+            }
+          F::add_moments(t, w, a.T);
+        }
     };
     const auto end_cell = [&](const unsigned int c) {
-        const auto &cc          = s.grid.cells[c];
-        double      cell_volume = 1.0;
+      const auto &cc          = s.grid.cells[c];
+      double      cell_volume = 1.0;
+      for (unsigned int d = 0; d < dim; ++d)
+        cell_volume *= cc.h[d];
+      // §6.6: a filled cell (Eq. 6.33) is integrated at its 2^dim Gauss points
+      // with a stress field linear in the cell, fitted to its points (mean =
+      // Eq. 6.32; see mixed_integration.h for why not constant on Q1 cells).
+      // With contact, only single-body cells are mixed-integrated (the body's
+      // force must equal the cell's).
+      const bool use_mixed = mixed && stress_fit.sV > fill * cell_volume && (!contact || touched.size() <= 1);
+      if (use_mixed)
+        stress_fit.moments(cell_volume, linear_stress, T);
+      double f[nv][dim];
+      for (unsigned int v = 0; v < nv; ++v)
         for (unsigned int d = 0; d < dim; ++d)
-          cell_volume *= cc.h[d];
-        // §6.6: a filled cell (Eq. 6.33) is integrated at its 2^dim Gauss points
-        // with a stress field linear in the cell, fitted to its points (mean =
-        // Eq. 6.32; see mixed_integration.h for why not constant on Q1 cells).
-        // With contact, only single-body cells are mixed-integrated (the body's
-        // force must equal the cell's).
-        const bool use_mixed = mixed && stress_fit.sV > fill * cell_volume && (!contact || touched.size() <= 1);
-        if (use_mixed)
-          stress_fit.moments(cell_volume, linear_stress, T);
-        double f[nv][dim];
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            f[v][d] = lm[v] * g[d];
-        F::expand_moments(T, cc.inv_h, f);
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              const unsigned int i = cc.dofs[v * dim + d];
-              M[i] += lm[v];
-              Fv[i] += f[v][d];
-            }
-        if (contact)
-          for (const unsigned int b : touched)
-            {
-              in_cell[b] = 0;
-              auto &a    = bacc[b];
-              if (use_mixed)
-                std::copy(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, &a.T[0][0][0]);
-              double fb[nv][dim];
-              for (unsigned int v = 0; v < nv; ++v)
+          f[v][d] = lm[v] * g[d];
+      F::expand_moments(T, cc.inv_h, f);
+      for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const unsigned int i = cc.dofs[v * dim + d];
+            M[i] += lm[v];
+            Fv[i] += f[v][d];
+          }
+      if (contact)
+        for (const unsigned int b : touched)
+          {
+            in_cell[b] = 0;
+            auto &a    = bacc[b];
+            if (use_mixed)
+              std::copy(&T[0][0][0], &T[0][0][0] + dim * F::npairs * dim, &a.T[0][0][0]);
+            double fb[nv][dim];
+            for (unsigned int v = 0; v < nv; ++v)
+              for (unsigned int d = 0; d < dim; ++d)
+                fb[v][d] = a.lm[v] * g[d];
+            F::expand_moments(a.T, cc.inv_h, fb);
+            auto         &fl = contact->fields[b];
+            double *const bm = fl.mass.begin();
+            double *const bf = fl.force.begin();
+            double *const bp = fl.momentum.begin();
+            for (unsigned int v = 0; v < nv; ++v)
+              {
+                bm[cc.dofs[v * dim + 0]] += a.lm[v];
+                bm[cc.dofs[v * dim + 1]] += a.lvol[v];
                 for (unsigned int d = 0; d < dim; ++d)
-                  fb[v][d] = a.lm[v] * g[d];
-              F::expand_moments(a.T, cc.inv_h, fb);
-              auto &        fl  = contact->fields[b];
-              double *const bm  = fl.mass.begin();
-              double *const bf  = fl.force.begin();
-              double *const bp  = fl.momentum.begin();
-              for (unsigned int v = 0; v < nv; ++v)
-                {
-                  bm[cc.dofs[v * dim + 0]] += a.lm[v];
-                  bm[cc.dofs[v * dim + 1]] += a.lvol[v];
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      const unsigned int i = cc.dofs[v * dim + d];
-                      bf[i] += fb[v][d];
-                      bp[i] += a.lp[v][d];
-                    }
-                }
-            }
+                  {
+                    const unsigned int i = cc.dofs[v * dim + d];
+                    bf[i] += fb[v][d];
+                    bp[i] += a.lp[v][d];
+                  }
+              }
+          }
     };
     transfer::for_each_active_cell(s.points, begin_cell, at_point, end_cell);
   }
@@ -297,7 +298,7 @@ namespace talus::explicit_mpm
   // ================================================================ smoothing
   template <int dim>
   StrainSmoothing<dim>::StrainSmoothing(const BackgroundGrid<dim> &grid, const NumericsOptions::Smoothing k)
-    : kind(k)
+      : kind(k)
   {
     cell_value.assign(grid.cells.size(), 0.0);
     if (kind == NumericsOptions::Smoothing::nodal)

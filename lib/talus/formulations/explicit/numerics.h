@@ -38,9 +38,13 @@ namespace talus::explicit_mpm
     };
     /// Shape functions of the particle-grid transfers ('numerics/shape function',
     /// declared with the shared scene; docs/shape-functions.md).
-    using ShapeFunction = talus::ShapeFunction;
+    using ShapeFunction          = talus::ShapeFunction;
     ShapeFunction shape_function = ShapeFunction::linear;
-    bool bspline() const { return shape_function == ShapeFunction::quadratic_bspline; }
+    bool
+    bspline() const
+    {
+      return shape_function == ShapeFunction::quadratic_bspline;
+    }
     /// Velocity transfer of the 1-phase step (docs/shape-functions.md, "APIC").
     enum class VelocityTransfer
     {
@@ -48,19 +52,24 @@ namespace talus::explicit_mpm
       apic  ///< affine particle-in-cell (Jiang et al. 2015): v_p, C_p from the nodal velocity
     };
     VelocityTransfer velocity_transfer = VelocityTransfer::flip;
-    bool apic() const { return velocity_transfer == VelocityTransfer::apic; }
-    /// The .prm word of `integration` (mpm, mpm-mixed, fem, ul-fem).
-    const char *integration_name() const
+    bool
+    apic() const
     {
-      return integration == Integration::fem       ? "fem" :
-             integration == Integration::ul_fem    ? "ul-fem" :
-             integration == Integration::mpm_mixed ? "mpm-mixed" :
-                                                     "mpm";
+      return velocity_transfer == VelocityTransfer::apic;
     }
-    Integration integration = Integration::mpm;
-    double      fill_factor = 0.9; ///< F_fill of Eq. 6.33
+    /// The .prm word of `integration` (mpm, mpm-mixed, fem, ul-fem).
+    const char *
+    integration_name() const
+    {
+      return integration == Integration::fem         ? "fem"
+             : integration == Integration::ul_fem    ? "ul-fem"
+             : integration == Integration::mpm_mixed ? "mpm-mixed"
+                                                     : "mpm";
+    }
+    Integration integration  = Integration::mpm;
+    double      fill_factor  = 0.9;  ///< F_fill of Eq. 6.33
     bool        mixed_linear = true; ///< MPM-MIXED cell stress linear (else constant, Eq. 6.32 alone)
-    Smoothing   smoothing   = Smoothing::none;
+    Smoothing   smoothing    = Smoothing::none;
 
     struct ContactPair
     {
@@ -70,11 +79,23 @@ namespace talus::explicit_mpm
     };
     std::vector<ContactPair> contact_pairs; ///< empty: contact off
 
-    bool contact() const { return !contact_pairs.empty(); }
+    bool
+    contact() const
+    {
+      return !contact_pairs.empty();
+    }
     /// integration points stay at the Gauss points of their cells (fem, ul-fem)
-    bool fem() const { return integration == Integration::fem || integration == Integration::ul_fem; }
+    bool
+    fem() const
+    {
+      return integration == Integration::fem || integration == Integration::ul_fem;
+    }
     /// the solver needs a full (non-fused) P2G pass every step
-    bool extended_p2g() const { return integration == Integration::mpm_mixed || contact(); }
+    bool
+    extended_p2g() const
+    {
+      return integration == Integration::mpm_mixed || contact();
+    }
   };
 
   /// `default_integration`: the default of 'numerics/integration' (talus-fem: "fem").
@@ -169,7 +190,7 @@ namespace talus::explicit_mpm
     std::vector<BodyFields> fields;
 
   private:
-    friend void p2g_extended<dim>(Solver<dim> &s);
+    friend void                p2g_extended<dim>(Solver<dim> &s);
     const BackgroundGrid<dim> &grid;
     unsigned int               n_bodies;
     /// pair_index[a * n + b]: index into pairs or -1 (stick)
@@ -180,8 +201,8 @@ namespace talus::explicit_mpm
     /// owned active nodes: local DoF indices of their dim components
     std::vector<std::array<unsigned int, dim>> nodes;
     std::vector<unsigned char>                 node_marker;
-    void collect_nodes(const Solver<dim> &s);
-    void compute_normals(const Solver<dim> &s);
+    void                                       collect_nodes(const Solver<dim> &s);
+    void                                       compute_normals(const Solver<dim> &s);
     /// the contact law at one node: predicted per-body velocities vb (in),
     /// corrected (out); returns true if a correction was applied
     bool correct_node(const std::array<unsigned int, dim> &dofs, const std::vector<unsigned char> &constrained,

@@ -21,9 +21,9 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::write_results(const std::string &series_csv) const
   {
-    using L                    = PropertyLayout<dim>;
-    constexpr unsigned int nst = L::n_stress;
-    constexpr unsigned int nv  = shape::Q1<dim>::n_vertices;
+    using L                     = PropertyLayout<dim>;
+    constexpr unsigned int nst  = L::n_stress;
+    constexpr unsigned int nv   = shape::Q1<dim>::n_vertices;
     const bool             root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
 
     // ---- series: the columns of series.csv (complete, also after a restart)
@@ -75,9 +75,9 @@ namespace talus::explicit_mpm
     out.set_attribute("probes", std::int64_t(n_probes));
     if (n_probes > 0)
       {
-        const char *ax[]     = {"x", "y", "z"};
-        const auto  pnames   = points.layout.names();
-        const auto  column   = [&](const std::string &n) -> const std::vector<double> & {
+        const char *ax[]   = {"x", "y", "z"};
+        const auto  pnames = points.layout.names();
+        const auto  column = [&](const std::string &n) -> const std::vector<double>  &{
           for (std::size_t k = 0; k < names.size(); ++k)
             if (names[k] == n)
               return columns[k];
@@ -115,9 +115,9 @@ namespace talus::explicit_mpm
           for (unsigned int k = 0; k < n_probes; ++k)
             if (pt.get_id() == probe_ids[k])
               for (unsigned int d = 0; d < dim; ++d)
-                X[k * dim + d] = fem && !fem->updated_lagrangian() ?
-                                   pt.get_location()[d] :
-                                   pt.get_location()[d] - pt.get_properties()[L::displacement + d];
+                X[k * dim + d] = fem && !fem->updated_lagrangian()
+                                   ? pt.get_location()[d]
+                                   : pt.get_location()[d] - pt.get_properties()[L::displacement + d];
         std::vector<double> Xs(X.size());
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(X), comm, dealii::ArrayView<double>(Xs));
         out.write_global("probes/initial_position", Xs, dim);
@@ -170,27 +170,28 @@ namespace talus::explicit_mpm
       // (linear hats whatever the run's shape function: a post-processing projection)
       const CellCache<dim> *cell     = nullptr;
       const auto            at_point = [&](const unsigned int, auto &pt) {
-              const auto &cc = *cell;
-              const auto  P  = pt->get_properties();
-              double     N[nv];
-              shape::Q1<dim>::values(pt->get_reference_location(), N);
-              for (unsigned int v = 0; v < nv; ++v)
-                {
-                  const double mN = P[L::mass] * N[v], VN = P[L::volume] * N[v];
-                  w[0].local_element(cc.dofs[v * dim + 0]) += mN;
-                  w[0].local_element(cc.dofs[v * dim + 1]) += VN;
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      w[1].local_element(cc.dofs[v * dim + d]) += mN * P[L::displacement + d];
-                      w[2].local_element(cc.dofs[v * dim + d]) += mN * P[L::velocity + d];
-                    }
-                  for (unsigned int q = 0; q < nst; ++q)
-                    w[3 + q / dim].local_element(cc.dofs[v * dim + q % dim]) += VN * P[L::stress + q];
-                }
+        const auto &cc = *cell;
+        const auto  P  = pt->get_properties();
+        double      N[nv];
+        shape::Q1<dim>::values(pt->get_reference_location(), N);
+        for (unsigned int v = 0; v < nv; ++v)
+          {
+            const double mN = P[L::mass] * N[v], VN = P[L::volume] * N[v];
+            w[0].local_element(cc.dofs[v * dim + 0]) += mN;
+            w[0].local_element(cc.dofs[v * dim + 1]) += VN;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                w[1].local_element(cc.dofs[v * dim + d]) += mN * P[L::displacement + d];
+                w[2].local_element(cc.dofs[v * dim + d]) += mN * P[L::velocity + d];
+              }
+            for (unsigned int q = 0; q < nst; ++q)
+              w[3 + q / dim].local_element(cc.dofs[v * dim + q % dim]) += VN * P[L::stress + q];
+          }
       };
       // the walk takes a mutable set (it hands out particle iterators); this one only reads
       transfer::for_each_active_cell(
-        const_cast<MaterialPointSet<dim> &>(points), [&](const unsigned int c) { cell = &grid.cells[c]; }, at_point, [](const unsigned int) {});
+        const_cast<MaterialPointSet<dim> &>(points), [&](const unsigned int c) { cell = &grid.cells[c]; }, at_point,
+        [](const unsigned int) {});
       for (auto &vec : w)
         vec.compress(dealii::VectorOperation::add);
       const unsigned int         n_owned = nodal_mass.locally_owned_size();

@@ -39,7 +39,7 @@ namespace talus::implicit_mpm
     template <int dim, bool with_matrix, bool with_vector>
     struct ConsistentInertia
     {
-      double                coef = 0;
+      double                coef   = 0;
       static constexpr bool matrix = with_matrix, vector = with_vector;
       template <int d_, unsigned int nc, class PN>
       inline void
@@ -174,7 +174,8 @@ namespace talus::implicit_mpm
                         "jump a grid row when the shifted region does); false: the nodes are fixed in space.");
       prm.declare_entry("negligible nodal mass", "0", Double(0, 1),
                         "The DoFs (displacement and, in mixed u-p, pressure) of an active node whose lumped mass is "
-                        "below this fraction of the largest nodal mass of the step are held at zero increment (nodes touched by the corner "
+                        "below this fraction of the largest nodal mass of the step are held at zero increment (nodes "
+                        "touched by the corner "
                         "of a point's support only, e.g. at a heaving free surface); 0 = off.");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
                         "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
@@ -256,18 +257,18 @@ namespace talus::implicit_mpm
     p.time_step = prm.get_double("time step");
     prm.leave_subsection();
     prm.enter_subsection("implicit");
-    p.analysis       = prm.get("analysis") == "static" ? Parameters<dim>::Analysis::quasi_static
-                                                       : Parameters<dim>::Analysis::dynamic;
-    p.gamma          = prm.get_double("newmark gamma");
-    p.beta           = prm.get_double("newmark beta");
-    p.rayleigh_alpha = prm.get_double("rayleigh alpha");
-    p.rayleigh_beta  = prm.get_double("rayleigh beta");
-    p.consistent_mass = prm.get("mass matrix") == "consistent";
-    p.ramp_loads     = prm.get_bool("ramp loads");
-    p.mixed_up       = prm.get("formulation") == "mixed up";
-    p.stabilisation  = prm.get_double("stabilisation factor");
-    p.fbar           = prm.get("volumetric stabilisation") == "f-bar";
-    p.axisymmetric   = prm.get("geometry") == "axisymmetric";
+    p.analysis =
+      prm.get("analysis") == "static" ? Parameters<dim>::Analysis::quasi_static : Parameters<dim>::Analysis::dynamic;
+    p.gamma                   = prm.get_double("newmark gamma");
+    p.beta                    = prm.get_double("newmark beta");
+    p.rayleigh_alpha          = prm.get_double("rayleigh alpha");
+    p.rayleigh_beta           = prm.get_double("rayleigh beta");
+    p.consistent_mass         = prm.get("mass matrix") == "consistent";
+    p.ramp_loads              = prm.get_bool("ramp loads");
+    p.mixed_up                = prm.get("formulation") == "mixed up";
+    p.stabilisation           = prm.get_double("stabilisation factor");
+    p.fbar                    = prm.get("volumetric stabilisation") == "f-bar";
+    p.axisymmetric            = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
     prm.leave_subsection();
@@ -348,7 +349,7 @@ namespace talus::implicit_mpm
               "load balancing is not available with contact walls on the nodes (boundary conditions/contact "
               "method = nodes: their active set per node is not carried through a repartition); allowed: "
               "interval = 0, or contact method = points");
-      const std::string f = prm.get("contact friction");
+      const std::string f  = prm.get("contact friction");
       double            mu = -1;
       if (p.contact_on_points && f != "no slip" && f != "frictionless")
         {
@@ -362,15 +363,17 @@ namespace talus::implicit_mpm
               used = 0;
             }
           require(used == f.size() && used > 0 && std::isfinite(mu) && mu >= 0, "boundary conditions/contact friction",
-                  "'" + f + "' is not a contact friction; allowed: no slip | frictionless | a Coulomb coefficient "
-                  "mu >= 0 (contact method = points)");
+                  "'" + f +
+                    "' is not a contact friction; allowed: no slip | frictionless | a Coulomb coefficient "
+                    "mu >= 0 (contact method = points)");
         }
       else
         require(f == "no slip" || f == "frictionless", "boundary conditions/contact friction",
-                "'" + f + "' is not a contact friction; allowed: no slip | frictionless (a Coulomb coefficient "
-                "needs 'contact method = points')");
-      p.contact_no_slip = f == "no slip";
-      p.contact_mu      = f == "no slip" ? std::numeric_limits<double>::infinity() : f == "frictionless" ? 0.0 : mu;
+                "'" + f +
+                  "' is not a contact friction; allowed: no slip | frictionless (a Coulomb coefficient "
+                  "needs 'contact method = points')");
+      p.contact_no_slip   = f == "no slip";
+      p.contact_mu        = f == "no slip" ? std::numeric_limits<double>::infinity() : f == "frictionless" ? 0.0 : mu;
       const std::string k = prm.get("contact penalty");
       double            kappa = -1;
       std::size_t       used  = 0;
@@ -430,7 +433,7 @@ namespace talus::implicit_mpm
       }
     for (unsigned int k = 0; k < p.stages.size(); ++k)
       {
-        const auto &      st    = p.stages[k];
+        const auto       &st    = p.stages[k];
         const std::string where = p.staged ? "stage " + std::to_string(k) : std::string("time");
         double            h     = p.time_step;
         if (p.staged)
@@ -446,7 +449,8 @@ namespace talus::implicit_mpm
         p.stage_time_steps.push_back(h);
         for (const auto &bc : st.boundary_conditions)
           for (const auto id : p.contact_ids)
-            require(bc.id != id, where == "time" ? std::string("boundary conditions/contact") : where + "/boundary conditions",
+            require(bc.id != id,
+                    where == "time" ? std::string("boundary conditions/contact") : where + "/boundary conditions",
                     "boundary " + std::to_string(id) + " is a contact wall and also fixed/roller here");
         // the stage's own tractions get slots after the global ones
         for (unsigned int j = st.n_global_tractions; j < st.tractions.size(); ++j)
@@ -460,9 +464,9 @@ namespace talus::implicit_mpm
                   "the grid's solution; allowed: boundary | region (prescribed grid nodes)");
       }
     prm.enter_subsection("linear solver");
-    p.linear.method = prm.get("method") == "direct"  ? LinearSolverOptions::Method::direct :
-                      prm.get("method") == "cg amg" ? LinearSolverOptions::Method::cg_amg :
-                                                      LinearSolverOptions::Method::gmres_amg;
+    p.linear.method             = prm.get("method") == "direct"   ? LinearSolverOptions::Method::direct
+                                  : prm.get("method") == "cg amg" ? LinearSolverOptions::Method::cg_amg
+                                                                  : LinearSolverOptions::Method::gmres_amg;
     p.linear.direct_package     = prm.get("direct package") == "mumps" ? "Amesos_Mumps" : "Amesos_Klu";
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
@@ -496,9 +500,11 @@ namespace talus::implicit_mpm
             const auto &m = *p.materials[k];
             require(m.has_volumetric_split(), "material " + std::to_string(k) + "/model",
                     "'mixed up' needs a volumetric/deviatoric split with a pressure-independent deviatoric response; "
-                    "allowed: 'neo hookean' with 'volumetric energy = split', 'j2 plasticity' (got '" + m.model_name() +
-                      (dynamic_cast<const materials::NeoHookean *>(&m) ? "' with 'volumetric energy = coupled')"
-                                                                        : "': its yield depends on the pressure or it has no split)"));
+                    "allowed: 'neo hookean' with 'volumetric energy = split', 'j2 plasticity' (got '" +
+                      m.model_name() +
+                      (dynamic_cast<const materials::NeoHookean *>(&m)
+                         ? "' with 'volumetric energy = coupled')"
+                         : "': its yield depends on the pressure or it has no split)"));
           }
       }
     // what the implicit family does not offer yet: refused, not ignored
@@ -518,14 +524,16 @@ namespace talus::implicit_mpm
         // what the axisymmetric form covers (docs/implicit.md, "Axisymmetry"); the rest is refused
         const std::string where = "implicit/geometry";
         require(dim == 2, where, "'axisymmetric' is a 2D geometry (x = radius, y = axis); in 3D use 'plane strain'");
-        require(!p.mixed_up, where, "'axisymmetric' is available with 'formulation = irreducible' only (the mixed u-p "
-                                    "form has no hoop terms yet)");
+        require(!p.mixed_up, where,
+                "'axisymmetric' is available with 'formulation = irreducible' only (the mixed u-p "
+                "form has no hoop terms yet)");
         require(p.grid_lower[0] >= 0, where,
                 "'axisymmetric' needs grid/lower corner x >= 0 (x is the radius; got " +
                   std::to_string(p.grid_lower[0]) + ")");
         for (unsigned int k = 0; k < p.stages.size(); ++k)
           require(p.stages[k].gravity[0] == 0,
-                  p.staged ? "stage " + std::to_string(k) + "/gravity/acceleration" : std::string("gravity/acceleration"),
+                  p.staged ? "stage " + std::to_string(k) + "/gravity/acceleration"
+                           : std::string("gravity/acceleration"),
                   "with 'axisymmetric' the body force must act along the axis (y): its x (radial) component must be 0");
         for (const auto &t : p.tractions)
           require(!t.total, t.where,
@@ -577,15 +585,16 @@ namespace talus::implicit_mpm
 
   template <int dim>
   Solver<dim>::Solver(const Parameters<dim> &p, MPI_Comm c)
-    : prm(p)
-    , comm(c)
-    , grid(c, p.balance.enabled())
-    , points(grid, "points")
-    , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
-    , space(grid, p.mixed_up ? dim + 1 : dim)
-    , active(space)
-    , newmark(p.gamma, p.beta)
-  {}
+      : prm(p)
+      , comm(c)
+      , grid(c, p.balance.enabled())
+      , points(grid, "points")
+      , balance(grid, p.balance, {&points}, [this] { grid_changed(); })
+      , space(grid, p.mixed_up ? dim + 1 : dim)
+      , active(space)
+      , newmark(p.gamma, p.beta)
+  {
+  }
 
   template <int dim>
   Solver<dim>::~Solver() = default;
@@ -612,7 +621,7 @@ namespace talus::implicit_mpm
       {
         // the contact walls as planes (box faces: id = 2 axis + (0 lower | 1 upper))
         std::vector<ContactPlane> planes;
-        const auto cell_size = [&](const unsigned int axis) {
+        const auto                cell_size = [&](const unsigned int axis) {
           return (prm.grid_upper[axis] - prm.grid_lower[axis]) / prm.grid_cells[axis];
         };
         for (const auto id : prm.contact_on_points ? prm.contact_ids : std::vector<dealii::types::boundary_id>())
@@ -630,15 +639,15 @@ namespace talus::implicit_mpm
           {
             const auto  &f = prm.footing;
             ContactPlane c;
-            c.axis     = f.axis;
-            c.sign     = f.sign;
-            c.wall_0   = f.level;
-            c.wall     = c.wall_n = f.level; // set_time moves it every step
-            c.velocity = f.velocity;
-            c.cell     = cell_size(c.axis);
-            c.penalty  = f.penalty;
-            c.friction = f.friction;
-            c.footing  = true;
+            c.axis   = f.axis;
+            c.sign   = f.sign;
+            c.wall_0 = f.level;
+            c.wall = c.wall_n = f.level; // set_time moves it every step
+            c.velocity        = f.velocity;
+            c.cell            = cell_size(c.axis);
+            c.penalty         = f.penalty;
+            c.friction        = f.friction;
+            c.footing         = true;
             for (unsigned int k = 0; k + 1 < dim; ++k)
               {
                 c.lower[k] = f.lower[k];
@@ -807,7 +816,7 @@ namespace talus::implicit_mpm
       else if (static_cast<unsigned int>(prm.traction_stage[j]) == k)
         f[j] = prm.tractions[j].function.value(t - stage_start_time) * r;
     point_forces.set_factors(std::move(f));
-    point_force_scale = 1;
+    point_force_scale               = 1;
     const dealii::Tensor<1, dim> &g = prm.stages[k].gravity;
     if (r == 1.0)
       return g;
@@ -830,8 +839,8 @@ namespace talus::implicit_mpm
   {
     const auto &st = prm.stages[k];
     boundary_flags = loads::wall_dof_flags(grid, st.boundary_conditions);
-    contact_nodes  = prm.contact_on_points ? std::vector<loads::ContactNode>() :
-                                             loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
+    contact_nodes  = prm.contact_on_points ? std::vector<loads::ContactNode>()
+                                           : loads::contact_wall_nodes(grid, prm.contact_ids, boundary_flags);
     node_contact.assign(boundary_flags.size(), -1);
     for (std::size_t k = 0; k < contact_nodes.size(); ++k)
       node_contact[contact_nodes[k].node] = int(k);
@@ -882,7 +891,7 @@ namespace talus::implicit_mpm
     // a wall, a prescribed line, contact, the inactive pins or the negligible
     // mass rule, which includes the prescribed lines of displacement plates;
     // plates share no node: check_plates)
-    const auto &owned = space.locally_owned_dofs();
+    const auto                                  &owned = space.locally_owned_dofs();
     std::vector<dealii::types::global_dof_index> mine;
     for (auto &v : plate_owned)
       v.clear();
@@ -925,7 +934,8 @@ namespace talus::implicit_mpm
       }
     // the cell terms (PPP cell means, F-bar's cell mean) couple all the nodes a cell's points touch
     const auto reach = prm.mixed_up || prm.fbar ? ActiveSet<dim>::Reach::cell : ActiveSet<dim>::Reach::point;
-    with_kernel([&](auto k) { active.template reinit<decltype(k)>({&points}, ActiveSet<dim>::Couplings::skip, reach); });
+    with_kernel(
+      [&](auto k) { active.template reinit<decltype(k)>({&points}, ActiveSet<dim>::Couplings::skip, reach); });
     active.reinit_matrix(tangent);
     project_to_grid();
     find_negligible_nodes();
@@ -945,17 +955,17 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::measure_contact_gaps()
   {
-    using L                = PropertyLayout<dim>;
-    const double far       = std::numeric_limits<double>::max();
-    contact_gap            = far;
+    using L          = PropertyLayout<dim>;
+    const double far = std::numeric_limits<double>::max();
+    contact_gap      = far;
     contact_gap.update_ghost_values();
     contact_gap.set_ghost_state(false); // ghost entries written below and sent to the owners (compress)
     for (const auto &pt : points.handler)
       {
-        const auto & cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
-        const auto & x  = pt.get_location();
-        const auto   P  = pt.get_properties();
-        double       V  = P[L::volume];
+        const auto &cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+        const auto &x  = pt.get_location();
+        const auto  P  = pt.get_properties();
+        double      V  = P[L::volume];
         if (prm.axisymmetric)
           V /= 2 * M_PI * std::max(x[0], 1e-300);
         const double half = 0.5 * std::pow(V, 1.0 / dim);
@@ -964,7 +974,7 @@ namespace talus::implicit_mpm
             const int k = node_contact[cc.dofs[v * dim]];
             if (k < 0)
               continue;
-            const auto & c   = contact_nodes[k];
+            const auto  &c   = contact_nodes[k];
             const auto   in  = space.node_dof(c.node, c.axis);
             const double gap = c.sign * (c.wall - x[c.axis]) - half;
             contact_gap(in)  = std::min(contact_gap(in), gap);
@@ -973,7 +983,7 @@ namespace talus::implicit_mpm
     contact_gap.compress(dealii::VectorOperation::min);
     contact_gap.update_ghost_values();
     // the material has left the wall at a node in contact: released
-    const auto & owned = space.locally_owned_dofs();
+    const auto  &owned = space.locally_owned_dofs();
     unsigned int left  = 0;
     for (const auto &c : contact_nodes)
       {
@@ -990,8 +1000,8 @@ namespace talus::implicit_mpm
 
   template <int dim>
   dealii::AffineConstraints<double>
-  Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact,
-                                const bool with_prescribed, const bool hold_plates) const
+  Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact, const bool with_prescribed,
+                                const bool hold_plates) const
   {
     // the contact nodes now in contact: their normal DoF, with no slip all
     std::vector<dealii::types::global_dof_index> held;
@@ -1010,9 +1020,8 @@ namespace talus::implicit_mpm
       for (const auto &p : plate_nodes)
         if (force_plate(p.condition) && p.component == prm.rigid_plates[p.condition].axis)
           held.push_back(space.node_dof(p.node, p.component));
-    return active.constraints_with(
-      loads::wall_constraints(grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values,
-                              &held));
+    return active.constraints_with(loads::wall_constraints(
+      grid, space, boundary_flags, with_prescribed ? &prescribed_dofs : nullptr, values, &held));
   }
 
   template <int dim>
@@ -1032,7 +1041,7 @@ namespace talus::implicit_mpm
     for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
       if (space.component(k) < dim)
         m_max = std::max(m_max, mass.local_element(k));
-    m_max = dealii::Utilities::MPI::max(m_max, comm);
+    m_max              = dealii::Utilities::MPI::max(m_max, comm);
     const double limit = prm.negligible_mass * m_max;
     // every component of such a node is held, in u-p its pressure too: the
     // pressure row scales with the node's tiny point volume (V N / K and the
@@ -1080,9 +1089,9 @@ namespace talus::implicit_mpm
         throw;
       }
     std::swap(constraints, free_contact);
-    const auto & owned    = space.locally_owned_dofs();
-    const auto & pins     = active.constraints();
-    const double du_max   = du.linfty_norm();
+    const auto  &owned  = space.locally_owned_dofs();
+    const auto  &pins   = active.constraints();
+    const double du_max = du.linfty_norm();
     // a pull below 1e-8 of the load scale and a penetration below 1e-8 of the
     // largest increment are round-off of the Newton solve, not a change
     const double tol_pull = 1e-8 * force_scale, tol_in = 1e-8 * du_max;
@@ -1123,8 +1132,8 @@ namespace talus::implicit_mpm
   {
     // v f integrated over [t, t + h] by the trapezoidal rule (exact for constant
     // and piecewise-linear time functions whose kinks fall on step ends)
-    const auto & st = prm.stages[current_stage];
-    const auto & pv = st.velocities[k];
+    const auto  &st = prm.stages[current_stage];
+    const auto  &pv = st.velocities[k];
     const double t0 = k < st.n_global_velocities ? 0.0 : stage_start_time; // stage loads: stage time
     return pv.velocity * (0.5 * (pv.function.value(time - t0) + pv.function.value(time + h - t0)) * h);
   }
@@ -1255,10 +1264,10 @@ namespace talus::implicit_mpm
             if (x.linfty_norm() == 0)
               continue;
             const auto one = solve_for_delta(x);
-            info.method = one.method;
+            info.method    = one.method;
             info.iterations += one.iterations;
             info.relative_residual = std::max(info.relative_residual, one.relative_residual);
-            x = delta;
+            x                      = delta;
           }
         return info;
       }
@@ -1331,9 +1340,9 @@ namespace talus::implicit_mpm
     // Du: the solve's free values, the prescribed increments at the prescribed
     // DoFs of active nodes, 0 at the other constrained DoFs
     constraints.set_zero(delta);
-    const auto &        pins  = active.constraints(); // inactive nodes: no mass, pinned to 0
-    const auto &        owned = space.locally_owned_dofs();
-    const auto &        velocities = prm.stages[current_stage].velocities;
+    const auto         &pins       = active.constraints(); // inactive nodes: no mass, pinned to 0
+    const auto         &owned      = space.locally_owned_dofs();
+    const auto         &velocities = prm.stages[current_stage].velocities;
     std::vector<double> n_active(velocities.size() + prm.rigid_plates.size(), 0.0);
     for (const auto &p : prescribed_dofs)
       {
@@ -1356,8 +1365,8 @@ namespace talus::implicit_mpm
           idle_conditions[k] = 1;
           log() << "  WARNING: "
                 << (k < velocities.size() ? velocities[k].where : prm.rigid_plates[k - velocities.size()].where)
-                << " reaches no grid node next to material at t = "
-                << time << " s (the prescribed nodes are fixed in space and the material has left their cells): "
+                << " reaches no grid node next to material at t = " << time
+                << " s (the prescribed nodes are fixed in space and the material has left their cells): "
                 << "the condition has no effect from here on" << std::endl;
         }
   }
@@ -1366,10 +1375,10 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::project_to_grid()
   {
-    using L = PropertyLayout<dim>;
+    using L                                   = PropertyLayout<dim>;
     std::vector<MaterialPointSet<dim> *> sets = {&points};
-    const auto &pins = active.constraints(); // inactive DoFs only: walls keep their mass
-    mass = 0;
+    const auto                          &pins = active.constraints(); // inactive DoFs only: walls keep their mass
+    mass                                      = 0;
     with_kernel([&](auto k) {
       with_components([&](auto nc) {
         transfer::assemble<dim, decltype(k), decltype(nc)::value>(sets, active, pins, transfer::NodalProjection<dim>{},
@@ -1393,7 +1402,7 @@ namespace talus::implicit_mpm
     });
     for (unsigned int i = 0; i < mass.locally_owned_size(); ++i)
       {
-        const double m = mass.local_element(i);
+        const double m       = mass.local_element(i);
         v_n.local_element(i) = m > 0 ? v_n.local_element(i) / m : 0.0;
         a_n.local_element(i) = m > 0 ? a_n.local_element(i) / m : 0.0;
       }
@@ -1412,9 +1421,9 @@ namespace talus::implicit_mpm
   double
   Solver<dim>::assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g)
   {
-    const auto start = Clock::now();
-    transfer::PointFailure                     failure;
-    transfer::UpdatedLagrangianForce<dim>      force;
+    const auto                            start = Clock::now();
+    transfer::PointFailure                failure;
+    transfer::UpdatedLagrangianForce<dim> force;
     force.materials      = &prm.materials;
     force.history_offset = PropertyLayout<dim>::history;
     force.gravity        = g;
@@ -1428,7 +1437,7 @@ namespace talus::implicit_mpm
         compute_cell_jbar();
         force.jbar = &cell_jbar;
       }
-    residual             = 0;
+    residual = 0;
     if (with_tangent)
       tangent = 0;
     if (prm.mixed_up)
@@ -1484,11 +1493,11 @@ namespace talus::implicit_mpm
       {
         // lumped inertia and mass-proportional damping at the nodes:
         // r_i += m_i (a_i + alpha v_i), tangent_ii += m_i (1/(beta h^2) + alpha gamma/(beta h))
-        const double coef = newmark.tangent_factors(prm.rayleigh_alpha, 0).mass;
-        const auto & owned = space.locally_owned_dofs();
+        const double coef  = newmark.tangent_factors(prm.rayleigh_alpha, 0).mass;
+        const auto  &owned = space.locally_owned_dofs();
         for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
           {
-            const auto i = owned.nth_index_in_set(k);
+            const auto   i = owned.nth_index_in_set(k);
             const double m = mass.local_element(k);
             if (m == 0 || constraints.is_constrained(i))
               continue;
@@ -1536,11 +1545,11 @@ namespace talus::implicit_mpm
     /// diagonal: the matrix of the system with those DoFs prescribed
     /// (symmetric if A is). In place on Epetra's values (the pattern is kept).
     void
-    zero_rows_and_columns(dealii::TrilinosWrappers::SparseMatrix &            A,
+    zero_rows_and_columns(dealii::TrilinosWrappers::SparseMatrix             &A,
                           const std::vector<dealii::types::global_dof_index> &dofs)
     {
-      auto &            E    = const_cast<Epetra_CrsMatrix &>(A.trilinos_matrix());
-      const Epetra_Map &rows = E.RowMap(), &cols = E.ColMap();
+      auto                      &E    = const_cast<Epetra_CrsMatrix &>(A.trilinos_matrix());
+      const Epetra_Map          &rows = E.RowMap(), &cols = E.ColMap();
       std::vector<unsigned char> col_hit(E.NumMyCols(), 0);
       for (const auto g : dofs)
         {
@@ -1550,12 +1559,12 @@ namespace talus::implicit_mpm
         }
       for (int r = 0; r < E.NumMyRows(); ++r)
         {
-          int     n = 0;
-          double *values = nullptr;
-          int *   indices = nullptr;
+          int     n       = 0;
+          double *values  = nullptr;
+          int    *indices = nullptr;
           E.ExtractMyRowView(r, n, values, indices);
-          const int  gid  = rows.GID(r);
-          const bool hit  = std::binary_search(dofs.begin(), dofs.end(), dealii::types::global_dof_index(gid));
+          const int  gid = rows.GID(r);
+          const bool hit = std::binary_search(dofs.begin(), dofs.end(), dealii::types::global_dof_index(gid));
           for (int j = 0; j < n; ++j)
             if ((hit && cols.GID(indices[j]) != gid) || (!hit && col_hit[indices[j]]))
               values[j] = 0.0;
@@ -1607,8 +1616,8 @@ namespace talus::implicit_mpm
     // plate"): exact, the same solution as a master-slave line u_i = u_m per
     // plate node, without couplings of the master in the sparsity or the
     // master as a ghost on every rank.
-    const auto         start = Clock::now();
-    const unsigned int n_all = prm.rigid_plates.size();
+    const auto                start = Clock::now();
+    const unsigned int        n_all = prm.rigid_plates.size();
     std::vector<unsigned int> ks; // the force plates
     for (unsigned int k = 0; k < n_all; ++k)
       if (force_plate(k))
@@ -1671,8 +1680,9 @@ namespace talus::implicit_mpm
             if (!idle_plates[k])
               {
                 idle_plates[k] = 1;
-                log() << "  WARNING: " << prm.rigid_plates[k].where << " reaches no free grid node next to material at t = "
-                      << time << " s: its force acts on nothing from here on" << std::endl;
+                log() << "  WARNING: " << prm.rigid_plates[k].where
+                      << " reaches no free grid node next to material at t = " << time
+                      << " s: its force acts on nothing from here on" << std::endl;
               }
             continue;
           }
@@ -1681,7 +1691,7 @@ namespace talus::implicit_mpm
         b[a] = plate_target[k] - plate_sum[k] - (w[a] * z0);
       }
     const std::vector<double> c = solve_dense(M, b);
-    delta = z0;
+    delta                       = z0;
     for (unsigned int a = 0; a < n; ++a)
       {
         delta.add(c[a], z[a]);
@@ -1702,7 +1712,7 @@ namespace talus::implicit_mpm
     // mass, only the free DoFs carry inertia: w = 0 at every DoF constrained in
     // this assembly (walls, held contact nodes, prescribed and inactive nodes),
     // so a constrained node neither feels nor exerts an inertial force.
-    const auto & owned = space.locally_owned_dofs();
+    const auto  &owned = space.locally_owned_dofs();
     const double alpha = prm.rayleigh_alpha;
     for (unsigned int k = 0; k < inertia_field.locally_owned_size(); ++k)
       {
@@ -1750,10 +1760,10 @@ namespace talus::implicit_mpm
     delta            = 0;
     with_kernel([&](auto k) {
       using K = decltype(k);
-      transfer::assemble<dim, K, dim + 1>({&points}, active, pins, transfer::PressureProjection<dim>{pressure_offset, true},
-                                          nullptr, &residual);
-      transfer::assemble<dim, K, dim + 1>({&points}, active, pins, transfer::PressureProjection<dim>{pressure_offset, false},
-                                          nullptr, &delta);
+      transfer::assemble<dim, K, dim + 1>({&points}, active, pins,
+                                          transfer::PressureProjection<dim>{pressure_offset, true}, nullptr, &residual);
+      transfer::assemble<dim, K, dim + 1>({&points}, active, pins,
+                                          transfer::PressureProjection<dim>{pressure_offset, false}, nullptr, &delta);
     });
     for (unsigned int k = 0; k < du.locally_owned_size(); ++k)
       if (space.component(k) == dim && delta.local_element(k) > 0)
@@ -1859,7 +1869,7 @@ namespace talus::implicit_mpm
       }
     if (prm.mixed_up)
       predict_pressure();
-    unsigned int  linear_iterations = 0;
+    unsigned int  linear_iterations     = 0;
     double        worst_linear_residual = 0;
     NewtonProblem problem;
     problem.assemble = [&](const bool with_tangent) { return assemble(with_tangent, g); };
@@ -1899,8 +1909,8 @@ namespace talus::implicit_mpm
           }
         catch (const NewtonFailure &e)
           {
-            log() << "  step " << step_number + 1 << " (t = " << time + h << "): the contact reactions failed: "
-                  << e.what() << std::endl;
+            log() << "  step " << step_number + 1 << " (t = " << time + h
+                  << "): the contact reactions failed: " << e.what() << std::endl;
             return StepOutcome::cut_back;
           }
         released += changed.first;
@@ -2020,9 +2030,8 @@ namespace talus::implicit_mpm
       compute_cell_jbar(); // of the converged du
     with_kernel([&](auto k) {
       transfer::CommitUpdatedLagrangian<dim, decltype(k)> commit(points, space, du, dynamic() ? &a_new : nullptr,
-                                                                 prm.materials, acceleration_offset, h,
-                                                                 newmark.gamma(), failure, pressure_offset,
-                                                                 radius_offset);
+                                                                 prm.materials, acceleration_offset, h, newmark.gamma(),
+                                                                 failure, pressure_offset, radius_offset);
       if (prm.fbar)
         commit.jbar = &cell_jbar;
       transfer::for_each_active_cell(points, commit);
@@ -2033,9 +2042,9 @@ namespace talus::implicit_mpm
     points.relocate();
     seconds_commit += seconds_since(start);
     log() << "  step " << step_number + 1 << " t = " << std::setprecision(6) << time + h << ": " << result.iterations
- << " Newton iterations, |r| " << last.history << ", order (|r|) " << std::setprecision(3)
-          << result.observed_order << ", (|du|) " << last.increment_order << ", " << linear_iterations << " linear iterations (largest |b - A x|/|b| "
-          << worst_linear_residual << ")";
+          << " Newton iterations, |r| " << last.history << ", order (|r|) " << std::setprecision(3)
+          << result.observed_order << ", (|du|) " << last.increment_order << ", " << linear_iterations
+          << " linear iterations (largest |b - A x|/|b| " << worst_linear_residual << ")";
     if (point_contact)
       log() << "; contact (points): " << last.point_contact.in_contact << " in contact (" << last.point_contact.slipping
             << " slipping, " << last.point_contact.new_contacts << " new, " << last.point_contact.released
@@ -2062,8 +2071,8 @@ namespace talus::implicit_mpm
     const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
     if (dynamic() && prm.rayleigh_beta > 0)
       assemble_damping_stiffness(g);
-    const auto &                 owned = space.locally_owned_dofs();
-    Vector                       v;
+    const auto &owned = space.locally_owned_dofs();
+    Vector      v;
     space.reinit_vector(v);
     for (unsigned int k = 0; k < du.locally_owned_size(); ++k)
       {
@@ -2071,7 +2080,7 @@ namespace talus::implicit_mpm
         // deterministic, rank-independent values from the global index
         du.local_element(k) =
           (space.component(k) == dim ? pressure_scale : 1.0) * scale * std::sin(1.3 * double(i) + 0.7);
-        v.local_element(k)  = std::cos(2.1 * double(i) + 0.3);
+        v.local_element(k) = std::cos(2.1 * double(i) + 0.3);
       }
     constraints.set_zero(du);
     constraints.set_zero(v);
@@ -2089,7 +2098,7 @@ namespace talus::implicit_mpm
     du.update_ghost_values();
     assemble(false, g);
     r_plus = residual;
-    du = u0;
+    du     = u0;
     du.add(-eps, v);
     du.update_ghost_values();
     assemble(false, g);
@@ -2153,9 +2162,11 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::describe(std::ostream &out) const
   {
-    out << "  grid: " << grid.tria.n_global_active_cells() << " cells; " << n_points() << " material points" << std::endl;
+    out << "  grid: " << grid.tria.n_global_active_cells() << " cells; " << n_points() << " material points"
+        << std::endl;
     out << "  analysis: " << (dynamic() ? "dynamic (Newmark gamma = " : "static (")
-        << (dynamic() ? std::to_string(prm.gamma) + ", beta = " + std::to_string(prm.beta) + (prm.consistent_mass ? ", consistent mass" : ", lumped mass") +
+        << (dynamic() ? std::to_string(prm.gamma) + ", beta = " + std::to_string(prm.beta) +
+                          (prm.consistent_mass ? ", consistent mass" : ", lumped mass") +
                           (prm.rayleigh_alpha > 0 ? ", Rayleigh alpha = " + std::to_string(prm.rayleigh_alpha) : "") +
                           (prm.rayleigh_beta > 0 ? ", Rayleigh beta = " + std::to_string(prm.rayleigh_beta) : "")
                       : std::string(prm.ramp_loads ? "loads ramped over the end time" : "full loads"))
@@ -2166,14 +2177,17 @@ namespace talus::implicit_mpm
                          : std::string("irreducible (displacement)"))
         << (prm.bspline() ? ", quadratic B-splines" : ", linear shape functions")
         << (prm.tractions.empty() ? "" : ", " + std::to_string(prm.tractions.size()) + " traction(s) (dead loads)")
-        << (prm.velocities.empty() ? "" :
-                                     ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")
-        << (dim == 3 ? std::string() : prm.axisymmetric ? ", axisymmetric (x = radius)" : ", plane strain")
+        << (prm.velocities.empty()
+              ? ""
+              : ", " + std::to_string(prm.velocities.size()) + " prescribed nodal velocity condition(s)")
+        << (dim == 3           ? std::string()
+            : prm.axisymmetric ? ", axisymmetric (x = radius)"
+                               : ", plane strain")
         << std::endl;
     if (!prm.contact_ids.empty())
       {
         out << "  contact walls (unilateral, "
-            << (prm.contact_no_slip ? std::string("no slip")
+            << (prm.contact_no_slip   ? std::string("no slip")
                 : prm.contact_mu == 0 ? std::string("frictionless")
                                       : "Coulomb mu = " + std::to_string(prm.contact_mu))
             << "): boundary";
@@ -2196,12 +2210,12 @@ namespace talus::implicit_mpm
         out << ", " << (std::isinf(f.friction) ? "rough (no slip)" : "smooth") << ", penalty k = " << f.penalty
             << " x M V_p / h^2" << std::endl;
       }
-    out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative " << prm.newton.residual_relative
-        << ", absolute " << prm.newton.residual_absolute << ", at most " << prm.newton.max_iterations
-        << " iterations; linear solver "
-        << (prm.linear.method == LinearSolverOptions::Method::direct   ? "direct (" + prm.linear.direct_package + ")" :
-            prm.linear.method == LinearSolverOptions::Method::cg_amg ? std::string("CG + ML AMG") :
-                                                                       std::string("GMRES + ML AMG"))
+    out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative "
+        << prm.newton.residual_relative << ", absolute " << prm.newton.residual_absolute << ", at most "
+        << prm.newton.max_iterations << " iterations; linear solver "
+        << (prm.linear.method == LinearSolverOptions::Method::direct   ? "direct (" + prm.linear.direct_package + ")"
+            : prm.linear.method == LinearSolverOptions::Method::cg_amg ? std::string("CG + ML AMG")
+                                                                       : std::string("GMRES + ML AMG"))
         << std::endl;
   }
 
@@ -2218,7 +2232,7 @@ namespace talus::implicit_mpm
     enter_stage(k);
     if (!prm.staged)
       return prm.end_time;
-    const auto &st = prm.stages[k];
+    const auto        &st = prm.stages[k];
     std::ostringstream os;
     os << "  stage " << k << " '" << st.name << "': t = " << stage_start_time << " s, duration " << st.duration
        << " s, dt = " << dt << " s, gravity " << st.gravity << ", " << st.boundary_conditions.size()
@@ -2236,10 +2250,9 @@ namespace talus::implicit_mpm
   std::vector<std::string>
   Solver<dim>::series_columns() const
   {
-    std::vector<std::string> c = {"newton_iterations", "residual_first",    "residual_last",
-                                  "newton_order",      "increment_order",   "linear_iterations",
-                                  "load_factor",       "kinetic_energy"};
-    const char *ax[] = {"x", "y", "z"};
+    std::vector<std::string> c    = {"newton_iterations", "residual_first",    "residual_last", "newton_order",
+                                     "increment_order",   "linear_iterations", "load_factor",   "kinetic_energy"};
+    const char              *ax[] = {"x", "y", "z"};
     for (unsigned int d = 0; d < dim; ++d)
       c.push_back(std::string("centre_of_mass_") + ax[d]);
     if (point_contact)
@@ -2264,8 +2277,10 @@ namespace talus::implicit_mpm
     const double        ke = kinetic_energy();
     std::vector<double> v  = {0, 0, 0, 0, 0, 0, load_factor(time), ke};
     if (after_step)
-      v = {double(last.iterations), last.residual_first,        last.residual_last, last.observed_order,
-           last.increment_order,    double(last.linear_iterations), load_factor(time), ke};
+      v = {double(last.iterations), last.residual_first,
+           last.residual_last,      last.observed_order,
+           last.increment_order,    double(last.linear_iterations),
+           load_factor(time),       ke};
     // centre of mass (mass-weighted mean position)
     std::vector<double> sums(dim + 1, 0.0);
     for (const auto &pt : points.handler)
@@ -2301,7 +2316,10 @@ namespace talus::implicit_mpm
       {
         const auto &plate = prm.rigid_plates[k];
         v.push_back(plate_displacement[k]);
-        v.push_back((force_plate(k) ? plate.force_at(time) : after_step ? plate_reaction[k][plate.axis] : 0.0) + 0.0); // no -0
+        v.push_back((force_plate(k) ? plate.force_at(time)
+                     : after_step   ? plate_reaction[k][plate.axis]
+                                    : 0.0) +
+                    0.0); // no -0
         if (plate.rough)
           {
             double t2 = 0;
@@ -2336,25 +2354,23 @@ namespace talus::implicit_mpm
   std::string
   Solver<dim>::write_checkpoint()
   {
-    return write_checkpoint_file(prm, *this, checkpoint_format, checkpoint_version,
-                                 scene_signature(prm, points.layout.n_properties()), comm, [&](io::H5File &f) {
-                                   f.set_attribute("newton iterations", std::int64_t(total_iterations));
-                                   f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
-                                   f.set_attribute("cut-backs", std::int64_t(cut_backs));
-                                   for (unsigned int k = 0; k < plate_displacement.size(); ++k)
-                                     {
-                                       // the plate's state, and its last reaction for the series
-                                       f.set_attribute("plate " + std::to_string(k) + " displacement",
-                                                       plate_displacement[k]);
-                                       for (unsigned int d = 0; d < dim; ++d)
-                                         f.set_attribute("plate " + std::to_string(k) + " reaction " +
-                                                           std::to_string(d),
-                                                         plate_reaction[k][d]);
-                                     }
-                                   write_points(f, points);
-                                   write_pvd_times(f, "output/pvd", pvd_records);
-                                   balance.write(f); // the partition of the last rebalance
-                                 });
+    return write_checkpoint_file(
+      prm, *this, checkpoint_format, checkpoint_version, scene_signature(prm, points.layout.n_properties()), comm,
+      [&](io::H5File &f) {
+        f.set_attribute("newton iterations", std::int64_t(total_iterations));
+        f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
+        f.set_attribute("cut-backs", std::int64_t(cut_backs));
+        for (unsigned int k = 0; k < plate_displacement.size(); ++k)
+          {
+            // the plate's state, and its last reaction for the series
+            f.set_attribute("plate " + std::to_string(k) + " displacement", plate_displacement[k]);
+            for (unsigned int d = 0; d < dim; ++d)
+              f.set_attribute("plate " + std::to_string(k) + " reaction " + std::to_string(d), plate_reaction[k][d]);
+          }
+        write_points(f, points);
+        write_pvd_times(f, "output/pvd", pvd_records);
+        balance.write(f); // the partition of the last rebalance
+      });
   }
 
   template <int dim>

@@ -46,7 +46,7 @@ namespace talus::implicit_mpm
       quasi_static, ///< no inertia; time is a load parameter
       dynamic       ///< Newmark
     };
-    Analysis analysis  = Analysis::dynamic;
+    Analysis analysis = Analysis::dynamic;
     /// mixed u-p (seed 001 ch. 5): nodal pressure as a second field, PPP stabilisation
     bool   mixed_up      = false;
     double stabilisation = 1; ///< alpha of Eq. 5.15 (mixed u-p)
@@ -59,18 +59,18 @@ namespace talus::implicit_mpm
     /// with the exact tangent (docs/implicit.md, "F-bar")
     bool fbar = false;
     // 'numerics/shape function' (SceneParameters::bspline()): the kernel of every grid transfer
-    double   time_step = 0; ///< > 0 (required)
-    double   gamma = 0.5, beta = 0.25;
-    double   rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
+    double time_step = 0; ///< > 0 (required)
+    double gamma = 0.5, beta = 0.25;
+    double rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
     /// C += beta K: stiffness-proportional Rayleigh damping [s], K the material + geometric
     /// tangent at the start of the step (frozen within it)
-    double   rayleigh_beta = 0;
+    double rayleigh_beta = 0;
     /// 'implicit/mass matrix = consistent': the inertia and damping with
     /// M_ij = sum_p m_p N_i N_j (per component) instead of its row sums; the
     /// projection of v_p and a_p to the nodes stays lumped (docs/implicit.md)
     bool consistent_mass = false;
     /// static: body forces grow linearly from 0 at t = 0 to full at the end time
-    bool           ramp_loads = true;
+    bool ramp_loads = true;
     /// Every traction of the run, one point-force slot each: first the
     /// top-level 'loads/traction k' (global, absolute time), then each stage's
     /// own ('stage k/loads', stage time). Dead loads carried by boundary points,
@@ -113,8 +113,8 @@ namespace talus::implicit_mpm
     struct Footing
     {
       bool         enabled = false;
-      unsigned int axis    = 1;  ///< normal axis
-      int          sign    = 1;  ///< +1: the footing is on the upper side of its base
+      unsigned int axis    = 1; ///< normal axis
+      int          sign    = 1; ///< +1: the footing is on the upper side of its base
       double       level = 0, velocity = 0, penalty = 1;
       double       lower[2] = {0, 0}, upper[2] = {0, 0};
       double       friction = std::numeric_limits<double>::infinity(); ///< rough: no slip; smooth: 0
@@ -127,8 +127,8 @@ namespace talus::implicit_mpm
     /// 'implicit/negligible nodal mass': the DoFs (displacement and, in u-p,
     /// pressure) of an active node whose lumped mass is below this fraction of
     /// the largest nodal mass are held at zero increment for the step (0: off)
-    double negligible_mass = 0;
-    NewtonSettings newton;
+    double              negligible_mass = 0;
+    NewtonSettings      newton;
     LinearSolverOptions linear;
   };
 
@@ -148,7 +148,7 @@ namespace talus::implicit_mpm
     unsigned int iterations = 0, linear_iterations = 0;
     double       residual_first = 0, residual_last = 0, observed_order = 0;
     double       increment_order = 0; ///< observed order of the increments |du_k|
-    std::string  history; ///< residual norms of the iterations, for the log
+    std::string  history;             ///< residual norms of the iterations, for the log
     /// contact walls: Newton solves (passes) of the step, nodes released and
     /// put (back) in contact over its passes, nodes in contact at its end
     unsigned int contact_passes = 0, contact_released = 0, contact_added = 0, contact_nodes = 0;
@@ -170,7 +170,11 @@ namespace talus::implicit_mpm
     /// Grid, spaces, points, constraints. Collective.
     void setup();
 
-    unsigned long long n_points() const { return points.handler.n_global_particles(); }
+    unsigned long long
+    n_points() const
+    {
+      return points.handler.n_global_particles();
+    }
 
     /// For tests: the tangent against central differences of the residual at
     /// the iterate du = `scale` x a pseudo-random field (constrained DoFs 0), in
@@ -180,16 +184,28 @@ namespace talus::implicit_mpm
     /// Mixed u-p: the pressure components of the iterate are `pressure_scale` x
     /// the pseudo-random field.
     double tangent_error(const double h, const double scale, const double eps, const double pressure_scale = 1.0);
-    double             kinetic_energy() const;
+    double kinetic_energy() const;
 
     // ---- the Formulation interface
-    std::string              tool_name() const override { return "talus-implicit"; }
-    void                     describe(std::ostream &out) const override;
-    unsigned int             n_stages() const override { return prm.stages.size(); }
-    double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
-    StepOutcome              advance_by(const double h) override;
-    void                     check_stability() const override;
-    unsigned long long       lost_points() const override { return points.relocation_stats.lost; }
+    std::string
+    tool_name() const override
+    {
+      return "talus-implicit";
+    }
+    void describe(std::ostream &out) const override;
+    unsigned int
+    n_stages() const override
+    {
+      return prm.stages.size();
+    }
+    double      begin_stage(const unsigned int k, const bool first, const bool resumed) override;
+    StepOutcome advance_by(const double h) override;
+    void        check_stability() const override;
+    unsigned long long
+    lost_points() const override
+    {
+      return points.relocation_stats.lost;
+    }
     std::vector<std::string> series_columns() const override;
     std::vector<double>      series_values(const bool after_step) override;
     void                     write_vtu(const unsigned int counter) override;
@@ -205,15 +221,19 @@ namespace talus::implicit_mpm
     MaterialPointSet<dim>  points;
     /// Load balancing by material points (formulations/common/load_balance.h);
     /// its repartitions call grid_changed().
-    LoadBalance<dim>       balance;
-    NodalSpace<dim>        space;
-    ActiveSet<dim>         active;
-    Newmark                newmark;
+    LoadBalance<dim>        balance;
+    NodalSpace<dim>         space;
+    ActiveSet<dim>          active;
+    Newmark                 newmark;
     loads::PointForces<dim> point_forces;
-    StepReport             last;
+    StepReport              last;
 
   private:
-    bool dynamic() const { return prm.analysis == Parameters<dim>::Analysis::dynamic; }
+    bool
+    dynamic() const
+    {
+      return prm.analysis == Parameters<dim>::Analysis::dynamic;
+    }
     /// The ramp of the current stage at time t (static with 'ramp loads': the
     /// fraction of the stage's duration elapsed, at most 1; else 1).
     double load_factor(const double t) const;
@@ -224,7 +244,7 @@ namespace talus::implicit_mpm
     /// Walls, prescribed nodes and the condition report of stage k.
     void enter_stage(const unsigned int k);
     /// The wall flags, contact nodes and prescribed nodes of stage k on the current partition.
-    void stage_nodes(const unsigned int k);
+    void   stage_nodes(const unsigned int k);
     double point_force_scale = 1; ///< multiplies the point forces (unstaged static ramp)
     /// After a repartition: what depends on the partition and lives across
     /// steps (the space's DoFs, the wall flags and prescribed nodes of the
@@ -235,10 +255,10 @@ namespace talus::implicit_mpm
     void prepare_step();
     /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,
     /// and the contact nodes now in contact) merged with the inactive pins.
-    dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values = nullptr,
-                                                       const bool with_contact = true,
-                                                       const bool with_prescribed = true,
-                                                       const bool hold_plates = false) const;
+    dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values          = nullptr,
+                                                       const bool                 with_contact    = true,
+                                                       const bool                 with_prescribed = true,
+                                                       const bool                 hold_plates     = false) const;
     /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
     /// normal DoF of each node, decided by the owner, ghosts updated.
     std::vector<loads::ContactNode> contact_nodes;
@@ -251,11 +271,12 @@ namespace talus::implicit_mpm
     /// over the points of the node's cells of (distance of the point to the
     /// wall) - (half its size, V_p^(1/dim) / 2). A node can be in contact only
     /// while its gap is at most half a point size (the material is at the wall).
-    Vector              contact_gap;
-    std::vector<int>    node_contact; ///< by grid local node: index into contact_nodes or -1
-    void                measure_contact_gaps();
+    Vector           contact_gap;
+    std::vector<int> node_contact; ///< by grid local node: index into contact_nodes or -1
+    void             measure_contact_gaps();
     /// 'contact gap' x the cell size normal to the wall
-    double contact_gap_tolerance(const loads::ContactNode &c) const
+    double
+    contact_gap_tolerance(const loads::ContactNode &c) const
     {
       return prm.contact_gap * (prm.grid_upper[c.axis] - prm.grid_lower[c.axis]) / prm.grid_cells[c.axis];
     }
@@ -266,11 +287,11 @@ namespace talus::implicit_mpm
     /// nodes that penetrate it are put in contact. Returns the global number
     /// of nodes released and added. Collective.
     std::pair<unsigned int, unsigned int> update_contact(const dealii::Tensor<1, dim> &g, const double force_scale);
-    unsigned long long total_contact_released = 0, total_contact_added = 0, total_contact_passes = 0;
+    unsigned long long                    total_contact_released = 0, total_contact_added = 0, total_contact_passes = 0;
     /// 'contact method = points': the penalty walls on the points (null otherwise)
     std::unique_ptr<PointContact<dim>> point_contact;
-    unsigned long long total_point_contacts = 0, total_point_releases = 0, total_point_slip_steps = 0;
-    double             worst_penetration_ratio = 0;
+    unsigned long long                 total_point_contacts = 0, total_point_releases = 0, total_point_slip_steps = 0;
+    double                             worst_penetration_ratio = 0;
     /// Lumped nodal mass and the mass-weighted projections of v_p and a_p
     /// (Eqs. 2.6-2.9) onto the active DoFs.
     void project_to_grid();
@@ -286,7 +307,8 @@ namespace talus::implicit_mpm
     void predict_pressure();
     /// f(std::integral_constant<unsigned int, nc>) with the space's components.
     template <class F>
-    void with_components(F &&f) const
+    void
+    with_components(F &&f) const
     {
       if (prm.mixed_up)
         f(std::integral_constant<unsigned int, dim + 1>());
@@ -304,22 +326,23 @@ namespace talus::implicit_mpm
     /// The newest valid checkpoint into the state (false: none). Collective.
     bool restore_checkpoint();
 
-    unsigned int                            acceleration_offset = 0;
-    unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int; ///< mixed u-p: p_p
+    unsigned int acceleration_offset = 0;
+    unsigned int pressure_offset     = dealii::numbers::invalid_unsigned_int; ///< mixed u-p: p_p
     /// axisymmetric: the point's radius r_n at the start of the step (set by prepare_step)
-    unsigned int radius_offset = dealii::numbers::invalid_unsigned_int;
-    std::vector<const materials::Material *> split_models; ///< mixed u-p, per material id
-    dealii::AffineConstraints<double>       constraints; ///< Dirichlet + inactive, homogeneous
-    std::vector<unsigned char>              boundary_flags; ///< by grid local DoF (fixed/roller walls)
-    std::vector<loads::PrescribedNodeDof>   prescribed_dofs; ///< of 'loads/velocity k' (owned + ghost)
-    std::vector<unsigned char>              idle_conditions; ///< per condition: reported as acting on nothing
+    unsigned int                             radius_offset = dealii::numbers::invalid_unsigned_int;
+    std::vector<const materials::Material *> split_models;    ///< mixed u-p, per material id
+    dealii::AffineConstraints<double>        constraints;     ///< Dirichlet + inactive, homogeneous
+    std::vector<unsigned char>               boundary_flags;  ///< by grid local DoF (fixed/roller walls)
+    std::vector<loads::PrescribedNodeDof>    prescribed_dofs; ///< of 'loads/velocity k' (owned + ghost)
+    std::vector<unsigned char>               idle_conditions; ///< per condition: reported as acting on nothing
     /// per condition of the stage: the displacement it has prescribed so far
     /// (the shift of its region with 'velocity regions follow')
     std::vector<dealii::Tensor<1, dim>> region_shift;
     /// DoFs (relevant, every component) of nodes of negligible mass, held this step
     std::vector<dealii::types::global_dof_index> negligible_dofs;
     /// some stage has 'velocity k' conditions (series columns prescribed_force_*)
-    bool any_velocity_condition() const
+    bool
+    any_velocity_condition() const
     {
       for (const auto &st : prm.stages)
         if (!st.velocities.empty())
@@ -339,12 +362,18 @@ namespace talus::implicit_mpm
     // plate is one unknown per plate: its nodes' DoFs are free in the assembly
     // (the tangent and residual keep their rows) and solve_with_plates()
     // condenses them exactly by superposition.
-    unsigned int n_velocities() const { return prm.stages[current_stage].velocities.size(); }
-    bool force_plate(const unsigned int k) const
+    unsigned int
+    n_velocities() const
+    {
+      return prm.stages[current_stage].velocities.size();
+    }
+    bool
+    force_plate(const unsigned int k) const
     {
       return prm.rigid_plates[k].control == loads::RigidPlate<dim>::Control::force;
     }
-    bool any_force_plate() const
+    bool
+    any_force_plate() const
     {
       for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
         if (force_plate(k))
@@ -352,7 +381,8 @@ namespace talus::implicit_mpm
       return false;
     }
     /// some plate has prescribed DoFs (displacement control or rough): reactions
-    bool any_plate_reaction() const
+    bool
+    any_plate_reaction() const
     {
       for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
         if (!force_plate(k) || prm.rigid_plates[k].rough)
@@ -385,20 +415,20 @@ namespace talus::implicit_mpm
     std::vector<double> plate_target, plate_sum;
     /// per plate: the converged reaction along the axis (displacement control)
     /// and the tangential one (rough), per component
-    std::vector<dealii::Tensor<1, dim>> plate_reaction;
+    std::vector<dealii::Tensor<1, dim>>   plate_reaction;
     std::vector<loads::PrescribedNodeDof> plate_nodes; ///< rigid_plate_node_dofs (owned + ghost)
     /// per force plate: its owned free axis DoFs this step
     std::vector<std::vector<dealii::types::global_dof_index>> plate_owned;
-    std::vector<dealii::types::global_dof_index>              plate_all; ///< every rank's, sorted
-    std::vector<unsigned char> idle_plates; ///< per plate: reported as acting on nothing
-    bool plates_held = false; ///< the predictor holds the force plates' DoFs (their increment 0)
-    double seconds_plates = 0; ///< the plates' extra linear algebra (products, zeroing, combination)
-    double seconds_plates_solve = 0; ///< the plates' Newton solves (all right-hand sides)
+    std::vector<dealii::types::global_dof_index>              plate_all;   ///< every rank's, sorted
+    std::vector<unsigned char>                                idle_plates; ///< per plate: reported as acting on nothing
+    bool   plates_held          = false; ///< the predictor holds the force plates' DoFs (their increment 0)
+    double seconds_plates       = 0;     ///< the plates' extra linear algebra (products, zeroing, combination)
+    double seconds_plates_solve = 0;     ///< the plates' Newton solves (all right-hand sides)
     /// The displacement of a prescribed DoF over the step [t, t + h].
     double prescribed_increment(const loads::PrescribedNodeDof &p, const double h) const;
     /// du before Newton: one linear solve with the prescribed increments lifted
     /// into the right-hand side (throws NewtonFailure if it fails).
-    void predict_prescribed(const double h, const dealii::Tensor<1, dim> &g);
+    void   predict_prescribed(const double h, const dealii::Tensor<1, dim> &g);
     double lifted_residual = 0; ///< |r| of the step's lifted system (0 without prescribed DoFs)
     /// delta from tangent delta = -residual (the step's linear solve, timed and
     /// counted); a failed or singular solve throws NewtonFailure.
@@ -406,19 +436,19 @@ namespace talus::implicit_mpm
     /// delta from tangent delta = -r
     LinearSolveInfo solve_for_delta(const Vector &r);
     /// each r[k] replaced by x solving tangent x = -r[k] (direct: one factorisation)
-    LinearSolveInfo solve_several(std::vector<Vector> &r);
-    dealii::TrilinosWrappers::SparseMatrix  tangent;
+    LinearSolveInfo                        solve_several(std::vector<Vector> &r);
+    dealii::TrilinosWrappers::SparseMatrix tangent;
     /// 'rayleigh beta' > 0: the stiffness K_n of the step's start (du = 0), whose beta K_n v^{n+1}
     /// is the damping force of the step (assemble_damping_stiffness)
-    dealii::TrilinosWrappers::SparseMatrix  damping_stiffness;
-    bool assembling_damping = false; ///< assemble() stops after the points' force (K_n for the damping)
-    Vector                                  du, delta, residual, mass, v_n, a_n, a_new;
+    dealii::TrilinosWrappers::SparseMatrix damping_stiffness;
+    bool   assembling_damping = false; ///< assemble() stops after the points' force (K_n for the damping)
+    Vector du, delta, residual, mass, v_n, a_n, a_new;
     /// F-bar: the mean det dF of each active cell at the current du (transfer::CellMeanJacobian)
     std::vector<double> cell_jbar;
     void                compute_cell_jbar();
     /// consistent mass: a^{n+1} + alpha_R v^{n+1} at the free DoFs (0 at constrained
     /// ones), ghosts updated, the field the inertia integrand reads
-    Vector inertia_field;
+    Vector                                      inertia_field;
     std::vector<std::pair<double, std::string>> pvd_records;
     // totals for the summary
     unsigned long long total_iterations = 0, total_linear_iterations = 0;

@@ -75,14 +75,34 @@ namespace talus::implicit_mpm
       dt_ = dt;
     }
 
-    double gamma() const { return gamma_; }
-    double beta() const { return beta_; }
-    double dt() const { return dt_; }
+    double
+    gamma() const
+    {
+      return gamma_;
+    }
+    double
+    beta() const
+    {
+      return beta_;
+    }
+    double
+    dt() const
+    {
+      return dt_;
+    }
 
     /// beta > 0: du is an unknown, solved for with the tangent.
-    bool implicit() const { return beta_ > 0; }
+    bool
+    implicit() const
+    {
+      return beta_ > 0;
+    }
     /// 2 beta >= gamma >= 1/2.
-    bool unconditionally_stable() const { return 2 * beta_ >= gamma_; }
+    bool
+    unconditionally_stable() const
+    {
+      return 2 * beta_ >= gamma_;
+    }
     /// Largest stable omega dt of an undamped linear oscillator:
     /// 1/sqrt(gamma/2 - beta) (2 for central difference); +inf when
     /// unconditionally stable.
@@ -96,10 +116,18 @@ namespace talus::implicit_mpm
 
     // ---- coefficients of the incremental form (beta > 0)
     /// d a^{n+1} / d du = 1/(beta dt^2): the factor of the mass in the tangent.
-    double mass_coefficient() const { return 1.0 / (implicit_beta() * dt_ * dt_); }
+    double
+    mass_coefficient() const
+    {
+      return 1.0 / (implicit_beta() * dt_ * dt_);
+    }
     /// d v^{n+1} / d du = gamma/(beta dt): the factor of a damping matrix C
     /// in the tangent.
-    double damping_coefficient() const { return gamma_ / (implicit_beta() * dt_); }
+    double
+    damping_coefficient() const
+    {
+      return gamma_ / (implicit_beta() * dt_);
+    }
 
     /// Factors of the tangent K_eff = m M + k K for Rayleigh damping
     /// C = alpha_R M + beta_R K: the residual gets C v^{n+1}, so
@@ -113,8 +141,7 @@ namespace talus::implicit_mpm
     TangentFactors
     tangent_factors(const double alpha_rayleigh = 0, const double beta_rayleigh = 0) const
     {
-      return {mass_coefficient() + alpha_rayleigh * damping_coefficient(),
-              1.0 + beta_rayleigh * damping_coefficient()};
+      return {mass_coefficient() + alpha_rayleigh * damping_coefficient(), 1.0 + beta_rayleigh * damping_coefficient()};
     }
 
     // ---- scalar relations (one DoF); T may be double or a deal.II Tensor<1,dim>
@@ -173,8 +200,8 @@ namespace talus::implicit_mpm
       for (std::size_t i = 0; i < n; ++i)
         {
           const double d = du[i], v = v_n[i], a = a_n[i];
-          v_new[i]       = cv * d - cvv * v - cva * a;
-          a_new[i]       = ca * d - cav * v - caa * a;
+          v_new[i] = cv * d - cvv * v - cva * a;
+          a_new[i] = ca * d - cav * v - caa * a;
         }
     }
     /// The predictor (Eq. 2.10-2.12 with du = 0): v_pred, a_pred.
@@ -188,8 +215,8 @@ namespace talus::implicit_mpm
       for (std::size_t i = 0; i < n; ++i)
         {
           const double v = v_n[i], a = a_n[i];
-          v_pred[i]      = -cvv * v - cva * a;
-          a_pred[i]      = -cav * v - caa * a;
+          v_pred[i] = -cvv * v - cva * a;
+          a_pred[i] = -cav * v - caa * a;
         }
     }
     /// v_p[i] <- v_p[i] + dt ((1 - gamma) a_old[i] + gamma a_new[i]) in place

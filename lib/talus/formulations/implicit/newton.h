@@ -32,8 +32,9 @@ namespace talus::implicit_mpm
   {
   public:
     explicit NewtonFailure(const std::string &what)
-      : std::runtime_error(what)
-    {}
+        : std::runtime_error(what)
+    {
+    }
   };
 
   /// Which tests must pass for convergence.
@@ -68,8 +69,8 @@ namespace talus::implicit_mpm
   inline NewtonCriterion
   parse_newton_criterion(const std::string &s)
   {
-    for (const auto c : {NewtonCriterion::residual, NewtonCriterion::increment,
-                         NewtonCriterion::residual_and_increment, NewtonCriterion::residual_or_increment})
+    for (const auto c : {NewtonCriterion::residual, NewtonCriterion::increment, NewtonCriterion::residual_and_increment,
+                         NewtonCriterion::residual_or_increment})
       if (s == to_string(c))
         return c;
     throw InputError("Newton convergence criterion '" + s +
@@ -92,9 +93,9 @@ namespace talus::implicit_mpm
     /// * |Du|, increment_absolute), Du the accumulated displacement increment
     /// of the step after iteration k (NewtonProblem::step_increment_norm; when
     /// absent, the norm of the first increment of the step stands in for it).
-    double increment_relative = 1e-4;
-    double increment_absolute = 1e-9;
-    NewtonCriterion criterion = NewtonCriterion::residual;
+    double          increment_relative = 1e-4;
+    double          increment_absolute = 1e-9;
+    NewtonCriterion criterion          = NewtonCriterion::residual;
 
     /// Backtracking line search on the residual norm: accept the step length
     /// alpha (1, 1/2, 1/4, ...) once r(alpha) <= (1 - armijo * alpha) r_prev,
@@ -116,9 +117,8 @@ namespace talus::implicit_mpm
     {
       const std::string w = "Newton settings";
       require(max_iterations >= 1, w, "max iterations must be at least 1");
-      require(residual_relative >= 0 && residual_absolute >= 0 && increment_relative >= 0 &&
-                increment_absolute >= 0,
-              w, "tolerances must be non-negative");
+      require(residual_relative >= 0 && residual_absolute >= 0 && increment_relative >= 0 && increment_absolute >= 0, w,
+              "tolerances must be non-negative");
       require(residual_relative > 0 || residual_absolute > 0 || criterion == NewtonCriterion::increment, w,
               "the residual test has no positive tolerance");
       require(increment_relative > 0 || increment_absolute > 0 || criterion == NewtonCriterion::residual, w,
@@ -156,11 +156,11 @@ namespace talus::implicit_mpm
   enum class NewtonStatus
   {
     converged,
-    max_iterations,      ///< not converged within max_iterations
-    non_finite,          ///< a residual or increment norm was NaN or inf
-    residual_diverged,   ///< residual grew by divergence_factor over the window
-    increment_diverged,  ///< increment grew by divergence_factor over the window
-    callable_failed      ///< a callable threw NewtonFailure
+    max_iterations,     ///< not converged within max_iterations
+    non_finite,         ///< a residual or increment norm was NaN or inf
+    residual_diverged,  ///< residual grew by divergence_factor over the window
+    increment_diverged, ///< increment grew by divergence_factor over the window
+    callable_failed     ///< a callable threw NewtonFailure
   };
 
   inline const char *
@@ -196,8 +196,8 @@ namespace talus::implicit_mpm
 
   struct NewtonResult
   {
-    bool                         converged  = false;
-    NewtonStatus                 status     = NewtonStatus::max_iterations;
+    bool                         converged = false;
+    NewtonStatus                 status    = NewtonStatus::max_iterations;
     std::string                  message;        ///< why it stopped, with numbers
     unsigned int                 iterations = 0; ///< linear solves done
     std::vector<NewtonIteration> history;
@@ -206,7 +206,11 @@ namespace talus::implicit_mpm
     double observed_order = std::numeric_limits<double>::quiet_NaN();
 
     /// The TimeLoop contract: not converged -> retry with half the step.
-    StepOutcome outcome() const { return converged ? StepOutcome::done : StepOutcome::cut_back; }
+    StepOutcome
+    outcome() const
+    {
+      return converged ? StepOutcome::done : StepOutcome::cut_back;
+    }
   };
 
   /// Order estimate p from the last three positive entries of a sequence of
@@ -233,12 +237,16 @@ namespace talus::implicit_mpm
   {
   public:
     explicit NewtonSolver(const NewtonSettings &s = NewtonSettings())
-      : settings_(s)
+        : settings_(s)
     {
       settings_.validate();
     }
 
-    const NewtonSettings &settings() const { return settings_; }
+    const NewtonSettings &
+    settings() const
+    {
+      return settings_;
+    }
 
     /// Iterate from the caller's current iterate (the predictor).
     NewtonResult
@@ -273,7 +281,7 @@ namespace talus::implicit_mpm
     void
     iterate(const NewtonProblem &p, NewtonResult &res) const
     {
-      const NewtonSettings &s = settings_;
+      const NewtonSettings &s  = settings_;
       const double          r0 = p.assemble(true);
       res.history.push_back({r0, 0, 0, 0, 0});
       if (!std::isfinite(r0))
@@ -309,7 +317,7 @@ namespace talus::implicit_mpm
             }
 
           // full step, then backtrack on the residual norm
-          double       alpha = 1;
+          double       alpha    = 1;
           unsigned int halvings = 0;
           // with line search, a trial the callables reject (e.g. an inverted
           // point at the full step) counts as an infinite residual: halve

@@ -11,12 +11,12 @@
 namespace talus::implicit_mpm
 {
   template <int dim>
-  PointContact<dim>::PointContact(std::vector<ContactPlane> planes_,
+  PointContact<dim>::PointContact(std::vector<ContactPlane>                                      planes_,
                                   const std::vector<std::shared_ptr<const materials::Material>> &materials,
                                   const bool axisymmetric_, const bool bspline_)
-    : planes(std::move(planes_))
-    , axisymmetric(axisymmetric_)
-    , bspline(bspline_)
+      : planes(std::move(planes_))
+      , axisymmetric(axisymmetric_)
+      , bspline(bspline_)
   {
     for (const auto &m : materials)
       modulus.push_back(m->constrained_modulus());
@@ -91,35 +91,35 @@ namespace talus::implicit_mpm
   void
   PointContact<dim>::extent_and_stiffness(const double *P, const ContactPlane &c, double &r, double &k) const
   {
-    using L         = PropertyLayout<dim>;
-    const double V  = P[L::volume];
+    using L        = PropertyLayout<dim>;
+    const double V = P[L::volume];
     // axisymmetric: V is the ring's volume; the extent is that of the point's area
-    const double A  = axisymmetric ? V / (2 * M_PI * std::max(P[offset_], 1e-300)) : V;
-    r               = 0.5 * std::pow(A, 1.0 / dim);
-    k               = c.penalty * modulus[static_cast<unsigned int>(P[L::material])] * V / (c.cell * c.cell);
+    const double A = axisymmetric ? V / (2 * M_PI * std::max(P[offset_], 1e-300)) : V;
+    r              = 0.5 * std::pow(A, 1.0 / dim);
+    k              = c.penalty * modulus[static_cast<unsigned int>(P[L::material])] * V / (c.cell * c.cell);
   }
 
   template <int dim>
   int
-  PointContact<dim>::law(const ContactPlane &c, const double *x, const double *x_n, const double *state,
-                         const double r, const double k, Law &out) const
+  PointContact<dim>::law(const ContactPlane &c, const double *x, const double *x_n, const double *state, const double r,
+                         const double k, Law &out) const
   {
     for (unsigned int i = 0; i < dim; ++i)
       {
-        out.f[i] = 0;
+        out.f[i]      = 0;
         out.anchor[i] = 0;
         for (unsigned int j = 0; j < dim; ++j)
           out.D[i][j] = 0;
       }
-    out.pen        = 0;
+    out.pen          = 0;
     const unsigned a = c.axis;
     const double   g = c.sign * (c.wall - x[a]) - r;
     if (!(g < 0))
       return 0;
-    const double pen = -g; // d pen / d x_a = sign
-    out.pen          = pen;
-    out.f[a]         = -k * pen * c.sign;
-    out.D[a][a]      = -k;
+    const double pen      = -g; // d pen / d x_a = sign
+    out.pen               = pen;
+    out.f[a]              = -k * pen * c.sign;
+    out.D[a][a]           = -k;
     const double friction = c.friction;
     if (friction == 0)
       return 1;
@@ -165,7 +165,7 @@ namespace talus::implicit_mpm
     struct ContactIntegrand
     {
       const PointContact<dim> *pc;
-      PointContactStats *      stats;
+      PointContactStats       *stats;
       static constexpr bool    matrix = true, vector = true;
 
       template <int d_, unsigned int nc, class PN>
@@ -173,7 +173,7 @@ namespace talus::implicit_mpm
       add(const double *P, const PN &p, transfer::LocalSystem &ls) const
       {
         const double *x_n    = P + pc->offset();
-        const auto &  planes = pc->walls();
+        const auto   &planes = pc->walls();
         for (unsigned int w = 0; w < planes.size(); ++w)
           {
             double r, k;
@@ -258,12 +258,12 @@ namespace talus::implicit_mpm
                               const dealii::AffineConstraints<double> &constraints, const Vector &du,
                               dealii::TrilinosWrappers::SparseMatrix *A, Vector &b) const
   {
-    PointContactStats          stats;
+    PointContactStats           stats;
     const ContactIntegrand<dim> integrand{this, &stats};
     const auto                  run = [&](auto nc) {
       shape::with_kernel<dim>(bspline, [&](auto k) {
         transfer::AssembleSystem<dim, decltype(k), decltype(nc)::value, ContactIntegrand<dim>> op(
-          active, constraints, integrand, A, &b, &du);
+                           active, constraints, integrand, A, &b, &du);
         transfer::for_each_active_cell(points, op);
       });
     };

@@ -53,11 +53,11 @@ namespace talus::implicit_mpm
   /// other axes and moving along its normal.
   struct ContactPlane
   {
-    unsigned int axis = 0;
-    int          sign = -1;
-    double       wall = 0;
-    double       cell = 1; ///< cell size normal to the plane (the penalty's h)
-    double       penalty  = 1;                                        ///< kappa: k_n = kappa M V_p / h^2
+    unsigned int axis     = 0;
+    int          sign     = -1;
+    double       wall     = 0;
+    double       cell     = 1; ///< cell size normal to the plane (the penalty's h)
+    double       penalty  = 1; ///< kappa: k_n = kappa M V_p / h^2
     double       friction = std::numeric_limits<double>::infinity(); ///< +inf no slip, 0 frictionless, else mu
     /// a footing's base: wall = wall_0 + velocity t at the end of the step,
     /// wall_n at its start (set_time)
@@ -69,7 +69,7 @@ namespace talus::implicit_mpm
     /// beside the footing that flows over its edge is not pulled through the
     /// footing: docs/implicit.md, "Rigid footing on the points"); a wall is
     /// unbounded
-    bool   footing = false;
+    bool   footing  = false;
     double lower[2] = {0, 0}, upper[2] = {0, 0};
   };
 
@@ -78,7 +78,7 @@ namespace talus::implicit_mpm
   {
     unsigned long long in_contact = 0, slipping = 0, new_contacts = 0, released = 0;
     double             normal_force = 0, tangential_force = 0; ///< sums of |f_n|, |f_t| over the points
-    double             footing_force = 0; ///< sum of f_n over the points on footing planes (along -sign e_axis)
+    double             footing_force  = 0; ///< sum of f_n over the points on footing planes (along -sign e_axis)
     unsigned long long behind_footing = 0; ///< points within a footing's span but deeper than their extent (ignored)
     double             max_penetration_ratio = 0; ///< largest p / r_p
   };
@@ -88,7 +88,7 @@ namespace talus::implicit_mpm
   {
   public:
     /// bspline: the grid basis of the solver (quadratic B-splines, else linear Q1)
-    PointContact(std::vector<ContactPlane> planes,
+    PointContact(std::vector<ContactPlane>                                      planes,
                  const std::vector<std::shared_ptr<const materials::Material>> &materials, const bool axisymmetric,
                  const bool bspline);
 
@@ -116,8 +116,16 @@ namespace talus::implicit_mpm
     /// stick anchors and contact flags of the converged increment. Collective.
     PointContactStats commit(MaterialPointSet<dim> &points, const NodalSpace<dim> &space, const Vector &du) const;
 
-    const std::vector<ContactPlane> &walls() const { return planes; }
-    unsigned int offset() const { return offset_; }
+    const std::vector<ContactPlane> &
+    walls() const
+    {
+      return planes;
+    }
+    unsigned int
+    offset() const
+    {
+      return offset_;
+    }
 
     /// The per-spot law: at x (current position of the contact spot), x_n (at
     /// the start of the step), with the offset r (0: x is the spot), stiffness

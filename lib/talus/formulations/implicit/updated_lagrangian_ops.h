@@ -118,8 +118,8 @@ namespace talus::transfer
   ///   K_ai,bk = that virtual dF of (a, i) : A : that of (b, k).
   template <unsigned int stride, class PN>
   inline void
-  add_axisymmetric_point(const double (&Pk)[3][3], const double (*A)[3][3][3], const double (&fe)[2],
-                         const double r, const PN &p, LocalSystem &ls)
+  add_axisymmetric_point(const double (&Pk)[3][3], const double (*A)[3][3][3], const double (&fe)[2], const double r,
+                         const PN &p, LocalSystem &ls)
   {
     const double ir = 1.0 / r;
     for (unsigned int a = 0; a < p.n; ++a)
@@ -135,8 +135,8 @@ namespace talus::transfer
     for (unsigned int a = 0; a < p.n; ++a)
       for (unsigned int b = 0; b < p.n; ++b)
         {
-          const auto & Ga = p.G[a];
-          const auto & Gb = p.G[b];
+          const auto  &Ga = p.G[a];
+          const auto  &Gb = p.G[b];
           const double ha = p.N[a] * ir, hb = p.N[b] * ir; // hoop entries of the virtual dF
           for (unsigned int i = 0; i < 2; ++i)
             for (unsigned int k = 0; k < 2; ++k)
@@ -240,7 +240,7 @@ namespace talus::transfer
   external_point_force(const double *P, const dealii::Tensor<1, dim> &g, const loads::PointForces<dim> *forces,
                        const double scale, double (&f)[dim])
   {
-    const double m = P[PropertyLayout<dim>::mass];
+    const double m       = P[PropertyLayout<dim>::mass];
     double       fp[dim] = {};
     if (forces && forces->any())
       forces->force(P, fp);
@@ -253,10 +253,10 @@ namespace talus::transfer
   template <int dim>
   struct ExternalForce
   {
-    dealii::Tensor<1, dim>          gravity;
-    const loads::PointForces<dim> * point_forces = nullptr;
-    double                          load_scale   = 1;
-    static constexpr bool           matrix = false, vector = true;
+    dealii::Tensor<1, dim>         gravity;
+    const loads::PointForces<dim> *point_forces = nullptr;
+    double                         load_scale   = 1;
+    static constexpr bool          matrix = false, vector = true;
     template <int d_, unsigned int nc, class PN>
     inline void
     add(const double *P, const PN &p, LocalSystem &ls) const
@@ -277,13 +277,13 @@ namespace talus::transfer
   template <int dim>
   struct UpdatedLagrangianForce
   {
-    const std::vector<std::shared_ptr<const materials::Material>> *materials = nullptr;
+    const std::vector<std::shared_ptr<const materials::Material>> *materials      = nullptr;
     unsigned int                                                   history_offset = 0;
     dealii::Tensor<1, dim>                                         gravity;
-    const loads::PointForces<dim> *                                point_forces = nullptr;
+    const loads::PointForces<dim>                                 *point_forces = nullptr;
     double                                                         load_scale   = 1;
-    bool                                                           tangent = true;
-    PointFailure *                                                 failure = nullptr;
+    bool                                                           tangent      = true;
+    PointFailure                                                  *failure      = nullptr;
     /// axisymmetric (2D): the property holding the point's radius r_n; invalid: plane strain / 3D
     unsigned int radius_offset = dealii::numbers::invalid_unsigned_int;
     /// F-bar: the mean det dF of each active cell (CellMeanJacobian, indexed by
@@ -329,11 +329,11 @@ namespace talus::transfer
     add(const double *P, const PN &p, LocalSystem &ls) const
     {
       static_assert(nc == dim && d_ == dim, "UpdatedLagrangianForce: a vector space (nc = dim)");
-      using L                = PropertyLayout<dim>;
-      const auto &         m = *(*materials)[static_cast<unsigned int>(P[L::material])];
+      using L                 = PropertyLayout<dim>;
+      const auto          &m  = *(*materials)[static_cast<unsigned int>(P[L::material])];
       const unsigned int   nh = m.n_history();
       double               history_new[64];
-      dealii::Tensor<2, 3> dF = incremental_deformation_gradient<dim>(ls.u, p);
+      dealii::Tensor<2, 3> dF           = incremental_deformation_gradient<dim>(ls.u, p);
       const bool           axisymmetric = dim == 2 && radius_offset != dealii::numbers::invalid_unsigned_int;
       if (axisymmetric)
         dF[2][2] = hoop_stretch<PN, dim>(ls.u, p, P[radius_offset]);
@@ -355,11 +355,8 @@ namespace talus::transfer
       dealii::Tensor<4, 3> dtau;
       try
         {
-          m.finite_strain_update(dF_bar,
-                                 dealii::ArrayView<const double>(P + history_offset, nh),
-                                 dealii::ArrayView<double>(history_new, nh),
-                                 tau,
-                                 tangent ? &dtau : nullptr);
+          m.finite_strain_update(dF_bar, dealii::ArrayView<const double>(P + history_offset, nh),
+                                 dealii::ArrayView<double>(history_new, nh), tau, tangent ? &dtau : nullptr);
         }
       catch (const std::exception &e) // inverted point, return mapping failed: cut the step
         {
@@ -466,17 +463,17 @@ namespace talus::transfer
   struct MixedUpForce
   {
     /// per material id: a model with has_volumetric_split() (checked when read)
-    const std::vector<const materials::Material *> *models = nullptr;
-    unsigned int                                      history_offset = 0;
-    dealii::Tensor<1, dim>                            gravity;
-    const loads::PointForces<dim> *                   point_forces = nullptr;
-    double                                            load_scale   = 1;
-    double                                            alpha        = 1; ///< stabilisation factor of Eq. 5.15
-    bool                                              tangent      = true;
-    PointFailure *                                    failure      = nullptr;
+    const std::vector<const materials::Material *> *models         = nullptr;
+    unsigned int                                    history_offset = 0;
+    dealii::Tensor<1, dim>                          gravity;
+    const loads::PointForces<dim>                  *point_forces = nullptr;
+    double                                          load_scale   = 1;
+    double                                          alpha        = 1; ///< stabilisation factor of Eq. 5.15
+    bool                                            tangent      = true;
+    PointFailure                                   *failure      = nullptr;
 
     static constexpr bool         matrix = true, vector = true, cell_terms = true;
-    static constexpr unsigned int nc     = dim + 1, max_local = 64;
+    static constexpr unsigned int nc = dim + 1, max_local = 64;
     // the cell's sums for the projection onto the cell mean
     mutable double cell_vn[max_local], cell_wn[max_local], cell_w = 0, cell_v = 0;
 
@@ -493,10 +490,10 @@ namespace talus::transfer
     add(const double *P, const PN &p, LocalSystem &ls) const
     {
       static_assert(nc_ == dim + 1 && d_ == dim, "MixedUpForce: a space of dim + 1 components");
-      using L                = PropertyLayout<dim>;
-      const auto &       m   = *(*models)[static_cast<unsigned int>(P[L::material])];
-      const unsigned int nh  = m.n_history();
-      double             history_new[64];
+      using L                       = PropertyLayout<dim>;
+      const auto                &m  = *(*models)[static_cast<unsigned int>(P[L::material])];
+      const unsigned int         nh = m.n_history();
+      double                     history_new[64];
       const dealii::Tensor<2, 3> dF = incremental_deformation_gradient<dim, PN, nc>(ls.u, p);
       materials::Stress          tau_dev;
       dealii::Tensor<4, 3>       dtau;
@@ -511,9 +508,9 @@ namespace talus::transfer
           failure->set(e.what());
           return;
         }
-      const double Vn = P[L::volume];
-      const double c  = Vn / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + history_offset, nh));
-      const double j  = determinant(dF);
+      const double               Vn = P[L::volume];
+      const double               c = Vn / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + history_offset, nh));
+      const double               j = determinant(dF);
       const dealii::Tensor<2, 3> Finv = invert(dF);
       double                     pp   = 0;
       for (unsigned int a = 0; a < p.n; ++a)
@@ -566,7 +563,7 @@ namespace talus::transfer
             const unsigned int ra = p.local[a] * nc, rb = p.local[b] * nc;
             for (unsigned int i = 0; i < dim; ++i)
               {
-                ls.a(ra + i, rb + dim) += Vn * j * gx[a][i] * p.N[b]; // K_up
+                ls.a(ra + i, rb + dim) += Vn * j * gx[a][i] * p.N[b];   // K_up
                 ls.a(ra + dim, rb + i) += vol_coef * p.N[a] * gx[b][i]; // K_pu
               }
             ls.a(ra + dim, rb + dim) -= (Vn * j / K + w) * p.N[a] * p.N[b]; // K_pp
@@ -584,7 +581,7 @@ namespace talus::transfer
         for (unsigned int b = 0; b < n_local; ++b)
           {
             const double ma = cell_vn[a] / cell_v, mb = cell_vn[b] / cell_v;
-            const double S  = -ma * cell_wn[b] - cell_wn[a] * mb + ma * mb * cell_w;
+            const double S = -ma * cell_wn[b] - cell_wn[a] * mb + ma * mb * cell_w;
             ls.b[a * nc + dim] -= S * ls.u[b * nc + dim];
             if (tangent)
               ls.a(a * nc + dim, b * nc + dim) -= S;
@@ -672,9 +669,9 @@ namespace talus::transfer
   struct CellMeanJacobian
   {
     const BackgroundGrid<dim> &grid;
-    const NodalSpace<dim> &    space;
-    const Vector &             du;
-    std::vector<double> &      jbar;
+    const NodalSpace<dim>     &space;
+    const Vector              &du;
+    std::vector<double>       &jbar;
 
     static constexpr bool prefetch_location = false;
     typename K::Cell      cell{};
@@ -695,7 +692,7 @@ namespace talus::transfer
       double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
       K::point_stencil(cell, it->get_reference_location(), slot, N, G);
       const dealii::Tensor<2, 3> dF = stencil_deformation_gradient<dim>(un, slot, G);
-      const double V = it->get_properties()[PropertyLayout<dim>::volume];
+      const double               V  = it->get_properties()[PropertyLayout<dim>::volume];
       sum_vj += V * fbar_det<dim>(dF);
       sum_v += V;
       return true;
@@ -723,30 +720,32 @@ namespace talus::transfer
     CommitUpdatedLagrangian(MaterialPointSet<dim> &set, const NodalSpace<dim> &space, const Vector &du,
                             const Vector *a_new, const std::vector<std::shared_ptr<const materials::Material>> &mats,
                             const unsigned int acceleration_offset, const double h, const double gamma,
-                            PointFailure &failure, const unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int,
-                            const unsigned int radius_offset = dealii::numbers::invalid_unsigned_int)
-      : set(set)
-      , grid(space.grid)
-      , space(space)
-      , du(du)
-      , a_new(a_new)
-      , materials(mats)
-      , acceleration(acceleration_offset)
-      , h(h)
-      , gamma(gamma)
-      , failure(failure)
-      , pressure(pressure_offset)
-      , radius(radius_offset)
-    {}
-    MaterialPointSet<dim> &                                        set;
-    const BackgroundGrid<dim> &                                    grid;
-    const NodalSpace<dim> &                                        space;
-    const Vector &                                                 du;
-    const Vector *                                                 a_new;
+                            PointFailure      &failure,
+                            const unsigned int pressure_offset = dealii::numbers::invalid_unsigned_int,
+                            const unsigned int radius_offset   = dealii::numbers::invalid_unsigned_int)
+        : set(set)
+        , grid(space.grid)
+        , space(space)
+        , du(du)
+        , a_new(a_new)
+        , materials(mats)
+        , acceleration(acceleration_offset)
+        , h(h)
+        , gamma(gamma)
+        , failure(failure)
+        , pressure(pressure_offset)
+        , radius(radius_offset)
+    {
+    }
+    MaterialPointSet<dim>                                         &set;
+    const BackgroundGrid<dim>                                     &grid;
+    const NodalSpace<dim>                                         &space;
+    const Vector                                                  &du;
+    const Vector                                                  *a_new;
     const std::vector<std::shared_ptr<const materials::Material>> &materials;
     const unsigned int                                             acceleration;
     const double                                                   h, gamma;
-    PointFailure &                                                 failure;
+    PointFailure                                                  &failure;
     const unsigned int                                             pressure;
     const unsigned int radius; ///< axisymmetric: the property with r_n (invalid: plane / 3D)
     /// F-bar: each active cell's mean det dF of the converged Du (CellMeanJacobian); null: none.
@@ -777,8 +776,8 @@ namespace talus::transfer
     inline bool
     point(const unsigned int c, PointIterator<dim> &it)
     {
-      using L   = PropertyLayout<dim>;
-      double *P = it->get_properties().data();
+      using L        = PropertyLayout<dim>;
+      double      *P = it->get_properties().data();
       unsigned int slot[K::n_point_nodes];
       double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
       K::point_stencil(cell, it->get_reference_location(), slot, N, G);
@@ -804,7 +803,7 @@ namespace talus::transfer
             }
           fbar_scale<dim>(dF, j, (*jbar)[c]);
         }
-      const auto &       m  = *materials[static_cast<unsigned int>(P[L::material])];
+      const auto        &m  = *materials[static_cast<unsigned int>(P[L::material])];
       const unsigned int nh = m.n_history();
       double             old[64];
       std::copy(P + L::history, P + L::history + nh, old);
@@ -822,7 +821,7 @@ namespace talus::transfer
       materials::Stress sigma = tau / m.kirchhoff_jacobian(dealii::ArrayView<const double>(P + L::history, nh));
       if (pressure != dealii::numbers::invalid_unsigned_int)
         {
-          sigma = dealii::deviator(sigma) + pp * dealii::unit_symmetric_tensor<3>();
+          sigma       = dealii::deviator(sigma) + pp * dealii::unit_symmetric_tensor<3>();
           P[pressure] = pp;
         }
       L::set_stress(sigma, P);
@@ -842,6 +841,7 @@ namespace talus::transfer
     }
     inline void
     end_cell(const unsigned int)
-    {}
+    {
+    }
   };
 } // namespace talus::transfer

@@ -67,7 +67,8 @@ namespace talus::semi_implicit
       declare_common_parameters(prm, prm_file,
                                 "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
                                 "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
-                                "conductivity (seed 002 §5.3).", /*png fields not written:*/ {"free surface"});
+                                "conductivity (seed 002 §5.3).",
+                                /*png fields not written:*/ {"free surface"});
     prm.enter_subsection("time");
     {
       prm.declare_entry("courant number", "0.5", Double(0, 1),
@@ -147,7 +148,8 @@ namespace talus::semi_implicit
                         "-rho_w g (water level - y) at water points below the water level, effective "
                         "vertical stress -(1-n)(rho_s - rho_w) g depth (buoyant below the water level, "
                         "(1-n) rho_s g above) and horizontal K0 times it at soil points (g = |gravity|).");
-      prm.declare_entry("water level", "0", Double(-1e300, 1e300), "Vertical coordinate of the free water surface [m].");
+      prm.declare_entry("water level", "0", Double(-1e300, 1e300),
+                        "Vertical coordinate of the free water surface [m].");
       prm.declare_entry("soil surface", "0", Double(-1e300, 1e300), "Vertical coordinate of the soil surface [m].");
       prm.declare_entry("K0", "1", Double(0), "Horizontal / vertical effective stress ratio.");
       prm.declare_entry("initialisation time", "0", Double(-1e300, 1e300),
@@ -188,7 +190,8 @@ namespace talus::semi_implicit
                           "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
                           "soil points carries it, each point the force q V_p / (h / particles per direction), "
                           "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
-        prm.declare_entry("surface load acts at", "body surface", dealii::Patterns::Selection("body surface|top points"),
+        prm.declare_entry("surface load acts at", "body surface",
+                          dealii::Patterns::Selection("body surface|top points"),
                           "Where a loaded point's force enters the grid. body surface: at the point's share of the "
                           "upper face, the point position plus half its sub-cell height, a vector carried by the "
                           "point's dF (the weak form's integral over the face: the top points carry the full q). "
@@ -264,8 +267,8 @@ namespace talus::semi_implicit
       double n_points = 0;
       for (unsigned int k = 0; k < p.bodies.size(); ++k)
         {
-          const auto &       b     = p.bodies[k];
-          const std::string  where = "body " + std::to_string(k) + " ('" + b.name + "')";
+          const auto       &b     = p.bodies[k];
+          const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
           if (b.shape == BodyDescription<dim>::Shape::file) // its rows; the seeding checks their positions
             {
               n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * double(check_file_body(p, k).rows);
@@ -281,8 +284,10 @@ namespace talus::semi_implicit
             {
               const std::string out = outside_extent(b, p.grid_lower, p.grid_upper);
               require(out.empty(), where,
-                      out + "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
-                            "the grid, or set 'clip to grid = true' in 'body " + std::to_string(k) + "')");
+                      out +
+                        "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                        "the grid, or set 'clip to grid = true' in 'body " +
+                        std::to_string(k) + "')");
             }
           // both sets for a saturated body
           n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * overlap / cell_volume *
@@ -294,8 +299,8 @@ namespace talus::semi_implicit
       int size = 1;
       MPI_Comm_size(MPI_COMM_WORLD, &size);
       const double per_cell = dim == 2 ? 1200 : 2400, per_point = dim == 2 ? 650 : 800;
-      const double need     = 180e6 * size + per_cell * n_cells + per_point * n_points;
-      const double avail    = available_memory_bytes();
+      const double need  = 180e6 * size + per_cell * n_cells + per_point * n_points;
+      const double avail = available_memory_bytes();
       require(avail < 0 || need <= avail * size, "grid/cells",
               number_text(n_cells) + " cells and about " + number_text(n_points) + " material points need about " +
                 number_text(need / 1e9) + " GB, but only " + number_text(avail / 1e9) +
@@ -320,16 +325,16 @@ namespace talus::semi_implicit
     require(p.courant > 0, "time/courant number", "must be > 0");
     prm.leave_subsection();
     prm.enter_subsection("semi implicit");
-    p.water_density         = prm.get_double("water density");
-    p.unit_weight_gravity   = prm.get_double("unit weight gravity");
-    p.free_surface_fraction = prm.get_double("free surface volume fraction");
-    p.pressure_tolerance    = prm.get_double("pressure solver tolerance");
+    p.water_density             = prm.get_double("water density");
+    p.unit_weight_gravity       = prm.get_double("unit weight gravity");
+    p.free_surface_fraction     = prm.get_double("free surface volume fraction");
+    p.pressure_tolerance        = prm.get_double("pressure solver tolerance");
     p.pressure_rebuild_interval = prm.get_integer("pressure preconditioner rebuild interval");
-    p.kozeny_carman         = prm.get_bool("kozeny carman");
-    p.pressure_smoothing    = prm.get("pressure smoothing") != "none";
-    p.linear_smoothing      = prm.get("pressure smoothing") == "linear";
-    p.flip_fraction         = prm.get_double("flip fraction");
-    p.rigid_skeleton        = prm.get_bool("rigid skeleton");
+    p.kozeny_carman             = prm.get_bool("kozeny carman");
+    p.pressure_smoothing        = prm.get("pressure smoothing") != "none";
+    p.linear_smoothing          = prm.get("pressure smoothing") == "linear";
+    p.flip_fraction             = prm.get_double("flip fraction");
+    p.rigid_skeleton            = prm.get_bool("rigid skeleton");
     // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
     // plate can move it (a physical impossibility, not a missing feature)
     if (p.grid_mesh == nullptr) // (a grid file is refused below)
@@ -342,7 +347,7 @@ namespace talus::semi_implicit
       const std::string text = prm.get("drained boundaries");
       for (const auto &item : dealii::Utilities::split_string_list(text, ','))
         {
-          bool         ok = !item.empty() && item.find_first_not_of("0123456789") == std::string::npos && item.size() < 3;
+          bool ok = !item.empty() && item.find_first_not_of("0123456789") == std::string::npos && item.size() < 3;
           unsigned int id = ok ? static_cast<unsigned int>(std::stoul(item)) : 0;
           ok              = ok && id < 2 * dim;
           require(ok, "semi implicit/drained boundaries",
@@ -352,12 +357,12 @@ namespace talus::semi_implicit
         }
     }
     {
-      const std::string st = prm.get("volumetric stabilisation");
-      p.stabilisation      = st == "f-bar"          ? VolumetricStabilisation::f_bar
-                             : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
-                                                      : VolumetricStabilisation::none;
-      p.patch_size = prm.get_double("patch size");
-      p.single_point = prm.get("point sets") == "single";
+      const std::string st       = prm.get("volumetric stabilisation");
+      p.stabilisation            = st == "f-bar"            ? VolumetricStabilisation::f_bar
+                                   : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
+                                                            : VolumetricStabilisation::none;
+      p.patch_size               = prm.get_double("patch size");
+      p.single_point             = prm.get("point sets") == "single";
       p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
       require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
     }
@@ -368,14 +373,13 @@ namespace talus::semi_implicit
     require(p.pressure_tolerance > 0, "semi implicit/pressure solver tolerance", "must be > 0");
     prm.leave_subsection();
     prm.enter_subsection("initial state");
-    p.geostatic    = prm.get_bool("geostatic");
-    p.water_level  = prm.get_double("water level");
-    p.soil_surface = prm.get_double("soil surface");
-    p.K0           = prm.get_double("K0");
+    p.geostatic                   = prm.get_bool("geostatic");
+    p.water_level                 = prm.get_double("water level");
+    p.soil_surface                = prm.get_double("soil surface");
+    p.K0                          = prm.get_double("K0");
     p.initialisation_time         = prm.get_double("initialisation time");
     p.initialisation_conductivity = prm.get_double("initialisation conductivity");
-    require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 &&
-              p.initialisation_time <= p.end_time,
+    require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 && p.initialisation_time <= p.end_time,
             "initial state/initialisation time",
             "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to the end time " +
               number_text(p.end_time) + " s");
@@ -388,8 +392,9 @@ namespace talus::semi_implicit
           const std::string model = p.materials[m]->model_name();
           require(model == "nor sand" || model == "linear elastic" || model == "neo hookean",
                   "material " + std::to_string(m) + "/model",
-                  "is " + model + ", which has no elastic-only mode for 'initial state/initialisation time'; "
-                  "allowed with an initialisation: nor sand, linear elastic, neo hookean");
+                  "is " + model +
+                    ", which has no elastic-only mode for 'initial state/initialisation time'; "
+                    "allowed with an initialisation: nor sand, linear elastic, neo hookean");
         }
     prm.leave_subsection();
     for (unsigned int k = 0; k < p.materials.size(); ++k)
@@ -422,7 +427,7 @@ namespace talus::semi_implicit
           const std::string extent = prm.get("surface load extent");
           if (!dealii::Utilities::trim(extent).empty())
             {
-              const auto v = dealii::Utilities::split_string_list(extent, ',');
+              const auto v  = dealii::Utilities::split_string_list(extent, ',');
               bool       ok = v.size() == 2;
               try
                 {
@@ -446,11 +451,12 @@ namespace talus::semi_implicit
         p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
         std::ostringstream q;
         q << p.surface_load.back().q;
-        require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0, "body " + std::to_string(k) + "/surface load",
-                "is " + q.str() + "; must be a pressure >= 0 Pa");
-        require(p.surface_load.back().q == 0 || (p.phase_of_body.back() != Phase::water &&
-                                                p.bodies[k].shape == BodyDescription<dim>::Shape::box),
-                "body " + std::to_string(k) + "/surface load", "needs a box body with soil points (phase saturated or soil)");
+        require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0,
+                "body " + std::to_string(k) + "/surface load", "is " + q.str() + "; must be a pressure >= 0 Pa");
+        require(p.surface_load.back().q == 0 ||
+                  (p.phase_of_body.back() != Phase::water && p.bodies[k].shape == BodyDescription<dim>::Shape::box),
+                "body " + std::to_string(k) + "/surface load",
+                "needs a box body with soil points (phase saturated or soil)");
         any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
         any_water = any_water || p.phase_of_body.back() != Phase::soil;
         // the material ids of the body's points: its entry, or those of its rows
@@ -463,7 +469,9 @@ namespace talus::semi_implicit
     std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
       phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
-                (p.phase_of_body[k] == Phase::soil ? "soil" : p.phase_of_body[k] == Phase::water ? "water" : "saturated");
+                (p.phase_of_body[k] == Phase::soil    ? "soil"
+                 : p.phase_of_body[k] == Phase::water ? "water"
+                                                      : "saturated");
     if (p.single_point)
       for (unsigned int b = 0; b < p.bodies.size(); ++b)
         require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
@@ -480,10 +488,12 @@ namespace talus::semi_implicit
           for (const unsigned int mid : p.materials_of_body[b])
             {
               const auto &m = *p.materials[mid];
-              require(keeps_elastic_b(m), "semi implicit/volumetric stabilisation",
-                      "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
-                        std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
-                        "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | f-bar)");
+              require(
+                keeps_elastic_b(m), "semi implicit/volumetric stabilisation",
+                "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
+                  std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
+                  "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | "
+                  "f-bar)");
             }
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
     check_scene(p);
@@ -500,7 +510,7 @@ namespace talus::semi_implicit
         for (const unsigned int m : p.materials_of_body[b])
           {
             const double rho = (1 - p.soil_of_material[m].porosity) * p.materials[m]->density();
-            dt = std::min(dt, h_min / std::sqrt(p.materials[m]->constrained_modulus() / rho));
+            dt               = std::min(dt, h_min / std::sqrt(p.materials[m]->constrained_modulus() / rho));
           }
     return dt;
   }
@@ -513,10 +523,10 @@ namespace talus::semi_implicit
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
       unsigned int pressure_gradient = 0, surface_force = 0;
-      unsigned int surface_offset = 0; // dim values: from the point to its share of the loaded face
-      unsigned int poisson_coefficient = 0, poisson_flux = 0; // poisson_flux: dim values, phi v*
+      unsigned int surface_offset      = 0; // dim values: from the point to its share of the loaded face
+      unsigned int poisson_coefficient = 0, poisson_flux = 0;                 // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
-      unsigned int smoothed_jacobian = 0; // Nor-Sand (96)-(97): Jbar^{t+1}
+      unsigned int smoothed_jacobian = 0;                                     // Nor-Sand (96)-(97): Jbar^{t+1}
       unsigned int plate_flux = 0; // rigid plates with force control: dim values, phi v* of a unit plate velocity
     };
 
@@ -567,7 +577,7 @@ namespace talus::semi_implicit
     /// the matrix already assembled (rigid plates, docs/semi-implicit.md)
     struct PoissonFluxSource
     {
-      unsigned int          flux = 0;
+      unsigned int          flux   = 0;
       static constexpr bool matrix = false, vector = true;
       template <int dim, unsigned int nc, class PN>
       inline void
@@ -596,25 +606,36 @@ namespace talus::semi_implicit
     using L = PropertyLayout<dim>;
 
     Solver(const Parameters<dim> &p, MPI_Comm comm)
-      : prm(p)
-      , comm(comm)
-      , grid(comm, p.balance.enabled())
-      , soil(grid, "soil")
-      , water(grid, "water")
-      , balance(grid, p.balance, {&soil, &water}, [this] {
-        grid_changed();
-        soil.collect_active_cells();
-        water.collect_active_cells();
-      })
-      , pspace(grid, 1)
-      , active(pspace)
-    {}
+        : prm(p)
+        , comm(comm)
+        , grid(comm, p.balance.enabled())
+        , soil(grid, "soil")
+        , water(grid, "water")
+        , balance(grid, p.balance, {&soil, &water},
+                  [this] {
+                    grid_changed();
+                    soil.collect_active_cells();
+                    water.collect_active_cells();
+                  })
+        , pspace(grid, 1)
+        , active(pspace)
+    {
+    }
 
     void setup();
-    std::string tool_name() const override { return "talus-semi-implicit"; }
-    void        describe(std::ostream &out) const override;
-    double      begin_stage(const unsigned int, const bool, const bool) override { return prm.end_time; }
-    StepOutcome advance_by(const double h) override
+    std::string
+    tool_name() const override
+    {
+      return "talus-semi-implicit";
+    }
+    void describe(std::ostream &out) const override;
+    double
+    begin_stage(const unsigned int, const bool, const bool) override
+    {
+      return prm.end_time;
+    }
+    StepOutcome
+    advance_by(const double h) override
     {
       if (prm.bspline())
         step<shape::BSpline2Box<dim>>(h);
@@ -622,8 +643,9 @@ namespace talus::semi_implicit
         step<shape::Q1Box<dim>>(h);
       return StepOutcome::done;
     }
-    void               check_stability() const override;
-    unsigned long long lost_points() const override
+    void check_stability() const override;
+    unsigned long long
+    lost_points() const override
     {
       return soil.relocation_stats.lost + water.relocation_stats.lost;
     }
@@ -632,9 +654,13 @@ namespace talus::semi_implicit
     void                     write_vtu(const unsigned int counter) override;
     void                     rewrite_records() override;
     std::string              write_checkpoint() override;
-    void finish(const std::string &series_csv) override;
-    void summary(const LoopTimings &timings) override;
-    void after_step() override { balance.after_step(step_number, prm.progress); } ///< the load-balance check
+    void                     finish(const std::string &series_csv) override;
+    void                     summary(const LoopTimings &timings) override;
+    void
+    after_step() override
+    {
+      balance.after_step(step_number, prm.progress);
+    } ///< the load-balance check
 
   private:
     template <class K>
@@ -653,7 +679,11 @@ namespace talus::semi_implicit
     /// compress(add) then update ghosts, for every vector given
     void exchange(std::initializer_list<Vector *> vs) const;
     /// local (owned + ghost) size of a grid vector
-    unsigned int n_local() const { return grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices(); }
+    unsigned int
+    n_local() const
+    {
+      return grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices();
+    }
 
     const Parameters<dim> &prm;
     MPI_Comm               comm;
@@ -661,47 +691,48 @@ namespace talus::semi_implicit
     MaterialPointSet<dim>  soil, water;
     /// Load balancing by material points of both sets (formulations/common/
     /// load_balance.h); its repartitions call grid_changed().
-    LoadBalance<dim>       balance;
+    LoadBalance<dim> balance;
     /// Everything of the grid's partition that lives across steps: the
     /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
     /// vectors; the next step rebuilds the active set and the pressure matrix.
     void grid_changed();
     /// the next step rebuilds the pressure DoF set (after a repartition and
     /// after a checkpoint write)
-    bool partition_changed = true;
-    Fields                 fs, fw; ///< offsets in the soil and the water layout
-    NodalSpace<dim>        pspace; ///< the scalar pressure space
-    ActiveSet<dim>         active;
+    bool                                   partition_changed = true;
+    Fields                                 fs, fw; ///< offsets in the soil and the water layout
+    NodalSpace<dim>                        pspace; ///< the scalar pressure space
+    ActiveSet<dim>                         active;
     dealii::TrilinosWrappers::SparseMatrix A;
     /// CG + ML AMG with the hierarchy kept between steps (solvers/linear_solver.h);
     /// invalidated when A is reinit and at every checkpoint write
-    ReusedAMGSolver                        pressure_solver;
+    ReusedAMGSolver pressure_solver;
     /// steps of this run (not of a checkpoint's past: a restart rebuilds once
     /// more) that built a new pressure DoF set, sparsity and matrix
-    unsigned long long                     n_pattern_changes = 0;
+    unsigned long long n_pattern_changes = 0;
     /// of which: the cells were the same, but a point's stencil left the kept pattern
-    unsigned long long                     n_pattern_window_changes = 0;
-    Vector                                 rhs, dp_solution;
+    unsigned long long n_pattern_window_changes = 0;
+    Vector             rhs, dp_solution;
 
     // per grid local DoF: the node's component-0 DoF, component, prescribed zero
     std::vector<unsigned int>  node_of;
     std::vector<unsigned char> component, constrained;
     std::vector<unsigned char> water_constrained, drained; // per DoF; per node (component-0 DoF): on a drained face
-    std::vector<dealii::Point<dim>> node_x; // position of the node of a local DoF
+    std::vector<dealii::Point<dim>> node_x;                // position of the node of a local DoF
     // nodal fields (grid vectors; scalars at the component-0 DoF)
-    Vector Ms, Ps, Mn, Mk, Fs;          // soil mass, momentum, sum m n, sum N n^2 rho_w g V / k (drag), force (internal + gravity)
-    Vector Ww, Pw0, Ww0, Mwp, Mw;       // sum N rho_w V, sum N rho_w V0 v, sum N rho_w V0, sum N m p, sum N m
-    Vector Gpw, Gps;                    // sum V N grad p^t over the water / the soil points (times n_I, 1 - n_I: the pore pressure forces)
-    Vector Mwg;                         // sum N m grad p (linear pressure map)
-    Vector n_node, Q_node, Mw_node;     // nodal porosity n_I, drag Q_I, water mass M_wI
+    Vector Ms, Ps, Mn, Mk,
+      Fs; // soil mass, momentum, sum m n, sum N n^2 rho_w g V / k (drag), force (internal + gravity)
+    Vector Ww, Pw0, Ww0, Mwp, Mw; // sum N rho_w V, sum N rho_w V0 v, sum N rho_w V0, sum N m p, sum N m
+    Vector Gpw, Gps; // sum V N grad p^t over the water / the soil points (times n_I, 1 - n_I: the pore pressure forces)
+    Vector Mwg;      // sum N m grad p (linear pressure map)
+    Vector n_node, Q_node, Mw_node; // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
     Vector p_node, dp_node, gs, gw, wet, dry, near_wet;
     std::vector<double> cell_water_volume;
-    Vector Mdj; // F-bar: sum N m dJ of the soil points
-    Vector Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
+    Vector              Mdj; // F-bar: sum N m dJ of the soil points
+    Vector              Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
     // modified F-bar patches: a fixed square tiling from the grid's lower corner
-    PatchTiling<dim>    patches;
-    std::vector<double> patch_mass, patch_mass_Je;
+    PatchTiling<dim>                            patches;
+    std::vector<double>                         patch_mass, patch_mass_Je;
     std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
 
     // rigid plates (issue 37; docs/semi-implicit.md 'Rigid plate'): per local
@@ -709,7 +740,7 @@ namespace talus::semi_implicit
     // held by a wall, which keeps it), and the plate of a rough plate's
     // tangential DoF (held at zero like a wall; its reaction is summed)
     static constexpr unsigned int no_plate = static_cast<unsigned int>(-1);
-    std::vector<unsigned int> plate_of, plate_tangential_of;
+    std::vector<unsigned int>     plate_of, plate_tangential_of;
     /// per node (component-0 DoF): a node of an impermeable plate, which covers
     /// the surface there: no free-surface p = 0 at it (the pressure is solved)
     std::vector<unsigned char> plate_sealed;
@@ -731,7 +762,7 @@ namespace talus::semi_implicit
       /// node in v^{t+1} (components no wall holds): 0 for a rough plate [m]
       double node_slip = 0;
     };
-    std::vector<PlateState> plate_state;
+    std::vector<PlateState>   plate_state;
     std::vector<unsigned int> force_plates; ///< indices of the force-controlled plates
     /// per plate: grid nodes (global count) and axis DoFs it moves (not held by a wall)
     std::vector<unsigned long long> plate_nodes, plate_axis_dofs;
@@ -748,7 +779,11 @@ namespace talus::semi_implicit
     // App. B.4 initialisation: the models of the elastic stage (nor sand
     // without plasticity, the others as they are), per material
     std::vector<std::shared_ptr<const materials::Material>> initialisation_models;
-    bool initialising(const double t) const { return t < prm.initialisation_time - 1e-9 * dt; } // as the loop's end test
+    bool
+    initialising(const double t) const
+    {
+      return t < prm.initialisation_time - 1e-9 * dt;
+    } // as the loop's end test
     /// End of the App. B.4 stage: every nor sand point's references from its
     /// current state (Eqs. 111-114). Logs one line.
     void end_initialisation();
@@ -756,7 +791,7 @@ namespace talus::semi_implicit
     // diagnostics
     LinearSolveInfo    last_solve;
     unsigned long long solver_iterations = 0, n_solves = 0;
-    double             seconds_solve = 0; ///< CG + AMG set-ups
+    double             seconds_solve    = 0; ///< CG + AMG set-ups
     double             dt_soil_critical = 0;
     // wall-clock phases of the step (a few clock reads per step; the solve is
     // seconds_solve): P2N, nodal updates, Poisson set-up and assembly, N2P
@@ -774,8 +809,9 @@ namespace talus::semi_implicit
     struct StencilCaches
     {
       transfer::StencilCache<dim, shape::BSpline2Box<dim>> bspline;
-      transfer::StencilCache<dim, shape::Q1Box<dim>>        linear;
-      void clear()
+      transfer::StencilCache<dim, shape::Q1Box<dim>>       linear;
+      void
+      clear()
       {
         bspline.clear();
         linear.clear();
@@ -819,19 +855,19 @@ namespace talus::semi_implicit
     node_x.assign(nl, dealii::Point<dim>());
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
       if (grid.cell_iterators[c] != grid.tria.end()) // artificial cells carry no DoFs (their cache is zero)
-      for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const auto &       cc = grid.cells[c];
-            const unsigned int i  = cc.dofs[v * dim + d];
-            if (i < nl)
-              {
-                node_of[i]   = cc.dofs[v * dim];
-                component[i] = d;
-                for (unsigned int e = 0; e < dim; ++e) // vertex v: bit e set = upper side in direction e
-                  node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
-              }
-          }
+        for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const auto        &cc = grid.cells[c];
+              const unsigned int i  = cc.dofs[v * dim + d];
+              if (i < nl)
+                {
+                  node_of[i]   = cc.dofs[v * dim];
+                  component[i] = d;
+                  for (unsigned int e = 0; e < dim; ++e) // vertex v: bit e set = upper side in direction e
+                    node_x[i][e] = cc.lower[e] + ((v >> e) & 1u) * cc.h[e];
+                }
+            }
     // rigid plates: the axis DoFs they move (a wall keeps what it holds), the
     // tangential DoFs of a rough plate held at zero for both phases (as a
     // wall), p = 0 at a permeable plate's nodes (with the drained faces below)
@@ -842,7 +878,7 @@ namespace talus::semi_implicit
     plate_node_of.assign(nl, no_plate);
     for (const auto &e : loads::rigid_plate_node_dofs(grid, prm.rigid_plates, false))
       {
-        const auto &pl = prm.rigid_plates[e.condition];
+        const auto &pl        = prm.rigid_plates[e.condition];
         plate_node_of[e.node] = e.condition;
         if (pl.permeable)
           plate_drained[e.node] = 1;
@@ -882,8 +918,10 @@ namespace talus::semi_implicit
             }
         }
     patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
-    for (Vector *v : {&Mdj, &Mjt, &Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &n_node, &Q_node, &Mw_node, &vs_t,
-                      &vw_t, &vs_star, &vw_star, &vs_new, &vw_new, &p_node, &dp_node, &gs, &gw, &wet, &dry, &near_wet})
+    for (Vector *v :
+         {&Mdj,    &Mjt,    &Ms,     &Ps,      &Mn,     &Mk,     &Fs,      &Ww,   &Pw0,     &Ww0,     &Mwp,
+          &Mw,     &Gpw,    &Gps,    &Mwg,     &n_node, &Q_node, &Mw_node, &vs_t, &vw_t,    &vs_star, &vw_star,
+          &vs_new, &vw_new, &p_node, &dp_node, &gs,     &gw,     &wet,     &dry,  &near_wet})
       grid.reinit_vector(*v);
     plate_response.resize(force_plates.size());
     for (auto &r : plate_response)
@@ -911,15 +949,15 @@ namespace talus::semi_implicit
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
-    soil.layout.n_history          = n_history;
-    fs.porosity                    = soil.layout.add_extra("porosity", 1);
-    fs.initial_porosity            = soil.layout.add_extra("initial_porosity", 1);
-    fs.initial_volume              = soil.layout.add_extra("initial_volume", 1);
-    fs.conductivity                = soil.layout.add_extra("conductivity", 1);
-    fs.surface_force               = soil.layout.add_extra("surface_force", 1);
-    fs.surface_offset              = soil.layout.add_extra("surface_offset", dim, true);
-    fs.poisson_coefficient         = soil.layout.add_extra("poisson_coefficient", 1);
-    fs.poisson_flux              = soil.layout.add_extra("poisson_flux", dim, true);
+    soil.layout.n_history  = n_history;
+    fs.porosity            = soil.layout.add_extra("porosity", 1);
+    fs.initial_porosity    = soil.layout.add_extra("initial_porosity", 1);
+    fs.initial_volume      = soil.layout.add_extra("initial_volume", 1);
+    fs.conductivity        = soil.layout.add_extra("conductivity", 1);
+    fs.surface_force       = soil.layout.add_extra("surface_force", 1);
+    fs.surface_offset      = soil.layout.add_extra("surface_offset", dim, true);
+    fs.poisson_coefficient = soil.layout.add_extra("poisson_coefficient", 1);
+    fs.poisson_flux        = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
       fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
     if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
@@ -933,13 +971,13 @@ namespace talus::semi_implicit
         fs.plate_flux = soil.layout.add_extra("plate_flux", dim, true);
         fw.plate_flux = water.layout.add_extra("plate_flux", dim, true);
       }
-    fw.pressure                    = water.layout.add_extra("pore_pressure", 1);
-    fw.pressure_gradient           = water.layout.add_extra("pore_pressure_gradient", dim, true);
-    fw.porosity                    = water.layout.add_extra("porosity", 1);
-    fw.initial_porosity            = water.layout.add_extra("initial_porosity", 1);
-    fw.initial_volume              = water.layout.add_extra("initial_volume", 1);
-    fw.poisson_coefficient         = water.layout.add_extra("poisson_coefficient", 1);
-    fw.poisson_flux              = water.layout.add_extra("poisson_flux", dim, true);
+    fw.pressure            = water.layout.add_extra("pore_pressure", 1);
+    fw.pressure_gradient   = water.layout.add_extra("pore_pressure_gradient", dim, true);
+    fw.porosity            = water.layout.add_extra("porosity", 1);
+    fw.initial_porosity    = water.layout.add_extra("initial_porosity", 1);
+    fw.initial_volume      = water.layout.add_extra("initial_volume", 1);
+    fw.poisson_coefficient = water.layout.add_extra("poisson_coefficient", 1);
+    fw.poisson_flux        = water.layout.add_extra("poisson_flux", dim, true);
     soil.initialize();
     water.initialize();
     initialisation_models = prm.materials;
@@ -1091,7 +1129,7 @@ namespace talus::semi_implicit
     // the index of the .prm body
     for (const bool is_soil : {true, false})
       {
-        MaterialPointSet<dim> &   set = is_soil ? soil : water;
+        MaterialPointSet<dim>            &set = is_soil ? soil : water;
         std::vector<BodyDescription<dim>> bodies;
         std::vector<unsigned int>         body_index;
         for (unsigned int b = 0; b < prm.bodies.size(); ++b)
@@ -1113,21 +1151,22 @@ namespace talus::semi_implicit
             P[L::body]           = b;
             const unsigned int m = static_cast<unsigned int>(P[L::material]); // a file body's: its row's
             // a water body's points take the porosity 1 (free water)
-            const double n0          = prm.phase_of_body[b] == Phase::water ? 1.0 : prm.soil_of_material[m].porosity;
-            const double V0          = P[L::volume];
-            P[f.porosity]            = n0;
-            P[f.initial_porosity]    = n0;
-            P[f.initial_volume]      = V0;
+            const double n0       = prm.phase_of_body[b] == Phase::water ? 1.0 : prm.soil_of_material[m].porosity;
+            const double V0       = P[L::volume];
+            P[f.porosity]         = n0;
+            P[f.initial_porosity] = n0;
+            P[f.initial_volume]   = V0;
             if (is_soil)
               {
-                P[L::mass]          = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
-                P[f.conductivity]   = prm.soil_of_material[m].conductivity;
+                P[L::mass]        = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
+                P[f.conductivity] = prm.soil_of_material[m].conductivity;
                 // the body's top layer of points carries its surface load
                 const SurfaceLoad &load = prm.surface_load[b];
                 const double       hy   = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
                 const double       dy   = hy / prm.bodies[b].particles_per_direction;
                 const auto         x    = pt.get_location();
-                const bool on_face = x[dim - 1] > prm.bodies[b].upper[dim - 1] - dy && x[0] >= load.from && x[0] <= load.to;
+                const bool         on_face =
+                  x[dim - 1] > prm.bodies[b].upper[dim - 1] - dy && x[0] >= load.from && x[0] <= load.to;
                 P[f.surface_force] = load.q > 0 && on_face ? load.q * V0 / dy : 0.0;
                 for (unsigned int d = 0; d < dim; ++d)
                   P[f.surface_offset + d] = 0;
@@ -1136,9 +1175,9 @@ namespace talus::semi_implicit
               }
             else
               {
-                P[L::mass]     = n0 * prm.water_density * V0; // Eq. 37
+                P[L::mass] = n0 * prm.water_density * V0;     // Eq. 37
                 L::set_stress(materials::Stress(), P.data()); // a particle file's stress is the soil's
-                P[f.pressure]  = 0;
+                P[f.pressure] = 0;
                 for (unsigned int d = 0; d < dim; ++d)
                   P[f.pressure_gradient + d] = 0;
               }
@@ -1154,9 +1193,9 @@ namespace talus::semi_implicit
     const double g = prm.gravity.norm();
     for (auto &pt : water.handler)
       {
-        auto         P = pt.get_properties();
-        const double y = pt.get_location()[dim - 1];
-        P[fw.pressure] = -prm.water_density * g * std::max(0.0, prm.water_level - y);
+        auto         P                    = pt.get_properties();
+        const double y                    = pt.get_location()[dim - 1];
+        P[fw.pressure]                    = -prm.water_density * g * std::max(0.0, prm.water_level - y);
         P[fw.pressure_gradient + dim - 1] = y < prm.water_level ? prm.water_density * g : 0.0;
       }
     for (auto &pt : soil.handler)
@@ -1167,9 +1206,9 @@ namespace talus::semi_implicit
         const double       n  = P[fs.porosity];
         const double       rs = prm.materials[m]->density();
         // dry unit weight above the water level, buoyant below
-        const double above = std::max(0.0, prm.soil_surface - std::max(y, prm.water_level));
-        const double below = std::max(0.0, std::min(prm.soil_surface, prm.water_level) - y);
-        const double sv    = -(1 - n) * g * (rs * above + (rs - prm.water_density) * below);
+        const double                  above = std::max(0.0, prm.soil_surface - std::max(y, prm.water_level));
+        const double                  below = std::max(0.0, std::min(prm.soil_surface, prm.water_level) - y);
+        const double                  sv    = -(1 - n) * g * (rs * above + (rs - prm.water_density) * below);
         dealii::SymmetricTensor<2, 3> s;
         for (unsigned int d = 0; d < 3; ++d)
           s[d][d] = prm.K0 * sv;
@@ -1184,25 +1223,25 @@ namespace talus::semi_implicit
   {
     const auto ns = soil.handler.n_global_particles(), nw = water.handler.n_global_particles();
     out << "talus-semi-implicit: " << dim << "D, grid " << grid.tria.n_global_active_cells() << " cells (h_min "
-        << grid.min_cell_size() << " m), " << (prm.bspline() ? "quadratic B-splines" : "linear shape functions")
-        << ", " << ns << " soil + " << nw << " water points\n"
+        << grid.min_cell_size() << " m), " << (prm.bspline() ? "quadratic B-splines" : "linear shape functions") << ", "
+        << ns << " soil + " << nw << " water points\n"
         << "  time step " << dt << " s (soil skeleton critical step " << dt_soil_critical << " s"
-        << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant)) << "), pressure: CG + ML AMG to "
-        << prm.pressure_tolerance << " relative residual, AMG rebuilt every "
+        << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant))
+        << "), pressure: CG + ML AMG to " << prm.pressure_tolerance << " relative residual, AMG rebuilt every "
         << prm.pressure_rebuild_interval << " steps" << std::endl;
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
       {
         const auto &pl = prm.rigid_plates[k];
         out << "  " << pl.where << ": "
             << (pl.target == loads::RigidPlate<dim>::Target::boundary ? "boundary id " + std::to_string(pl.boundary)
-                                                                        : std::string("region"))
+                                                                      : std::string("region"))
             << ", " << plate_nodes[k] << " nodes"
             << (plate_axis_dofs[k] < plate_nodes[k]
-                  ? " (" + std::to_string(plate_axis_dofs[k]) + " move along " + "xyz"[pl.axis] +
-                      ", the others' " + "xyz"[pl.axis] + " is held by a wall)"
+                  ? " (" + std::to_string(plate_axis_dofs[k]) + " move along " + "xyz"[pl.axis] + ", the others' " +
+                      "xyz"[pl.axis] + " is held by a wall)"
                   : std::string(" moving along ") + "xyz"[pl.axis])
-            << ", " << (pl.rough ? "rough" : "frictionless") << ", "
-            << (pl.permeable ? "permeable" : "impermeable") << ", "
+            << ", " << (pl.rough ? "rough" : "frictionless") << ", " << (pl.permeable ? "permeable" : "impermeable")
+            << ", "
             << (pl.control == loads::RigidPlate<dim>::Control::force
                   ? "force control: " + number_text(pl.force) + " N x f(t), displacement unknown"
                   : "displacement control: " + number_text(pl.displacement) + " m x f(t), reaction reported")
@@ -1216,22 +1255,23 @@ namespace talus::semi_implicit
   void
   Solver<dim>::step(const double h)
   {
-    using Stencil     = transfer::PointStencil<dim, K>;
-    using It          = transfer::PointIterator<dim>;
+    using Stencil = transfer::PointStencil<dim, K>;
+    using It      = transfer::PointIterator<dim>;
     // App. B.4 stage: gravity ramped over it (the factor at mid-step), elastic
     // models, the water on the soil, the initialisation conductivity
     const bool   initial_stage = initialising(time);
-    const auto   g = (initial_stage ? std::min(1.0, (time + 0.5 * h) / prm.initialisation_time) : 1.0) * prm.gravity;
-    const double rw   = prm.water_density;
-    const unsigned int nl = n_local();
-    auto lap = Clock::now(); // phase timers: add_lap(x) adds the time since the last lap to x
-    auto add_lap = [&lap](double &x) {
+    const auto   g  = (initial_stage ? std::min(1.0, (time + 0.5 * h) / prm.initialisation_time) : 1.0) * prm.gravity;
+    const double rw = prm.water_density;
+    const unsigned int nl      = n_local();
+    auto               lap     = Clock::now(); // phase timers: add_lap(x) adds the time since the last lap to x
+    auto               add_lap = [&lap](double &x) {
       const auto now = Clock::now();
       x += std::chrono::duration<double>(now - lap).count();
       lap = now;
     };
 
-    for (Vector *v : {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
+    for (Vector *v :
+         {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
@@ -1241,29 +1281,31 @@ namespace talus::semi_implicit
     {
       double *ms = at(Ms), *ps = at(Ps), *mn = at(Mn), *mk = at(Mk), *fsv = at(Fs);
       Stencil surface; // a loaded point's stencil at its share of the face
-      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int c, It &it, const Stencil &s) {
-        const double *P = it->get_properties().data();
-        const double  m = P[L::mass];
-        s.scatter(ms, m);
-        s.scatter_vector(ps, m, P + L::velocity);
-        s.scatter(mn, m * P[fs.porosity]);
-        const double k = initial_stage ? prm.initialisation_conductivity : P[fs.conductivity];
-        s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / k);
-        double gm[dim];
-        for (unsigned int d = 0; d < dim; ++d)
-          gm[d] = g[d];
-        s.scatter_vector(fsv, m, gm);
-        double t[dim][dim];
-        minus_V_sigma<dim>(P, P[L::volume], t);
-        s.scatter_divergence(fsv, t);
-        if (P[fs.surface_force] != 0)
-          {
-            double f[dim] = {};
-            f[dim - 1]    = -P[fs.surface_force] * prm.surface_load[static_cast<unsigned int>(P[L::body])].factor(time, h);
-            transfer::offset_stencil<dim, K>(grid, c, it->get_location(), P + fs.surface_offset, surface);
-            surface.scatter_vector(fsv, 1.0, f);
-          }
-      });
+      transfer::for_each_point_stencil<dim, K>(
+        grid, soil, stencils<K>(soil), [&](unsigned int c, It &it, const Stencil &s) {
+          const double *P = it->get_properties().data();
+          const double  m = P[L::mass];
+          s.scatter(ms, m);
+          s.scatter_vector(ps, m, P + L::velocity);
+          s.scatter(mn, m * P[fs.porosity]);
+          const double k = initial_stage ? prm.initialisation_conductivity : P[fs.conductivity];
+          s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / k);
+          double gm[dim];
+          for (unsigned int d = 0; d < dim; ++d)
+            gm[d] = g[d];
+          s.scatter_vector(fsv, m, gm);
+          double t[dim][dim];
+          minus_V_sigma<dim>(P, P[L::volume], t);
+          s.scatter_divergence(fsv, t);
+          if (P[fs.surface_force] != 0)
+            {
+              double f[dim] = {};
+              f[dim - 1] =
+                -P[fs.surface_force] * prm.surface_load[static_cast<unsigned int>(P[L::body])].factor(time, h);
+              transfer::offset_stencil<dim, K>(grid, c, it->get_location(), P + fs.surface_offset, surface);
+              surface.scatter_vector(fsv, 1.0, f);
+            }
+        });
     }
     exchange({&Ms, &Ps, &Mn, &Mk, &Fs});
     double ms_max = 0;
@@ -1274,12 +1316,12 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
         {
-          const double m = Ms.local_element(i);
+          const double m          = Ms.local_element(i);
           n_node.local_element(i) = m > ms_cut ? Mn.local_element(i) / m : 1.0;
         }
     for (unsigned int i = 0; i < nl; ++i)
       {
-        const double m = Ms.local_element(node_of[i]);
+        const double m        = Ms.local_element(node_of[i]);
         vs_t.local_element(i) = m > ms_cut ? Ps.local_element(i) / m : 0.0;
       }
 
@@ -1290,31 +1332,32 @@ namespace talus::semi_implicit
     cell_water_volume.assign(grid.cells.size(), 0.0);
     {
       const double *nn = at(n_node);
-      double *      ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw), *mwg = at(Mwg);
+      double       *ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw), *mwg = at(Mwg);
       const bool    linear = prm.linear_smoothing;
-      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int c, It &it, const Stencil &s) {
-        double *     P  = it->get_properties().data();
-        const double n  = std::clamp(s.value(nn), 1e-6, 1.0);
-        const double V0 = P[fw.initial_volume];
-        P[fw.porosity]  = n;
-        P[L::volume]    = P[fw.initial_porosity] / n * V0; // Eq. 36
-        s.scatter(ww, rw * P[L::volume]);
-        s.scatter_vector(pw0, rw * V0, P + L::velocity);
-        s.scatter(ww0, rw * V0);
-        if (linear) // sum N m (p - grad p . x_p); the node adds (sum N m grad p) . x_I
-          {
-            const auto x  = it->get_location();
-            double     px = P[fw.pressure];
-            for (unsigned int d = 0; d < dim; ++d)
-              px -= P[fw.pressure_gradient + d] * x[d];
-            s.scatter(mwp, P[L::mass] * px);
-            s.scatter_vector(mwg, P[L::mass], P + fw.pressure_gradient);
-          }
-        else
-          s.scatter(mwp, P[L::mass] * P[fw.pressure]);
-        s.scatter(mw, P[L::mass]);
-        cell_water_volume[c] += P[L::volume];
-      });
+      transfer::for_each_point_stencil<dim, K>(
+        grid, water, stencils<K>(water), [&](unsigned int c, It &it, const Stencil &s) {
+          double      *P  = it->get_properties().data();
+          const double n  = std::clamp(s.value(nn), 1e-6, 1.0);
+          const double V0 = P[fw.initial_volume];
+          P[fw.porosity]  = n;
+          P[L::volume]    = P[fw.initial_porosity] / n * V0; // Eq. 36
+          s.scatter(ww, rw * P[L::volume]);
+          s.scatter_vector(pw0, rw * V0, P + L::velocity);
+          s.scatter(ww0, rw * V0);
+          if (linear) // sum N m (p - grad p . x_p); the node adds (sum N m grad p) . x_I
+            {
+              const auto x  = it->get_location();
+              double     px = P[fw.pressure];
+              for (unsigned int d = 0; d < dim; ++d)
+                px -= P[fw.pressure_gradient + d] * x[d];
+              s.scatter(mwp, P[L::mass] * px);
+              s.scatter_vector(mwg, P[L::mass], P + fw.pressure_gradient);
+            }
+          else
+            s.scatter(mwp, P[L::mass] * P[fw.pressure]);
+          s.scatter(mw, P[L::mass]);
+          cell_water_volume[c] += P[L::volume];
+        });
     }
     exchange({&Ww, &Pw0, &Ww0, &Mwp, &Mw, &Mwg});
     if (prm.linear_smoothing) // the node's share (sum N m grad p) . x_I, component by component
@@ -1327,7 +1370,7 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
         {
-          const bool   has_water     = Mw.local_element(i) > mw_cut;
+          const bool has_water     = Mw.local_element(i) > mw_cut;
           p_node.local_element(i)  = has_water ? Mwp.local_element(i) / Mw.local_element(i) : 0.0;
           Mw_node.local_element(i) = has_water ? n_node.local_element(i) * Ww.local_element(i) : 0.0; // Eq. 50
           // the drag Q_I = sum_s N n^2 rho_w g V / k over the soil points: Eq. 58
@@ -1338,7 +1381,7 @@ namespace talus::semi_implicit
         }
     for (unsigned int i = 0; i < nl; ++i)
       {
-        const double w = Ww0.local_element(node_of[i]);
+        const double w        = Ww0.local_element(node_of[i]);
         vw_t.local_element(i) = Mw.local_element(node_of[i]) > mw_cut && w > 0 ? Pw0.local_element(i) / w : 0.0;
       }
 
@@ -1349,12 +1392,13 @@ namespace talus::semi_implicit
     // printed mixture form -sum_w V p grad N split by n_I gives the soil of a
     // node at a free-water interface the buoyancy of the whole support)
     {
-      const double *pn = at(p_node);
-      double *      gpw = at(Gpw), *gps = at(Gps);
-      transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), pn, L::volume, gpw, [&](It &it, const Stencil &s) {
-        if (prm.pressure_smoothing)
-          it->get_properties()[fw.pressure] = s.value(pn);
-      });
+      const double *pn  = at(p_node);
+      double       *gpw = at(Gpw), *gps = at(Gps);
+      transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), pn, L::volume, gpw,
+                                              [&](It &it, const Stencil &s) {
+                                                if (prm.pressure_smoothing)
+                                                  it->get_properties()[fw.pressure] = s.value(pn);
+                                              });
       transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), pn, L::volume, gps);
     }
     exchange({&Gpw, &Gps});
@@ -1387,11 +1431,11 @@ namespace talus::semi_implicit
         const unsigned int j   = node_of[i];
         const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j);
         const double       Q = Q_node.local_element(j), n = n_node.local_element(j);
-        const double       b  = g[component[i]];
-        const double       rs = Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i));
-        const double       rwv = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
-        double             vw = 0, vs = 0;
-        const bool         has_soil = Msi > ms_cut, has_water = Mwi > 0;
+        const double       b = g[component[i]];
+        const double rs      = Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i));
+        const double rwv     = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
+        double       vw = 0, vs = 0;
+        const bool   has_soil = Msi > ms_cut, has_water = Mwi > 0;
         if (prm.rigid_skeleton) // v_s = 0: the water alone, its drag implicit
           vw = has_water ? rwv / (Mwi + h * Q) : 0.0;
         else if (has_soil && has_water)
@@ -1413,8 +1457,8 @@ namespace talus::semi_implicit
             const bool permeable = prm.rigid_plates[k].permeable;
             // the water's factor of V: 1 (impermeable), its row's drag share
             // (permeable, with soil at the node), 0 (no coupling)
-            const double ew = !permeable ? (has_water ? 1.0 : 0.0)
-                                         : (has_soil && has_water ? h * Q / (Mwi + h * Q) : 0.0);
+            const double ew =
+              !permeable ? (has_water ? 1.0 : 0.0) : (has_soil && has_water ? h * Q / (Mwi + h * Q) : 0.0);
             vs = plate_v[k];
             if (!permeable)
               vw = ew * plate_v[k];
@@ -1437,223 +1481,229 @@ namespace talus::semi_implicit
     // soil, n for the water; point porosity, see docs/semi-implicit.md)
     {
       const double *vss = at(vs_star), *vws = at(vw_star);
-      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-        double *     P   = it->get_properties().data();
-        const double phi = 1 - P[fs.porosity];
-        const double rs  = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
-        P[fs.poisson_coefficient] = prm.rigid_skeleton ? 0.0 : h * phi / rs;
-        double v[dim];
-        s.vector_value(vss, v);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[fs.poisson_flux + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
-      });
-      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
-        double *     P   = it->get_properties().data();
-        const double phi = P[fw.porosity];
-        P[fw.poisson_coefficient] = h * phi / rw;
-        double v[dim];
-        s.vector_value(vws, v);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[fw.poisson_flux + d] = phi * v[d];
-      });
+      transfer::for_each_point_stencil<dim, K>(
+        grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+          double      *P            = it->get_properties().data();
+          const double phi          = 1 - P[fs.porosity];
+          const double rs           = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
+          P[fs.poisson_coefficient] = prm.rigid_skeleton ? 0.0 : h * phi / rs;
+          double v[dim];
+          s.vector_value(vss, v);
+          for (unsigned int d = 0; d < dim; ++d)
+            P[fs.poisson_flux + d] = prm.rigid_skeleton ? 0.0 : phi * v[d];
+        });
+      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water),
+                                               [&](unsigned int, It &it, const Stencil &s) {
+                                                 double      *P            = it->get_properties().data();
+                                                 const double phi          = P[fw.porosity];
+                                                 P[fw.poisson_coefficient] = h * phi / rw;
+                                                 double v[dim];
+                                                 s.vector_value(vws, v);
+                                                 for (unsigned int d = 0; d < dim; ++d)
+                                                   P[fw.poisson_flux + d] = phi * v[d];
+                                               });
     }
     add_lap(phase.poisson); // the points' Poisson coefficient and flux (also in a dry scene)
     // a dry scene (soil points only) is a single-phase solid: no pressure
     if (water.handler.n_global_particles() == 0)
       dp_node = 0;
     else
-    {
-    // the pressure DoF set: rebuilt (with the sparsity, the matrix and the AMG
-    // hierarchy) only when a point set's cells changed on some rank, or a
-    // point's B-spline window moved (a half-cell line) onto a pair the kept
-    // pattern lacks (couplings_covered). The decision is global:
-    // ActiveSet::reinit and the AMG set-up are collective.
-    const bool cells_changed = soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 ||
-                               partition_changed || A.m() == 0;
-    const bool window_moved = !cells_changed && !active.template couplings_covered<K>({&soil, &water});
-    const unsigned int why  = dealii::Utilities::MPI::max(cells_changed ? 2u : window_moved ? 1u : 0u, comm);
-    const bool new_pattern  = why != 0;
-    if (new_pattern)
       {
-        active.template reinit<K>({&soil, &water}, ActiveSet<dim>::Couplings::record);
-        ++n_pattern_changes;
-        if (why == 1)
-          ++n_pattern_window_changes;
-      }
-    partition_changed = false;
-    // free water surface: per node, whether it is a vertex of a wet and of a
-    // dry cell, and whether it is a vertex of a cell next to a wet one
-    // (shares a vertex with it: the layer of nodes just outside the water)
-    {
-      double *wt = at(wet), *dr = at(dry);
-      for (unsigned int c = 0; c < grid.cells.size(); ++c)
-        if (grid.cells[c].locally_owned)
+        // the pressure DoF set: rebuilt (with the sparsity, the matrix and the AMG
+        // hierarchy) only when a point set's cells changed on some rank, or a
+        // point's B-spline window moved (a half-cell line) onto a pair the kept
+        // pattern lacks (couplings_covered). The decision is global:
+        // ActiveSet::reinit and the AMG set-up are collective.
+        const bool cells_changed =
+          soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 || partition_changed || A.m() == 0;
+        const bool         window_moved = !cells_changed && !active.template couplings_covered<K>({&soil, &water});
+        const unsigned int why         = dealii::Utilities::MPI::max(cells_changed ? 2u : window_moved ? 1u : 0u, comm);
+        const bool         new_pattern = why != 0;
+        if (new_pattern)
           {
-            double cell_volume = 1;
-            for (unsigned int d = 0; d < dim; ++d)
-              cell_volume *= grid.cells[c].h[d];
-            const bool is_wet = cell_water_volume[c] >= prm.free_surface_fraction * cell_volume;
-            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-              (is_wet ? wt : dr)[grid.cells[c].dofs[v * dim]] += 1;
+            active.template reinit<K>({&soil, &water}, ActiveSet<dim>::Couplings::record);
+            ++n_pattern_changes;
+            if (why == 1)
+              ++n_pattern_window_changes;
           }
-    }
-    exchange({&wet, &dry});
-    {
-      const double *wt = at(wet);
-      double *      nr = at(near_wet);
-      for (unsigned int c = 0; c < grid.cells.size(); ++c)
-        if (grid.cells[c].locally_owned)
-          {
-            bool touches_wet = false;
-            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-              touches_wet = touches_wet || wt[grid.cells[c].dofs[v * dim]] > 0;
-            if (touches_wet)
-              for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
-                nr[grid.cells[c].dofs[v * dim]] += 1;
-          }
-    }
-    exchange({&near_wet});
-    dealii::AffineConstraints<double> dirichlet, dirichlet_homogeneous; // the second: a plate's unit response
-    dirichlet.reinit(pspace.locally_relevant_dofs());
-    dirichlet_homogeneous.reinit(pspace.locally_relevant_dofs());
-    for (unsigned int i = 0; i < nl; ++i)
-      if (component[i] == 0)
+        partition_changed = false;
+        // free water surface: per node, whether it is a vertex of a wet and of a
+        // dry cell, and whether it is a vertex of a cell next to a wet one
+        // (shares a vertex with it: the layer of nodes just outside the water)
         {
-          const auto gdof = pspace.node_dof(i, 0);
-          if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
-            continue;
-          const bool has_water = Mw.local_element(i) > mw_cut;
-          const bool surface   = dry.local_element(i) > 0 && !plate_sealed[i];
-          if (has_water && drained[i]) // a drained face: p^{t+1} = 0
-            {
-              dirichlet.add_line(gdof);
-              dirichlet_homogeneous.add_line(gdof);
-              dirichlet.set_inhomogeneity(gdof, -p_node.local_element(i));
-            }
-          else if (!has_water || surface)
-            {
-              // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
-              // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
-              // Delta p = -p^t. The dry nodes next to a wet cell (B-spline: the
-              // node above the surface that the top points still touch) keep the
-              // mapped p^t, the linear extrapolation of the water's pressure
-              // (Delta p = 0); forcing 0 there fed the top cell a spurious
-              // pressure step every step (docs/semi-implicit.md, A6).
-              const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
-              dirichlet.add_line(gdof);
-              dirichlet_homogeneous.add_line(gdof);
-              dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
-            }
-        }
-    dirichlet.close();
-    dirichlet_homogeneous.close();
-    const auto constraints = active.constraints_with(dirichlet);
-    if (new_pattern)
-      {
-        active.reinit_matrix(A); // a new Epetra matrix: the kept hierarchy referenced the old one
-        pressure_solver.invalidate();
-      }
-    else
-      A = 0; // same pattern: refill the values in place
-    pspace.reinit_vector(rhs);
-    pspace.reinit_vector(dp_solution);
-    {
-      // one local system per cell for the soil and the water points of the
-      // cell, distributed once (the distribution was the step's largest single
-      // cost when each set's cells were distributed on their own)
-      const PoissonWithFlux terms[2] = {{fs.poisson_coefficient, fs.poisson_flux},
-                                        {fw.poisson_coefficient, fw.poisson_flux}};
-      transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> assembly(active, constraints, terms[0], &A, &rhs);
-      transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
-                                           [&](const unsigned int k) { assembly.integrand = terms[k]; });
-      transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, &A, &rhs);
-    }
-    add_lap(phase.poisson);
-    {
-      const auto          t0 = Clock::now();
-      LinearSolverOptions options;
-      options.method             = LinearSolverOptions::Method::cg_amg;
-      options.relative_tolerance = prm.pressure_tolerance;
-      pressure_solver.set_rebuild_interval(prm.pressure_rebuild_interval);
-      if (rhs.l2_norm() > 0)
-        last_solve = pressure_solver.solve(A, dp_solution, rhs, options, step_number);
-      else
-        last_solve = {"cg_amg", 0, 0.0};
-      constraints.distribute(dp_solution);
-      dp_solution.update_ghost_values();
-      seconds_solve += seconds_since(t0);
-      solver_iterations += last_solve.iterations;
-      ++n_solves;
-      lap = Clock::now();
-    }
-    for (unsigned int i = 0; i < nl; ++i)
-      if (component[i] == 0)
-        dp_node.local_element(i) = dp_solution(pspace.node_dof(i, 0));
-
-    // rigid plates under force control: the pressure increment of a unit
-    // plate velocity, on the same matrix and hierarchy, with homogeneous
-    // Dirichlet values (the equation is linear in V: dp = dp(V = 0) + V dp_1)
-    if (!force_plates.empty())
-      {
-        // without any Dirichlet row the pressure is fixed only up to a
-        // constant and a plate's unit inflow has no consistent answer
-        const unsigned int n_dirichlet = dealii::Utilities::MPI::sum(static_cast<unsigned int>(dirichlet.n_constraints()), comm);
-        require(n_dirichlet > 0, prm.rigid_plates[force_plates[0]].where,
-                "the pore water has no pressure reference: no free surface, drained boundary or permeable plate "
-                "(a closed, impermeable box); allowed: 'drainage = permeable', 'semi implicit/drained boundaries', "
-                "or water with a free surface");
-        const auto constraints_h = active.constraints_with(dirichlet_homogeneous);
-        for (auto &r : plate_response)
-          {
-            const double *es = at(r.es), *ew = at(r.ew);
-            transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-              double *P = it->get_properties().data();
-              double  v[dim];
-              s.vector_value(es, v);
-              for (unsigned int d = 0; d < dim; ++d)
-                P[fs.plate_flux + d] = (1 - P[fs.porosity]) * v[d];
-            });
-            transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
-              double *P = it->get_properties().data();
-              double  v[dim];
-              s.vector_value(ew, v);
-              for (unsigned int d = 0; d < dim; ++d)
-                P[fw.plate_flux + d] = P[fw.porosity] * v[d];
-            });
-            Vector rhs1, x1;
-            pspace.reinit_vector(rhs1);
-            pspace.reinit_vector(x1);
-            const PoissonFluxSource terms[2] = {{fs.plate_flux}, {fw.plate_flux}};
-            transfer::AssembleSystem<dim, K, 1, PoissonFluxSource> assembly(active, constraints_h, terms[0], nullptr, &rhs1);
-            transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
-                                                 [&](const unsigned int k) { assembly.integrand = terms[k]; });
-            transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, nullptr, &rhs1);
-            const auto          t0 = Clock::now();
-            LinearSolverOptions options;
-            options.method             = LinearSolverOptions::Method::cg_amg;
-            options.relative_tolerance = prm.pressure_tolerance;
-            if (rhs1.l2_norm() > 0)
+          double *wt = at(wet), *dr = at(dry);
+          for (unsigned int c = 0; c < grid.cells.size(); ++c)
+            if (grid.cells[c].locally_owned)
               {
-                const auto info = pressure_solver.solve(A, x1, rhs1, options, step_number);
-                solver_iterations += info.iterations;
-                last_solve.iterations += info.iterations;
-                last_solve.relative_residual = std::max(last_solve.relative_residual, info.relative_residual);
+                double cell_volume = 1;
+                for (unsigned int d = 0; d < dim; ++d)
+                  cell_volume *= grid.cells[c].h[d];
+                const bool is_wet = cell_water_volume[c] >= prm.free_surface_fraction * cell_volume;
+                for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+                  (is_wet ? wt : dr)[grid.cells[c].dofs[v * dim]] += 1;
               }
-            constraints_h.distribute(x1);
-            x1.update_ghost_values();
-            seconds_solve += seconds_since(t0);
-            for (unsigned int i = 0; i < nl; ++i)
-              if (component[i] == 0)
-                r.dp.local_element(i) = x1(pspace.node_dof(i, 0));
+        }
+        exchange({&wet, &dry});
+        {
+          const double *wt = at(wet);
+          double       *nr = at(near_wet);
+          for (unsigned int c = 0; c < grid.cells.size(); ++c)
+            if (grid.cells[c].locally_owned)
+              {
+                bool touches_wet = false;
+                for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+                  touches_wet = touches_wet || wt[grid.cells[c].dofs[v * dim]] > 0;
+                if (touches_wet)
+                  for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+                    nr[grid.cells[c].dofs[v * dim]] += 1;
+              }
+        }
+        exchange({&near_wet});
+        dealii::AffineConstraints<double> dirichlet, dirichlet_homogeneous; // the second: a plate's unit response
+        dirichlet.reinit(pspace.locally_relevant_dofs());
+        dirichlet_homogeneous.reinit(pspace.locally_relevant_dofs());
+        for (unsigned int i = 0; i < nl; ++i)
+          if (component[i] == 0)
+            {
+              const auto gdof = pspace.node_dof(i, 0);
+              if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
+                continue;
+              const bool has_water = Mw.local_element(i) > mw_cut;
+              const bool surface   = dry.local_element(i) > 0 && !plate_sealed[i];
+              if (has_water && drained[i]) // a drained face: p^{t+1} = 0
+                {
+                  dirichlet.add_line(gdof);
+                  dirichlet_homogeneous.add_line(gdof);
+                  dirichlet.set_inhomogeneity(gdof, -p_node.local_element(i));
+                }
+              else if (!has_water || surface)
+                {
+                  // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
+                  // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
+                  // Delta p = -p^t. The dry nodes next to a wet cell (B-spline: the
+                  // node above the surface that the top points still touch) keep the
+                  // mapped p^t, the linear extrapolation of the water's pressure
+                  // (Delta p = 0); forcing 0 there fed the top cell a spurious
+                  // pressure step every step (docs/semi-implicit.md, A6).
+                  const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
+                  dirichlet.add_line(gdof);
+                  dirichlet_homogeneous.add_line(gdof);
+                  dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
+                }
+            }
+        dirichlet.close();
+        dirichlet_homogeneous.close();
+        const auto constraints = active.constraints_with(dirichlet);
+        if (new_pattern)
+          {
+            active.reinit_matrix(A); // a new Epetra matrix: the kept hierarchy referenced the old one
+            pressure_solver.invalidate();
           }
-        lap = Clock::now();
+        else
+          A = 0; // same pattern: refill the values in place
+        pspace.reinit_vector(rhs);
+        pspace.reinit_vector(dp_solution);
+        {
+          // one local system per cell for the soil and the water points of the
+          // cell, distributed once (the distribution was the step's largest single
+          // cost when each set's cells were distributed on their own)
+          const PoissonWithFlux                                terms[2] = {{fs.poisson_coefficient, fs.poisson_flux},
+                                                                           {fw.poisson_coefficient, fw.poisson_flux}};
+          transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> assembly(active, constraints, terms[0], &A, &rhs);
+          transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
+                                               [&](const unsigned int k) { assembly.integrand = terms[k]; });
+          transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, &A, &rhs);
+        }
+        add_lap(phase.poisson);
+        {
+          const auto          t0 = Clock::now();
+          LinearSolverOptions options;
+          options.method             = LinearSolverOptions::Method::cg_amg;
+          options.relative_tolerance = prm.pressure_tolerance;
+          pressure_solver.set_rebuild_interval(prm.pressure_rebuild_interval);
+          if (rhs.l2_norm() > 0)
+            last_solve = pressure_solver.solve(A, dp_solution, rhs, options, step_number);
+          else
+            last_solve = {"cg_amg", 0, 0.0};
+          constraints.distribute(dp_solution);
+          dp_solution.update_ghost_values();
+          seconds_solve += seconds_since(t0);
+          solver_iterations += last_solve.iterations;
+          ++n_solves;
+          lap = Clock::now();
+        }
+        for (unsigned int i = 0; i < nl; ++i)
+          if (component[i] == 0)
+            dp_node.local_element(i) = dp_solution(pspace.node_dof(i, 0));
+
+        // rigid plates under force control: the pressure increment of a unit
+        // plate velocity, on the same matrix and hierarchy, with homogeneous
+        // Dirichlet values (the equation is linear in V: dp = dp(V = 0) + V dp_1)
+        if (!force_plates.empty())
+          {
+            // without any Dirichlet row the pressure is fixed only up to a
+            // constant and a plate's unit inflow has no consistent answer
+            const unsigned int n_dirichlet =
+              dealii::Utilities::MPI::sum(static_cast<unsigned int>(dirichlet.n_constraints()), comm);
+            require(n_dirichlet > 0, prm.rigid_plates[force_plates[0]].where,
+                    "the pore water has no pressure reference: no free surface, drained boundary or permeable plate "
+                    "(a closed, impermeable box); allowed: 'drainage = permeable', 'semi implicit/drained boundaries', "
+                    "or water with a free surface");
+            const auto constraints_h = active.constraints_with(dirichlet_homogeneous);
+            for (auto &r : plate_response)
+              {
+                const double *es = at(r.es), *ew = at(r.ew);
+                transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                                         [&](unsigned int, It &it, const Stencil &s) {
+                                                           double *P = it->get_properties().data();
+                                                           double  v[dim];
+                                                           s.vector_value(es, v);
+                                                           for (unsigned int d = 0; d < dim; ++d)
+                                                             P[fs.plate_flux + d] = (1 - P[fs.porosity]) * v[d];
+                                                         });
+                transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water),
+                                                         [&](unsigned int, It &it, const Stencil &s) {
+                                                           double *P = it->get_properties().data();
+                                                           double  v[dim];
+                                                           s.vector_value(ew, v);
+                                                           for (unsigned int d = 0; d < dim; ++d)
+                                                             P[fw.plate_flux + d] = P[fw.porosity] * v[d];
+                                                         });
+                Vector rhs1, x1;
+                pspace.reinit_vector(rhs1);
+                pspace.reinit_vector(x1);
+                const PoissonFluxSource                                terms[2] = {{fs.plate_flux}, {fw.plate_flux}};
+                transfer::AssembleSystem<dim, K, 1, PoissonFluxSource> assembly(active, constraints_h, terms[0],
+                                                                                nullptr, &rhs1);
+                transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
+                                                     [&](const unsigned int k) { assembly.integrand = terms[k]; });
+                transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, nullptr, &rhs1);
+                const auto          t0 = Clock::now();
+                LinearSolverOptions options;
+                options.method             = LinearSolverOptions::Method::cg_amg;
+                options.relative_tolerance = prm.pressure_tolerance;
+                if (rhs1.l2_norm() > 0)
+                  {
+                    const auto info = pressure_solver.solve(A, x1, rhs1, options, step_number);
+                    solver_iterations += info.iterations;
+                    last_solve.iterations += info.iterations;
+                    last_solve.relative_residual = std::max(last_solve.relative_residual, info.relative_residual);
+                  }
+                constraints_h.distribute(x1);
+                x1.update_ghost_values();
+                seconds_solve += seconds_since(t0);
+                for (unsigned int i = 0; i < nl; ++i)
+                  if (component[i] == 0)
+                    r.dp.local_element(i) = x1(pspace.node_dof(i, 0));
+              }
+            lap = Clock::now();
+          }
       }
-    }
 
     // (6) correction (64)-(68): sum V N grad(Delta p) over each phase's points
     {
       const double *dpn = at(dp_node);
-      double *      gsv = at(gs), *gwv = at(gw);
+      double       *gsv = at(gs), *gwv = at(gw);
       transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, gsv);
       transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), dpn, L::volume, gwv);
     }
@@ -1668,8 +1718,8 @@ namespace talus::semi_implicit
     add_lap(phase.p2n);
     // v^{t+1} from v* and the pressure increment's force; a plate's axis DoF
     // moves with its velocity Vp[k] (the water too at an impermeable plate)
-    const auto correct = [&](const unsigned int i, const double vss, const double vws, const double gsi, const double gwi,
-                             const double *Vp, double &vs, double &vw) {
+    const auto correct = [&](const unsigned int i, const double vss, const double vws, const double gsi,
+                             const double gwi, const double *Vp, double &vs, double &vw) {
       const unsigned int j   = node_of[i];
       const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
       vw = Mwi > 0 ? vws + h * n * gwi / Mwi : 0.0;
@@ -1704,14 +1754,14 @@ namespace talus::semi_implicit
         const unsigned int nf    = force_plates.size();
         // R0 (the V = 0 step, displacement plates at their velocities) and R1
         std::vector<double> R(n_plates * (1 + nf), 0.0);
-        const auto add_residual = [&](const unsigned int column, const Vector &vsn, const Vector &vwn, const Vector &gsv,
-                                      const Vector &gwv, const bool base) {
+        const auto          add_residual = [&](const unsigned int column, const Vector &vsn, const Vector &vwn,
+                                      const Vector &gsv, const Vector &gwv, const bool base) {
           for (unsigned int i = 0; i < owned; ++i)
             if (const unsigned int k = plate_of[i]; k != no_plate)
               {
-                const unsigned int j   = node_of[i];
-                const double       Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
-                double r = (Msi * vsn.local_element(i) + Mwi * vwn.local_element(i)) / h -
+                const unsigned int j = node_of[i];
+                const double Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
+                double       r = (Msi * vsn.local_element(i) + Mwi * vwn.local_element(i)) / h -
                            (1 - n) * gsv.local_element(i) - n * gwv.local_element(i);
                 if (base)
                   r -= (Msi * vs_t.local_element(i) + Mwi * vw_t.local_element(i)) / h + Fs.local_element(i) +
@@ -1722,7 +1772,7 @@ namespace talus::semi_implicit
         add_residual(0, vs_new, vw_new, gs, gw, true);
         for (unsigned int r = 0; r < nf; ++r)
           {
-            PlateResponse &u = plate_response[r];
+            PlateResponse      &u = plate_response[r];
             std::vector<double> unit(n_plates, 0.0);
             unit[force_plates[r]] = 1.0;
             for (unsigned int i = 0; i < nl; ++i)
@@ -1744,7 +1794,7 @@ namespace talus::semi_implicit
                 x[q] = pl.force_at(time + h) - R[force_plates[q]];
                 if (!(a[q * nf + q] > 0))
                   throw InstabilityError(pl.where + ": the plate touches no material (its nodes carry no mass), so "
-                                         "its velocity under a force is undetermined");
+                                                    "its velocity under a force is undetermined");
               }
             for (unsigned int c = 0; c < nf; ++c) // no pivoting: R1 is dominated by its diagonal (mass / h)
               for (unsigned int q = c + 1; q < nf; ++q)
@@ -1762,8 +1812,8 @@ namespace talus::semi_implicit
               }
             for (unsigned int r = 0; r < nf; ++r)
               {
-                const double   V = x[r];
-                PlateResponse &u = plate_response[r];
+                const double   V         = x[r];
+                PlateResponse &u         = plate_response[r];
                 plate_v[force_plates[r]] = V;
                 for (unsigned int i = 0; i < nl; ++i) // owned and ghost entries alike
                   {
@@ -1783,10 +1833,12 @@ namespace talus::semi_implicit
             {
               const unsigned int j   = node_of[i];
               const double       Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
-              T[k * dim + component[i]] +=
-                (Msi * (vs_new.local_element(i) - vs_t.local_element(i)) + Mwi * (vw_new.local_element(i) - vw_t.local_element(i))) / h -
-                Fs.local_element(i) - Mwi * g[component[i]] - (1 - n) * (Gps.local_element(i) + gs.local_element(i)) -
-                n * (Gpw.local_element(i) + gw.local_element(i));
+              T[k * dim + component[i]] += (Msi * (vs_new.local_element(i) - vs_t.local_element(i)) +
+                                            Mwi * (vw_new.local_element(i) - vw_t.local_element(i))) /
+                                             h -
+                                           Fs.local_element(i) - Mwi * g[component[i]] -
+                                           (1 - n) * (Gps.local_element(i) + gs.local_element(i)) -
+                                           n * (Gpw.local_element(i) + gw.local_element(i));
             }
         MPI_Allreduce(MPI_IN_PLACE, T.data(), static_cast<int>(T.size()), MPI_DOUBLE, MPI_SUM, comm);
         for (unsigned int k = 0; k < n_plates; ++k)
@@ -1810,39 +1862,41 @@ namespace talus::semi_implicit
     // (8a) MUSL: the soil's new momentum to the nodes (Ps reused)
     Ps = 0;
     {
-      const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *dpn = at(dp_node), *pn = at(p_node);
-      const double  flip = prm.flip_fraction;
-      double *      ps = at(Ps);
-      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-        double *P = it->get_properties().data();
-        double  a[dim], b[dim];
-        s.vector_value(vsn, a);
-        s.vector_value(vst, b);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-        s.scatter_vector(ps, P[L::mass], P + L::velocity);
-      });
-      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
-        double *P = it->get_properties().data();
-        double  a[dim], b[dim];
-        s.vector_value(vwn, a);
-        s.vector_value(vwt, b);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-        P[fw.pressure] += s.value(dpn); // (7c) as an increment: p_I^t + dp_I interpolated differs by the remap
-        double gp[dim], gdp[dim];
-        s.gradient(pn, gp);
-        s.gradient(dpn, gdp);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[fw.pressure_gradient + d] = gp[d] + gdp[d];
-
-      });
+      const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *dpn = at(dp_node),
+                   *pn  = at(p_node);
+      const double flip = prm.flip_fraction;
+      double      *ps   = at(Ps);
+      transfer::for_each_point_stencil<dim, K>(
+        grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+          double *P = it->get_properties().data();
+          double  a[dim], b[dim];
+          s.vector_value(vsn, a);
+          s.vector_value(vst, b);
+          for (unsigned int d = 0; d < dim; ++d)
+            P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+          s.scatter_vector(ps, P[L::mass], P + L::velocity);
+        });
+      transfer::for_each_point_stencil<dim, K>(
+        grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
+          double *P = it->get_properties().data();
+          double  a[dim], b[dim];
+          s.vector_value(vwn, a);
+          s.vector_value(vwt, b);
+          for (unsigned int d = 0; d < dim; ++d)
+            P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+          P[fw.pressure] += s.value(dpn); // (7c) as an increment: p_I^t + dp_I interpolated differs by the remap
+          double gp[dim], gdp[dim];
+          s.gradient(pn, gp);
+          s.gradient(dpn, gdp);
+          for (unsigned int d = 0; d < dim; ++d)
+            P[fw.pressure_gradient + d] = gp[d] + gdp[d];
+        });
     }
     exchange({&Ps});
     for (unsigned int i = 0; i < nl; ++i)
       {
-        const double m          = Ms.local_element(node_of[i]);
-        vs_t.local_element(i)   = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
+        const double m        = Ms.local_element(node_of[i]);
+        vs_t.local_element(i) = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
         if (plate_of[i] != no_plate) // the plate's velocity, as the walls' zero (A11)
           vs_t.local_element(i) = plate_v[plate_of[i]];
       }
@@ -1859,8 +1913,10 @@ namespace talus::semi_implicit
             if (plate_of[i] != no_plate)
               spread[k] = std::max({spread[k], std::abs(vs_new.local_element(i) - plate_v[k]),
                                     std::abs(vs_t.local_element(i) - plate_v[k])});
-            else if (component[i] != prm.rigid_plates[k].axis && (!constrained[i] || plate_tangential_of[i] != no_plate))
-              spread[np + k] = std::max({spread[np + k], std::abs(vs_new.local_element(i)), std::abs(vs_t.local_element(i))});
+            else if (component[i] != prm.rigid_plates[k].axis &&
+                     (!constrained[i] || plate_tangential_of[i] != no_plate))
+              spread[np + k] =
+                std::max({spread[np + k], std::abs(vs_new.local_element(i)), std::abs(vs_t.local_element(i))});
           }
         MPI_Allreduce(MPI_IN_PLACE, spread.data(), static_cast<int>(spread.size()), MPI_DOUBLE, MPI_MAX, comm);
         for (unsigned int k = 0; k < np; ++k)
@@ -1878,15 +1934,16 @@ namespace talus::semi_implicit
     // remapped increment at x^t, volume, J, porosity, conductivity, stress
     struct SoilUpdate
     {
-      const Solver &        s;
+      const Solver                                                  &s;
       const std::vector<std::shared_ptr<const materials::Material>> &models; // per material, this step's
-      const double *        v_grid; // v_s^{t+1}: the point moves with it
-      const double          h;
+      const double                                                  *v_grid; // v_s^{t+1}: the point moves with it
+      const double                                                   h;
       struct PointState
-      {};
+      {
+      };
       inline void
-      increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du,
-                 const double *, double (&gu)[dim][dim], double (&dx)[dim])
+      increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du, const double *,
+                 double (&gu)[dim][dim], double (&dx)[dim])
       {
         double unused[dim];
         K::value_and_gradient(cell, du, e, unused, gu);
@@ -1906,10 +1963,11 @@ namespace talus::semi_implicit
             dF[i][j] += gu[i][j];
         const double dJ = dealii::determinant(dF);
         if (!(dJ > 0))
-          throw InstabilityError("a soil point's volume increment det(ΔF) = " + std::to_string(dJ) + " is not positive");
-        const unsigned int mid = static_cast<unsigned int>(P[L::material]);
-        const materials::Material &m = *models[mid];
-        double *const history = P + s.soil.layout.history;
+          throw InstabilityError("a soil point's volume increment det(ΔF) = " + std::to_string(dJ) +
+                                 " is not positive");
+        const unsigned int         mid     = static_cast<unsigned int>(P[L::material]);
+        const materials::Material &m       = *models[mid];
+        double *const              history = P + s.soil.layout.history;
         // the increment the model sees: ΔF, or ΔF-bar (79); the modified F-bar
         // also replaces the model's b_e by b_e-bar (82) before the push (81)
         dealii::Tensor<2, 3> dF_model = dF;
@@ -1923,7 +1981,7 @@ namespace talus::semi_implicit
               scale_elastic_b(history, P[s.fs.patch_elastic_jacobian] / elastic_jacobian(m, history));
             dF_model = stabilised_increment<dim>(dF, dJ_bar);
           }
-        P[L::volume] *= dJ;                                     // (8d)
+        P[L::volume] *= dJ;             // (8d)
         if (P[s.fs.surface_force] != 0) // the loaded face moves with the material: d <- dF d
           {
             double d[dim];
@@ -1937,14 +1995,14 @@ namespace talus::semi_implicit
                 P[s.fs.surface_offset + i] = di;
               }
           }
-        const double J  = P[L::volume] / P[s.fs.initial_volume]; // (8e)
-        const double n0 = P[s.fs.initial_porosity];
-        const double n  = std::clamp(1 - (1 - n0) / J, 1e-6, 1 - 1e-6); // (8f)
+        const double J   = P[L::volume] / P[s.fs.initial_volume]; // (8e)
+        const double n0  = P[s.fs.initial_porosity];
+        const double n   = std::clamp(1 - (1 - n0) / J, 1e-6, 1 - 1e-6); // (8f)
         P[s.fs.porosity] = n;
         if (s.prm.kozeny_carman) // (8g), C1 from k0 and n0
           {
-            const double k0 = s.prm.soil_of_material[mid].conductivity;
-            const double C1 = k0 * (1 - n0) * (1 - n0) / (n0 * n0 * n0);
+            const double k0      = s.prm.soil_of_material[mid].conductivity;
+            const double C1      = k0 * (1 - n0) * (1 - n0) / (n0 * n0 * n0);
             P[s.fs.conductivity] = C1 * n * n * n / ((1 - n) * (1 - n));
           }
         // Nor-Sand (96): v^{t+1} = v0 Jbar^{t+1}; the model multiplies its v by
@@ -1985,36 +2043,40 @@ namespace talus::semi_implicit
       }
       inline void
       moved(const It &, double *, const dealii::Point<dim> &, PointState &)
-      {}
+      {
+      }
     };
     struct WaterMove
     {
       struct PointState
-      {};
+      {
+      };
       inline void
-      increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du,
-                 const double *, double (&gu)[dim][dim], double (&dx)[dim])
+      increments(const typename K::Cell &cell, const typename K::Eval &e, const typename K::Field &du, const double *,
+                 double (&gu)[dim][dim], double (&dx)[dim])
       {
         transfer::default_increments<dim, K>(cell, e, du, gu, dx);
       }
       inline void
       update(const unsigned int, const typename K::Cell &, double *, const double (&)[dim][dim], PointState &)
-      {}
+      {
+      }
       inline void
       moved(const It &, double *, const dealii::Point<dim> &, PointState &)
-      {}
+      {
+      }
     };
     {
       SoilUpdate su{*this, initial_stage ? initialisation_models : prm.materials, at(vs_new), h};
-      transfer::UpdateAndMove<dim, K, SoilUpdate>             move_soil(grid, soil, at(vs_t), h, su);
+      transfer::UpdateAndMove<dim, K, SoilUpdate> move_soil(grid, soil, at(vs_t), h, su);
       transfer::for_each_active_cell(soil, move_soil);
       add_lap(phase.stress);
       soil.relocate();
-      WaterMove                                               wm;
+      WaterMove wm;
       // single point: the water rides on the soil points (the same positions,
       // moved by the same velocity field and the same arithmetic)
-      transfer::UpdateAndMove<dim, K, WaterMove> move_water(grid, water,
-                                                            at(prm.single_point || initial_stage ? vs_new : vw_new), h, wm);
+      transfer::UpdateAndMove<dim, K, WaterMove> move_water(
+        grid, water, at(prm.single_point || initial_stage ? vs_new : vw_new), h, wm);
       transfer::for_each_active_cell(water, move_water);
       water.relocate();
       add_lap(phase.relocation);
@@ -2034,7 +2096,8 @@ namespace talus::semi_implicit
     for (auto &pt : soil.handler)
       {
         auto P = pt.get_properties();
-        if (const auto *ns = dynamic_cast<const materials::NorSand *>(prm.materials[static_cast<unsigned int>(P[L::material])].get()))
+        if (const auto *ns =
+              dynamic_cast<const materials::NorSand *>(prm.materials[static_cast<unsigned int>(P[L::material])].get()))
           {
             ns->reinitialize_reference(dealii::ArrayView<double>(P.data() + soil.layout.history, ns->n_history()));
             ++n;
@@ -2058,7 +2121,7 @@ namespace talus::semi_implicit
     // optimised away: each point pass of the step pays this once. The least
     // of 5 walks (one walk is short: a shared machine's hiccup would dominate)
     double        sum = 0, t = std::numeric_limits<double>::max();
-    const double *nn  = n_node.begin();
+    const double *nn = n_node.begin();
     for (unsigned int repeat = 0; repeat < 5; ++repeat)
       {
         const auto t0 = Clock::now();
@@ -2079,9 +2142,9 @@ namespace talus::semi_implicit
   void
   Solver<dim>::volume_averages(const double h, const double ms_cut)
   {
-    const bool fbar = prm.stabilisation != VolumetricStabilisation::none;
-    using Stencil      = transfer::PointStencil<dim, K>;
-    using It           = transfer::PointIterator<dim>;
+    const bool fbar     = prm.stabilisation != VolumetricStabilisation::none;
+    using Stencil       = transfer::PointStencil<dim, K>;
+    using It            = transfer::PointIterator<dim>;
     const bool modified = prm.stabilisation == VolumetricStabilisation::modified_f_bar;
     if (modified)
       {
@@ -2093,30 +2156,31 @@ namespace talus::semi_implicit
     Mjt = 0;
     {
       const double *v  = vs_t.begin();
-      double *      mj = Mdj.begin(), *mt = Mjt.begin();
-      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-        double *P = it->get_properties().data();
-        double  gv[dim][dim];
-        s.vector_gradient(v, gv);
-        dealii::Tensor<2, 3> dF; // I + h grad v (plane strain: dF_33 = 1)
-        for (unsigned int i = 0; i < 3; ++i)
-          dF[i][i] = 1;
-        for (unsigned int i = 0; i < dim; ++i)
-          for (unsigned int j = 0; j < dim; ++j)
-            dF[i][j] += h * gv[i][j];
-        const double dJ = dealii::determinant(dF);
-        if (fbar)
-          s.scatter(mj, P[L::mass] * dJ);
-        if (smooth_jacobian) // J^{t+1} = (V / V0) dJ
-          s.scatter(mt, P[L::mass] * P[L::volume] / P[fs.initial_volume] * dJ);
-        if (modified)
-          {
-            const auto &       m = *prm.materials[static_cast<unsigned int>(P[L::material])];
-            const unsigned int k = patches.index(it->get_location());
-            patch_mass[k] += P[L::mass];
-            patch_mass_Je[k] += P[L::mass] * elastic_jacobian(m, P + soil.layout.history);
-          }
-      });
+      double       *mj = Mdj.begin(), *mt = Mjt.begin();
+      transfer::for_each_point_stencil<dim, K>(
+        grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+          double *P = it->get_properties().data();
+          double  gv[dim][dim];
+          s.vector_gradient(v, gv);
+          dealii::Tensor<2, 3> dF; // I + h grad v (plane strain: dF_33 = 1)
+          for (unsigned int i = 0; i < 3; ++i)
+            dF[i][i] = 1;
+          for (unsigned int i = 0; i < dim; ++i)
+            for (unsigned int j = 0; j < dim; ++j)
+              dF[i][j] += h * gv[i][j];
+          const double dJ = dealii::determinant(dF);
+          if (fbar)
+            s.scatter(mj, P[L::mass] * dJ);
+          if (smooth_jacobian) // J^{t+1} = (V / V0) dJ
+            s.scatter(mt, P[L::mass] * P[L::volume] / P[fs.initial_volume] * dJ);
+          if (modified)
+            {
+              const auto        &m = *prm.materials[static_cast<unsigned int>(P[L::material])];
+              const unsigned int k = patches.index(it->get_location());
+              patch_mass[k] += P[L::mass];
+              patch_mass_Je[k] += P[L::mass] * elastic_jacobian(m, P + soil.layout.history);
+            }
+        });
     }
     exchange({&Mdj, &Mjt});
     // every rank needs the sums of the patches its points are in; a patch may
@@ -2130,25 +2194,26 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < n_local(); ++i)
       if (component[i] == 0)
         {
-          const double m         = Ms.local_element(i);
-          Mdj.local_element(i)   = m > ms_cut ? Mdj.local_element(i) / m : 0.0; // now dJ_I
-          Mjt.local_element(i)   = m > ms_cut ? Mjt.local_element(i) / m : 0.0; // now J_I
+          const double m       = Ms.local_element(i);
+          Mdj.local_element(i) = m > ms_cut ? Mdj.local_element(i) / m : 0.0; // now dJ_I
+          Mjt.local_element(i) = m > ms_cut ? Mjt.local_element(i) / m : 0.0; // now J_I
         }
     const double *dj = Mdj.begin(), *jt = Mjt.begin();
-    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-      double *P = it->get_properties().data();
-      // the stencil's nodes all carry soil mass (this point's), so the
-      // partition of unity holds: a uniform dJ is returned exactly
-      if (fbar)
-        P[fs.smoothed_volume_increment] = s.value(dj);
-      if (smooth_jacobian)
-        P[fs.smoothed_jacobian] = s.value(jt);
-      if (modified)
-        {
-          const unsigned int k           = patches.index(it->get_location());
-          P[fs.patch_elastic_jacobian] = patch_mass_Je[k] / patch_mass[k];
-        }
-    });
+    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                             [&](unsigned int, It &it, const Stencil &s) {
+                                               double *P = it->get_properties().data();
+                                               // the stencil's nodes all carry soil mass (this point's), so the
+                                               // partition of unity holds: a uniform dJ is returned exactly
+                                               if (fbar)
+                                                 P[fs.smoothed_volume_increment] = s.value(dj);
+                                               if (smooth_jacobian)
+                                                 P[fs.smoothed_jacobian] = s.value(jt);
+                                               if (modified)
+                                                 {
+                                                   const unsigned int k         = patches.index(it->get_location());
+                                                   P[fs.patch_elastic_jacobian] = patch_mass_Je[k] / patch_mass[k];
+                                                 }
+                                             });
   }
 
   // ---------------------------------------------------------------- diagnostics and files
@@ -2168,9 +2233,16 @@ namespace talus::semi_implicit
   std::vector<std::string>
   Solver<dim>::series_columns() const
   {
-    std::vector<std::string> c = {"kinetic_energy_soil", "kinetic_energy_water", "max_speed_soil", "max_speed_water",
-                                  "min_pore_pressure", "pressure_cg_iterations", "pressure_relative_residual", "soil_volume",
-                                  "load_settlement", "pressure_amg_setups"};
+    std::vector<std::string> c = {"kinetic_energy_soil",
+                                  "kinetic_energy_water",
+                                  "max_speed_soil",
+                                  "max_speed_water",
+                                  "min_pore_pressure",
+                                  "pressure_cg_iterations",
+                                  "pressure_relative_residual",
+                                  "soil_volume",
+                                  "load_settlement",
+                                  "pressure_amg_setups"};
     for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
       c.push_back(name);
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k) // this family's check that the nodes move as one
@@ -2207,8 +2279,8 @@ namespace talus::semi_implicit
               fsum += P[fs.surface_force];
             }
         }
-    fu   = dealii::Utilities::MPI::sum(fu, comm);
-    fsum = dealii::Utilities::MPI::sum(fsum, comm);
+    fu                    = dealii::Utilities::MPI::sum(fu, comm);
+    fsum                  = dealii::Utilities::MPI::sum(fsum, comm);
     std::vector<double> v = {dealii::Utilities::MPI::sum(ek[0], comm),
                              dealii::Utilities::MPI::sum(ek[1], comm),
                              dealii::Utilities::MPI::max(vmax[0], comm),
@@ -2241,11 +2313,11 @@ namespace talus::semi_implicit
   {
     for (const bool is_soil : {true, false})
       {
-        MaterialPointSet<dim> &set = is_soil ? soil : water;
+        MaterialPointSet<dim>          &set = is_soil ? soil : water;
         dealii::Particles::DataOut<dim> out;
         out.build_patches(set.handler, set.layout.names(), set.layout.interpretations());
-        const std::string name = io::write_vtu_atomic(out, prm.output_directory, set.name(), counter, comm);
-        auto &            records = pvd_records[is_soil ? 0 : 1];
+        const std::string name    = io::write_vtu_atomic(out, prm.output_directory, set.name(), counter, comm);
+        auto             &records = pvd_records[is_soil ? 0 : 1];
         records.emplace_back(time, name);
         if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) // soil.pvd, water.pvd for ParaView
           io::write_pvd(prm.output_directory + "/" + set.name() + ".pvd", records);
@@ -2280,12 +2352,12 @@ namespace talus::semi_implicit
             const std::string path = prm.output_directory + "/" + set.name() + "_final.csv";
             {
               std::ofstream f(path + ".tmp");
-              const char *  xyz[] = {"x", "y", "z"};
+              const char   *xyz[] = {"x", "y", "z"};
               for (unsigned int d = 0; d < dim; ++d)
                 f << "pos_" << xyz[d] << ",";
               // vector properties get their component as suffix (velocity_x,
               // pore_pressure_gradient_y, ...)
-              const auto   names = set.layout.names();
+              const auto       names = set.layout.names();
               std::vector<int> component(names.size(), -1);
               for (unsigned int k = L::velocity; k < L::stress; ++k)
                 component[k] = (k - L::velocity) % dim;
@@ -2318,8 +2390,8 @@ namespace talus::semi_implicit
           << pressure_solver.n_setups() << " (interval " << prm.pressure_rebuild_interval << ", fallbacks "
           << pressure_solver.n_fallbacks() << ", after slow solves " << pressure_solver.n_slow_solves()
           << "), pressure DoF set rebuilds " << n_pattern_changes << " (" << n_pattern_window_changes
-          << " for a stencil outside the kept pattern)), lost points "
-          << lost_points() << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
+          << " for a stencil outside the kept pattern)), lost points " << lost_points() << balance.summary()
+          << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
     // the timing walk only when asked (make bench passes --time-shape-walk): it is work of its own
@@ -2327,11 +2399,11 @@ namespace talus::semi_implicit
     const double walk      = !time_walk      ? 0.0
                              : prm.bspline() ? shape_walk_seconds<shape::BSpline2Box<dim>>()
                                              : shape_walk_seconds<shape::Q1Box<dim>>();
-    log() << std::setprecision(4) << "  breakdown [s]: P2N " << phase.p2n << ", grid " << phase.grid << ", Poisson assembly "
-          << phase.poisson << ", pressure solve " << seconds_solve << " (AMG set-up "
-          << pressure_solver.setup_seconds() << "), N2P " << phase.n2p << ", update+stress "
-          << phase.stress << ", relocation " << phase.relocation << "; points soil "
-          << soil.handler.n_global_particles() << " water " << water.handler.n_global_particles();
+    log() << std::setprecision(4) << "  breakdown [s]: P2N " << phase.p2n << ", grid " << phase.grid
+          << ", Poisson assembly " << phase.poisson << ", pressure solve " << seconds_solve << " (AMG set-up "
+          << pressure_solver.setup_seconds() << "), N2P " << phase.n2p << ", update+stress " << phase.stress
+          << ", relocation " << phase.relocation << "; points soil " << soil.handler.n_global_particles() << " water "
+          << water.handler.n_global_particles();
     if (time_walk)
       log() << "; shape functions: one stencil walk over both sets " << walk << " s";
     log() << std::endl;

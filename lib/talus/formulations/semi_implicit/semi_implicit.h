@@ -45,7 +45,7 @@ namespace talus::semi_implicit
   /// A surface load on the upper face of a box body (decision A13).
   struct SurfaceLoad
   {
-    double q = 0;         ///< pressure [Pa], >= 0 pushing down
+    double q    = 0;      ///< pressure [Pa], >= 0 pushing down
     double from = -1e300; ///< strip: first horizontal coordinate from ...
     double to   = 1e300;  ///< ... to (the whole face by default)
     double ramp = 0;      ///< linear ramp time [s]; 0: sudden at t = 0
@@ -53,7 +53,8 @@ namespace talus::semi_implicit
     /// position + its half sub-cell spacing, carried by dF), or at the point
     bool at_surface = true;
     /// the fraction of q applied over a step that starts at t
-    double factor(const double t, const double h) const
+    double
+    factor(const double t, const double h) const
     {
       return ramp > 0 ? std::min(1.0, (t + 0.5 * h) / ramp) : 1.0;
     }
@@ -66,24 +67,24 @@ namespace talus::semi_implicit
     std::vector<SoilData> soil_of_material;
     /// per body: the material ids of its points (a file body: those of its rows)
     std::vector<std::vector<unsigned int>> materials_of_body;
-    std::vector<SurfaceLoad> surface_load; ///< per body: q [Pa] on its upper face
+    std::vector<SurfaceLoad>               surface_load; ///< per body: q [Pa] on its upper face
     // time step: fixed, or courant x the soil skeleton's critical step
     double time_step = 0, courant = 0.5;
     // 'semi implicit' subsection
-    double water_density            = 1000;  ///< rho_w [kg/m^3]
-    double unit_weight_gravity      = 9.81;  ///< g of the drag (Eq. 15), kept when the body force is 0
-    double free_surface_fraction    = 0.5;   ///< a cell is wet when its water volume / cell volume >= this
-    double pressure_tolerance       = 1e-10; ///< CG relative residual of the Poisson solve
+    double water_density         = 1000;  ///< rho_w [kg/m^3]
+    double unit_weight_gravity   = 9.81;  ///< g of the drag (Eq. 15), kept when the body force is 0
+    double free_surface_fraction = 0.5;   ///< a cell is wet when its water volume / cell volume >= this
+    double pressure_tolerance    = 1e-10; ///< CG relative residual of the Poisson solve
     /// the ML hierarchy of the Poisson solve is rebuilt at every step that is a
     /// multiple of this (and when the pressure DoF set changes, at checkpoints);
     /// 1: every step
-    unsigned int pressure_rebuild_interval = 100;
-    bool   kozeny_carman            = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
-    bool   pressure_smoothing       = true;  ///< Eq. 77 map-remap of the pore pressure every step
-    bool   linear_smoothing         = true;  ///< the map carries each point's value by its gradient
-    double flip_fraction            = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
-    VolumetricStabilisation stabilisation = VolumetricStabilisation::none;
-    double patch_size = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
+    unsigned int            pressure_rebuild_interval = 100;
+    bool                    kozeny_carman             = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
+    bool                    pressure_smoothing        = true;  ///< Eq. 77 map-remap of the pore pressure every step
+    bool                    linear_smoothing          = true;  ///< the map carries each point's value by its gradient
+    double                  flip_fraction             = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
+    VolumetricStabilisation stabilisation             = VolumetricStabilisation::none;
+    double                  patch_size                = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;
