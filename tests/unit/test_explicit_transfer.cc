@@ -14,14 +14,14 @@
 
 using namespace talus;
 
-using Shape = explicit_mpm::NumericsOptions::ShapeFunction;
+using Shape = talus::ShapeFunction;
 
 template <int dim>
 explicit_mpm::Parameters<dim>
 scene(const Shape shape = Shape::linear)
 {
   explicit_mpm::Parameters<dim> p;
-  p.numerics.shape_function = shape;
+  p.shape_function = shape;
   // B-splines couple points up to 1.5 cells apart, so the bodies of these
   // scenes (no boundary conditions) drift towards the walls as one: the grid
   // gets two more cells on every side, so that no point leaves it

@@ -4,7 +4,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
-#include <talus/formulations/common/load_balance.h>
+#include <talus/formulations/common/simulation.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/explicit/fem.h>
 #include <talus/formulations/explicit/forward.h>
@@ -79,9 +79,22 @@ namespace talus::explicit_mpm
   /// (formulations/common/time_loop.h) drives it. The run state (time, dt,
   /// step_number, stage, output counters) is the RunState base.
   template <int dim>
-  class Solver : public Formulation
+  class Solver : public Simulation<dim>
   {
   public:
+    // the members of the (dependent) base this class uses by name
+    using Simulation<dim>::comm;
+    using Simulation<dim>::grid;
+    using Simulation<dim>::balance;
+    using Simulation<dim>::time;
+    using Simulation<dim>::dt;
+    using Simulation<dim>::step_number;
+    using Simulation<dim>::current_stage;
+    using Simulation<dim>::stage_start_time;
+    using Simulation<dim>::counters;
+    using Simulation<dim>::restored_from;
+    using Simulation<dim>::lost_points;
+
     Solver(const Parameters<dim> &prm, MPI_Comm comm);
     ~Solver();
 
@@ -134,10 +147,8 @@ namespace talus::explicit_mpm
     std::pair<double, dealii::Tensor<1, dim>> grid_mass_and_momentum();
 
     const Parameters<dim> &prm;
-    MPI_Comm               comm;
-    BackgroundGrid<dim>    grid;
-    /// The material points (one set; its layout, cell list and relocation).
-    MaterialPointSet<dim>      points;
+    /// The material points (the Simulation's one set: its layout, cell list and relocation).
+    MaterialPointSet<dim>     &points;
     std::vector<unsigned char> constrained;
     /// Nodal lumped mass; nodal_a holds the force until nodal_acceleration()
     /// divides it, then the acceleration; nodal_p the momentum until
@@ -154,28 +165,19 @@ namespace talus::explicit_mpm
     /// removed). Collective. Returns the file name.
     std::string write_checkpoint() override;
 
-    /// Load balancing by material points (formulations/common/load_balance.h);
-    /// its repartitions call grid_changed().
-    LoadBalance<dim> balance;
-
     // ---- the Formulation interface (the time loop's view)
     std::string
     tool_name() const override
     {
       return "talus-explicit";
     }
-    void         describe(std::ostream &out) const override;
-    unsigned int n_stages() const override;
-    double       begin_stage(const unsigned int k, const bool first, const bool resumed) override;
-    bool         stage_converged(std::string &message) override;
-    void         before_step(const double h, const bool diagnostics_due) override;
-    StepOutcome  advance_by(const double h) override;
-    void         check_stability() const override;
-    unsigned long long
-    lost_points() const override
-    {
-      return points.relocation_stats.lost;
-    }
+    void                     describe(std::ostream &out) const override;
+    unsigned int             n_stages() const override;
+    double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
+    bool                     stage_converged(std::string &message) override;
+    void                     before_step(const double h, const bool diagnostics_due) override;
+    StepOutcome              advance_by(const double h) override;
+    void                     check_stability() const override;
     void                     prepare_output() override;
     std::vector<std::string> series_columns() const override;
     std::vector<double>      series_values(const bool after_step) override;
@@ -183,7 +185,6 @@ namespace talus::explicit_mpm
     void                     rewrite_records() override;
     void                     finish(const std::string &series_csv) override;
     void                     summary(const LoopTimings &loop_timings) override;
-    void                     after_step() override; ///< the load-balance check
 
     /// Checkpoint files in the directory, newest first (rank 0 lists, all get it).
     std::vector<std::string> list_checkpoints() const;
@@ -232,7 +233,7 @@ namespace talus::explicit_mpm
     void zero_on_active(Vector &v) const;
     /// After the partition changed: boundary flags, nodal vectors, cell lists,
     /// active DoFs and the features' grid data.
-    void                       grid_changed();
+    void                       grid_changed() override;
     std::vector<unsigned char> dof_marker;
     /// Call f(kernel) with the shape kernel of the run (numerics/shape
     /// function): the walks of the step are templates on it.
@@ -258,14 +259,16 @@ namespace talus::explicit_mpm
 
     bool p2g_ready = false; ///< nodal mass/force of the current state accumulated
     // local energy/stability sums from the last update pass
-    Energies                                    local_energies;
-    dealii::Tensor<1, dim>                      local_momentum;
-    bool                                        local_bad = false;
-    std::string                                 bad_what;
-    double                                      external_work = 0;
-    std::vector<std::pair<double, std::string>> pvd_records, grid_pvd_records;
-    std::vector<dealii::types::particle_index>  probe_ids;
-    std::vector<double>                         probe_values; // local, (u, v) per probe
-    std::vector<double>                         probe_stress; // local, n_stress per probe
+    Energies               local_energies;
+    dealii::Tensor<1, dim> local_momentum;
+    bool                   local_bad = false;
+    std::string            bad_what;
+    double                 external_work = 0;
+    /// the PVD records of the points (the Simulation's) and of the grid
+    std::vector<std::pair<double, std::string>> &pvd_records;
+    std::vector<std::pair<double, std::string>>  grid_pvd_records;
+    std::vector<dealii::types::particle_index>   probe_ids;
+    std::vector<double>                          probe_values; // local, (u, v) per probe
+    std::vector<double>                          probe_stress; // local, n_stress per probe
   };
 } // namespace talus::explicit_mpm

@@ -73,8 +73,6 @@ namespace talus::explicit_mpm
   {
     NumericsOptions o;
     prm.enter_subsection("numerics");
-    o.shape_function =
-      prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline : ShapeFunction::linear;
     o.velocity_transfer = prm.get("velocity transfer") == "apic" ? NumericsOptions::VelocityTransfer::apic
                                                                  : NumericsOptions::VelocityTransfer::flip;
     {

@@ -36,15 +36,8 @@ namespace talus::explicit_mpm
       cell, ///< volumetric strain increment replaced by the cell average (mean dilatation)
       nodal ///< nodal mixed discretisation: cell values averaged to the nodes and back (Eqs. 6.35-6.37)
     };
-    /// Shape functions of the particle-grid transfers ('numerics/shape function',
-    /// declared with the shared scene; docs/shape-functions.md).
-    using ShapeFunction          = talus::ShapeFunction;
-    ShapeFunction shape_function = ShapeFunction::linear;
-    bool
-    bspline() const
-    {
-      return shape_function == ShapeFunction::quadratic_bspline;
-    }
+    // The shape functions ('numerics/shape function') are the scene's:
+    // SceneParameters::shape_function (docs/shape-functions.md).
     /// Velocity transfer of the 1-phase step (docs/shape-functions.md, "APIC").
     enum class VelocityTransfer
     {

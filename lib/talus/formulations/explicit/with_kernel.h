@@ -14,6 +14,6 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::with_kernel(F &&f)
   {
-    shape::with_kernel<dim>(prm.numerics.bspline(), std::forward<F>(f));
+    shape::with_kernel<dim>(prm.bspline(), std::forward<F>(f));
   }
 } // namespace talus::explicit_mpm

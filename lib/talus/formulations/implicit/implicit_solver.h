@@ -8,7 +8,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
-#include <talus/formulations/common/load_balance.h>
+#include <talus/formulations/common/simulation.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/implicit/newmark.h>
 #include <talus/formulations/implicit/newton.h>
@@ -161,9 +161,23 @@ namespace talus::implicit_mpm
   };
 
   template <int dim>
-  class Solver : public Formulation
+  class Solver : public Simulation<dim>
   {
   public:
+    // the members of the (dependent) base this class uses by name
+    using Simulation<dim>::comm;
+    using Simulation<dim>::grid;
+    using Simulation<dim>::balance;
+    using Simulation<dim>::time;
+    using Simulation<dim>::dt;
+    using Simulation<dim>::step_number;
+    using Simulation<dim>::current_stage;
+    using Simulation<dim>::stage_start_time;
+    using Simulation<dim>::counters;
+    using Simulation<dim>::restored_from;
+    using Simulation<dim>::cut_backs;
+    using Simulation<dim>::lost_points;
+
     Solver(const Parameters<dim> &prm, MPI_Comm comm);
     ~Solver();
 
@@ -198,14 +212,9 @@ namespace talus::implicit_mpm
     {
       return prm.stages.size();
     }
-    double      begin_stage(const unsigned int k, const bool first, const bool resumed) override;
-    StepOutcome advance_by(const double h) override;
-    void        check_stability() const override;
-    unsigned long long
-    lost_points() const override
-    {
-      return points.relocation_stats.lost;
-    }
+    double                   begin_stage(const unsigned int k, const bool first, const bool resumed) override;
+    StepOutcome              advance_by(const double h) override;
+    void                     check_stability() const override;
     std::vector<std::string> series_columns() const override;
     std::vector<double>      series_values(const bool after_step) override;
     void                     write_vtu(const unsigned int counter) override;
@@ -213,15 +222,9 @@ namespace talus::implicit_mpm
     void                     rewrite_records() override;
     void                     finish(const std::string &series_csv) override;
     void                     summary(const LoopTimings &timings) override;
-    void                     after_step() override; ///< the load-balance check
 
-    const Parameters<dim> &prm;
-    MPI_Comm               comm;
-    BackgroundGrid<dim>    grid;
-    MaterialPointSet<dim>  points;
-    /// Load balancing by material points (formulations/common/load_balance.h);
-    /// its repartitions call grid_changed().
-    LoadBalance<dim>        balance;
+    const Parameters<dim>  &prm;
+    MaterialPointSet<dim>  &points; ///< the Simulation's one point set
     NodalSpace<dim>         space;
     ActiveSet<dim>          active;
     Newmark                 newmark;
@@ -250,7 +253,7 @@ namespace talus::implicit_mpm
     /// steps (the space's DoFs, the wall flags and prescribed nodes of the
     /// stage, the nodal vectors); the active set, the sparsity, the tangent and
     /// the constraints are rebuilt by every step's prepare_step().
-    void grid_changed();
+    void grid_changed() override;
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
     /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,
@@ -448,8 +451,8 @@ namespace talus::implicit_mpm
     void                compute_cell_jbar();
     /// consistent mass: a^{n+1} + alpha_R v^{n+1} at the free DoFs (0 at constrained
     /// ones), ghosts updated, the field the inertia integrand reads
-    Vector                                      inertia_field;
-    std::vector<std::pair<double, std::string>> pvd_records;
+    Vector                                       inertia_field;
+    std::vector<std::pair<double, std::string>> &pvd_records; ///< the Simulation's, of the points
     // totals for the summary
     unsigned long long total_iterations = 0, total_linear_iterations = 0;
     double             seconds_assembly = 0, seconds_solve = 0, seconds_commit = 0;

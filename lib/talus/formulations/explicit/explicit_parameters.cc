@@ -1,0 +1,216 @@
+// talus — the .prm of talus-explicit (and talus-fem): its entries in the shared
+// subsections (time, stability, output, 'material k' pore liquid, 'body k'
+// tractions), the numerics, loads and stages, parsed into Parameters<dim> and
+// checked (input_checks.h).
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/common/run_formulation.h>
+#include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/input_checks.h>
+#include <talus/formulations/explicit/load_control.h>
+#include <talus/io/png_snapshots.h>
+#include <talus/loads/kinematics.h>
+#include <talus/shape/bspline2.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace talus::explicit_mpm
+{
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+
+  // ================================================================ parameters
+  void
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
+  {
+    declare_parameters_with_integration(prm, prm_file, "mpm");
+  }
+
+  void
+  declare_parameters_with_integration(dealii::ParameterHandler &prm, const std::string &prm_file,
+                                      const std::string &default_integration)
+  {
+    const SceneCounts counts =
+      declare_common_parameters(prm, prm_file,
+                                "Fixed time step [s]; 0 = courant number x critical time step. A value above the "
+                                "critical time step is refused unless 'force time step' is true.");
+    // the explicit family's entries in the shared subsections
+    prm.enter_subsection("time");
+    {
+      prm.declare_entry("courant number", "0.5", Double(0, 1),
+                        "Time step as a fraction of the critical time step L_min/c (seed 000 Eq. 4.120), "
+                        "used when 'time step' is 0. Range (0, 1].");
+      prm.declare_entry("force time step", "false", Bool(),
+                        "Accept a 'time step' above the critical one (stability studies).");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("stability");
+    prm.declare_entry("energy growth limit", "10", Double(1),
+                      "The run is stopped as unstable when kinetic + strain energy exceed this factor times "
+                      "the energy available (initial kinetic + strain energy + released potential energy + "
+                      "external work), or when any state becomes non-finite.");
+    prm.leave_subsection();
+    for (unsigned int k = 0; k < counts.n_materials; ++k)
+      {
+        prm.enter_subsection("material " + std::to_string(k));
+        declare_pore_liquid(prm);
+        prm.leave_subsection();
+      }
+    for (unsigned int k = 0; k < counts.n_bodies; ++k)
+      {
+        prm.enter_subsection("body " + std::to_string(k));
+        declare_body_traction(prm, counts.dim);
+        prm.leave_subsection();
+      }
+    // the explicit family's own subsections
+    declare_numerics_parameters(prm, default_integration);
+    declare_liquid_output(prm);
+    loads::declare_parameters(prm, prm_file, counts.dim, counts.n_bodies);
+  }
+
+  template <int dim>
+  Parameters<dim>
+  parse_parameters(dealii::ParameterHandler &prm)
+  {
+    Parameters<dim> p;
+    parse_run_parameters<dim>(prm, p);
+    prm.enter_subsection("time");
+    p.courant         = prm.get_double("courant number");
+    p.time_step       = prm.get_double("time step");
+    p.force_time_step = prm.get_bool("force time step");
+    require(p.courant > 0, "time/courant number", "must be > 0");
+    prm.leave_subsection();
+    prm.enter_subsection("stability");
+    p.energy_growth_limit = prm.get_double("energy growth limit");
+    prm.leave_subsection();
+
+    parse_scene_parameters<dim>(prm, p);
+    parse_liquid_output(prm, p.liquid);
+    for (unsigned int k = 0; k < p.materials.size(); ++k)
+      {
+        const std::string where = "material " + std::to_string(k);
+        prm.enter_subsection(where);
+        p.liquid.pore_liquid.push_back(parse_pore_liquid(prm, where, p.materials[k]));
+        prm.leave_subsection();
+      }
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      {
+        const std::string where = "body " + std::to_string(k);
+        prm.enter_subsection(where);
+        p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
+        prm.leave_subsection();
+      }
+    const unsigned int n_bodies = p.bodies.size();
+    p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
+    if (p.loads.staged)
+      {
+        p.end_time = 0; // the sum of the stage durations
+        for (const auto &st : p.loads.stages)
+          p.end_time += st.duration;
+      }
+    p.numerics = parse_numerics_parameters(prm, n_bodies);
+    if (p.numerics.apic())
+      {
+        // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step, affine_offset);
+        // the passes below keep their own (FLIP) velocity transfer or were not checked with it
+        const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
+                                "FLIP velocity update, or were not checked with the affine transfer); allowed: ";
+        // linear shape functions: the transfers are implemented and unit-tested
+        // (C_p = grad v), but the collapse a = 3 blows up at Courant 0.5 and 0.2
+        // (a = f / m at nodes a point barely touches goes straight into v^L)
+        require(p.bspline(), "numerics/velocity transfer",
+                "apic needs numerics/shape function = quadratic bspline: with linear shape functions the APIC "
+                "step was measured unstable (granular column collapse, Courant 0.5 and 0.2; "
+                "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
+        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
+                std::string(p.numerics.integration_name()) + why + "mpm, or velocity transfer = flip");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing" + why + "none, or velocity transfer = flip");
+        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
+                "coupled 2-phase materials and body tractions" + why +
+                  "1-phase materials, or velocity transfer = flip");
+        require(!p.balance.enabled(), "load balancing/interval",
+                "load balancing" + why + "interval = 0, or velocity transfer = flip");
+        for (const auto &st : p.loads.stages)
+          {
+            require(st.tractions.empty(), "loads/traction",
+                    "tractions" + why + "no traction conditions, or velocity transfer = flip");
+            require(st.friction_ids.empty(), "boundary conditions/friction",
+                    "boundary friction" + why + "no friction walls, or velocity transfer = flip");
+            for (const auto &v : st.velocities)
+              require(v.target != loads::PrescribedVelocity<dim>::Target::body, "loads/velocity",
+                      "prescribed velocities of bodies (apply to = body)" + why +
+                        "apply to = boundary | region, or velocity transfer = flip");
+          }
+      }
+    if (p.bspline())
+      {
+        // the passes that are not yet kernel templates (transfer/) walk with Q1
+        const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
+                                "(its particle passes use linear shape functions); allowed: ";
+        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
+                std::string(p.numerics.integration_name()) + why + "mpm");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing" + why + "none");
+        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
+        // the loads are kernel templates: the nodal momentum p^t (ScatterMomentum),
+        // the traction point forces and the momentum of prescribed point
+        // velocities (ScatterPointVectors); wall friction acts on the wall nodes'
+        // sums, whichever kernel made them. The 2-phase step is a kernel template
+        // too, but with B-splines its point pore pressures carry a spurious mode
+        // (docs/shape-functions.md, "2-phase"): refused until a pressure smoothing exists.
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/shape function",
+                "coupled 2-phase materials and their body tractions are not available with numerics/shape "
+                "function = quadratic bspline: without a pore-pressure smoothing the point pressures carry a "
+                "spurious mode next to a drained face (Terzaghi: 6.6 % L2 error against 0.3 % with linear "
+                "shape functions; docs/shape-functions.md); allowed: linear, or 1-phase materials");
+        require(!p.grid_mesh, "grid/source",
+                "a grid file with quadratic B-splines: they need a uniform box grid; allowed: box");
+        for (unsigned int d = 0; d < dim; ++d)
+          require(p.grid_cells[d] >= shape::BSpline2<dim>::min_cells, "grid/cells",
+                  "quadratic B-splines need at least 3 cells per direction (the wall treatment)");
+      }
+    if (p.balance.enabled())
+      {
+        // UL-FEM keeps the displacement of its moving mesh on the grid between
+        // steps, which a repartition does not carry (docs/scaling.md); FEM's
+        // state is on its Gauss points (the mesh is fixed), which travel with
+        // their cells
+        const std::string why = " is not available with load balancing (allowed with it: the 1-phase and "
+                                "2-phase MPM steps with loads, damping, stages, free-surface output, contact, "
+                                "strain smoothing, MPM-MIXED, and integration = fem); set load balancing/interval "
+                                "= 0, or ";
+        require(p.numerics.integration != NumericsOptions::Integration::ul_fem, "load balancing/interval",
+                "numerics/integration = ul-fem" + why + "integration = mpm | fem");
+      }
+    if (p.numerics.fem())
+      {
+        const std::string mode = p.numerics.integration == NumericsOptions::Integration::fem ? "fem" : "ul-fem";
+        require(!p.numerics.contact(), "contact/pairs",
+                "contact is not available with numerics/integration = " + mode +
+                  " (the Gauss points of one mesh share one velocity field); allowed: empty");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing is not available with numerics/integration = " + mode + "; allowed: none");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/integration",
+                "'" + mode +
+                  "' runs the 1-phase step only: coupled 2-phase materials and body tractions are "
+                  "refused (allowed with them: mpm)");
+        require(p.numerics.integration == NumericsOptions::Integration::fem ||
+                  (p.checkpoint_interval == 0 && p.checkpoint_wall_interval == 0 &&
+                   p.restart == Parameters<dim>::Restart::no),
+                "checkpoint",
+                "checkpoints and restarts are not available with numerics/integration = ul-fem (the moved "
+                "mesh is not saved); allowed: interval = 0, wall clock interval = 0, restart = false");
+      }
+    check_consistency(p);
+    return p;
+  }
+
+
+  template struct Parameters<2>;
+  template struct Parameters<3>;
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+} // namespace talus::explicit_mpm
