@@ -261,6 +261,208 @@ namespace talus::semi_implicit
               "is " + number_text(p.time_step) + " s, above the soil skeleton's critical step " + number_text(dt_cr) +
                 " s (h_min / sqrt(E_c / ((1 - n) rho_s))); the semi-implicit step is limited by it");
     }
+
+    /// 'semi implicit': the family's numerics, drained boundaries, stabilisation
+    template <int dim>
+    void
+    parse_semi_implicit(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      prm.enter_subsection("semi implicit");
+      p.water_density             = prm.get_double("water density");
+      p.unit_weight_gravity       = prm.get_double("unit weight gravity");
+      p.free_surface_fraction     = prm.get_double("free surface volume fraction");
+      p.pressure_tolerance        = prm.get_double("pressure solver tolerance");
+      p.pressure_rebuild_interval = prm.get_integer("pressure preconditioner rebuild interval");
+      p.kozeny_carman             = prm.get_bool("kozeny carman");
+      p.pressure_smoothing        = prm.get("pressure smoothing") != "none";
+      p.linear_smoothing          = prm.get("pressure smoothing") == "linear";
+      p.flip_fraction             = prm.get_double("flip fraction");
+      p.rigid_skeleton            = prm.get_bool("rigid skeleton");
+      // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
+      // plate can move it (a physical impossibility, not a missing feature)
+      if (p.grid_mesh == nullptr) // (a grid file is refused below)
+        loads::check_rigid_plates_on_box(p.rigid_plates, p.grid_lower, p.grid_upper, p.grid_cells,
+                                         p.boundary_conditions);
+      if (p.rigid_skeleton)
+        loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit",
+                                   "'semi implicit/rigid skeleton = true' holds every soil node at rest, so no plate "
+                                   "can move the soil (allowed: rigid skeleton = false, or no plate)");
+      {
+        const std::string text = prm.get("drained boundaries");
+        for (const auto &item : dealii::Utilities::split_string_list(text, ','))
+          {
+            bool ok = !item.empty() && item.find_first_not_of("0123456789") == std::string::npos && item.size() < 3;
+            unsigned int id = ok ? static_cast<unsigned int>(std::stoul(item)) : 0;
+            ok              = ok && id < 2 * dim;
+            require(ok, "semi implicit/drained boundaries",
+                    "is '" + text + "'; allowed: empty or comma-separated boundary ids of the " + std::to_string(dim) +
+                      "D box, 0 to " + std::to_string(2 * dim - 1) + " (x-, x+, y-, y+" +
+                      (dim == 3 ? ", z-, z+)" : ")"));
+            p.drained_boundaries.push_back(id);
+          }
+      }
+      {
+        const std::string st       = prm.get("volumetric stabilisation");
+        p.stabilisation            = st == "f-bar"            ? VolumetricStabilisation::f_bar
+                                     : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
+                                                              : VolumetricStabilisation::none;
+        p.patch_size               = prm.get_double("patch size");
+        p.single_point             = prm.get("point sets") == "single";
+        p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
+        require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
+      }
+      require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
+      require(p.unit_weight_gravity > 0, "semi implicit/unit weight gravity", "must be > 0 m/s^2");
+      require(p.free_surface_fraction > 0 && p.free_surface_fraction < 1, "semi implicit/free surface volume fraction",
+              "must lie in (0, 1)");
+      require(p.pressure_tolerance > 0, "semi implicit/pressure solver tolerance", "must be > 0");
+      prm.leave_subsection();
+    }
+
+    /// 'initial state': geostatic state and the App. B.4 initialisation
+    template <int dim>
+    void
+    parse_initial_state(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      prm.enter_subsection("initial state");
+      p.geostatic                   = prm.get_bool("geostatic");
+      p.water_level                 = prm.get_double("water level");
+      p.soil_surface                = prm.get_double("soil surface");
+      p.K0                          = prm.get_double("K0");
+      p.initialisation_time         = prm.get_double("initialisation time");
+      p.initialisation_conductivity = prm.get_double("initialisation conductivity");
+      require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 && p.initialisation_time <= p.end_time,
+              "initial state/initialisation time",
+              "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to the end time " +
+                number_text(p.end_time) + " s");
+      require(std::isfinite(p.initialisation_conductivity) && p.initialisation_conductivity > 0,
+              "initial state/initialisation conductivity",
+              "is " + number_text(p.initialisation_conductivity) + "; must be > 0 m/s");
+      if (p.initialisation_time > 0)
+        for (unsigned int m = 0; m < p.materials.size(); ++m)
+          {
+            const std::string model = p.materials[m]->model_name();
+            require(model == "nor sand" || model == "linear elastic" || model == "neo hookean",
+                    "material " + std::to_string(m) + "/model",
+                    "is " + model +
+                      ", which has no elastic-only mode for 'initial state/initialisation time'; "
+                      "allowed with an initialisation: nor sand, linear elastic, neo hookean");
+          }
+      prm.leave_subsection();
+    }
+
+    /// 'material k/soil' of every material: porosity and conductivity
+    template <int dim>
+    void
+    parse_soil_data(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      for (unsigned int k = 0; k < p.materials.size(); ++k)
+        {
+          const std::string where = "material " + std::to_string(k) + "/soil/";
+          prm.enter_subsection("material " + std::to_string(k));
+          prm.enter_subsection("soil");
+          SoilData s;
+          s.porosity     = prm.get_double("porosity");
+          s.conductivity = prm.get_double("hydraulic conductivity");
+          prm.leave_subsection();
+          prm.leave_subsection();
+          std::ostringstream n0, k0;
+          n0 << s.porosity;
+          k0 << s.conductivity;
+          require(s.porosity > 0 && s.porosity < 1, where + "porosity", "is " + n0.str() + "; must lie in (0, 1)");
+          require(s.conductivity > 0, where + "hydraulic conductivity", "is " + k0.str() + "; must be > 0 m/s");
+          p.soil_of_material.push_back(s);
+        }
+    }
+
+    /// 'body k': phase, surface load, the material ids of its points; the
+    /// checks of the phases against the point sets and the stabilisation
+    template <int dim>
+    void
+    parse_bodies(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      bool any_soil = false, any_water = false;
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
+        {
+          prm.enter_subsection("body " + std::to_string(k));
+          const std::string ph = prm.get("phase");
+          {
+            SurfaceLoad sl;
+            sl.q                     = prm.get_double("surface load");
+            sl.ramp                  = prm.get_double("surface load ramp time");
+            sl.at_surface            = prm.get("surface load acts at") == "body surface";
+            const std::string extent = prm.get("surface load extent");
+            if (!dealii::Utilities::trim(extent).empty())
+              {
+                const auto v  = dealii::Utilities::split_string_list(extent, ',');
+                bool       ok = v.size() == 2;
+                try
+                  {
+                    if (ok)
+                      {
+                        sl.from = std::stod(v[0]);
+                        sl.to   = std::stod(v[1]);
+                      }
+                  }
+                catch (const std::exception &)
+                  {
+                    ok = false;
+                  }
+                require(ok && std::isfinite(sl.from) && std::isfinite(sl.to) && sl.from < sl.to,
+                        "body " + std::to_string(k) + "/surface load extent",
+                        "is '" + extent + "'; allowed: empty (the whole upper face) or two numbers 'a, b' with a < b");
+              }
+            p.surface_load.push_back(sl);
+          }
+          prm.leave_subsection();
+          p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
+          std::ostringstream q;
+          q << p.surface_load.back().q;
+          require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0,
+                  "body " + std::to_string(k) + "/surface load", "is " + q.str() + "; must be a pressure >= 0 Pa");
+          require(p.surface_load.back().q == 0 ||
+                    (p.phase_of_body.back() != Phase::water && p.bodies[k].shape == BodyDescription<dim>::Shape::box),
+                  "body " + std::to_string(k) + "/surface load",
+                  "needs a box body with soil points (phase saturated or soil)");
+          any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
+          any_water = any_water || p.phase_of_body.back() != Phase::soil;
+          // the material ids of the body's points: its entry, or those of its rows
+          // (checked: rows of its body id exist, their material ids too)
+          if (p.bodies[k].shape == BodyDescription<dim>::Shape::file)
+            p.materials_of_body.push_back(check_file_body(p, k).materials);
+          else
+            p.materials_of_body.push_back({p.bodies[k].material_id});
+        }
+      std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
+        phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
+                  (p.phase_of_body[k] == Phase::soil    ? "soil"
+                   : p.phase_of_body[k] == Phase::water ? "water"
+                                                        : "saturated");
+      if (p.single_point)
+        for (unsigned int b = 0; b < p.bodies.size(); ++b)
+          require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
+                  "single needs every body to carry soil points (the water rides on them), but body " +
+                    std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
+      // a dry scene (soil points only) is a single-phase solid: allowed
+      (void)any_water;
+      require(any_soil, phases,
+              "the scene has no soil points (free water needs a skeleton for the drag and the mixture): give a "
+              "body phase = saturated or soil");
+      if (p.stabilisation == VolumetricStabilisation::modified_f_bar)
+        for (unsigned int b = 0; b < p.bodies.size(); ++b)
+          if (p.phase_of_body[b] != Phase::water)
+            for (const unsigned int mid : p.materials_of_body[b])
+              {
+                const auto &m = *p.materials[mid];
+                require(
+                  m.keeps_elastic_b(), "semi implicit/volumetric stabilisation",
+                  "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
+                    std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
+                    "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | "
+                    "f-bar)");
+              }
+    }
   } // namespace
 
   template <int dim>
@@ -275,177 +477,10 @@ namespace talus::semi_implicit
     p.courant   = prm.get_double("courant number");
     require(p.courant > 0, "time/courant number", "must be > 0");
     prm.leave_subsection();
-    prm.enter_subsection("semi implicit");
-    p.water_density             = prm.get_double("water density");
-    p.unit_weight_gravity       = prm.get_double("unit weight gravity");
-    p.free_surface_fraction     = prm.get_double("free surface volume fraction");
-    p.pressure_tolerance        = prm.get_double("pressure solver tolerance");
-    p.pressure_rebuild_interval = prm.get_integer("pressure preconditioner rebuild interval");
-    p.kozeny_carman             = prm.get_bool("kozeny carman");
-    p.pressure_smoothing        = prm.get("pressure smoothing") != "none";
-    p.linear_smoothing          = prm.get("pressure smoothing") == "linear";
-    p.flip_fraction             = prm.get_double("flip fraction");
-    p.rigid_skeleton            = prm.get_bool("rigid skeleton");
-    // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
-    // plate can move it (a physical impossibility, not a missing feature)
-    if (p.grid_mesh == nullptr) // (a grid file is refused below)
-      loads::check_rigid_plates_on_box(p.rigid_plates, p.grid_lower, p.grid_upper, p.grid_cells, p.boundary_conditions);
-    if (p.rigid_skeleton)
-      loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit",
-                                 "'semi implicit/rigid skeleton = true' holds every soil node at rest, so no plate "
-                                 "can move the soil (allowed: rigid skeleton = false, or no plate)");
-    {
-      const std::string text = prm.get("drained boundaries");
-      for (const auto &item : dealii::Utilities::split_string_list(text, ','))
-        {
-          bool ok = !item.empty() && item.find_first_not_of("0123456789") == std::string::npos && item.size() < 3;
-          unsigned int id = ok ? static_cast<unsigned int>(std::stoul(item)) : 0;
-          ok              = ok && id < 2 * dim;
-          require(ok, "semi implicit/drained boundaries",
-                  "is '" + text + "'; allowed: empty or comma-separated boundary ids of the " + std::to_string(dim) +
-                    "D box, 0 to " + std::to_string(2 * dim - 1) + " (x-, x+, y-, y+" + (dim == 3 ? ", z-, z+)" : ")"));
-          p.drained_boundaries.push_back(id);
-        }
-    }
-    {
-      const std::string st       = prm.get("volumetric stabilisation");
-      p.stabilisation            = st == "f-bar"            ? VolumetricStabilisation::f_bar
-                                   : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
-                                                            : VolumetricStabilisation::none;
-      p.patch_size               = prm.get_double("patch size");
-      p.single_point             = prm.get("point sets") == "single";
-      p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
-      require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
-    }
-    require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
-    require(p.unit_weight_gravity > 0, "semi implicit/unit weight gravity", "must be > 0 m/s^2");
-    require(p.free_surface_fraction > 0 && p.free_surface_fraction < 1, "semi implicit/free surface volume fraction",
-            "must lie in (0, 1)");
-    require(p.pressure_tolerance > 0, "semi implicit/pressure solver tolerance", "must be > 0");
-    prm.leave_subsection();
-    prm.enter_subsection("initial state");
-    p.geostatic                   = prm.get_bool("geostatic");
-    p.water_level                 = prm.get_double("water level");
-    p.soil_surface                = prm.get_double("soil surface");
-    p.K0                          = prm.get_double("K0");
-    p.initialisation_time         = prm.get_double("initialisation time");
-    p.initialisation_conductivity = prm.get_double("initialisation conductivity");
-    require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 && p.initialisation_time <= p.end_time,
-            "initial state/initialisation time",
-            "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to the end time " +
-              number_text(p.end_time) + " s");
-    require(std::isfinite(p.initialisation_conductivity) && p.initialisation_conductivity > 0,
-            "initial state/initialisation conductivity",
-            "is " + number_text(p.initialisation_conductivity) + "; must be > 0 m/s");
-    if (p.initialisation_time > 0)
-      for (unsigned int m = 0; m < p.materials.size(); ++m)
-        {
-          const std::string model = p.materials[m]->model_name();
-          require(model == "nor sand" || model == "linear elastic" || model == "neo hookean",
-                  "material " + std::to_string(m) + "/model",
-                  "is " + model +
-                    ", which has no elastic-only mode for 'initial state/initialisation time'; "
-                    "allowed with an initialisation: nor sand, linear elastic, neo hookean");
-        }
-    prm.leave_subsection();
-    for (unsigned int k = 0; k < p.materials.size(); ++k)
-      {
-        const std::string where = "material " + std::to_string(k) + "/soil/";
-        prm.enter_subsection("material " + std::to_string(k));
-        prm.enter_subsection("soil");
-        SoilData s;
-        s.porosity     = prm.get_double("porosity");
-        s.conductivity = prm.get_double("hydraulic conductivity");
-        prm.leave_subsection();
-        prm.leave_subsection();
-        std::ostringstream n0, k0;
-        n0 << s.porosity;
-        k0 << s.conductivity;
-        require(s.porosity > 0 && s.porosity < 1, where + "porosity", "is " + n0.str() + "; must lie in (0, 1)");
-        require(s.conductivity > 0, where + "hydraulic conductivity", "is " + k0.str() + "; must be > 0 m/s");
-        p.soil_of_material.push_back(s);
-      }
-    bool any_soil = false, any_water = false;
-    for (unsigned int k = 0; k < p.bodies.size(); ++k)
-      {
-        prm.enter_subsection("body " + std::to_string(k));
-        const std::string ph = prm.get("phase");
-        {
-          SurfaceLoad sl;
-          sl.q                     = prm.get_double("surface load");
-          sl.ramp                  = prm.get_double("surface load ramp time");
-          sl.at_surface            = prm.get("surface load acts at") == "body surface";
-          const std::string extent = prm.get("surface load extent");
-          if (!dealii::Utilities::trim(extent).empty())
-            {
-              const auto v  = dealii::Utilities::split_string_list(extent, ',');
-              bool       ok = v.size() == 2;
-              try
-                {
-                  if (ok)
-                    {
-                      sl.from = std::stod(v[0]);
-                      sl.to   = std::stod(v[1]);
-                    }
-                }
-              catch (const std::exception &)
-                {
-                  ok = false;
-                }
-              require(ok && std::isfinite(sl.from) && std::isfinite(sl.to) && sl.from < sl.to,
-                      "body " + std::to_string(k) + "/surface load extent",
-                      "is '" + extent + "'; allowed: empty (the whole upper face) or two numbers 'a, b' with a < b");
-            }
-          p.surface_load.push_back(sl);
-        }
-        prm.leave_subsection();
-        p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
-        std::ostringstream q;
-        q << p.surface_load.back().q;
-        require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0,
-                "body " + std::to_string(k) + "/surface load", "is " + q.str() + "; must be a pressure >= 0 Pa");
-        require(p.surface_load.back().q == 0 ||
-                  (p.phase_of_body.back() != Phase::water && p.bodies[k].shape == BodyDescription<dim>::Shape::box),
-                "body " + std::to_string(k) + "/surface load",
-                "needs a box body with soil points (phase saturated or soil)");
-        any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
-        any_water = any_water || p.phase_of_body.back() != Phase::soil;
-        // the material ids of the body's points: its entry, or those of its rows
-        // (checked: rows of its body id exist, their material ids too)
-        if (p.bodies[k].shape == BodyDescription<dim>::Shape::file)
-          p.materials_of_body.push_back(check_file_body(p, k).materials);
-        else
-          p.materials_of_body.push_back({p.bodies[k].material_id});
-      }
-    std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
-    for (unsigned int k = 0; k < p.bodies.size(); ++k)
-      phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
-                (p.phase_of_body[k] == Phase::soil    ? "soil"
-                 : p.phase_of_body[k] == Phase::water ? "water"
-                                                      : "saturated");
-    if (p.single_point)
-      for (unsigned int b = 0; b < p.bodies.size(); ++b)
-        require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
-                "single needs every body to carry soil points (the water rides on them), but body " +
-                  std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
-    // a dry scene (soil points only) is a single-phase solid: allowed
-    (void)any_water;
-    require(any_soil, phases,
-            "the scene has no soil points (free water needs a skeleton for the drag and the mixture): give a "
-            "body phase = saturated or soil");
-    if (p.stabilisation == VolumetricStabilisation::modified_f_bar)
-      for (unsigned int b = 0; b < p.bodies.size(); ++b)
-        if (p.phase_of_body[b] != Phase::water)
-          for (const unsigned int mid : p.materials_of_body[b])
-            {
-              const auto &m = *p.materials[mid];
-              require(
-                m.keeps_elastic_b(), "semi implicit/volumetric stabilisation",
-                "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
-                  std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
-                  "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | "
-                  "f-bar)");
-            }
+    parse_semi_implicit(prm, p);
+    parse_initial_state(prm, p);
+    parse_soil_data(prm, p);
+    parse_bodies(prm, p);
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
     check_scene(p);
     return p;
