@@ -146,6 +146,50 @@ namespace talus::materials
       return 1.0;
     }
 
+    /// ---- State queries of the semi-implicit driver (seed 002). The defaults
+    /// describe a model without b_e, specific volume or initialisation stage.
+    /// Whether the history keeps the elastic left Cauchy-Green tensor b_e (the
+    /// modified F-bar scales it, Eqs. 81-83).
+    virtual bool
+    keeps_elastic_b() const
+    {
+      return false;
+    }
+    /// J^e = sqrt(det b_e) of the history's b_e (Eq. 82); 0 without b_e.
+    virtual double
+    elastic_jacobian(ArrayView<const double> /*history*/) const
+    {
+      return 0.0;
+    }
+    /// Whether the history keeps a specific volume v that each step multiplies
+    /// by det of its increment (v = v0 J; Nor-Sand).
+    virtual bool
+    has_specific_volume() const
+    {
+      return false;
+    }
+    /// Set that specific volume to v0 J / det_increment, so that the next step,
+    /// with an increment of determinant det_increment, ends at v0 J (seed 002
+    /// Eq. 96 with a J of the driver's). Nothing for a model without it.
+    virtual void
+    set_specific_volume(const double /*J*/, const double /*det_increment*/, ArrayView<double> /*history*/) const
+    {
+    }
+    /// The model of the elastic initialisation stage (seed 002 App. B.4): an
+    /// elastic copy, or null when the model serves as it is.
+    virtual std::shared_ptr<const Material>
+    initialisation_model() const
+    {
+      return nullptr;
+    }
+    /// End of that stage: the current state becomes the model's reference
+    /// (Nor-Sand, Eqs. 111-114). False (history untouched) for a model without.
+    virtual bool
+    reinitialize_reference(ArrayView<double> /*history*/) const
+    {
+      return false;
+    }
+
     /// ---- Volumetric/deviatoric split (the mixed u-p driver, seed 001 ch. 5).
     /// A model has it when tau = J p(J) I + tau_dev with p a function of
     /// J = kirchhoff_jacobian(history) alone, J_{n+1} = J_n det dF (isochoric

@@ -65,10 +65,15 @@ namespace talus::materials
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
     /// J^e = sqrt(det b_e) of the history's elastic left Cauchy-Green tensor
     /// (the modified F-bar of the semi-implicit family, seed 002 Eq. 82).
-    double elastic_jacobian(ArrayView<const double> history) const;
-    void   finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
-                                ArrayView<double> history_new, Stress &tau,
-                                dealii::Tensor<4, 3> *dtau_ddF) const override;
+    double elastic_jacobian(ArrayView<const double> history) const override;
+    bool
+    keeps_elastic_b() const override
+    {
+      return true;
+    }
+    void finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                              ArrayView<double> history_new, Stress &tau,
+                              dealii::Tensor<4, 3> *dtau_ddF) const override;
 
     double elastic_energy_density(const Stress &sigma) const override;
 

@@ -165,7 +165,7 @@ namespace talus::materials
     h[12] = P.eps_v0;
   }
 
-  void
+  bool
   NorSand::reinitialize_reference(ArrayView<double> h) const
   {
     const Stress       be = fs::load_sym(h, 0);
@@ -178,6 +178,15 @@ namespace talus::materials
     h[12]          = ev;
     h[8]           = P.ocr * image_pressure_through(p, 0.0);
     // v0 <- J v0: the specific volume in the history already is J v0.
+    return true;
+  }
+
+  std::shared_ptr<const Material>
+  NorSand::initialisation_model() const
+  {
+    auto elastic = std::make_shared<NorSand>(P);
+    elastic->set_plasticity(false);
+    return elastic;
   }
 
   int

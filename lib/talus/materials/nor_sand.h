@@ -79,7 +79,21 @@ namespace talus::materials
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
     /// App. B.4: after elastic gravity loading, take the current p and eps_v as the
     /// reference, p_i from the OCR (Eq. 113) and v0 <- J v0 (kept in the history).
-    void reinitialize_reference(ArrayView<double> history) const;
+    /// Returns true.
+    bool reinitialize_reference(ArrayView<double> history) const override;
+    /// The App. B.4 stage's model: this one without plasticity.
+    std::shared_ptr<const Material> initialisation_model() const override;
+    bool
+    has_specific_volume() const override
+    {
+      return true;
+    }
+    /// history[specific_volume_slot] = v0 J / det_increment
+    void
+    set_specific_volume(const double J, const double det_increment, ArrayView<double> history) const override
+    {
+      history[specific_volume_slot] = P.v0 * J / det_increment;
+    }
     /// Elastic only (App. B.4 gravity phase) when false.
     void
     set_plasticity(const bool on)
@@ -99,10 +113,15 @@ namespace talus::materials
     double kirchhoff_jacobian(ArrayView<const double> history) const override;
     /// J^e = sqrt(det b_e) of the history's elastic left Cauchy-Green tensor
     /// (the modified F-bar of the semi-implicit family, seed 002 Eq. 82).
-    double elastic_jacobian(ArrayView<const double> history) const;
-    void   finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
-                                ArrayView<double> history_new, Stress &tau,
-                                dealii::Tensor<4, 3> *dtau_ddF) const override;
+    double elastic_jacobian(ArrayView<const double> history) const override;
+    bool
+    keeps_elastic_b() const override
+    {
+      return true;
+    }
+    void finite_strain_update(const dealii::Tensor<2, 3> &dF, ArrayView<const double> history_old,
+                              ArrayView<double> history_new, Stress &tau,
+                              dealii::Tensor<4, 3> *dtau_ddF) const override;
 
     const Parameters &
     parameters() const

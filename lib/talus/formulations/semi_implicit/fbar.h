@@ -1,7 +1,7 @@
 // talus — the F-bar pieces of the semi-implicit family (seed 002 §4.4.2,
 // Eqs. 79-83) that need no grid: the stabilised increment a soil point's model
 // sees, and the fixed patch tiling of the modified F-bar. The averages (the node
-// map-remap of dJ, the patch means of J^e) are walks in semi_implicit.cc.
+// map-remap of dJ, the patch means of J^e) are walks in semi_implicit_step.cc.
 #pragma once
 
 #include <deal.II/base/point.h>

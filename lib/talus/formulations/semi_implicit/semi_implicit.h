@@ -120,4 +120,7 @@ namespace talus::semi_implicit
   /// h / sqrt(E_c / ((1 - n) rho_s)) (the skeleton alone, the fastest wave).
   template <int dim>
   double soil_critical_time_step(const Parameters<dim> &p, double h_min);
+
+  /// x with 4 significant digits (the numbers in messages).
+  std::string number_text(const double x);
 } // namespace talus::semi_implicit

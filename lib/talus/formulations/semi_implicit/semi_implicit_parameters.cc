@@ -1,0 +1,517 @@
+// talus — the .prm of talus-semi-implicit: its entries (declare_parameters),
+// their reading and validation (parse_parameters, InputError naming the entry),
+// the scene checks that need no grid, the soil skeleton's critical step and the
+// tool's --check.
+#include <talus/base/errors.h>
+#include <talus/base/tool.h>
+#include <talus/formulations/common/run_formulation.h>
+#include <talus/formulations/common/scene_checks.h>
+#include <talus/formulations/common/scene_parameters.h>
+#include <talus/formulations/semi_implicit/semi_implicit.h>
+#include <talus/loads/rigid_plate.h>
+#include <talus/loads/rigid_plate_nodes.h>
+#include <talus/materials/material.h>
+#include <talus/particles/material_points.h>
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/utilities.h>
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace talus::semi_implicit
+{
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Selection;
+
+  // ================================================================ parameters
+  void
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file)
+  {
+    const SceneCounts counts =
+      declare_common_parameters(prm, prm_file,
+                                "Fixed time step [s]; 0 = courant number x the soil skeleton's critical step "
+                                "h_min / sqrt(E_c / ((1 - n) rho_s)). The step does not depend on the hydraulic "
+                                "conductivity (seed 002 §5.3).",
+                                /*png fields not written:*/ {"free surface"});
+    prm.enter_subsection("time");
+    {
+      prm.declare_entry("courant number", "0.5", Double(0, 1),
+                        "Fraction of the soil skeleton's critical step used when 'time step' is 0.");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("semi implicit");
+    {
+      prm.declare_entry("water density", "1000", Double(0), "rho_w [kg/m^3], > 0.");
+      prm.declare_entry("unit weight gravity", "9.81", Double(0),
+                        "g of the Darcy drag n^2 rho_w g / k (Eq. 15) [m/s^2], > 0; kept when the body force "
+                        "is zero (it converts the hydraulic conductivity, it is not a load).");
+      prm.declare_entry("free surface volume fraction", "0.5", Double(0, 1),
+                        "A cell is wet when the volume of its water points divided by the cell volume is at "
+                        "least this; a node touched by water points that is a vertex of a wet and of a dry "
+                        "cell is on the free water surface and gets p = 0. In (0, 1).");
+      prm.declare_entry("pressure solver tolerance", "1e-10", Double(0, 1e-2),
+                        "Relative residual |b - A x| / |b| at which CG + ML AMG stops on the pressure-"
+                        "increment Poisson equation.");
+      prm.declare_entry("pressure preconditioner rebuild interval", "100", dealii::Patterns::Integer(1),
+                        "The ML AMG hierarchy of the pressure solve is kept between steps and rebuilt at "
+                        "every step whose number is a multiple of this, whenever the pressure DoF set (the "
+                        "active nodes) changes, after a checkpoint is written, at a restart and after a "
+                        "solve that needed more than 2 x + 10 the CG iterations of the hierarchy's first; CG reaches "
+                        "the same tolerance with a kept hierarchy in a few more iterations. 1 = rebuilt at "
+                        "every step. An integer >= 1.");
+      prm.declare_entry("pressure smoothing", "linear", Selection("linear|mass weighted|none"),
+                        "mass weighted: the water points' pore pressure is replaced by the mass-weighted "
+                        "map and remap through the nodes at every step (Eq. 77); it is biased by O(h grad p) "
+                        "where a node's support is cut by a wall or the free surface. linear: the same map "
+                        "with each point's value carried to the node by its pressure gradient, "
+                        "p_I = sum N m (p + grad p . (x_I - x_p)) / sum N m, exact for linear fields "
+                        "(docs/semi-implicit.md). none: the pressure changes only by the interpolated "
+                        "increments (p += sum N dp).");
+      prm.declare_entry("flip fraction", "1", Double(0, 1),
+                        "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
+                        "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
+      prm.declare_entry("volumetric stabilisation", "none", Selection("none|f-bar|modified f-bar"),
+                        "Soil volumetric-locking stabilisation (seed 002 §4.4.2). none: the increment dF as "
+                        "computed. f-bar: dF scaled by (dJbar / dJ)^(1/dim), dJbar the mass-weighted node map "
+                        "and remap of the points' dJ (Eqs. 79-80). modified f-bar: in addition the elastic b_e "
+                        "of the last step scaled by (Jebar / J^e)^(2/3), Jebar the mass-weighted mean of "
+                        "J^e = sqrt(det b_e) over the soil points of a fixed square patch (Eqs. 81-83); needs a "
+                        "model that keeps b_e (hencky mohr coulomb, nor sand, neo hookean).");
+      prm.declare_entry("point sets", "double", Selection("double|single"),
+                        "double: soil and water are two sets of material points, each moving with its own "
+                        "velocity (the paper's double-point method). single: the water is carried on the soil "
+                        "points: the water points are seeded on the soil points and move with the soil's "
+                        "velocity, so they stay on them; the water keeps its own velocity, mass, pressure and "
+                        "the same equations and basis (the single-point comparison). single needs every body "
+                        "to be saturated or soil.");
+      prm.declare_entry("nor sand specific volume", "node-smoothed", Selection("node-smoothed|point"),
+                        "The specific volume v of nor sand soil points. node-smoothed: v = v0 Jbar, Jbar the "
+                        "mass-weighted node map and remap of the points' total J (seed 002 Eqs. 96-97). point: "
+                        "v = v0 J of the point itself (Borja & Andrade, Eq. 95).");
+      prm.declare_entry("patch size", "1.5", Double(0),
+                        "Side of the modified F-bar patches in cells (1.5 for quadratic B-splines, 1 = the "
+                        "cell-wise average); the patches tile the grid from its lower corner and stay fixed.");
+      prm.declare_entry("rigid skeleton", "false", Bool(),
+                        "true: the soil skeleton does not move (v_s = 0 at every node, no deformation, the "
+                        "soil's terms dropped from the pressure equation): seepage through a fixed soil. The "
+                        "water keeps its equations, drag and boundary conditions.");
+      prm.declare_entry("drained boundaries", "", dealii::Patterns::Anything(),
+                        "Comma-separated boundary ids of the box grid (0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, "
+                        "5 = z+) where the water drains: the pore pressure is 0 on their nodes that carry water "
+                        "and the water's velocity is not held by the wall condition there (the water can leave "
+                        "the grid; the soil keeps its wall condition). Empty: none.");
+      prm.declare_entry("kozeny carman", "false", Bool(),
+                        "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
+                        "(Alg. 8(g)); false: k stays k0.");
+    }
+    prm.leave_subsection();
+    prm.enter_subsection("initial state");
+    {
+      prm.declare_entry("geostatic", "false", Bool(),
+                        "Start from the geostatic state of a horizontally layered scene: pore pressure "
+                        "-rho_w g (water level - y) at water points below the water level, effective "
+                        "vertical stress -(1-n)(rho_s - rho_w) g depth (buoyant below the water level, "
+                        "(1-n) rho_s g above) and horizontal K0 times it at soil points (g = |gravity|).");
+      prm.declare_entry("water level", "0", Double(-1e300, 1e300),
+                        "Vertical coordinate of the free water surface [m].");
+      prm.declare_entry("soil surface", "0", Double(-1e300, 1e300), "Vertical coordinate of the soil surface [m].");
+      prm.declare_entry("K0", "1", Double(0), "Horizontal / vertical effective stress ratio.");
+      prm.declare_entry("initialisation time", "0", Double(-1e300, 1e300),
+                        "Seed 002 App. B.4 (0: none). For t below this time [s] gravity grows linearly from 0 "
+                        "to full, the soil models are elastic (nor sand without plasticity; linear elastic and "
+                        "neo hookean as they are; other models are refused), the water points move with the "
+                        "soil velocity (no seepage of the points) and every soil point has the 'initialisation "
+                        "conductivity'. At its end each nor sand point takes its current pressure and elastic "
+                        "volumetric strain as the reference, its image pressure from the OCR (Eq. 113) and "
+                        "v0 <- J v0 (Eq. 114); then plasticity is on. The time continues: the end time includes "
+                        "this stage (an end time equal to it ends the run on the initialised state).");
+      prm.declare_entry("initialisation conductivity", "1", Double(-1e300, 1e300),
+                        "Hydraulic conductivity [m/s] of every soil point during the App. B.4 initialisation "
+                        "(the paper: 1 m/s), > 0.");
+    }
+    prm.leave_subsection();
+    for (unsigned int k = 0; k < counts.n_materials; ++k)
+      {
+        prm.enter_subsection("material " + std::to_string(k));
+        prm.enter_subsection("soil");
+        prm.declare_entry("porosity", "0.3", Double(-1e300, 1e300), "Initial porosity n0 of the soil, in (0, 1).");
+        prm.declare_entry("hydraulic conductivity", "1e-3", Double(-1e300, 1e300),
+                          "Hydraulic conductivity k0 [m/s], > 0.");
+        prm.leave_subsection();
+        prm.leave_subsection();
+      }
+    for (unsigned int k = 0; k < counts.n_bodies; ++k)
+      {
+        prm.enter_subsection("body " + std::to_string(k));
+        prm.declare_entry("surface load extent", "", dealii::Patterns::Anything(),
+                          "Empty: the surface load covers the body's whole upper face. 'a, b': only the top "
+                          "points with a <= x <= b carry it (a strip load, e.g. a footing; x the first "
+                          "coordinate).");
+        prm.declare_entry("surface load ramp time", "0", Double(0),
+                          "The surface load grows linearly from 0 to q over this time [s]; 0: sudden at t = 0.");
+        prm.declare_entry("surface load", "0", Double(-1e300, 1e300),
+                          "A uniform vertical pressure q [Pa] (>= 0, pushing down) on the upper face of a box "
+                          "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
+                          "soil points carries it, each point the force q V_p / (h / particles per direction), "
+                          "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
+        prm.declare_entry("surface load acts at", "body surface",
+                          dealii::Patterns::Selection("body surface|top points"),
+                          "Where a loaded point's force enters the grid. body surface: at the point's share of the "
+                          "upper face, the point position plus half its sub-cell height, a vector carried by the "
+                          "point's dF (the weak form's integral over the face: the top points carry the full q). "
+                          "top points: at the point itself (the top layer then carries only part of q and is "
+                          "too stiff; kept for comparison; docs/semi-implicit.md).");
+        // must be set: it makes a .prm this family's (an explicit scene is not
+        // silently read as a saturated two-phase one)
+        prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
+                          "What the body seeds (must be set): saturated: soil and water points over the region "
+                          "(the material is the soil's); soil: soil points only; water: water points only "
+                          "(density 'semi implicit/water density'; the material entry is unused).",
+                          /*has_to_be_set=*/true);
+        prm.leave_subsection();
+      }
+  }
+
+  std::string
+  number_text(const double x)
+  {
+    std::ostringstream os;
+    os << std::setprecision(4) << x;
+    return os.str();
+  }
+
+  namespace
+  {
+    /// The checks of a scene that need no grid: every body wholly inside the
+    /// grid (or clipped), the memory the grid and points need, the time step.
+    template <int dim>
+    void
+    check_scene(const Parameters<dim> &p)
+    {
+      double n_cells = 1, cell_volume = 1, h_min = std::numeric_limits<double>::max();
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double h = (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
+          n_cells *= p.grid_cells[d];
+          cell_volume *= h;
+          h_min = std::min(h_min, h);
+        }
+      // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
+      for (const auto &bc : p.boundary_conditions)
+        require(bc.id < 2 * dim,
+                std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
+                "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
+                  "D box has the ids 0 to " + std::to_string(2 * dim - 1) + ": x-, x+, y-, y+" +
+                  (dim == 3 ? ", z-, z+)" : ")"));
+      if (p.bspline())
+        for (unsigned int d = 0; d < dim; ++d)
+          require(p.grid_cells[d] >= 3, "grid/cells",
+                  "quadratic B-splines need at least 3 cells in every direction (a point's 3-node window)");
+      double n_points = 0;
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
+        {
+          const auto       &b     = p.bodies[k];
+          const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
+          if (b.shape == BodyDescription<dim>::Shape::file) // its rows; the seeding checks their positions
+            {
+              n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * double(check_file_body(p, k).rows);
+              continue;
+            }
+          dealii::Point<dim> lo, hi;
+          b.bounding_box(lo, hi);
+          double overlap = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+            overlap *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
+          require(overlap > 0, where, "contains no material point: it lies entirely outside the grid");
+          if (!b.clip_to_grid)
+            {
+              const std::string out = outside_extent(b, p.grid_lower, p.grid_upper);
+              require(out.empty(), where,
+                      out +
+                        "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
+                        "the grid, or set 'clip to grid = true' in 'body " +
+                        std::to_string(k) + "')");
+            }
+          // both sets for a saturated body
+          n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * overlap / cell_volume *
+                      std::pow(double(b.particles_per_direction), dim);
+        }
+      // rough peak memory: the explicit family's measured figures per cell and
+      // point (docs/reliability.md) doubled for the pressure space, its matrix
+      // and the two-phase nodal vectors
+      int size = 1;
+      MPI_Comm_size(MPI_COMM_WORLD, &size);
+      const double per_cell = dim == 2 ? 1200 : 2400, per_point = dim == 2 ? 650 : 800;
+      const double need  = 180e6 * size + per_cell * n_cells + per_point * n_points;
+      const double avail = available_memory_bytes();
+      require(avail < 0 || need <= avail * size, "grid/cells",
+              number_text(n_cells) + " cells and about " + number_text(n_points) + " material points need about " +
+                number_text(need / 1e9) + " GB, but only " + number_text(avail / 1e9) +
+                " GB are available; use fewer cells or particles per direction");
+      const double dt_cr = soil_critical_time_step(p, h_min);
+      require(p.time_step <= dt_cr, "time/time step",
+              "is " + number_text(p.time_step) + " s, above the soil skeleton's critical step " + number_text(dt_cr) +
+                " s (h_min / sqrt(E_c / ((1 - n) rho_s))); the semi-implicit step is limited by it");
+    }
+
+    /// 'semi implicit': the family's numerics, drained boundaries, stabilisation
+    template <int dim>
+    void
+    parse_semi_implicit(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      prm.enter_subsection("semi implicit");
+      p.water_density             = prm.get_double("water density");
+      p.unit_weight_gravity       = prm.get_double("unit weight gravity");
+      p.free_surface_fraction     = prm.get_double("free surface volume fraction");
+      p.pressure_tolerance        = prm.get_double("pressure solver tolerance");
+      p.pressure_rebuild_interval = prm.get_integer("pressure preconditioner rebuild interval");
+      p.kozeny_carman             = prm.get_bool("kozeny carman");
+      p.pressure_smoothing        = prm.get("pressure smoothing") != "none";
+      p.linear_smoothing          = prm.get("pressure smoothing") == "linear";
+      p.flip_fraction             = prm.get_double("flip fraction");
+      p.rigid_skeleton            = prm.get_bool("rigid skeleton");
+      // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
+      // plate can move it (a physical impossibility, not a missing feature)
+      if (p.grid_mesh == nullptr) // (a grid file is refused below)
+        loads::check_rigid_plates_on_box(p.rigid_plates, p.grid_lower, p.grid_upper, p.grid_cells,
+                                         p.boundary_conditions);
+      if (p.rigid_skeleton)
+        loads::refuse_rigid_plates(p.rigid_plates, "talus-semi-implicit",
+                                   "'semi implicit/rigid skeleton = true' holds every soil node at rest, so no plate "
+                                   "can move the soil (allowed: rigid skeleton = false, or no plate)");
+      {
+        const std::string text = prm.get("drained boundaries");
+        for (const auto &item : dealii::Utilities::split_string_list(text, ','))
+          {
+            bool ok = !item.empty() && item.find_first_not_of("0123456789") == std::string::npos && item.size() < 3;
+            unsigned int id = ok ? static_cast<unsigned int>(std::stoul(item)) : 0;
+            ok              = ok && id < 2 * dim;
+            require(ok, "semi implicit/drained boundaries",
+                    "is '" + text + "'; allowed: empty or comma-separated boundary ids of the " + std::to_string(dim) +
+                      "D box, 0 to " + std::to_string(2 * dim - 1) + " (x-, x+, y-, y+" +
+                      (dim == 3 ? ", z-, z+)" : ")"));
+            p.drained_boundaries.push_back(id);
+          }
+      }
+      {
+        const std::string st       = prm.get("volumetric stabilisation");
+        p.stabilisation            = st == "f-bar"            ? VolumetricStabilisation::f_bar
+                                     : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
+                                                              : VolumetricStabilisation::none;
+        p.patch_size               = prm.get_double("patch size");
+        p.single_point             = prm.get("point sets") == "single";
+        p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
+        require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
+      }
+      require(p.water_density > 0, "semi implicit/water density", "must be > 0 kg/m^3");
+      require(p.unit_weight_gravity > 0, "semi implicit/unit weight gravity", "must be > 0 m/s^2");
+      require(p.free_surface_fraction > 0 && p.free_surface_fraction < 1, "semi implicit/free surface volume fraction",
+              "must lie in (0, 1)");
+      require(p.pressure_tolerance > 0, "semi implicit/pressure solver tolerance", "must be > 0");
+      prm.leave_subsection();
+    }
+
+    /// 'initial state': geostatic state and the App. B.4 initialisation
+    template <int dim>
+    void
+    parse_initial_state(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      prm.enter_subsection("initial state");
+      p.geostatic                   = prm.get_bool("geostatic");
+      p.water_level                 = prm.get_double("water level");
+      p.soil_surface                = prm.get_double("soil surface");
+      p.K0                          = prm.get_double("K0");
+      p.initialisation_time         = prm.get_double("initialisation time");
+      p.initialisation_conductivity = prm.get_double("initialisation conductivity");
+      require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 && p.initialisation_time <= p.end_time,
+              "initial state/initialisation time",
+              "is " + number_text(p.initialisation_time) + "; allowed: 0 (none) up to the end time " +
+                number_text(p.end_time) + " s");
+      require(std::isfinite(p.initialisation_conductivity) && p.initialisation_conductivity > 0,
+              "initial state/initialisation conductivity",
+              "is " + number_text(p.initialisation_conductivity) + "; must be > 0 m/s");
+      if (p.initialisation_time > 0)
+        for (unsigned int m = 0; m < p.materials.size(); ++m)
+          {
+            const std::string model = p.materials[m]->model_name();
+            require(model == "nor sand" || model == "linear elastic" || model == "neo hookean",
+                    "material " + std::to_string(m) + "/model",
+                    "is " + model +
+                      ", which has no elastic-only mode for 'initial state/initialisation time'; "
+                      "allowed with an initialisation: nor sand, linear elastic, neo hookean");
+          }
+      prm.leave_subsection();
+    }
+
+    /// 'material k/soil' of every material: porosity and conductivity
+    template <int dim>
+    void
+    parse_soil_data(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      for (unsigned int k = 0; k < p.materials.size(); ++k)
+        {
+          const std::string where = "material " + std::to_string(k) + "/soil/";
+          prm.enter_subsection("material " + std::to_string(k));
+          prm.enter_subsection("soil");
+          SoilData s;
+          s.porosity     = prm.get_double("porosity");
+          s.conductivity = prm.get_double("hydraulic conductivity");
+          prm.leave_subsection();
+          prm.leave_subsection();
+          std::ostringstream n0, k0;
+          n0 << s.porosity;
+          k0 << s.conductivity;
+          require(s.porosity > 0 && s.porosity < 1, where + "porosity", "is " + n0.str() + "; must lie in (0, 1)");
+          require(s.conductivity > 0, where + "hydraulic conductivity", "is " + k0.str() + "; must be > 0 m/s");
+          p.soil_of_material.push_back(s);
+        }
+    }
+
+    /// 'body k': phase, surface load, the material ids of its points; the
+    /// checks of the phases against the point sets and the stabilisation
+    template <int dim>
+    void
+    parse_bodies(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    {
+      bool any_soil = false, any_water = false;
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
+        {
+          prm.enter_subsection("body " + std::to_string(k));
+          const std::string ph = prm.get("phase");
+          {
+            SurfaceLoad sl;
+            sl.q                     = prm.get_double("surface load");
+            sl.ramp                  = prm.get_double("surface load ramp time");
+            sl.at_surface            = prm.get("surface load acts at") == "body surface";
+            const std::string extent = prm.get("surface load extent");
+            if (!dealii::Utilities::trim(extent).empty())
+              {
+                const auto v  = dealii::Utilities::split_string_list(extent, ',');
+                bool       ok = v.size() == 2;
+                try
+                  {
+                    if (ok)
+                      {
+                        sl.from = std::stod(v[0]);
+                        sl.to   = std::stod(v[1]);
+                      }
+                  }
+                catch (const std::exception &)
+                  {
+                    ok = false;
+                  }
+                require(ok && std::isfinite(sl.from) && std::isfinite(sl.to) && sl.from < sl.to,
+                        "body " + std::to_string(k) + "/surface load extent",
+                        "is '" + extent + "'; allowed: empty (the whole upper face) or two numbers 'a, b' with a < b");
+              }
+            p.surface_load.push_back(sl);
+          }
+          prm.leave_subsection();
+          p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
+          std::ostringstream q;
+          q << p.surface_load.back().q;
+          require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0,
+                  "body " + std::to_string(k) + "/surface load", "is " + q.str() + "; must be a pressure >= 0 Pa");
+          require(p.surface_load.back().q == 0 ||
+                    (p.phase_of_body.back() != Phase::water && p.bodies[k].shape == BodyDescription<dim>::Shape::box),
+                  "body " + std::to_string(k) + "/surface load",
+                  "needs a box body with soil points (phase saturated or soil)");
+          any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
+          any_water = any_water || p.phase_of_body.back() != Phase::soil;
+          // the material ids of the body's points: its entry, or those of its rows
+          // (checked: rows of its body id exist, their material ids too)
+          if (p.bodies[k].shape == BodyDescription<dim>::Shape::file)
+            p.materials_of_body.push_back(check_file_body(p, k).materials);
+          else
+            p.materials_of_body.push_back({p.bodies[k].material_id});
+        }
+      std::string phases; // e.g. "body 0/phase = water": the entries that left a phase out
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
+        phases += (k ? ", body " : "body ") + std::to_string(k) + "/phase = " +
+                  (p.phase_of_body[k] == Phase::soil    ? "soil"
+                   : p.phase_of_body[k] == Phase::water ? "water"
+                                                        : "saturated");
+      if (p.single_point)
+        for (unsigned int b = 0; b < p.bodies.size(); ++b)
+          require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
+                  "single needs every body to carry soil points (the water rides on them), but body " +
+                    std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
+      // a dry scene (soil points only) is a single-phase solid: allowed
+      (void)any_water;
+      require(any_soil, phases,
+              "the scene has no soil points (free water needs a skeleton for the drag and the mixture): give a "
+              "body phase = saturated or soil");
+      if (p.stabilisation == VolumetricStabilisation::modified_f_bar)
+        for (unsigned int b = 0; b < p.bodies.size(); ++b)
+          if (p.phase_of_body[b] != Phase::water)
+            for (const unsigned int mid : p.materials_of_body[b])
+              {
+                const auto &m = *p.materials[mid];
+                require(
+                  m.keeps_elastic_b(), "semi implicit/volumetric stabilisation",
+                  "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
+                    std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
+                    "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | "
+                    "f-bar)");
+              }
+    }
+  } // namespace
+
+  template <int dim>
+  Parameters<dim>
+  parse_parameters(dealii::ParameterHandler &prm)
+  {
+    Parameters<dim> p;
+    parse_run_parameters<dim>(prm, p);
+    parse_scene_parameters<dim>(prm, p);
+    prm.enter_subsection("time");
+    p.time_step = prm.get_double("time step");
+    p.courant   = prm.get_double("courant number");
+    require(p.courant > 0, "time/courant number", "must be > 0");
+    prm.leave_subsection();
+    parse_semi_implicit(prm, p);
+    parse_initial_state(prm, p);
+    parse_soil_data(prm, p);
+    parse_bodies(prm, p);
+    require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
+    check_scene(p);
+    return p;
+  }
+
+  template <int dim>
+  double
+  soil_critical_time_step(const Parameters<dim> &p, const double h_min)
+  {
+    double dt = std::numeric_limits<double>::max();
+    for (unsigned int b = 0; b < p.bodies.size(); ++b)
+      if (p.phase_of_body[b] != Phase::water)
+        for (const unsigned int m : p.materials_of_body[b])
+          {
+            const double rho = (1 - p.soil_of_material[m].porosity) * p.materials[m]->density();
+            dt               = std::min(dt, h_min / std::sqrt(p.materials[m]->constrained_modulus() / rho));
+          }
+    return dt;
+  }
+
+  void
+  check_parameters(dealii::ParameterHandler &prm, const std::string &)
+  {
+    check_formulation(prm, &parse_parameters<2>, &parse_parameters<3>);
+  }
+
+  // the Solver's instantiations: semi_implicit_setup.cc and the other parts'
+  template struct Parameters<2>;
+  template struct Parameters<3>;
+  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  template double        soil_critical_time_step<2>(const Parameters<2> &, double);
+  template double        soil_critical_time_step<3>(const Parameters<3> &, double);
+} // namespace talus::semi_implicit
