@@ -33,13 +33,13 @@ namespace talus
   template <int dim>
   Simulation<dim>::Simulation(const SceneParameters<dim> &scene_, const RunParameters<dim> &run_, MPI_Comm c,
                               const std::vector<std::string> &set_names)
-    : comm(c)
-    , grid(c, run_.balance.enabled())
-    , point_sets(make_sets(grid, set_names))
-    , balance(grid, run_.balance, set_pointers(point_sets), [this] { grid_changed(); })
-    , point_set_records(set_names.size())
-    , scene(scene_)
-    , run(run_)
+      : comm(c)
+      , grid(c, run_.balance.enabled())
+      , point_sets(make_sets(grid, set_names))
+      , balance(grid, run_.balance, set_pointers(point_sets), [this] { grid_changed(); })
+      , point_set_records(set_names.size())
+      , scene(scene_)
+      , run(run_)
   {
   }
 

@@ -117,27 +117,14 @@ namespace talus::semi_implicit
   void
   Solver<dim>::write_vtu(const unsigned int counter)
   {
-    for (const bool is_soil : {true, false})
-      {
-        MaterialPointSet<dim>          &set = is_soil ? soil : water;
-        dealii::Particles::DataOut<dim> out;
-        out.build_patches(set.handler, set.layout.names(), set.layout.interpretations());
-        const std::string name    = io::write_vtu_atomic(out, prm.output_directory, set.name(), counter, comm);
-        auto             &records = pvd_records[is_soil ? 0 : 1];
-        records.emplace_back(time, name);
-        if (dealii::Utilities::MPI::this_mpi_process(comm) == 0) // soil.pvd, water.pvd for ParaView
-          io::write_pvd(prm.output_directory + "/" + set.name() + ".pvd", records);
-      }
+    this->write_point_sets(counter); // soil-<n>, water-<n>; soil.pvd, water.pvd for ParaView
   }
 
   template <int dim>
   void
   Solver<dim>::rewrite_records()
   {
-    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-      for (const bool is_soil : {true, false})
-        io::write_pvd(prm.output_directory + "/" + (is_soil ? soil : water).name() + ".pvd",
-                      pvd_records[is_soil ? 0 : 1]);
+    this->rewrite_point_set_records();
   }
 
   template <int dim>

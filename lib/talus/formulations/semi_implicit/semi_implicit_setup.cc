@@ -111,17 +111,16 @@ namespace talus::semi_implicit
     for (auto &r : plate_response)
       for (Vector *v : {&r.es, &r.ew, &r.dp, &r.gs, &r.gw, &r.vs, &r.vw})
         grid.reinit_vector(*v);
-    partition_changed = true; // the next step rebuilds the active set and the matrix
+    partition_changed = true;    // the next step rebuilds the active set and the matrix
+    soil.collect_active_cells(); // the sets' cell lists on the new partition (empty before seeding)
+    water.collect_active_cells();
   }
 
   template <int dim>
   void
   Solver<dim>::setup()
   {
-    grid.make_box(prm.grid_lower, prm.grid_upper, prm.grid_cells);
-    grid.setup();
-    if (prm.bspline())
-      grid.setup_bspline_patches();
+    this->make_grid(); // a box: grid files are refused by the parameters
     plate_state.assign(prm.rigid_plates.size(), PlateState());
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
       if (prm.rigid_plates[k].control == loads::RigidPlate<dim>::Control::force)
@@ -250,8 +249,8 @@ namespace talus::semi_implicit
                                      }
                                    write_points(f, soil, "soil");
                                    write_points(f, water, "water");
-                                   write_pvd_times(f, "output/soil_pvd", pvd_records[0]);
-                                   write_pvd_times(f, "output/water_pvd", pvd_records[1]);
+                                   write_pvd_times(f, "output/soil_pvd", this->point_set_records[0]);
+                                   write_pvd_times(f, "output/water_pvd", this->point_set_records[1]);
                                    balance.write(f); // the partition of the last rebalance
                                  });
   }
@@ -286,8 +285,8 @@ namespace talus::semi_implicit
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, soil, grid, where, "soil");
     read_points(*fp, water, grid, where, "water");
-    pvd_records[0] = read_pvd_records(*fp, "output/soil_pvd", soil.name());
-    pvd_records[1] = read_pvd_records(*fp, "output/water_pvd", water.name());
+    this->point_set_records[0] = read_pvd_records(*fp, "output/soil_pvd", soil.name());
+    this->point_set_records[1] = read_pvd_records(*fp, "output/water_pvd", water.name());
     return true;
   }
 

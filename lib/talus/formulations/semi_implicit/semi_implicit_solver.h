@@ -14,7 +14,7 @@
 
 #include <talus/base/tool.h>
 #include <talus/formulations/common/formulation.h>
-#include <talus/formulations/common/load_balance.h>
+#include <talus/formulations/common/simulation.h>
 #include <talus/formulations/semi_implicit/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
@@ -55,23 +55,26 @@ namespace talus::semi_implicit
   };
 
   template <int dim>
-  class Solver : public Formulation
+  class Solver : public Simulation<dim>
   {
   public:
     using L = PropertyLayout<dim>;
+    // the members of the (dependent) base this class uses by name
+    using Simulation<dim>::comm;
+    using Simulation<dim>::grid;
+    using Simulation<dim>::balance;
+    using Simulation<dim>::time;
+    using Simulation<dim>::dt;
+    using Simulation<dim>::step_number;
+    using Simulation<dim>::counters;
+    using Simulation<dim>::restored_from;
+    using Simulation<dim>::lost_points;
 
     Solver(const Parameters<dim> &p, MPI_Comm comm)
-        : prm(p)
-        , comm(comm)
-        , grid(comm, p.balance.enabled())
-        , soil(grid, "soil")
-        , water(grid, "water")
-        , balance(grid, p.balance, {&soil, &water},
-                  [this] {
-                    grid_changed();
-                    soil.collect_active_cells();
-                    water.collect_active_cells();
-                  })
+        : Simulation<dim>(p, p, comm, {"soil", "water"})
+        , prm(p)
+        , soil(*this->point_sets[0])
+        , water(*this->point_sets[1])
         , pspace(grid, 1)
         , active(pspace)
     {
@@ -90,13 +93,8 @@ namespace talus::semi_implicit
       return prm.end_time;
     }
     /// One step (step<K>) with the run's shape functions.
-    StepOutcome advance_by(const double h) override;
-    void        check_stability() const override;
-    unsigned long long
-    lost_points() const override
-    {
-      return soil.relocation_stats.lost + water.relocation_stats.lost;
-    }
+    StepOutcome              advance_by(const double h) override;
+    void                     check_stability() const override;
     std::vector<std::string> series_columns() const override;
     std::vector<double>      series_values(const bool after_step) override;
     void                     write_vtu(const unsigned int counter) override;
@@ -104,11 +102,6 @@ namespace talus::semi_implicit
     std::string              write_checkpoint() override;
     void                     finish(const std::string &series_csv) override;
     void                     summary(const LoopTimings &timings) override;
-    void
-    after_step() override
-    {
-      balance.after_step(step_number, prm.progress);
-    } ///< the load-balance check
 
   private:
     /// What the phases of one step share: its size and gravity, whether it is
@@ -222,16 +215,12 @@ namespace talus::semi_implicit
     }
 
     const Parameters<dim> &prm;
-    MPI_Comm               comm;
-    BackgroundGrid<dim>    grid;
-    MaterialPointSet<dim>  soil, water;
-    /// Load balancing by material points of both sets (formulations/common/
-    /// load_balance.h); its repartitions call grid_changed().
-    LoadBalance<dim> balance;
+    MaterialPointSet<dim> &soil, &water; ///< the Simulation's two point sets
     /// Everything of the grid's partition that lives across steps: the
     /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
-    /// vectors; the next step rebuilds the active set and the pressure matrix.
-    void grid_changed();
+    /// vectors, the sets' cell lists; the next step rebuilds the active set and
+    /// the pressure matrix. Called by the load balancer after a repartition.
+    void grid_changed() override;
     /// the next step rebuilds the pressure DoF set (after a repartition and
     /// after a checkpoint write)
     bool                                   partition_changed = true;
@@ -267,9 +256,9 @@ namespace talus::semi_implicit
     Vector              Mdj; // F-bar: sum N m dJ of the soil points
     Vector              Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
     // modified F-bar patches: a fixed square tiling from the grid's lower corner
-    PatchTiling<dim>                            patches;
-    std::vector<double>                         patch_mass, patch_mass_Je;
-    std::vector<std::pair<double, std::string>> pvd_records[2]; // soil, water
+    PatchTiling<dim>    patches;
+    std::vector<double> patch_mass, patch_mass_Je;
+
 
     // rigid plates (issue 37; docs/semi-implicit.md 'Rigid plate'): per local
     // grid DoF the plate whose axis component it is (none: not a plate DoF or
