@@ -57,6 +57,11 @@ cases = [
     ("surface load on water", [("body 0/surface load", "1e4"), ("number of bodies", "2"), ("body 1/phase", "water"),
                                ("body 1/surface load", "1e3"), ("body 1/upper corner", "0.075, 1.05"),
                                ("body 1/lower corner", "0, 1")], "body 1/surface load"),
+    # the shared scene checks (formulations/common/scene_checks.h): the memory of
+    # the grid and both point sets, a boundary id the box lacks
+    ("grid too large for the memory", [("grid/cells", "100000, 100000")], "grid/cells: 1e+10 cells"),
+    ("boundary id the box lacks", [("boundary conditions/fixed", "7")],
+     "boundary conditions/fixed: boundary id 7 does not exist"),
     # rigid plates (issue 37): both controls; a boundary id the box lacks; a
     # region holding no grid node; the axis held by a wall at every plate node
     # (the base is a roller: it holds y); a rigid skeleton cannot be moved

@@ -220,7 +220,7 @@ namespace talus::loads
               i0[d] = 0, i1[d] = n;
             else
               {
-                // (the wording of check_scene_consistency, which not every family calls)
+                // (the wording of check_scene_consistency; talus-semi-implicit runs this check before it)
                 require(p.lower[d] <= upper[d] && p.upper[d] >= lower[d], p.where + "/region lower corner",
                         "the region lies outside the grid (grid extent " + std::to_string(lower[d]) + " .. " +
                           std::to_string(upper[d]) + " along " + std::string(1, char('x' + d)) + ")");

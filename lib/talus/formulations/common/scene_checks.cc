@@ -67,21 +67,27 @@ namespace talus
 
   double
   estimated_memory_bytes(const double n_cells, const double n_points, const unsigned int dim,
-                         const unsigned int ranks_on_node)
+                         const unsigned int ranks_on_node, const double cell_factor)
   {
     // measured peak resident memory of talus-explicit (docs/reliability.md):
     // a process, a cell (triangulation, p4est, DoFs, cell cache, nodal vectors)
     // and a material point (ParticleHandler entry, properties, scratch)
     const double per_process = 180e6;
-    const double per_cell    = dim == 2 ? 600 : 1200;
+    const double per_cell    = (dim == 2 ? 600 : 1200) * cell_factor;
     const double per_point   = dim == 2 ? 650 : 800;
     return per_process * ranks_on_node + per_cell * n_cells + per_point * n_points;
   }
 
   template <int dim>
   void
-  check_scene_consistency(const SceneParameters<dim> &p)
+  check_scene_consistency(const SceneParameters<dim> &p, const SceneCheckOptions &options)
   {
+    // the point sets body k seeds
+    const auto sets = [&](const unsigned int k) {
+      return k < options.point_sets_of_body.size() ? double(options.point_sets_of_body[k]) : 1.0;
+    };
+    // the rows of the file bodies (read once; the checks of check_file_body)
+    std::vector<double> file_rows(p.bodies.size(), 0.0);
     if (p.grid_mesh)
       {
         const auto  ids = p.grid_mesh->boundary_ids();
@@ -129,10 +135,15 @@ namespace talus
     {
       // points of the shape bodies (as below) and file bodies, for the memory estimate
       double n_points_estimate = 0;
-      for (const auto &b : p.bodies)
+      for (unsigned int k = 0; k < p.bodies.size(); ++k)
         {
+          const auto &b = p.bodies[k];
           if (b.shape == BodyDescription<dim>::Shape::file)
-            continue;
+            {
+              file_rows[k] = double(check_file_body(p, k).rows);
+              n_points_estimate += sets(k) * file_rows[k];
+              continue;
+            }
           dealii::Point<dim> lo, hi;
           b.bounding_box(lo, hi);
           double v = 1, cv = 1;
@@ -141,15 +152,16 @@ namespace talus
               v *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
               cv *= (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
             }
-          n_points_estimate += v / cv * std::pow(double(b.particles_per_direction), dim);
+          n_points_estimate += sets(k) * v / cv * std::pow(double(b.particles_per_direction), dim);
         }
       int size = 1;
       MPI_Comm_size(MPI_COMM_WORLD, &size);
       // ranks sharing this node: Open MPI says; otherwise assume all (the conservative case)
       const char        *local   = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
       const unsigned int on_node = local ? std::max(1, std::atoi(local)) : size;
-      const double       need    = estimated_memory_bytes(n_cells, n_points_estimate, dim, on_node) * on_node / size;
-      const double       avail   = available_memory_bytes();
+      const double       need =
+        estimated_memory_bytes(n_cells, n_points_estimate, dim, on_node, options.cell_memory_factor) * on_node / size;
+      const double avail = available_memory_bytes();
       require(avail < 0 || need <= avail, "grid/cells",
               fmt(n_cells) + " cells and about " + fmt(n_points_estimate) + " material points need about " +
                 fmt_bytes(need) + " on this node" + (on_node > 1 ? " (" + std::to_string(on_node) + " ranks)" : "") +
@@ -171,7 +183,7 @@ namespace talus
         const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
         if (b.shape == BodyDescription<dim>::Shape::file)
           {
-            n_points += check_file_body(p, k).rows;
+            n_points += sets(k) * file_rows[k];
             continue;
           }
         // bounding box of the body
@@ -223,7 +235,7 @@ namespace talus
                     "contains no material point: it is thinner than one sub-cell (cell size / particles per "
                     "direction) in direction " +
                       std::to_string(d) + " and holds no seeding position");
-        n_points += overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
+        n_points += sets(k) * overlap / cell_volume * std::pow(double(b.particles_per_direction), dim);
       }
     require(n_points <= max_material_points, "bodies",
             "about " + fmt(n_points) + " material points would be seeded, more than the limit of " +
@@ -310,6 +322,6 @@ namespace talus
   template double       smallest_cell_edge(const SceneParameters<3> &);
   template void         check_run_files(const RunParameters<2> &);
   template void         check_run_files(const RunParameters<3> &);
-  template void         check_scene_consistency(const SceneParameters<2> &);
-  template void         check_scene_consistency(const SceneParameters<3> &);
+  template void         check_scene_consistency(const SceneParameters<2> &, const SceneCheckOptions &);
+  template void         check_scene_consistency(const SceneParameters<3> &, const SceneCheckOptions &);
 } // namespace talus

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace talus
 {
@@ -18,8 +19,26 @@ namespace talus
   inline constexpr double max_grid_cells      = 1e8;
   inline constexpr double max_material_points = 2e9;
 
+  /// What a family changes in the shared scene checks.
+  struct SceneCheckOptions
+  {
+    /// Material point sets each body seeds, by body (bodies without an entry:
+    /// 1); the semi-implicit family's saturated bodies seed two, soil and water.
+    std::vector<unsigned int> point_sets_of_body;
+    /// Memory per cell as a multiple of the explicit family's measured figure
+    /// (the semi-implicit family's pressure space, its matrix and its two-phase
+    /// nodal vectors: 2).
+    double cell_memory_factor = 1;
+  };
+
+  /// The scene checks every family runs before any heavy work: boundary ids
+  /// that exist (box grid or grid file), rigid plate regions that meet the
+  /// grid, the memory the grid and the points need on this node, the cell and
+  /// point limits, every body inside the grid (or clipped to it) holding at
+  /// least one seeding position, file bodies whose rows exist. InputError
+  /// naming the entry and what is allowed.
   template <int dim>
-  void check_scene_consistency(const SceneParameters<dim> &p);
+  void check_scene_consistency(const SceneParameters<dim> &p, const SceneCheckOptions &options = {});
 
   /// What a file body takes from its particle file (known before seeding).
   struct FileBodyRows
@@ -54,6 +73,8 @@ namespace talus
   void check_run_files(const RunParameters<dim> &p);
 
   /// Estimated peak memory of one node [bytes] for a scene of n_cells and
-  /// n_points run on ranks_on_node ranks (measured figures, docs/reliability.md).
-  double estimated_memory_bytes(double n_cells, double n_points, unsigned int dim, unsigned int ranks_on_node);
+  /// n_points run on ranks_on_node ranks (measured figures, docs/reliability.md);
+  /// `cell_factor` scales the memory per cell (SceneCheckOptions::cell_memory_factor).
+  double estimated_memory_bytes(double n_cells, double n_points, unsigned int dim, unsigned int ranks_on_node,
+                                double cell_factor = 1);
 } // namespace talus

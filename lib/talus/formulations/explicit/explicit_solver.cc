@@ -413,9 +413,8 @@ namespace talus::explicit_mpm
       std::vector<double>                                           &probe_values;
       std::vector<double>                                           &probe_stress;
 
-      Energies               e        = {};
-      dealii::Tensor<1, dim> momentum = {};
-      bool                   bad      = false;
+      diagnostics::PointSums<dim> sums = {};
+      bool                        bad  = false;
       /// from update() to moved() of one point
       struct PointState
       {
@@ -523,19 +522,9 @@ namespace talus::explicit_mpm
       moved(const transfer::PointIterator<dim> &it, const double *P, const dealii::Point<dim> &x,
             const PointState &state)
       {
-        const double mass = P[L::mass];
-        double       v2 = 0, gx = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += g[d] * x[d];
-          }
-        e.kinetic += 0.5 * mass * v2;
-        for (unsigned int d = 0; d < dim; ++d)
-          momentum[d] += mass * P[L::velocity + d];
-        e.gravity_potential -= mass * gx;
+        const double v2 = sums.add(P[L::mass], P + L::velocity, x, g);
         if (need_strain_energy)
-          e.strain += P[L::volume] * state.material->elastic_energy_density(state.sigma);
+          sums.add_strain(P[L::volume] * state.material->elastic_energy_density(state.sigma));
         const auto &sigma = state.sigma;
         if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
             !(P[L::volume] > 0))
@@ -610,9 +599,8 @@ namespace talus::explicit_mpm
         transfer::Fused                    fused{update, p2g};
         transfer::for_each_active_cell(points, fused);
       }
-    local_energies = physics.e;
-    local_momentum = physics.momentum;
-    local_bad      = physics.bad;
+    local_sums = physics.sums;
+    local_bad  = physics.bad;
   }
 
   template <int dim>
@@ -632,9 +620,8 @@ namespace talus::explicit_mpm
     transfer::ScatterMassForce<dim, K>                       p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
     transfer::Fused                                          fused{update, p2g};
     transfer::for_each_active_cell(points, fused);
-    local_energies = physics.e;
-    local_momentum = physics.momentum;
-    local_bad      = physics.bad;
+    local_sums = physics.sums;
+    local_bad  = physics.bad;
   }
 
   template <int dim>
@@ -735,51 +722,38 @@ namespace talus::explicit_mpm
   Energies
   Solver<dim>::energies() const
   {
+    const auto s = point_sums(true);
+    return {s.kinetic, s.strain, s.gravity_potential, external_work};
+  }
+
+  template <int dim>
+  diagnostics::PointSums<dim>
+  Solver<dim>::point_sums(const bool strain) const
+  {
+    diagnostics::SumOptions<dim> o;
+    o.gravity          = gravity;
+    o.add_displacement = fem && !fem->updated_lagrangian(); // at their Gauss points: x = X + u
+    if (strain)
+      o.materials = &prm.materials;
     if (two_phase)
-      return two_phase->energies();
-    using L = PropertyLayout<dim>;
-    Energies   e;
-    const bool fixed_points = fem && !fem->updated_lagrangian(); // at their Gauss points: x = X + u
-    for (const auto &pt : points.handler)
-      {
-        const auto  P  = pt.get_properties();
-        const auto &m  = *prm.materials[static_cast<unsigned int>(P[L::material])];
-        double      v2 = 0, gx = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += gravity[d] * (pt.get_location()[d] + (fixed_points ? P[L::displacement + d] : 0.0));
-          }
-        e.kinetic += 0.5 * P[L::mass] * v2;
-        e.gravity_potential -= P[L::mass] * gx;
-        e.strain += P[L::volume] * m.elastic_energy_density(L::get_stress(P.data()));
-      }
-    double v[3] = {e.kinetic, e.strain, e.gravity_potential};
-    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3), comm, dealii::ArrayView<double>(v, 3));
-    return {v[0], v[1], v[2], external_work};
+      two_phase->add_sum_options(o, strain); // the pore liquid of the points
+    auto s = diagnostics::sum_points(points, o);
+    s.sum_over_ranks(comm);
+    return s;
   }
 
   template <int dim>
   dealii::Tensor<1, dim>
   Solver<dim>::total_momentum() const
   {
-    if (two_phase)
-      return two_phase->total_momentum();
-    dealii::Tensor<1, dim> p;
-    for (const auto &pt : points.handler)
-      for (unsigned int d = 0; d < dim; ++d)
-        p[d] += pt.get_properties()[PropertyLayout<dim>::mass] * pt.get_properties()[PropertyLayout<dim>::velocity + d];
-    return dealii::Utilities::MPI::sum(p, comm);
+    return point_sums(false).total_momentum();
   }
 
   template <int dim>
   double
   Solver<dim>::total_mass() const
   {
-    double m = 0;
-    for (const auto &pt : points.handler)
-      m += pt.get_properties()[PropertyLayout<dim>::mass];
-    return dealii::Utilities::MPI::sum(m, comm);
+    return point_sums(false).mass; // of the solid (the first phase)
   }
 
   template <int dim>
@@ -845,16 +819,20 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::check_stability() const
   {
-    double v[5] = {local_energies.kinetic, need_strain_energy ? local_energies.strain : 0.0,
-                   local_energies.gravity_potential, local_bad ? 1.0 : 0.0, 0.0};
+    double v[5] = {local_sums.kinetic, need_strain_energy ? local_sums.strain : 0.0, local_sums.gravity_potential,
+                   local_bad ? 1.0 : 0.0, 0.0};
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 5), comm, dealii::ArrayView<double>(v, 5));
     std::ostringstream os;
     os << std::setprecision(4);
     if (v[3] > 0 || !std::isfinite(v[0] + v[1] + v[2]))
       {
+        // the point (fields up to the stress; the history may hold infinities)
+        const std::string which = diagnostics::find_invalid_point(points, comm, PropertyLayout<dim>::history);
         os << "step " << step_number << " (t = " << time << " s, dt = " << dt
            << " s): the state became non-finite or a material point volume became non-positive "
-              "(velocity, stress or position). Reduce the time step (courant number) or check the material data.";
+              "(velocity, stress or position"
+           << (which.empty() ? std::string() : "; first: " + which)
+           << "). Reduce the time step (courant number) or check the material data.";
         throw InstabilityError(os.str());
       }
     const double available = initial_energies.kinetic + initial_energies.strain +
@@ -1049,19 +1027,16 @@ namespace talus::explicit_mpm
     dealii::Tensor<1, dim> p;
     if (after_step && !points.relocator().sorted_last)
       {
-        double v[3 + dim] = {local_energies.kinetic, local_energies.strain, local_energies.gravity_potential};
-        for (unsigned int d = 0; d < dim; ++d)
-          v[3 + d] = local_momentum[d];
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3 + dim), comm,
-                                    dealii::ArrayView<double>(v, 3 + dim));
-        e = {v[0], v[1], v[2], external_work};
-        for (unsigned int d = 0; d < dim; ++d)
-          p[d] = v[3 + d];
+        auto s = local_sums;
+        s.sum_over_ranks(comm);
+        e = {s.kinetic, s.strain, s.gravity_potential, external_work};
+        p = s.total_momentum();
       }
     else
       {
-        e = energies();
-        p = total_momentum();
+        const auto s = point_sums(true);
+        e            = {s.kinetic, s.strain, s.gravity_potential, external_work};
+        p            = s.total_momentum();
       }
     if (free_surface)
       free_surface->update();

@@ -3,6 +3,7 @@
 // update), Jaumann-rate stress update, volume update, relocation.
 #pragma once
 
+#include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/common/formulation.h>
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/common/scene_parameters.h>
@@ -117,10 +118,13 @@ namespace talus::explicit_mpm
       return dt;
     }
 
-    /// Global sums over particles (collective).
+    /// Global sums over particles (collective; formulations/common/diagnostics.h).
     Energies               energies() const;
     dealii::Tensor<1, dim> total_momentum() const;
-    double                 total_mass() const;
+    double                 total_mass() const; ///< of the solid (2-phase: without the pore liquid)
+    /// The point sums of the current state, both phases of 2-phase points,
+    /// reduced over the ranks; `strain`: with the strain energy. Collective.
+    diagnostics::PointSums<dim> point_sums(bool strain) const;
     unsigned long long
     n_particles() const
     {
@@ -258,12 +262,10 @@ namespace talus::explicit_mpm
     void write_final_particles() const;
 
     bool p2g_ready = false; ///< nodal mass/force of the current state accumulated
-    // local energy/stability sums from the last update pass
-    Energies               local_energies;
-    dealii::Tensor<1, dim> local_momentum;
-    bool                   local_bad = false;
-    std::string            bad_what;
-    double                 external_work = 0;
+    // local point sums (energies, momentum) and validity from the last update pass
+    diagnostics::PointSums<dim> local_sums;
+    bool                        local_bad     = false;
+    double                      external_work = 0;
     /// the PVD records of the points (the Simulation's) and of the grid
     std::vector<std::pair<double, std::string>> &pvd_records;
     std::vector<std::pair<double, std::string>>  grid_pvd_records;

@@ -407,57 +407,23 @@ namespace talus::explicit_mpm
   }
 
   template <int dim>
-  Energies
-  TwoPhase<dim>::energies() const
+  void
+  TwoPhase<dim>::add_sum_options(diagnostics::SumOptions<dim> &o, const bool strain) const
   {
-    using L        = PropertyLayout<dim>;
-    const auto &pl = s.prm.liquid.pore_liquid;
-    Energies    e;
-    for (const auto &pt : s.points.handler)
-      {
-        const auto         P   = pt.get_properties();
-        const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-        const auto        &m   = *s.prm.materials[mat];
-        double             v2 = 0, gx = 0, vl2 = 0, mL = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            v2 += P[L::velocity + d] * P[L::velocity + d];
-            gx += s.gravity[d] * pt.get_location()[d]; // of the running stage
-          }
-        e.strain += P[L::volume] * m.elastic_energy_density(L::get_stress(P.data()));
-        if (coupled && pl[mat].drainage == Drainage::coupled)
-          {
-            const double n = P[porosity];
-            mL             = n * pl[mat].density * P[L::volume];
-            for (unsigned int d = 0; d < dim; ++d)
-              vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
-            e.strain += P[L::volume] * n * P[pore_pressure] * P[pore_pressure] / (2 * pl[mat].bulk_modulus);
-          }
-        e.kinetic += 0.5 * P[L::mass] * v2 + 0.5 * mL * vl2;
-        e.gravity_potential -= (P[L::mass] + mL) * gx;
-      }
-    double v[3] = {e.kinetic, e.strain, e.gravity_potential};
-    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(v, 3), s.comm, dealii::ArrayView<double>(v, 3));
-    return {v[0], v[1], v[2], s.external_work};
-  }
-
-  template <int dim>
-  dealii::Tensor<1, dim>
-  TwoPhase<dim>::total_momentum() const
-  {
-    using L                   = PropertyLayout<dim>;
-    const auto            &pl = s.prm.liquid.pore_liquid;
-    dealii::Tensor<1, dim> p;
-    for (const auto &pt : s.points.handler)
-      {
-        const auto         P   = pt.get_properties();
-        const unsigned int mat = static_cast<unsigned int>(P[L::material]);
-        const double       mL =
-          (coupled && pl[mat].drainage == Drainage::coupled) ? P[porosity] * pl[mat].density * P[L::volume] : 0.0;
-        for (unsigned int d = 0; d < dim; ++d)
-          p[d] += P[L::mass] * P[L::velocity + d] + (mL > 0 ? mL * P[liquid_velocity + d] : 0.0);
-      }
-    return dealii::Utilities::MPI::sum(p, s.comm);
+    using L = PropertyLayout<dim>;
+    if (!coupled)
+      return;
+    o.second_phase = [this](const double *P, const double *&vL) {
+      vL = P + liquid_velocity;
+      return liquid_mass(P);
+    };
+    if (strain)
+      o.extra_strain = [this](const double *P) {
+        const auto &pl = s.prm.liquid.pore_liquid[static_cast<unsigned int>(P[L::material])];
+        if (pl.drainage != Drainage::coupled)
+          return 0.0;
+        return P[L::volume] * P[porosity] * P[pore_pressure] * P[pore_pressure] / (2 * pl.bulk_modulus);
+      };
   }
 
   template <int dim>
@@ -664,12 +630,11 @@ namespace talus::explicit_mpm
     s.timings.p2g += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     // ---- 6-11. strains, effective stress, pore pressure, volume, porosity, positions
-    const auto             t1 = std::chrono::steady_clock::now();
-    Energies               e;
-    dealii::Tensor<1, dim> momentum;
-    bool                   bad    = false;
-    double                 work   = 0; // of the tractions over this step
-    const bool             loaded = control && control->any_traction();
+    const auto                  t1 = std::chrono::steady_clock::now();
+    diagnostics::PointSums<dim> sums;
+    bool                        bad    = false;
+    double                      work   = 0; // of the tractions over this step
+    const bool                  loaded = control && control->any_traction();
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
@@ -722,8 +687,8 @@ namespace talus::explicit_mpm
           for (unsigned int d = 0; d < dim; ++d)
             vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
           if (s.need_strain_energy)
-            e.strain += P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
-                        (2 * pl[mat].bulk_modulus);
+            sums.add_strain(P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
+                            (2 * pl[mat].bulk_modulus));
           if (!std::isfinite(P[pore_pressure] + vl2) || !(P[porosity] > 0 && P[porosity] < 1))
             bad = true;
         }
@@ -744,18 +709,10 @@ namespace talus::explicit_mpm
           x[d] += dx[d]; // Eq. 4.119
           P[L::displacement + d] += dx[d];
         }
-      const double mS = P[L::mass];
-      double       v2 = 0, gx = 0;
-      for (unsigned int d = 0; d < dim; ++d)
-        {
-          v2 += P[L::velocity + d] * P[L::velocity + d];
-          gx += g[d] * x[d];
-          momentum[d] += mS * P[L::velocity + d] + (cp ? mL * P[liquid_velocity + d] : 0.0);
-        }
-      e.kinetic += 0.5 * mS * v2 + 0.5 * mL * vl2;
-      e.gravity_potential -= (mS + mL) * gx;
+      const double v2 = cp ? sums.add(P[L::mass], P + L::velocity, mL, P + liquid_velocity, x, g)
+                           : sums.add(P[L::mass], P + L::velocity, x, g);
       if (s.need_strain_energy)
-        e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+        sums.add_strain(P[L::volume] * m.elastic_energy_density(sigma));
       if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
           !(P[L::volume] > 0))
         bad = true;
@@ -773,9 +730,8 @@ namespace talus::explicit_mpm
       dealii::Point<dim> xi_new;
       transfer::place_moved_point(s.points, s.grid, c, pt, x, xi_new);
     });
-    s.local_energies = e;
-    s.local_momentum = momentum;
-    s.local_bad      = bad;
+    s.local_sums = sums;
+    s.local_bad  = bad;
     if (loaded)
       s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
     s.timings.g2p += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();

@@ -11,6 +11,7 @@
 // hot loop nothing.
 #pragma once
 
+#include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/explicit/forward.h>
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
@@ -120,10 +121,11 @@ namespace talus::explicit_mpm
     void step(const double dt);
     /// step() with the shape kernel K of the run (numerics/shape function).
     template <class K>
-    void     step_with(const double dt);
-    Energies energies() const;
-    /// sum m_S v_S + m_L v_L (collective)
-    dealii::Tensor<1, dim> total_momentum() const;
+    void step_with(const double dt);
+    /// What the points' pore liquid adds to the point sums (Solver::point_sums):
+    /// its mass n rho_L V and velocity, and with `strain` the energy of the pore
+    /// pressure V n p^2 / (2 K_L), for the points of coupled materials.
+    void add_sum_options(diagnostics::SumOptions<dim> &o, bool strain) const;
     /// Liquid mass n rho_L V of a point (0 unless it is of a coupled material).
     double liquid_mass(const double *P) const;
 

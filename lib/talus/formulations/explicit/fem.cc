@@ -195,16 +195,15 @@ namespace talus::explicit_mpm
   void
   FemIntegration<dim>::update(const double h)
   {
-    using L                    = PropertyLayout<dim>;
-    constexpr unsigned int nst = L::n_stress;
-    const double *const    Vn  = s.nodal_p.begin();
-    const auto             g   = s.gravity;
-    double *const          M   = s.nodal_mass.begin();
-    double *const          F   = s.nodal_a.begin();
-    Energies               e;
-    dealii::Tensor<1, dim> momentum;
-    bool                   bad          = false;
-    const bool             track_probes = !s.probe_ids.empty();
+    using L                         = PropertyLayout<dim>;
+    constexpr unsigned int      nst = L::n_stress;
+    const double *const         Vn  = s.nodal_p.begin();
+    const auto                  g   = s.gravity;
+    double *const               M   = s.nodal_mass.begin();
+    double *const               F   = s.nodal_a.begin();
+    diagnostics::PointSums<dim> point_sums;
+    bool                        bad          = false;
+    const bool                  track_probes = !s.probe_ids.empty();
     std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
     std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
     s.zero_on_active(s.nodal_mass);
@@ -260,19 +259,14 @@ namespace talus::explicit_mpm
             x[d] += dx[d];
           pt->set_location(x);
         }
-      const double mass = P[L::mass];
-      double       v2 = 0, gx = 0;
-      for (unsigned int d = 0; d < dim; ++d)
-        {
-          v2 += P[L::velocity + d] * P[L::velocity + d];
-          // fem: the current position is the Gauss point plus the displacement
-          gx += g[d] * (ul ? x[d] : x[d] + P[L::displacement + d]);
-          momentum[d] += mass * P[L::velocity + d];
-        }
-      e.kinetic += 0.5 * mass * v2;
-      e.gravity_potential -= mass * gx;
+      const double       mass = P[L::mass];
+      dealii::Point<dim> xp   = x; // fem: the current position is the Gauss point plus the displacement
+      if (!ul)
+        for (unsigned int d = 0; d < dim; ++d)
+          xp[d] += P[L::displacement + d];
+      const double v2 = point_sums.add(mass, P + L::velocity, xp, g);
       if (s.need_strain_energy)
-        e.strain += P[L::volume] * m.elastic_energy_density(sigma);
+        point_sums.add_strain(P[L::volume] * m.elastic_energy_density(sigma));
       if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
           !(P[L::volume] > 0) || !(det1 > 0))
         bad = true;
@@ -306,9 +300,8 @@ namespace talus::explicit_mpm
         for (const unsigned int i : moving_dofs)
           U[i] += h * Vn[i];
       }
-    s.local_energies = e;
-    s.local_momentum = momentum;
-    s.local_bad      = bad;
+    s.local_sums = point_sums;
+    s.local_bad  = bad;
   }
 
   template class FemIntegration<2>;

@@ -449,7 +449,7 @@ namespace talus::loads
         for (const unsigned int i : s.active_dofs)
           if (M[i] > 0)
             v[2] += 0.5 * Pm[i] * Pm[i] / M[i];
-        v[3] = s.local_energies.gravity_potential;
+        v[3] = s.local_sums.gravity_potential;
         // rigid plates (once, on rank 0): a force-controlled plate adds its
         // unbalanced force and its load; a displacement-controlled one is
         // balanced by construction and adds its reaction as a load on the
@@ -563,7 +563,7 @@ namespace talus::loads
         if (cp && mLn[i] > 0)
           v[2] += 0.5 * PL[i] * PL[i] / mLn[i];
       }
-    v[3] = s.local_energies.gravity_potential;                 // of both masses (TwoPhase::step)
+    v[3] = s.local_sums.gravity_potential;                     // of both masses (TwoPhase::step)
     if (dealii::Utilities::MPI::this_mpi_process(s.comm) == 0) // rigid plates, as in nodal_forces
       for (unsigned int k = 0; k < plate_run.size(); ++k)
         {

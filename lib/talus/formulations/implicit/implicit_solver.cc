@@ -1,5 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
@@ -1615,31 +1616,11 @@ namespace talus::implicit_mpm
   void
   Solver<dim>::check_stability() const
   {
-    bool bad = false;
-    using L  = PropertyLayout<dim>;
-    for (const auto &pt : points.handler)
-      {
-        const auto P = pt.get_properties();
-        for (unsigned int k = 0; k < L::history; ++k)
-          bad = bad || !std::isfinite(P[k]);
-      }
-    if (dealii::Utilities::MPI::max(bad ? 1 : 0, comm) > 0)
-      throw InstabilityError("a material point holds a non-finite value after step " + std::to_string(step_number));
-  }
-
-  template <int dim>
-  double
-  Solver<dim>::kinetic_energy() const
-  {
-    using L  = PropertyLayout<dim>;
-    double e = 0;
-    for (const auto &pt : points.handler)
-      {
-        const auto P = pt.get_properties();
-        for (unsigned int d = 0; d < dim; ++d)
-          e += 0.5 * P[L::mass] * P[L::velocity + d] * P[L::velocity + d];
-      }
-    return dealii::Utilities::MPI::sum(e, comm);
+    // the fields up to the stress (the history may hold infinities)
+    const std::string which = diagnostics::find_invalid_point(points, comm, PropertyLayout<dim>::history, false);
+    if (!which.empty())
+      throw InstabilityError("a material point holds a non-finite value after step " + std::to_string(step_number) +
+                             ": " + which);
   }
 
   template <int dim>
@@ -1758,25 +1739,18 @@ namespace talus::implicit_mpm
   std::vector<double>
   Solver<dim>::series_values(const bool after_step)
   {
-    const double        ke = kinetic_energy();
+    // kinetic energy and centre of mass (the mass-weighted mean position)
+    auto sums = diagnostics::sum_points(points);
+    sums.sum_over_ranks(comm);
+    const double        ke = sums.kinetic;
     std::vector<double> v  = {0, 0, 0, 0, 0, 0, load_factor(time), ke};
     if (after_step)
       v = {double(last.iterations), last.residual_first,
            last.residual_last,      last.observed_order,
            last.increment_order,    double(last.linear_iterations),
            load_factor(time),       ke};
-    // centre of mass (mass-weighted mean position)
-    std::vector<double> sums(dim + 1, 0.0);
-    for (const auto &pt : points.handler)
-      {
-        const double m = pt.get_properties()[PropertyLayout<dim>::mass];
-        for (unsigned int d = 0; d < dim; ++d)
-          sums[d] += m * pt.get_location()[d];
-        sums[dim] += m;
-      }
-    dealii::Utilities::MPI::sum(sums, comm, sums);
     for (unsigned int d = 0; d < dim; ++d)
-      v.push_back(sums[d] / sums[dim]);
+      v.push_back(sums.mass_moment[d] / sums.mass);
     if (point_contact)
       {
         const auto &s = last.point_contact; // zeros before the first step

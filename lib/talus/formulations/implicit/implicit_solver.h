@@ -198,7 +198,6 @@ namespace talus::implicit_mpm
     /// Mixed u-p: the pressure components of the iterate are `pressure_scale` x
     /// the pseudo-random field.
     double tangent_error(const double h, const double scale, const double eps, const double pressure_scale = 1.0);
-    double kinetic_energy() const;
 
     // ---- the Formulation interface
     std::string

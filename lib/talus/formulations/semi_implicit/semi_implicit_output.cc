@@ -4,6 +4,7 @@
 // with its phase timings.
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/semi_implicit/semi_implicit_solver.h>
 #include <talus/io/output.h>
 #include <talus/io/vtu.h>
@@ -64,7 +65,9 @@ namespace talus::semi_implicit
   std::vector<double>
   Solver<dim>::series_values(const bool)
   {
-    double ek[2] = {0, 0}, vmax[2] = {0, 0}, pmin = 0, soil_volume = 0, fu = 0, fsum = 0;
+    auto ek = diagnostics::sum_points(soil), ew = diagnostics::sum_points(water); // kinetic energies
+    diagnostics::sum_over_ranks<dim>({&ek, &ew}, comm);
+    double vmax[2] = {0, 0}, pmin = 0, soil_volume = 0, fu = 0, fsum = 0;
     for (const bool is_soil : {true, false})
       for (const auto &pt : (is_soil ? soil : water).handler)
         {
@@ -72,7 +75,6 @@ namespace talus::semi_implicit
           double     v2 = 0;
           for (unsigned int d = 0; d < dim; ++d)
             v2 += P[L::velocity + d] * P[L::velocity + d];
-          ek[is_soil ? 0 : 1] += 0.5 * P[L::mass] * v2;
           vmax[is_soil ? 0 : 1] = std::max(vmax[is_soil ? 0 : 1], std::sqrt(v2));
           if (!is_soil)
             pmin = std::min(pmin, P[fw.pressure]);
@@ -87,8 +89,8 @@ namespace talus::semi_implicit
         }
     fu                    = dealii::Utilities::MPI::sum(fu, comm);
     fsum                  = dealii::Utilities::MPI::sum(fsum, comm);
-    std::vector<double> v = {dealii::Utilities::MPI::sum(ek[0], comm),
-                             dealii::Utilities::MPI::sum(ek[1], comm),
+    std::vector<double> v = {ek.kinetic,
+                             ew.kinetic,
                              dealii::Utilities::MPI::max(vmax[0], comm),
                              dealii::Utilities::MPI::max(vmax[1], comm),
                              dealii::Utilities::MPI::min(pmin, comm),

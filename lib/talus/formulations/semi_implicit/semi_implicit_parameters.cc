@@ -190,72 +190,25 @@ namespace talus::semi_implicit
 
   namespace
   {
-    /// The checks of a scene that need no grid: every body wholly inside the
-    /// grid (or clipped), the memory the grid and points need, the time step.
+    /// The checks of a scene that need no grid: the shared ones (boundary ids,
+    /// bodies inside the grid, the memory of the grid and both point sets:
+    /// formulations/common/scene_checks.h), the B-spline window, the time step.
     template <int dim>
     void
     check_scene(const Parameters<dim> &p)
     {
-      double n_cells = 1, cell_volume = 1, h_min = std::numeric_limits<double>::max();
+      SceneCheckOptions o;
+      o.cell_memory_factor = 2;              // the pressure space, its matrix and the two-phase nodal vectors
+      for (const Phase ph : p.phase_of_body) // a saturated body seeds soil and water points
+        o.point_sets_of_body.push_back(ph == Phase::saturated ? 2 : 1);
+      check_scene_consistency(p, o);
+      double h_min = std::numeric_limits<double>::max();
       for (unsigned int d = 0; d < dim; ++d)
-        {
-          const double h = (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d];
-          n_cells *= p.grid_cells[d];
-          cell_volume *= h;
-          h_min = std::min(h_min, h);
-        }
-      // boundary ids of the box grid: 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+
-      for (const auto &bc : p.boundary_conditions)
-        require(bc.id < 2 * dim,
-                std::string("boundary conditions/") + (bc.kind == BoundaryCondition::Kind::fixed ? "fixed" : "roller"),
-                "boundary id " + std::to_string(bc.id) + " does not exist in the grid (a " + std::to_string(dim) +
-                  "D box has the ids 0 to " + std::to_string(2 * dim - 1) + ": x-, x+, y-, y+" +
-                  (dim == 3 ? ", z-, z+)" : ")"));
+        h_min = std::min(h_min, (p.grid_upper[d] - p.grid_lower[d]) / p.grid_cells[d]);
       if (p.bspline())
         for (unsigned int d = 0; d < dim; ++d)
           require(p.grid_cells[d] >= 3, "grid/cells",
                   "quadratic B-splines need at least 3 cells in every direction (a point's 3-node window)");
-      double n_points = 0;
-      for (unsigned int k = 0; k < p.bodies.size(); ++k)
-        {
-          const auto       &b     = p.bodies[k];
-          const std::string where = "body " + std::to_string(k) + " ('" + b.name + "')";
-          if (b.shape == BodyDescription<dim>::Shape::file) // its rows; the seeding checks their positions
-            {
-              n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * double(check_file_body(p, k).rows);
-              continue;
-            }
-          dealii::Point<dim> lo, hi;
-          b.bounding_box(lo, hi);
-          double overlap = 1;
-          for (unsigned int d = 0; d < dim; ++d)
-            overlap *= std::max(0.0, std::min(hi[d], p.grid_upper[d]) - std::max(lo[d], p.grid_lower[d]));
-          require(overlap > 0, where, "contains no material point: it lies entirely outside the grid");
-          if (!b.clip_to_grid)
-            {
-              const std::string out = outside_extent(b, p.grid_lower, p.grid_upper);
-              require(out.empty(), where,
-                      out +
-                        "; a body must lie wholly inside the grid (allowed: move or shrink the body, enlarge "
-                        "the grid, or set 'clip to grid = true' in 'body " +
-                        std::to_string(k) + "')");
-            }
-          // both sets for a saturated body
-          n_points += (p.phase_of_body[k] == Phase::saturated ? 2 : 1) * overlap / cell_volume *
-                      std::pow(double(b.particles_per_direction), dim);
-        }
-      // rough peak memory: the explicit family's measured figures per cell and
-      // point (docs/reliability.md) doubled for the pressure space, its matrix
-      // and the two-phase nodal vectors
-      int size = 1;
-      MPI_Comm_size(MPI_COMM_WORLD, &size);
-      const double per_cell = dim == 2 ? 1200 : 2400, per_point = dim == 2 ? 650 : 800;
-      const double need  = 180e6 * size + per_cell * n_cells + per_point * n_points;
-      const double avail = available_memory_bytes();
-      require(avail < 0 || need <= avail * size, "grid/cells",
-              number_text(n_cells) + " cells and about " + number_text(n_points) + " material points need about " +
-                number_text(need / 1e9) + " GB, but only " + number_text(avail / 1e9) +
-                " GB are available; use fewer cells or particles per direction");
       const double dt_cr = soil_critical_time_step(p, h_min);
       require(p.time_step <= dt_cr, "time/time step",
               "is " + number_text(p.time_step) + " s, above the soil skeleton's critical step " + number_text(dt_cr) +
