@@ -62,12 +62,11 @@ namespace talus
   }
 } // namespace talus
 
-/// Explicit instantiation of a family's Solver and Parameters for dim 2 and 3
-/// (in the family's one .cc that defines them; inside its namespace).
-#define TALUS_INSTANTIATE_FORMULATION(SolverKind)                         \
+/// Explicit instantiation of a family's Parameters and parse_parameters for
+/// dim 2 and 3 (in the family's parameters .cc, inside its namespace; the
+/// Solver<dim> members are instantiated where they are defined).
+#define TALUS_INSTANTIATE_PARAMETERS()                                    \
   template struct Parameters<2>;                                          \
   template struct Parameters<3>;                                          \
   template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &); \
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &); \
-  template SolverKind    Solver<2>;                                       \
-  template SolverKind    Solver<3>
+  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &)

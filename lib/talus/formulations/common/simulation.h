@@ -29,6 +29,28 @@
 
 namespace talus
 {
+  /// The Simulation members a Solver<dim> uses by name, declared in its class
+  /// body: a class template does not look names up in a base that depends on
+  /// its template parameter, so each needs a using-declaration.
+#define TALUS_SIMULATION_MEMBERS                    \
+  using Simulation<dim>::comm;                      \
+  using Simulation<dim>::grid;                      \
+  using Simulation<dim>::balance;                   \
+  using Simulation<dim>::point_sets;                \
+  using Simulation<dim>::point_set_records;         \
+  using Simulation<dim>::make_grid;                 \
+  using Simulation<dim>::write_point_sets;          \
+  using Simulation<dim>::rewrite_point_set_records; \
+  using Simulation<dim>::lost_points;               \
+  using Simulation<dim>::time;                      \
+  using Simulation<dim>::dt;                        \
+  using Simulation<dim>::step_number;               \
+  using Simulation<dim>::current_stage;             \
+  using Simulation<dim>::stage_start_time;          \
+  using Simulation<dim>::counters;                  \
+  using Simulation<dim>::restored_from;             \
+  using Simulation<dim>::cut_backs
+
   template <int dim>
   class Simulation : public Formulation
   {

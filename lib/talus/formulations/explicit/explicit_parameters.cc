@@ -209,8 +209,5 @@ namespace talus::explicit_mpm
   }
 
 
-  template struct Parameters<2>;
-  template struct Parameters<3>;
-  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
+  TALUS_INSTANTIATE_PARAMETERS();
 } // namespace talus::explicit_mpm

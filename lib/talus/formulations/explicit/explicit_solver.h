@@ -83,18 +83,7 @@ namespace talus::explicit_mpm
   class Solver : public Simulation<dim>
   {
   public:
-    // the members of the (dependent) base this class uses by name
-    using Simulation<dim>::comm;
-    using Simulation<dim>::grid;
-    using Simulation<dim>::balance;
-    using Simulation<dim>::time;
-    using Simulation<dim>::dt;
-    using Simulation<dim>::step_number;
-    using Simulation<dim>::current_stage;
-    using Simulation<dim>::stage_start_time;
-    using Simulation<dim>::counters;
-    using Simulation<dim>::restored_from;
-    using Simulation<dim>::lost_points;
+    TALUS_SIMULATION_MEMBERS;
 
     Solver(const Parameters<dim> &prm, MPI_Comm comm);
     ~Solver();

@@ -461,10 +461,7 @@ namespace talus::semi_implicit
   }
 
   // the Solver's instantiations: semi_implicit_setup.cc and the other parts'
-  template struct Parameters<2>;
-  template struct Parameters<3>;
-  template Parameters<2> parse_parameters<2>(dealii::ParameterHandler &);
-  template Parameters<3> parse_parameters<3>(dealii::ParameterHandler &);
-  template double        soil_critical_time_step<2>(const Parameters<2> &, double);
-  template double        soil_critical_time_step<3>(const Parameters<3> &, double);
+  TALUS_INSTANTIATE_PARAMETERS();
+  template double soil_critical_time_step<2>(const Parameters<2> &, double);
+  template double soil_critical_time_step<3>(const Parameters<3> &, double);
 } // namespace talus::semi_implicit

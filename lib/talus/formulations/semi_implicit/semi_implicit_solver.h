@@ -59,16 +59,7 @@ namespace talus::semi_implicit
   {
   public:
     using L = PropertyLayout<dim>;
-    // the members of the (dependent) base this class uses by name
-    using Simulation<dim>::comm;
-    using Simulation<dim>::grid;
-    using Simulation<dim>::balance;
-    using Simulation<dim>::time;
-    using Simulation<dim>::dt;
-    using Simulation<dim>::step_number;
-    using Simulation<dim>::counters;
-    using Simulation<dim>::restored_from;
-    using Simulation<dim>::lost_points;
+    TALUS_SIMULATION_MEMBERS;
 
     Solver(const Parameters<dim> &p, MPI_Comm comm)
         : Simulation<dim>(p, p, comm, {"soil", "water"})
