@@ -13,6 +13,7 @@
 #include <talus/formulations/common/seeding.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/time_loop.h>
+#include <talus/formulations/semi_implicit/boundary_loads.h>
 #include <talus/formulations/semi_implicit/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
@@ -135,7 +136,9 @@ namespace talus::semi_implicit
                         "Comma-separated boundary ids of the box grid (0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, "
                         "5 = z+) where the water drains: the pore pressure is 0 on their nodes that carry water "
                         "and the water's velocity is not held by the wall condition there (the water can leave "
-                        "the grid; the soil keeps its wall condition). Empty: none.");
+                        "the grid; the soil keeps its wall condition). Empty: none. An alias of "
+                        "'boundary conditions/drainage k' with apply to = boundary, condition = drained "
+                        "(docs/boundary-conditions.md).");
       prm.declare_entry("kozeny carman", "false", Bool(),
                         "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
                         "(Alg. 8(g)); false: k stays k0.");
@@ -166,6 +169,9 @@ namespace talus::semi_implicit
                         "(the paper: 1 m/s), > 0.");
     }
     prm.leave_subsection();
+    // issue 37 hook: the shared 'loads' (tractions, velocity conditions), the
+    // drainage conditions and 'semi implicit/traction acts at' (boundary_loads.cc)
+    declare_boundary_load_parameters(prm, prm_file, counts.dim);
     for (unsigned int k = 0; k < counts.n_materials; ++k)
       {
         prm.enter_subsection("material " + std::to_string(k));
@@ -179,24 +185,6 @@ namespace talus::semi_implicit
     for (unsigned int k = 0; k < counts.n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
-        prm.declare_entry("surface load extent", "", dealii::Patterns::Anything(),
-                          "Empty: the surface load covers the body's whole upper face. 'a, b': only the top "
-                          "points with a <= x <= b carry it (a strip load, e.g. a footing; x the first "
-                          "coordinate).");
-        prm.declare_entry("surface load ramp time", "0", Double(0),
-                          "The surface load grows linearly from 0 to q over this time [s]; 0: sudden at t = 0.");
-        prm.declare_entry("surface load", "0", Double(-1e300, 1e300),
-                          "A uniform vertical pressure q [Pa] (>= 0, pushing down) on the upper face of a box "
-                          "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
-                          "soil points carries it, each point the force q V_p / (h / particles per direction), "
-                          "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
-        prm.declare_entry("surface load acts at", "body surface",
-                          dealii::Patterns::Selection("body surface|top points"),
-                          "Where a loaded point's force enters the grid. body surface: at the point's share of the "
-                          "upper face, the point position plus half its sub-cell height, a vector carried by the "
-                          "point's dF (the weak form's integral over the face: the top points carry the full q). "
-                          "top points: at the point itself (the top layer then carries only part of q and is "
-                          "too stiff; kept for comparison; docs/semi-implicit.md).");
         // must be set: it makes a .prm this family's (an explicit scene is not
         // silently read as a saturated two-phase one)
         prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
@@ -353,7 +341,9 @@ namespace talus::semi_implicit
           require(ok, "semi implicit/drained boundaries",
                   "is '" + text + "'; allowed: empty or comma-separated boundary ids of the " + std::to_string(dim) +
                     "D box, 0 to " + std::to_string(2 * dim - 1) + " (x-, x+, y-, y+" + (dim == 3 ? ", z-, z+)" : ")"));
-          p.drained_boundaries.push_back(id);
+          // issue 37: an alias of 'boundary conditions/drainage k' (drained boundary)
+          p.drainage.push_back(loads::drained_boundary<dim>(static_cast<dealii::types::boundary_id>(id),
+                                                            "semi implicit/drained boundaries"));
         }
     }
     {
@@ -419,44 +409,8 @@ namespace talus::semi_implicit
       {
         prm.enter_subsection("body " + std::to_string(k));
         const std::string ph = prm.get("phase");
-        {
-          SurfaceLoad sl;
-          sl.q                     = prm.get_double("surface load");
-          sl.ramp                  = prm.get_double("surface load ramp time");
-          sl.at_surface            = prm.get("surface load acts at") == "body surface";
-          const std::string extent = prm.get("surface load extent");
-          if (!dealii::Utilities::trim(extent).empty())
-            {
-              const auto v  = dealii::Utilities::split_string_list(extent, ',');
-              bool       ok = v.size() == 2;
-              try
-                {
-                  if (ok)
-                    {
-                      sl.from = std::stod(v[0]);
-                      sl.to   = std::stod(v[1]);
-                    }
-                }
-              catch (const std::exception &)
-                {
-                  ok = false;
-                }
-              require(ok && std::isfinite(sl.from) && std::isfinite(sl.to) && sl.from < sl.to,
-                      "body " + std::to_string(k) + "/surface load extent",
-                      "is '" + extent + "'; allowed: empty (the whole upper face) or two numbers 'a, b' with a < b");
-            }
-          p.surface_load.push_back(sl);
-        }
         prm.leave_subsection();
         p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
-        std::ostringstream q;
-        q << p.surface_load.back().q;
-        require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0,
-                "body " + std::to_string(k) + "/surface load", "is " + q.str() + "; must be a pressure >= 0 Pa");
-        require(p.surface_load.back().q == 0 ||
-                  (p.phase_of_body.back() != Phase::water && p.bodies[k].shape == BodyDescription<dim>::Shape::box),
-                "body " + std::to_string(k) + "/surface load",
-                "needs a box body with soil points (phase saturated or soil)");
         any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
         any_water = any_water || p.phase_of_body.back() != Phase::soil;
         // the material ids of the body's points: its entry, or those of its rows
@@ -496,6 +450,7 @@ namespace talus::semi_implicit
                   "f-bar)");
             }
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
+    parse_boundary_load_parameters(prm, p); // issue 37 hook: tractions, velocity and drainage conditions
     check_scene(p);
     return p;
   }
@@ -522,7 +477,7 @@ namespace talus::semi_implicit
     struct Fields
     {
       unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
-      unsigned int pressure_gradient = 0, surface_force = 0;
+      unsigned int pressure_gradient   = 0;
       unsigned int surface_offset      = 0; // dim values: from the point to its share of the loaded face
       unsigned int poisson_coefficient = 0, poisson_flux = 0;                 // poisson_flux: dim values, phi v*
       unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
@@ -617,6 +572,7 @@ namespace talus::semi_implicit
                     soil.collect_active_cells();
                     water.collect_active_cells();
                   })
+        , bloads(p, grid, comm)
         , pspace(grid, 1)
         , active(pspace)
     {
@@ -692,6 +648,9 @@ namespace talus::semi_implicit
     /// Load balancing by material points of both sets (formulations/common/
     /// load_balance.h); its repartitions call grid_changed().
     LoadBalance<dim> balance;
+    /// issue 37: the shared tractions, prescribed velocities and drainage
+    /// conditions (boundary_loads.h); its hooks are called from the step
+    BoundaryLoads<dim> bloads;
     /// Everything of the grid's partition that lives across steps: the
     /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
     /// vectors; the next step rebuilds the active set and the pressure matrix.
@@ -897,26 +856,15 @@ namespace talus::semi_implicit
             constrained[e.dof]         = 1;
           }
       }
-    // drained faces: their nodes get p = 0; the water's velocity component
-    // normal to such a face is free there (the soil keeps the wall condition)
+    // drained faces (issue 37 hook): the drainage conditions' node flags and
+    // the water's wall hold freed at a draining boundary (boundary_loads.cc);
+    // drained[]: the permeable plates' nodes (p = 0)
     water_constrained = constrained;
     drained.assign(nl, 0);
     for (unsigned int i = 0; i < nl; ++i)
       if (plate_drained[i])
         drained[i] = 1;
-    for (unsigned int i = 0; i < nl; ++i)
-      for (const unsigned int id : prm.drained_boundaries)
-        {
-          const unsigned int d    = id / 2;
-          const double       face = id % 2 ? prm.grid_upper[d] : prm.grid_lower[d];
-          const double       tol  = 1e-9 * (prm.grid_upper[d] - prm.grid_lower[d]);
-          if (std::abs(node_x[i][d] - face) <= tol)
-            {
-              drained[node_of[i]] = 1;
-              if (component[i] == d)
-                water_constrained[i] = 0;
-            }
-        }
+    bloads.grid_changed(node_of, component, node_x, water_constrained);
     patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
     for (Vector *v :
          {&Mdj,    &Mjt,    &Ms,     &Ps,      &Mn,     &Mk,     &Fs,      &Ww,   &Pw0,     &Ww0,     &Mwp,
@@ -949,13 +897,13 @@ namespace talus::semi_implicit
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
-    soil.layout.n_history  = n_history;
-    fs.porosity            = soil.layout.add_extra("porosity", 1);
-    fs.initial_porosity    = soil.layout.add_extra("initial_porosity", 1);
-    fs.initial_volume      = soil.layout.add_extra("initial_volume", 1);
-    fs.conductivity        = soil.layout.add_extra("conductivity", 1);
-    fs.surface_force       = soil.layout.add_extra("surface_force", 1);
-    fs.surface_offset      = soil.layout.add_extra("surface_offset", dim, true);
+    soil.layout.n_history = n_history;
+    fs.porosity           = soil.layout.add_extra("porosity", 1);
+    fs.initial_porosity   = soil.layout.add_extra("initial_porosity", 1);
+    fs.initial_volume     = soil.layout.add_extra("initial_volume", 1);
+    fs.conductivity       = soil.layout.add_extra("conductivity", 1);
+    fs.surface_offset     = soil.layout.add_extra("surface_offset", dim, true);
+    bloads.extend_layout(soil.layout, fs.surface_offset); // issue 37 hook: the point tractions' slots
     fs.poisson_coefficient = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_flux        = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
@@ -995,6 +943,7 @@ namespace talus::semi_implicit
         return;            // the points, the step and the loop's state as saved
       }
     seed();
+    bloads.assign(soil, prm.bodies); // issue 37 hook: the loaded points' forces and face offsets
     if (prm.geostatic)
       geostatic_state();
     initialize_point_histories(prm.materials, soil, soil.layout.history);
@@ -1160,18 +1109,8 @@ namespace talus::semi_implicit
               {
                 P[L::mass]        = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
                 P[f.conductivity] = prm.soil_of_material[m].conductivity;
-                // the body's top layer of points carries its surface load
-                const SurfaceLoad &load = prm.surface_load[b];
-                const double       hy   = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
-                const double       dy   = hy / prm.bodies[b].particles_per_direction;
-                const auto         x    = pt.get_location();
-                const bool         on_face =
-                  x[dim - 1] > prm.bodies[b].upper[dim - 1] - dy && x[0] >= load.from && x[0] <= load.to;
-                P[f.surface_force] = load.q > 0 && on_face ? load.q * V0 / dy : 0.0;
-                for (unsigned int d = 0; d < dim; ++d)
+                for (unsigned int d = 0; d < dim; ++d) // its share of a loaded face: BoundaryLoads::assign
                   P[f.surface_offset + d] = 0;
-                if (P[f.surface_force] != 0 && load.at_surface)
-                  P[f.surface_offset + dim - 1] = 0.5 * dy;
               }
             else
               {
@@ -1247,6 +1186,7 @@ namespace talus::semi_implicit
                   : "displacement control: " + number_text(pl.displacement) + " m x f(t), reaction reported")
             << std::endl;
       }
+    bloads.describe(out); // issue 37 hook
   }
 
   // ---------------------------------------------------------------- the step
@@ -1273,6 +1213,7 @@ namespace talus::semi_implicit
     for (Vector *v :
          {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
+    bloads.begin_step(time, h);                    // issue 37 hook: the loads' time factors over [t, t + h]
     auto at = [](Vector &v) { return v.begin(); }; // local (owned, then ghost) values
 
     // (1)-(2) P2N of the soil: mass (44), momentum (45), porosity (46), the
@@ -1297,14 +1238,8 @@ namespace talus::semi_implicit
           double t[dim][dim];
           minus_V_sigma<dim>(P, P[L::volume], t);
           s.scatter_divergence(fsv, t);
-          if (P[fs.surface_force] != 0)
-            {
-              double f[dim] = {};
-              f[dim - 1] =
-                -P[fs.surface_force] * prm.surface_load[static_cast<unsigned int>(P[L::body])].factor(time, h);
-              transfer::offset_stencil<dim, K>(grid, c, it->get_location(), P + fs.surface_offset, surface);
-              surface.scatter_vector(fsv, 1.0, f);
-            }
+          // issue 37 hook: a loaded point's traction force (at the body surface)
+          bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, fsv);
         });
     }
     exchange({&Ms, &Ps, &Mn, &Mk, &Fs});
@@ -1312,6 +1247,7 @@ namespace talus::semi_implicit
     for (unsigned int i = 0; i < nl; ++i)
       ms_max = std::max(ms_max, Ms.local_element(i));
     const double ms_cut = relative_mass_cutoff * dealii::Utilities::MPI::max(ms_max, comm);
+    bloads.add_boundary_tractions(Fs, Ms, ms_cut); // issue 37 hook: tractions on grid boundary ids
     // nodal porosity; nodes without soil: n = 1, no drag (A1)
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
@@ -1452,6 +1388,7 @@ namespace talus::semi_implicit
           vs = 0;
         if (water_constrained[i])
           vw = 0;
+        bloads.predictor(i, has_soil, has_water, Mwi, Q, h, rwv, vs, vw); // issue 37 hook: prescribed velocities
         if (const unsigned int k = plate_of[i]; k != no_plate)
           {
             const bool permeable = prm.rigid_plates[k].permeable;
@@ -1569,30 +1506,23 @@ namespace talus::semi_implicit
               if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
                 continue;
               const bool has_water = Mw.local_element(i) > mw_cut;
-              const bool surface   = dry.local_element(i) > 0 && !plate_sealed[i];
-              if (has_water && drained[i]) // a drained face: p^{t+1} = 0
+              // issue 37 hook: the pressure row from the free-surface rule (A6),
+              // the drainage conditions and the sealing of loaded faces
+              // (BoundaryLoads::pressure_row): dp = -p^t at a drained node (p^{t+1}
+              // = 0), dp = 0 at a node without water or one that keeps its mapped p^t
+              const auto row =
+                bloads.pressure_row(i, has_water, drained[i], plate_sealed[i], wet.local_element(i),
+                                    dry.local_element(i), near_wet.local_element(i), p_node.local_element(i));
+              if (row.first)
                 {
                   dirichlet.add_line(gdof);
                   dirichlet_homogeneous.add_line(gdof);
-                  dirichlet.set_inhomogeneity(gdof, -p_node.local_element(i));
-                }
-              else if (!has_water || surface)
-                {
-                  // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
-                  // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
-                  // Delta p = -p^t. The dry nodes next to a wet cell (B-spline: the
-                  // node above the surface that the top points still touch) keep the
-                  // mapped p^t, the linear extrapolation of the water's pressure
-                  // (Delta p = 0); forcing 0 there fed the top cell a spurious
-                  // pressure step every step (docs/semi-implicit.md, A6).
-                  const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
-                  dirichlet.add_line(gdof);
-                  dirichlet_homogeneous.add_line(gdof);
-                  dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
+                  dirichlet.set_inhomogeneity(gdof, row.second);
                 }
             }
         dirichlet.close();
         dirichlet_homogeneous.close();
+        bloads.check_pressure_reference(); // issue 37 hook: a sealed box is refused
         const auto constraints = active.constraints_with(dirichlet);
         if (new_pattern)
           {
@@ -1728,6 +1658,7 @@ namespace talus::semi_implicit
         vs = 0;
       if (water_constrained[i])
         vw = 0;
+      bloads.correct(i, Mwi, vs, vw); // issue 37 hook: prescribed velocities
       if (const unsigned int k = plate_of[i]; k != no_plate)
         {
           vs = Vp[k];
@@ -1856,6 +1787,17 @@ namespace talus::semi_implicit
             st.tangential = std::sqrt(t2);
           }
       }
+    // issue 37 hook: the reactions of the velocity conditions, the mixture's
+    // momentum residual over their DoFs (the plates' R and T)
+    bloads.reactions([&](const unsigned int i) {
+      const unsigned int j   = node_of[i];
+      const double       Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
+      return (Msi * (vs_new.local_element(i) - vs_t.local_element(i)) +
+              Mwi * (vw_new.local_element(i) - vw_t.local_element(i))) /
+               h -
+             Fs.local_element(i) - Mwi * g[component[i]] - (1 - n) * (Gps.local_element(i) + gs.local_element(i)) -
+             n * (Gpw.local_element(i) + gw.local_element(i));
+    });
     add_lap(phase.grid);
 
     // (7) FLIP velocities of both sets, pore pressure to the water points;
@@ -1899,6 +1841,7 @@ namespace talus::semi_implicit
         vs_t.local_element(i) = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
         if (plate_of[i] != no_plate) // the plate's velocity, as the walls' zero (A11)
           vs_t.local_element(i) = plate_v[plate_of[i]];
+        bloads.remap(i, vs_t.local_element(i)); // issue 37 hook: prescribed velocities
       }
     if (!prm.rigid_plates.empty()) // what the nodes moved the soil with: node_spread
       {
@@ -1982,7 +1925,7 @@ namespace talus::semi_implicit
             dF_model = stabilised_increment<dim>(dF, dJ_bar);
           }
         P[L::volume] *= dJ;             // (8d)
-        if (P[s.fs.surface_force] != 0) // the loaded face moves with the material: d <- dF d
+        if (s.bloads.carries_offsets()) // the loaded face moves with the material: d <- dF d (0 stays 0)
           {
             double d[dim];
             for (unsigned int i = 0; i < dim; ++i)
@@ -2250,6 +2193,8 @@ namespace talus::semi_implicit
         c.push_back("plate_" + std::to_string(k) + "_node_spread");
         c.push_back("plate_" + std::to_string(k) + "_node_slip");
       }
+    for (const auto &name : bloads.series_columns()) // issue 37 hook: velocity_k_reaction_x, ...
+      c.push_back(name);
     balance.add_series_column(c);
     return c;
   }
@@ -2273,10 +2218,13 @@ namespace talus::semi_implicit
           else // the mixture volume of the skeleton: a 1D column's height x its width
             {
               soil_volume += P[L::volume];
-              // the points carrying a surface load: their force-weighted mean
-              // downward displacement (the settlement conjugate to the load)
-              fu += P[fs.surface_force] * -P[L::displacement + dim - 1];
-              fsum += P[fs.surface_force];
+              // the points carrying a traction: their force-weighted mean
+              // displacement along the force (issue 37 hook: the settlement
+              // conjugate to the load)
+              double fdu, f;
+              bloads.settlement_weights(P.data(), fdu, f);
+              fu += fdu;
+              fsum += f;
             }
         }
     fu                    = dealii::Utilities::MPI::sum(fu, comm);
@@ -2303,6 +2251,7 @@ namespace talus::semi_implicit
         v.push_back(plate_state[k].node_spread);
         v.push_back(plate_state[k].node_slip);
       }
+    bloads.series_values(v); // issue 37 hook
     balance.add_series_value(v);
     return v;
   }
