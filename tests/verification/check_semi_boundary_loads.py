@@ -21,6 +21,10 @@ Modes (one ctest each):
                 the body face y+ (point forces at the body surface); settlement
                 H (1 - V / V0) within 1 % of q H / E_oed = 7.4286e-4 m in both,
                 the mean sigma'_yy within 1 % of -q.
+  pressure      the top face's pore pressure prescribed ('drainage 0': condition =
+                pressure, -5 kPa ramped over 0.1 s), nothing else loading: at
+                0.2 s every water point's pressure within 1 % of it, half of it at
+                0.05 s (5 %), no effective stress (< 1 % of 5 kPa), no settlement.
   dry_face      the layer under dry cells (grid to 1.25 m), a sudden q = 1 kPa on
                 the body face y+: impermeable by default (no drainage condition):
                 at t = 0.05 s the mean pore pressure of the water points within
@@ -140,6 +144,28 @@ elif mode == "traction":
                  f"q H / E_oed = {s_inf:.6e} m ({100 * (S / s_inf - 1):+.3f} %)")
         syy = mean(soil["stress_yy"])
         tv.check(abs(syy / -q - 1) < 0.01, f"{name}: mean sigma'_yy {syy:.6g} Pa vs {-q:.6g} ({100 * (syy / -q - 1):+.3f} %)")
+
+elif mode == "pressure":
+    # the top face's pore pressure prescribed: -5 kPa (a 5 kPa water pressure, tension
+    # positive) ramped over 0.1 s; with incompressible grains and water and nothing else
+    # loading the layer, the pressure is the same everywhere at once and the skeleton
+    # carries nothing: no effective stress, no settlement
+    P0 = -5e3
+    run("pressure", base, **{"boundary conditions/drainage 0/condition": "pressure",
+                             "boundary conditions/drainage 0/pressure": str(P0),
+                             "boundary conditions/drainage 0/time function": "ramp 0.1",
+                             "time/end time": "0.2", "output/series interval": "0.01"})
+    s, soil, water = series("pressure"), final("pressure", "soil"), final("pressure", "water")
+    worst = max(abs(p / P0 - 1) for p in water["pore_pressure"])
+    tv.check(worst < 0.01, f"prescribed pore pressure {P0:g} Pa on the top face: every water point within "
+             f"{100 * worst:.3g} % of it (1 %)")
+    half = at_time(s, "min_pore_pressure", 0.05)
+    tv.check(abs(half / (0.5 * P0) - 1) < 0.05, f"at 0.05 s (f = 0.5) the pore pressure {half:.5g} Pa follows the time "
+             f"function ({0.5 * P0:g} Pa, 5 %)")
+    smax = max(abs(x) for x in soil["stress_yy"])
+    tv.check(smax < 0.01 * abs(P0), f"the skeleton carries nothing: largest |sigma'_yy| {smax:.3g} Pa (< 1 % of {abs(P0):g})")
+    S = H * (1 - s["soil_volume"][-1] / s["soil_volume"][0])
+    tv.check(abs(S) < 1e-3 * abs(P0) * H / E_oed, f"no settlement: {S:.3g} m")
 
 elif mode in ("dry_face", "refuse"):
     # (drainage 0 stays on boundary id 3, now the grid's top at 1.25 m, which no water reaches)

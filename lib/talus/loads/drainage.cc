@@ -42,8 +42,8 @@ namespace talus::loads
   {
     if (prm_file.empty())
       return 0;
-    return dealii::Utilities::string_to_int(peek_entry(prm_file, "boundary conditions", "number of drainage conditions",
-                                                       "0", Integer(0, max_drainage)));
+    return dealii::Utilities::string_to_int(
+      peek_entry(prm_file, "boundary conditions", "number of drainage conditions", "0", Integer(0, max_drainage)));
   }
 
   void

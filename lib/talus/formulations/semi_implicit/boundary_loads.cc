@@ -104,7 +104,8 @@ namespace talus::semi_implicit
               {
                 const double h = cell_size(p, d), tol = 1e-9 * h;
                 const double i0 = std::max(0.0, std::ceil((v.lower[d] - tol - p.grid_lower[d]) / h));
-                const double i1 = std::min<double>(p.grid_cells[d], std::floor((v.upper[d] + tol - p.grid_lower[d]) / h));
+                const double i1 =
+                  std::min<double>(p.grid_cells[d], std::floor((v.upper[d] + tol - p.grid_lower[d]) / h));
                 any = any && i0 <= i1;
               }
             require(any, v.where,
@@ -164,9 +165,9 @@ namespace talus::semi_implicit
                   loaded_by_j = loaded_by_j || P[off + j * dim + d] != 0.0;
                 if (!loaded_by_j)
                   continue;
-                const auto        &t  = prm.tractions[j];
-                const auto        &cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
-                const unsigned int b  = static_cast<unsigned int>(P[L::body]);
+                const auto        &t     = prm.tractions[j];
+                const auto        &cc    = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
+                const unsigned int b     = static_cast<unsigned int>(P[L::body]);
                 P[offset_field + t.axis] = t.side * 0.5 * cc.h[t.axis] / bodies[b].particles_per_direction;
                 break;
               }
@@ -197,7 +198,8 @@ namespace talus::semi_implicit
 
   template <int dim>
   void
-  BoundaryLoads<dim>::grid_changed(const std::vector<unsigned int> &node_of, const std::vector<unsigned char> &component,
+  BoundaryLoads<dim>::grid_changed(const std::vector<unsigned int>       &node_of,
+                                   const std::vector<unsigned char>      &component,
                                    const std::vector<dealii::Point<dim>> &node_x,
                                    std::vector<unsigned char>            &water_constrained)
   {
@@ -278,7 +280,8 @@ namespace talus::semi_implicit
                                    std::abs(node_x[i][d] - prm.grid_upper[d]) < 1e-9 * h;
                   area *= end ? 0.5 * h : h;
                 }
-            nodal_tractions.push_back({i, node_of[i], j, t.traction[component[i]] * area / (t.total ? face_area : 1.0)});
+            nodal_tractions.push_back(
+              {i, node_of[i], j, t.traction[component[i]] * area / (t.total ? face_area : 1.0)});
           }
       }
     reaction.assign(prm.velocities.size() * dim, 0.0);
@@ -306,10 +309,10 @@ namespace talus::semi_implicit
           << (c.target == loads::Drainage<dim>::Target::boundary ? "boundary id " + std::to_string(c.boundary)
                                                                  : std::string("the free surface inside a region"))
           << ", "
-          << (c.kind == loads::Drainage<dim>::Kind::drained       ? "drained (p = 0)"
-              : c.kind == loads::Drainage<dim>::Kind::impermeable ? "impermeable"
-                                                                  : "pore pressure " + std::to_string(c.pressure) +
-                                                                      " Pa x f(t) = " + c.function.text())
+          << (c.kind == loads::Drainage<dim>::Kind::drained ? "drained (p = 0)"
+              : c.kind == loads::Drainage<dim>::Kind::impermeable
+                ? "impermeable"
+                : "pore pressure " + std::to_string(c.pressure) + " Pa x f(t) = " + c.function.text())
           << std::endl;
   }
 
@@ -399,8 +402,8 @@ namespace talus::semi_implicit
         // load acts (a loaded face drains only where the user says so), drained
         // elsewhere (A6)
         const unsigned int r    = drain_surface[i];
-        const Kind         kind = r != none               ? prm.drainage[r].kind
-                                  : a != none             ? Kind::impermeable
+        const Kind         kind = r != none                     ? prm.drainage[r].kind
+                                  : a != none                   ? Kind::impermeable
                                   : loaded.local_element(i) > 0 ? Kind::impermeable
                                                                 : Kind::drained;
         if (kind == Kind::impermeable)
@@ -463,8 +466,8 @@ namespace talus::semi_implicit
   void
   BoundaryLoads<dim>::settlement_weights(const double *P, double &force_dot_u, double &force) const
   {
-    force_dot_u = force = 0;
-    const unsigned int off = point_forces.offset();
+    force_dot_u = force       = 0;
+    const unsigned int off    = point_forces.offset();
     double             f[dim] = {};
     for (unsigned int j = 0; j < point_forces.n_slots(); ++j)
       for (unsigned int d = 0; d < dim; ++d)
