@@ -16,7 +16,7 @@ model asked for. The settlement history (t, T_v, S, S / S_ultimate, and the
 degree of consolidation of the single-drainage Xie & Leo form
 U = 1 - sum 2 / M^2 exp(-M^2 T_v), M = (m - 1/2) pi) is written to
 <WORKDIR>/<model>/settlement_history.csv.
-The load acts on the body surface (`surface load acts at = body surface`, the
+The load acts on the body surface (`semi implicit/traction acts at = body surface`, the
 default); MODEL@top runs it at the top layer of points instead (the earlier
 point-force load, which leaves the top half-row unloaded): that run must MISS
 the tolerance by more than twice the surface run's error, which shows that the
@@ -135,7 +135,7 @@ for name in models:
     model, top, kc = name.split("@")[0].split("+")[0], name.endswith("@top"), name.endswith("+kc")
     text = base if model == "hencky" else tv.prm_set(base, "material 0/model", "linear elastic")
     if top:
-        text = tv.prm_set(text, "body 0/surface load acts at", "top points")
+        text = tv.prm_set(text, "semi implicit/traction acts at", "load points")
     if kc:
         text = tv.prm_set(text, "semi implicit/kozeny carman", "true")
     d = os.path.join(work, name.replace("@", "_").replace("+", "_"))

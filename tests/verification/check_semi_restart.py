@@ -49,7 +49,13 @@ for k, v in {"time/end time": "0.06", "time/time step": "3e-4", "output/vtu inte
              "material 0/hencky mohr coulomb/friction angle": "1",
              "material 0/hencky mohr coulomb/dilatancy angle": "0",
              "semi implicit/volumetric stabilisation": "modified f-bar",
-             "body 0/surface load": "1e4",
+             # the sudden 10 kPa on the soil's upper face (the shared traction), its
+             # surface drained as the free surface around it
+             "loads/number of tractions": "1", "loads/traction 0/traction": "0, -1e4",
+             "boundary conditions/number of drainage conditions": "1",
+             "boundary conditions/drainage 0/apply to": "region",
+             "boundary conditions/drainage 0/region lower corner": "0, 0",
+             "boundary conditions/drainage 0/region upper corner": "1e3, 1e3",
              # the AMG hierarchy kept between steps, rebuilt every 30 steps: the
              # restart step 100 is no multiple, so only the rebuild at the
              # checkpoint write keeps the runs alike
@@ -131,7 +137,11 @@ for k, v in {"dimension": "3", "grid/lower corner": "0, 0, 0", "grid/upper corne
              "grid/cells": "3, 3, 24", "boundary conditions/roller": "0, 1, 2, 3, 4",
              "gravity/acceleration": "0, 0, -9.81", "body 0/lower corner": "0, 0, 0",
              "body 0/upper corner": "0.15, 0.15, 1", "time/end time": "6e-4",
-             "checkpoint/interval": "3e-4"}.items():
+             "checkpoint/interval": "3e-4",
+             # the traction on the upper face (z+ in 3D) and the drained region in 3D
+             "loads/traction 0/face": "z+", "loads/traction 0/traction": "0, 0, -1e4",
+             "boundary conditions/drainage 0/region lower corner": "0, 0, 0",
+             "boundary conditions/drainage 0/region upper corner": "1e3, 1e3, 1e3"}.items():
     text3 = tv.prm_set(text3, k, v)
 run("three_d", text=text3)
 shutil.copytree(os.path.join(work, "three_d", "checkpoints"), os.path.join(work, "dim", "checkpoints"))

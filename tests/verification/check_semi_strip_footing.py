@@ -38,6 +38,7 @@ if h_arg:
     n = round(10 / h)
     base = tv.prm_set(base, "grid/cells", f"{n}, {n + 1}")
     base = tv.prm_set(base, "grid/upper corner", f"10, {10 + h}")
+    base = tv.prm_set(base, "loads/traction 0/region lower corner", f"0, {10 - h / 2}")  # the top layer
 
 
 def zigzag(s):

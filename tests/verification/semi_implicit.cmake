@@ -248,3 +248,21 @@ foreach(_mode layer displacement terzaghi footing restart)
 endforeach()
 set_tests_properties(verification.semi_implicit_rigid_plate_layer verification.semi_implicit_rigid_plate_footing
                      verification.semi_implicit_rigid_plate_restart PROPERTIES PROCESSORS 2)
+
+# the shared boundary conditions and loads (issue 37; docs/semi-implicit.md 'Boundary
+# conditions and loads'), parameter_files/verification/semi_implicit_boundary_loads.prm:
+# displacement: a prescribed velocity compressing the drained layer, reaction and stress
+# within 1 % of E_oed d / H; traction: q on grid boundary id 3 and on the body face,
+# drained settlement within 1 % of q H / E_oed; pressure: a prescribed pore pressure on the
+# top face reaches every water point (1 %), the skeleton unloaded; dry_face: a loaded face beside dry cells
+# impermeable by default (undrained pore pressure) and drained when a drainage region says
+# so (Terzaghi's mean pore pressure); refuse: talus-explicit and talus-implicit refuse a
+# traction on a boundary id, a sealed closed box is refused
+foreach(_mode displacement traction pressure dry_face refuse)
+  add_test(NAME verification.semi_implicit_boundary_loads_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_boundary_loads.py ${_mode} ${TALUS_TOOLS_DIR}
+                   ${TALUS_PRM_DIR}/verification/semi_implicit_boundary_loads.prm ${TALUS_PRM_DIR}
+                   ${_w}/semi_implicit_boundary_loads_${_mode})
+  set_tests_properties(verification.semi_implicit_boundary_loads_${_mode} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 600)
+endforeach()

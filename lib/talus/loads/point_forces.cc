@@ -45,8 +45,10 @@ namespace talus::loads
     have_tractions = !tractions.empty();
     for (unsigned int j = 0; j < tractions.size(); ++j)
       {
-        const auto &t       = tractions[j];
-        const auto  initial = [&](const auto &pt) {
+        const auto &t = tractions[j];
+        if (t.target == Traction<dim>::Target::boundary) // grid nodal forces: no point carries it
+          continue;
+        const auto initial = [&](const auto &pt) {
           auto X = pt.get_location();
           for (unsigned int d = 0; d < dim; ++d)
             X[d] -= pt.get_properties()[L::displacement + d];

@@ -42,6 +42,8 @@ namespace talus::loads
     /// region), give each its area share A_p (V_p / the sub-cell spacing normal
     /// to the face; for a body face normalised to the box face, so the total is
     /// exactly traction x area) and store t_j A_p in slot j; other slots 0.
+    /// A traction on a grid boundary id (nodal forces) selects no point: its
+    /// slot stays 0.
     /// Logs one line per traction; a traction selecting no point is an
     /// InputError. Collective.
     void assign(const std::vector<Traction<dim>> &tractions, MaterialPointSet<dim> &points,

@@ -58,10 +58,13 @@ namespace talus::loads
       for (unsigned int k = 0; k < n_tr; ++k)
         {
           prm.enter_subsection("traction " + std::to_string(k));
-          prm.declare_entry("apply to", "body face", Selection("body face|region"),
+          prm.declare_entry("apply to", "body face", Selection("body face|region|boundary"),
                             "'body face': the outermost layer of material points of a box body on 'face'; "
                             "'region': the points whose initial position lies in the region box, loaded on the "
-                            "face normal to the axis of 'face'.");
+                            "face normal to the axis of 'face'; 'boundary': the grid nodes of the faces with "
+                            "'boundary id' (nodal forces on the material touching that grid face; "
+                            "talus-semi-implicit only, docs/boundary-conditions.md).");
+          prm.declare_entry("boundary id", "0", Integer(0), "Grid boundary id (apply to = boundary).");
           prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body face).");
           prm.declare_entry("face", dim == 2 ? "y+" : "z+", Selection(face_names),
                             "Loaded face: its outward normal axis and side.");
@@ -117,8 +120,22 @@ namespace talus::loads
           t.axis              = static_cast<unsigned int>(f[0] - 'x');
           t.side              = f[1] == '+' ? +1 : -1;
           require(t.axis < dim, where + "/face", "'" + f + "' does not exist in " + std::to_string(dim) + "D");
-          t.target = prm.get("apply to") == "region" ? Traction<dim>::Target::region : Traction<dim>::Target::body_face;
-          if (t.target == Traction<dim>::Target::body_face)
+          const std::string a = prm.get("apply to");
+          t.target            = a == "region"     ? Traction<dim>::Target::region
+                                : a == "boundary" ? Traction<dim>::Target::boundary
+                                                  : Traction<dim>::Target::body_face;
+          if (t.target == Traction<dim>::Target::boundary)
+            {
+              // the face's normal is the boundary's; 'face' is not used
+              const unsigned int b = prm.get_integer("boundary id");
+              require(b < 2 * dim, where + "/boundary id",
+                      "boundary id " + std::to_string(b) + " does not exist (box grid ids 0.." +
+                        std::to_string(2 * dim - 1) + ")");
+              t.boundary = static_cast<dealii::types::boundary_id>(b);
+              t.axis     = b / 2;
+              t.side     = b % 2 ? +1 : -1;
+            }
+          else if (t.target == Traction<dim>::Target::body_face)
             {
               t.body = prm.get_integer("body");
               require(t.body < bodies.size(), where + "/body",
@@ -563,6 +580,18 @@ namespace talus::loads
     return t;
   }
 
+  template <int dim>
+  void
+  refuse_boundary_tractions(const std::vector<Traction<dim>> &tractions, const std::string &tool,
+                            const std::string &reason)
+  {
+    for (const auto &t : tractions)
+      require(t.target != Traction<dim>::Target::boundary, t.where + "/apply to",
+              "is 'boundary': " + tool + " cannot honour a traction on a grid boundary id: " + reason);
+  }
+
+  template void refuse_boundary_tractions(const std::vector<Traction<2>> &, const std::string &, const std::string &);
+  template void refuse_boundary_tractions(const std::vector<Traction<3>> &, const std::string &, const std::string &);
   template std::vector<Traction<2>> parse_traction_parameters<2>(dealii::ParameterHandler &,
                                                                  const std::vector<BodyDescription<2>> &,
                                                                  std::vector<PrescribedVelocity<2>> *);

@@ -21,24 +21,26 @@
 namespace talus::loads
 {
   /// A surface traction carried by the boundary material points of a face
-  /// (seed 000 Eqs. 4.28-4.29, 5.1-5.3).
+  /// (seed 000 Eqs. 4.28-4.29, 5.1-5.3), or by the grid nodes of a boundary id.
   template <int dim>
   struct Traction
   {
     enum class Target
     {
       body_face, ///< the outermost layer of points of a box body on one face
-      region     ///< the points whose initial position lies in a box region
+      region,    ///< the points whose initial position lies in a box region
+      boundary   ///< the grid nodes of the faces with `boundary` (nodal forces; not every family)
     };
-    Target                 target = Target::body_face;
-    unsigned int           body   = 0;
-    unsigned int           axis   = dim - 1; ///< normal axis of the face
-    int                    side   = +1;      ///< +1: upper face, -1: lower face
-    dealii::Point<dim>     lower, upper;     ///< region
-    dealii::Tensor<1, dim> traction;         ///< [Pa] (force per area); with `total`: the resultant [N]
-    bool                   total = false;    ///< `traction` is the resultant over the selected points
-    TimeFunction           function;
-    std::string            where;
+    Target                     target   = Target::body_face;
+    dealii::types::boundary_id boundary = 0; ///< apply to = boundary
+    unsigned int               body     = 0;
+    unsigned int               axis     = dim - 1; ///< normal axis of the face
+    int                        side     = +1;      ///< +1: upper face, -1: lower face
+    dealii::Point<dim>         lower, upper;       ///< region
+    dealii::Tensor<1, dim>     traction;           ///< [Pa] (force per area); with `total`: the resultant [N]
+    bool                       total = false;      ///< `traction` is the resultant over the selected points
+    TimeFunction               function;
+    std::string                where;
   };
 
   /// Prescribed velocity on grid nodes (boundary id or region) or on the
@@ -122,6 +124,13 @@ namespace talus::loads
   /// or damping: talus-implicit).
   void declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
                                    bool with_velocities = false);
+  /// InputError naming 'loads/traction k/apply to' of the first traction on a
+  /// grid boundary id, for a family (`tool`) that applies tractions through
+  /// material points only, with `reason`.
+  template <int dim>
+  void refuse_boundary_tractions(const std::vector<Traction<dim>> &tractions, const std::string &tool,
+                                 const std::string &reason);
+
   /// The tractions of declare_traction_parameters (global loads, absolute
   /// time) and, if `velocities` is given, the velocity conditions.
   template <int dim>

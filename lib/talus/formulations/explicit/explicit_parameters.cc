@@ -103,6 +103,11 @@ namespace talus::explicit_mpm
       }
     const unsigned int n_bodies = p.bodies.size();
     p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
+    // a traction on a grid boundary id (nodal forces): talus-semi-implicit only
+    for (const auto &st : p.loads.stages)
+      loads::refuse_boundary_tractions(st.tractions, "talus-explicit",
+                                       "its tractions are carried by material points; allowed: 'body face' or "
+                                       "'region' (docs/boundary-conditions.md)");
     if (p.loads.staged)
       {
         p.end_time = 0; // the sum of the stage durations

@@ -369,6 +369,11 @@ namespace talus::implicit_mpm
       if (!p.staged)
         p.stages.push_back(top);
     }
+    // a traction on a grid boundary id (nodal forces): talus-semi-implicit only
+    for (const auto &st : p.stages)
+      loads::refuse_boundary_tractions(st.tractions, "talus-implicit",
+                                       "its tractions are carried by material points; allowed: 'body face' or "
+                                       "'region' (docs/boundary-conditions.md)");
     if (!p.staged)
       {
         require(p.time_step > 0, "time/time step", "must be > 0 (the implicit step is chosen by the user)");

@@ -10,6 +10,8 @@
 
 #include <talus/formulations/common/formulation.h>
 #include <talus/formulations/common/scene_parameters.h>
+#include <talus/loads/drainage.h>
+#include <talus/loads/settings.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -42,24 +44,6 @@ namespace talus::semi_implicit
     modified_f_bar ///< and b_e^t by (patch mean J^e / J^e)^(2/3) (Eqs. 81-83)
   };
 
-  /// A surface load on the upper face of a box body (decision A13).
-  struct SurfaceLoad
-  {
-    double q    = 0;      ///< pressure [Pa], >= 0 pushing down
-    double from = -1e300; ///< strip: first horizontal coordinate from ...
-    double to   = 1e300;  ///< ... to (the whole face by default)
-    double ramp = 0;      ///< linear ramp time [s]; 0: sudden at t = 0
-    /// where each loaded point's force acts: at the body's surface (the point
-    /// position + its half sub-cell spacing, carried by dF), or at the point
-    bool at_surface = true;
-    /// the fraction of q applied over a step that starts at t
-    double
-    factor(const double t, const double h) const
-    {
-      return ramp > 0 ? std::min(1.0, (t + 0.5 * h) / ramp) : 1.0;
-    }
-  };
-
   template <int dim>
   struct Parameters : SceneParameters<dim>, RunParameters<dim>
   {
@@ -67,7 +51,14 @@ namespace talus::semi_implicit
     std::vector<SoilData> soil_of_material;
     /// per body: the material ids of its points (a file body: those of its rows)
     std::vector<std::vector<unsigned int>> materials_of_body;
-    std::vector<SurfaceLoad>               surface_load; ///< per body: q [Pa] on its upper face
+    /// the shared loads (issue 37; boundary_loads.h): 'loads/traction k',
+    /// 'loads/velocity k' and 'boundary conditions/drainage k' (after the
+    /// drained boundaries of the alias 'semi implicit/drained boundaries')
+    std::vector<loads::Traction<dim>>           tractions;
+    std::vector<loads::PrescribedVelocity<dim>> velocities;
+    std::vector<loads::Drainage<dim>>           drainage;
+    /// 'semi implicit/traction acts at': the body surface (true) or the load points
+    bool traction_at_surface = true;
     // time step: fixed, or courant x the soil skeleton's critical step
     double time_step = 0, courant = 0.5;
     // 'semi implicit' subsection
@@ -94,9 +85,6 @@ namespace talus::semi_implicit
     /// rigid skeleton: v_s = 0 at every node, the soil's terms dropped from the
     /// pressure equation (seepage through a fixed soil)
     bool rigid_skeleton = false;
-    /// boundary ids where the water drains: p = 0 on their nodes that carry
-    /// water, the water's velocity not held by the wall condition there
-    std::vector<unsigned int> drained_boundaries;
     // 'initial state' subsection: geostatic water pressure and effective stress
     bool   geostatic    = false;
     double water_level  = 0; ///< vertical coordinate of the free water surface

@@ -57,6 +57,8 @@ namespace talus::semi_implicit
         c.push_back("plate_" + std::to_string(k) + "_node_spread");
         c.push_back("plate_" + std::to_string(k) + "_node_slip");
       }
+    for (const auto &name : bloads.series_columns()) // velocity_k_reaction_x, ...
+      c.push_back(name);
     balance.add_series_column(c);
     return c;
   }
@@ -81,10 +83,13 @@ namespace talus::semi_implicit
           else // the mixture volume of the skeleton: a 1D column's height x its width
             {
               soil_volume += P[L::volume];
-              // the points carrying a surface load: their force-weighted mean
-              // downward displacement (the settlement conjugate to the load)
-              fu += P[fs.surface_force] * -P[L::displacement + dim - 1];
-              fsum += P[fs.surface_force];
+              // the points carrying a traction: their force-weighted mean
+              // displacement along the force (issue 37 hook: the settlement
+              // conjugate to the load)
+              double fdu, f;
+              bloads.settlement_weights(P.data(), fdu, f);
+              fu += fdu;
+              fsum += f;
             }
         }
     fu                    = dealii::Utilities::MPI::sum(fu, comm);
@@ -111,6 +116,7 @@ namespace talus::semi_implicit
         v.push_back(plate_state[k].node_spread);
         v.push_back(plate_state[k].node_slip);
       }
+    bloads.series_values(v);
     balance.add_series_value(v);
     return v;
   }

@@ -7,6 +7,7 @@
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/scene_parameters.h>
+#include <talus/formulations/semi_implicit/boundary_loads.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/loads/rigid_plate.h>
 #include <talus/loads/rigid_plate_nodes.h>
@@ -107,7 +108,9 @@ namespace talus::semi_implicit
                         "Comma-separated boundary ids of the box grid (0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, "
                         "5 = z+) where the water drains: the pore pressure is 0 on their nodes that carry water "
                         "and the water's velocity is not held by the wall condition there (the water can leave "
-                        "the grid; the soil keeps its wall condition). Empty: none.");
+                        "the grid; the soil keeps its wall condition). Empty: none. An alias of "
+                        "'boundary conditions/drainage k' with apply to = boundary, condition = drained "
+                        "(docs/boundary-conditions.md).");
       prm.declare_entry("kozeny carman", "false", Bool(),
                         "Update the soil points' conductivity k = C1 n^3 / (1 - n)^2 with C1 from k0, n0 "
                         "(Alg. 8(g)); false: k stays k0.");
@@ -138,6 +141,9 @@ namespace talus::semi_implicit
                         "(the paper: 1 m/s), > 0.");
     }
     prm.leave_subsection();
+    // the shared 'loads' (tractions, velocity conditions), the
+    // drainage conditions and 'semi implicit/traction acts at' (boundary_loads.cc)
+    declare_boundary_load_parameters(prm, prm_file, counts.dim);
     for (unsigned int k = 0; k < counts.n_materials; ++k)
       {
         prm.enter_subsection("material " + std::to_string(k));
@@ -151,24 +157,6 @@ namespace talus::semi_implicit
     for (unsigned int k = 0; k < counts.n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
-        prm.declare_entry("surface load extent", "", dealii::Patterns::Anything(),
-                          "Empty: the surface load covers the body's whole upper face. 'a, b': only the top "
-                          "points with a <= x <= b carry it (a strip load, e.g. a footing; x the first "
-                          "coordinate).");
-        prm.declare_entry("surface load ramp time", "0", Double(0),
-                          "The surface load grows linearly from 0 to q over this time [s]; 0: sudden at t = 0.");
-        prm.declare_entry("surface load", "0", Double(-1e300, 1e300),
-                          "A uniform vertical pressure q [Pa] (>= 0, pushing down) on the upper face of a box "
-                          "body with soil points, applied suddenly at t = 0 and kept: the body's top layer of "
-                          "soil points carries it, each point the force q V_p / (h / particles per direction), "
-                          "h the cell height (the traction of the paper's Eq. 54 as point loads; decision A13).");
-        prm.declare_entry("surface load acts at", "body surface",
-                          dealii::Patterns::Selection("body surface|top points"),
-                          "Where a loaded point's force enters the grid. body surface: at the point's share of the "
-                          "upper face, the point position plus half its sub-cell height, a vector carried by the "
-                          "point's dF (the weak form's integral over the face: the top points carry the full q). "
-                          "top points: at the point itself (the top layer then carries only part of q and is "
-                          "too stiff; kept for comparison; docs/semi-implicit.md).");
         // must be set: it makes a .prm this family's (an explicit scene is not
         // silently read as a saturated two-phase one)
         prm.declare_entry("phase", "saturated", Selection("saturated|soil|water"),
@@ -251,7 +239,9 @@ namespace talus::semi_implicit
                     "is '" + text + "'; allowed: empty or comma-separated boundary ids of the " + std::to_string(dim) +
                       "D box, 0 to " + std::to_string(2 * dim - 1) + " (x-, x+, y-, y+" +
                       (dim == 3 ? ", z-, z+)" : ")"));
-            p.drained_boundaries.push_back(id);
+            // issue 37: an alias of 'boundary conditions/drainage k' (drained boundary)
+            p.drainage.push_back(loads::drained_boundary<dim>(static_cast<dealii::types::boundary_id>(id),
+                                                              "semi implicit/drained boundaries"));
           }
       }
       {
@@ -328,7 +318,7 @@ namespace talus::semi_implicit
         }
     }
 
-    /// 'body k': phase, surface load, the material ids of its points; the
+    /// 'body k': phase, the material ids of its points; the
     /// checks of the phases against the point sets and the stabilisation
     template <int dim>
     void
@@ -339,44 +329,8 @@ namespace talus::semi_implicit
         {
           prm.enter_subsection("body " + std::to_string(k));
           const std::string ph = prm.get("phase");
-          {
-            SurfaceLoad sl;
-            sl.q                     = prm.get_double("surface load");
-            sl.ramp                  = prm.get_double("surface load ramp time");
-            sl.at_surface            = prm.get("surface load acts at") == "body surface";
-            const std::string extent = prm.get("surface load extent");
-            if (!dealii::Utilities::trim(extent).empty())
-              {
-                const auto v  = dealii::Utilities::split_string_list(extent, ',');
-                bool       ok = v.size() == 2;
-                try
-                  {
-                    if (ok)
-                      {
-                        sl.from = std::stod(v[0]);
-                        sl.to   = std::stod(v[1]);
-                      }
-                  }
-                catch (const std::exception &)
-                  {
-                    ok = false;
-                  }
-                require(ok && std::isfinite(sl.from) && std::isfinite(sl.to) && sl.from < sl.to,
-                        "body " + std::to_string(k) + "/surface load extent",
-                        "is '" + extent + "'; allowed: empty (the whole upper face) or two numbers 'a, b' with a < b");
-              }
-            p.surface_load.push_back(sl);
-          }
           prm.leave_subsection();
           p.phase_of_body.push_back(ph == "soil" ? Phase::soil : ph == "water" ? Phase::water : Phase::saturated);
-          std::ostringstream q;
-          q << p.surface_load.back().q;
-          require(std::isfinite(p.surface_load.back().q) && p.surface_load.back().q >= 0,
-                  "body " + std::to_string(k) + "/surface load", "is " + q.str() + "; must be a pressure >= 0 Pa");
-          require(p.surface_load.back().q == 0 ||
-                    (p.phase_of_body.back() != Phase::water && p.bodies[k].shape == BodyDescription<dim>::Shape::box),
-                  "body " + std::to_string(k) + "/surface load",
-                  "needs a box body with soil points (phase saturated or soil)");
           any_soil  = any_soil || p.phase_of_body.back() != Phase::water;
           any_water = any_water || p.phase_of_body.back() != Phase::soil;
           // the material ids of the body's points: its entry, or those of its rows
@@ -435,6 +389,7 @@ namespace talus::semi_implicit
     parse_soil_data(prm, p);
     parse_bodies(prm, p);
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
+    parse_boundary_load_parameters(prm, p); // tractions, velocity and drainage conditions
     check_scene(p);
     return p;
   }

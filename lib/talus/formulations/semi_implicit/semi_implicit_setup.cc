@@ -81,26 +81,15 @@ namespace talus::semi_implicit
             constrained[e.dof]         = 1;
           }
       }
-    // drained faces: their nodes get p = 0; the water's velocity component
-    // normal to such a face is free there (the soil keeps the wall condition)
+    // drained faces: the drainage conditions' node flags and
+    // the water's wall hold freed at a draining boundary (boundary_loads.cc);
+    // drained[]: the permeable plates' nodes (p = 0)
     water_constrained = constrained;
     drained.assign(nl, 0);
     for (unsigned int i = 0; i < nl; ++i)
       if (plate_drained[i])
         drained[i] = 1;
-    for (unsigned int i = 0; i < nl; ++i)
-      for (const unsigned int id : prm.drained_boundaries)
-        {
-          const unsigned int d    = id / 2;
-          const double       face = id % 2 ? prm.grid_upper[d] : prm.grid_lower[d];
-          const double       tol  = 1e-9 * (prm.grid_upper[d] - prm.grid_lower[d]);
-          if (std::abs(node_x[i][d] - face) <= tol)
-            {
-              drained[node_of[i]] = 1;
-              if (component[i] == d)
-                water_constrained[i] = 0;
-            }
-        }
+    bloads.grid_changed(node_of, component, node_x, water_constrained);
     patches.reinit(prm.grid_lower, prm.grid_upper, prm.grid_cells, prm.patch_size);
     for (Vector *v :
          {&Mdj,    &Mjt,    &Ms,     &Ps,      &Mn,     &Mk,     &Fs,      &Ww,   &Pw0,     &Ww0,     &Mwp,
@@ -132,13 +121,13 @@ namespace talus::semi_implicit
     unsigned int n_history = 0;
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
-    soil.layout.n_history  = n_history;
-    fs.porosity            = soil.layout.add_extra("porosity", 1);
-    fs.initial_porosity    = soil.layout.add_extra("initial_porosity", 1);
-    fs.initial_volume      = soil.layout.add_extra("initial_volume", 1);
-    fs.conductivity        = soil.layout.add_extra("conductivity", 1);
-    fs.surface_force       = soil.layout.add_extra("surface_force", 1);
-    fs.surface_offset      = soil.layout.add_extra("surface_offset", dim, true);
+    soil.layout.n_history = n_history;
+    fs.porosity           = soil.layout.add_extra("porosity", 1);
+    fs.initial_porosity   = soil.layout.add_extra("initial_porosity", 1);
+    fs.initial_volume     = soil.layout.add_extra("initial_volume", 1);
+    fs.conductivity       = soil.layout.add_extra("conductivity", 1);
+    fs.surface_offset     = soil.layout.add_extra("surface_offset", dim, true);
+    bloads.extend_layout(soil.layout, fs.surface_offset); // the point tractions' slots
     fs.poisson_coefficient = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_flux        = soil.layout.add_extra("poisson_flux", dim, true);
     if (prm.stabilisation != VolumetricStabilisation::none)
@@ -174,6 +163,7 @@ namespace talus::semi_implicit
         return;            // the points, the step and the loop's state as saved
       }
     seed();
+    bloads.assign(soil, prm.bodies); // the loaded points' forces and face offsets
     if (prm.geostatic)
       geostatic_state();
     initialize_point_histories(prm.materials, soil, soil.layout.history);
@@ -329,18 +319,8 @@ namespace talus::semi_implicit
               {
                 P[L::mass]        = (1 - n0) * prm.materials[m]->density() * V0; // Eq. 35
                 P[f.conductivity] = prm.soil_of_material[m].conductivity;
-                // the body's top layer of points carries its surface load
-                const SurfaceLoad &load = prm.surface_load[b];
-                const double       hy   = (prm.grid_upper[dim - 1] - prm.grid_lower[dim - 1]) / prm.grid_cells[dim - 1];
-                const double       dy   = hy / prm.bodies[b].particles_per_direction;
-                const auto         x    = pt.get_location();
-                const bool         on_face =
-                  x[dim - 1] > prm.bodies[b].upper[dim - 1] - dy && x[0] >= load.from && x[0] <= load.to;
-                P[f.surface_force] = load.q > 0 && on_face ? load.q * V0 / dy : 0.0;
-                for (unsigned int d = 0; d < dim; ++d)
+                for (unsigned int d = 0; d < dim; ++d) // its share of a loaded face: BoundaryLoads::assign
                   P[f.surface_offset + d] = 0;
-                if (P[f.surface_force] != 0 && load.at_surface)
-                  P[f.surface_offset + dim - 1] = 0.5 * dy;
               }
             else
               {
@@ -416,6 +396,7 @@ namespace talus::semi_implicit
                   : "displacement control: " + number_text(pl.displacement) + " m x f(t), reaction reported")
             << std::endl;
       }
+    bloads.describe(out);
   }
 
   int

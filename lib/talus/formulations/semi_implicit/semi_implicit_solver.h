@@ -15,6 +15,7 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/common/formulation.h>
 #include <talus/formulations/common/simulation.h>
+#include <talus/formulations/semi_implicit/boundary_loads.h>
 #include <talus/formulations/semi_implicit/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
@@ -46,7 +47,7 @@ namespace talus::semi_implicit
   struct Fields
   {
     unsigned int porosity = 0, initial_porosity = 0, initial_volume = 0, conductivity = 0, pressure = 0;
-    unsigned int pressure_gradient = 0, surface_force = 0;
+    unsigned int pressure_gradient   = 0;
     unsigned int surface_offset      = 0; // dim values: from the point to its share of the loaded face
     unsigned int poisson_coefficient = 0, poisson_flux = 0;                 // poisson_flux: dim values, phi v*
     unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
@@ -66,6 +67,7 @@ namespace talus::semi_implicit
         , prm(p)
         , soil(*this->point_sets[0])
         , water(*this->point_sets[1])
+        , bloads(p, grid, comm)
         , pspace(grid, 1)
         , active(pspace)
     {
@@ -172,6 +174,10 @@ namespace talus::semi_implicit
     /// Solve R0 + R1 V = F(t + h) for the force plates' V; add V x their unit
     /// responses to the step's fields.
     void solve_force_plates(StepState &this_step, const std::vector<double> &R);
+    /// The reactions of the velocity conditions (BoundaryLoads::reactions):
+    /// the mixture's momentum residual of their DoFs, as the plates' R and T.
+    /// Collective.
+    void velocity_reactions(const StepState &this_step);
     /// (7)-(8a): FLIP velocities and pore pressure of the points, the MUSL
     /// remap of the soil's velocity (vs_t).
     template <class K>
@@ -207,6 +213,9 @@ namespace talus::semi_implicit
 
     const Parameters<dim> &prm;
     MaterialPointSet<dim> &soil, &water; ///< the Simulation's two point sets
+    /// issue 37: the shared tractions, prescribed velocities and drainage
+    /// conditions (boundary_loads.h); its hooks are called from the phases
+    BoundaryLoads<dim> bloads;
     /// Everything of the grid's partition that lives across steps: the
     /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
     /// vectors, the sets' cell lists; the next step rebuilds the active set and

@@ -168,6 +168,7 @@ namespace talus::semi_implicit
     correction<K>(this_step);
     if (!prm.rigid_plates.empty())
       plate_balance(this_step);
+    velocity_reactions(this_step);
     add_lap(phase.grid);
     nodes_to_particles<K>(this_step);
     if (!prm.rigid_plates.empty()) // what the nodes moved the soil with: node_spread
@@ -197,6 +198,7 @@ namespace talus::semi_implicit
     for (Vector *v :
          {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
+    bloads.begin_step(time, h); // the loads' time factors over [t, t + h]
     // the displacement-controlled plates' velocities over the step (those of
     // force control follow from the plates' balance at its end)
     const unsigned int   n_plates = prm.rigid_plates.size();
@@ -226,7 +228,6 @@ namespace talus::semi_implicit
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
 
-    const double       h             = this_step.h;
     const bool         initial_stage = this_step.initial_stage;
     const auto        &g             = this_step.g;
     const double       rw            = prm.water_density;
@@ -253,14 +254,8 @@ namespace talus::semi_implicit
           double t[dim][dim];
           minus_V_sigma<dim>(P, P[L::volume], t);
           s.scatter_divergence(fsv, t);
-          if (P[fs.surface_force] != 0)
-            {
-              double f[dim] = {};
-              f[dim - 1] =
-                -P[fs.surface_force] * prm.surface_load[static_cast<unsigned int>(P[L::body])].factor(time, h);
-              transfer::offset_stencil<dim, K>(grid, c, it->get_location(), P + fs.surface_offset, surface);
-              surface.scatter_vector(fsv, 1.0, f);
-            }
+          // a loaded point's traction force (at the body surface)
+          bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, fsv);
         });
     }
     exchange({&Ms, &Ps, &Mn, &Mk, &Fs});
@@ -269,6 +264,7 @@ namespace talus::semi_implicit
       ms_max = std::max(ms_max, Ms.local_element(i));
     const double ms_cut = relative_mass_cutoff * dealii::Utilities::MPI::max(ms_max, comm);
     this_step.ms_cut    = ms_cut;
+    bloads.add_boundary_tractions(Fs, Ms, ms_cut); // tractions on grid boundary ids
     // nodal porosity; nodes without soil: n = 1, no drag (A1)
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0)
@@ -434,6 +430,7 @@ namespace talus::semi_implicit
           vs = 0;
         if (water_constrained[i])
           vw = 0;
+        bloads.predictor(i, has_soil, has_water, Mwi, Q, h, rwv, vs, vw); // prescribed velocities
         if (const unsigned int k = plate_of[i]; k != no_plate)
           {
             const bool permeable = prm.rigid_plates[k].permeable;
@@ -606,30 +603,23 @@ namespace talus::semi_implicit
           if (!pspace.locally_relevant_dofs().is_element(gdof) || dirichlet.is_constrained(gdof))
             continue;
           const bool has_water = Mw.local_element(i) > mw_cut;
-          const bool surface   = dry.local_element(i) > 0 && !plate_sealed[i];
-          if (has_water && drained[i]) // a drained face: p^{t+1} = 0
+          // the pressure row from the free-surface rule (A6),
+          // the drainage conditions and the sealing of loaded faces
+          // (BoundaryLoads::pressure_row): dp = -p^t at a drained node (p^{t+1}
+          // = 0), dp = 0 at a node without water or one that keeps its mapped p^t
+          const auto row =
+            bloads.pressure_row(i, has_water, drained[i], plate_sealed[i], wet.local_element(i), dry.local_element(i),
+                                near_wet.local_element(i), p_node.local_element(i));
+          if (row.first)
             {
               dirichlet.add_line(gdof);
               dirichlet_homogeneous.add_line(gdof);
-              dirichlet.set_inhomogeneity(gdof, -p_node.local_element(i));
-            }
-          else if (!has_water || surface)
-            {
-              // no water: Delta p = 0 (A2, A4). On the surface (a vertex of a wet
-              // and a dry cell, or of dry cells far from the water) p^{t+1} = 0,
-              // Delta p = -p^t. The dry nodes next to a wet cell (B-spline: the
-              // node above the surface that the top points still touch) keep the
-              // mapped p^t, the linear extrapolation of the water's pressure
-              // (Delta p = 0); forcing 0 there fed the top cell a spurious
-              // pressure step every step (docs/semi-implicit.md, A6).
-              const bool keep = wet.local_element(i) == 0 && near_wet.local_element(i) > 0;
-              dirichlet.add_line(gdof);
-              dirichlet_homogeneous.add_line(gdof);
-              dirichlet.set_inhomogeneity(gdof, has_water && !keep ? -p_node.local_element(i) : 0.0);
+              dirichlet.set_inhomogeneity(gdof, row.second);
             }
         }
     dirichlet.close();
     dirichlet_homogeneous.close();
+    bloads.check_pressure_reference(); // a sealed box is refused
   }
 
   template <int dim>
@@ -799,6 +789,7 @@ namespace talus::semi_implicit
       vs = 0;
     if (water_constrained[i])
       vw = 0;
+    bloads.correct(i, Mwi, vs, vw); // prescribed velocities
     if (const unsigned int k = plate_of[i]; k != no_plate)
       {
         vs = Vp[k];
@@ -860,6 +851,25 @@ namespace talus::semi_implicit
         st.force      = f;
         st.tangential = std::sqrt(t2);
       }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::velocity_reactions(const StepState &this_step)
+  {
+    const double h = this_step.h;
+    const auto  &g = this_step.g;
+    // the reactions of the velocity conditions, the mixture's
+    // momentum residual over their DoFs (the plates' R and T)
+    bloads.reactions([&](const unsigned int i) {
+      const unsigned int j   = node_of[i];
+      const double       Msi = Ms.local_element(j), Mwi = Mw_node.local_element(j), n = n_node.local_element(j);
+      return (Msi * (vs_new.local_element(i) - vs_t.local_element(i)) +
+              Mwi * (vw_new.local_element(i) - vw_t.local_element(i))) /
+               h -
+             Fs.local_element(i) - Mwi * g[component[i]] - (1 - n) * (Gps.local_element(i) + gs.local_element(i)) -
+             n * (Gpw.local_element(i) + gw.local_element(i));
+    });
   }
 
   template <int dim>
@@ -1007,6 +1017,7 @@ namespace talus::semi_implicit
         vs_t.local_element(i) = (m > ms_cut && !constrained[i]) ? Ps.local_element(i) / m : 0.0; // remapped
         if (plate_of[i] != no_plate) // the plate's velocity, as the walls' zero (A11)
           vs_t.local_element(i) = plate_v[plate_of[i]];
+        bloads.remap(i, vs_t.local_element(i)); // prescribed velocities
       }
   }
 
@@ -1118,7 +1129,7 @@ namespace talus::semi_implicit
           dF_model = stabilised_increment<dim>(dF, dJ_bar);
         }
       P[L::volume] *= dJ;             // (8d)
-      if (P[s.fs.surface_force] != 0) // the loaded face moves with the material: d <- dF d
+      if (s.bloads.carries_offsets()) // the loaded face moves with the material: d <- dF d (0 stays 0)
         {
           double d[dim];
           for (unsigned int i = 0; i < dim; ++i)
