@@ -453,9 +453,8 @@ namespace talus::implicit_mpm
                     "'mixed up' needs a volumetric/deviatoric split with a pressure-independent deviatoric response; "
                     "allowed: 'neo hookean' with 'volumetric energy = split', 'j2 plasticity' (got '" +
                       m.model_name() +
-                      (dynamic_cast<const materials::NeoHookean *>(&m)
-                         ? "' with 'volumetric energy = coupled')"
-                         : "': its yield depends on the pressure or it has no split)"));
+                      (m.model_name() == "neo hookean" ? "' with 'volumetric energy = coupled')"
+                                                       : "': its yield depends on the pressure or it has no split)"));
           }
       }
     // what the implicit family does not offer yet: refused, not ignored

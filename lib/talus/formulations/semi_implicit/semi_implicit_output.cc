@@ -84,7 +84,7 @@ namespace talus::semi_implicit
             {
               soil_volume += P[L::volume];
               // the points carrying a traction: their force-weighted mean
-              // displacement along the force (issue 37 hook: the settlement
+              // displacement along the force (the settlement
               // conjugate to the load)
               double fdu, f;
               bloads.settlement_weights(P.data(), fdu, f);
