@@ -20,3 +20,12 @@ add_test(NAME verification.rigid_plate_bad_input
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_rigid_plate_input.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
                  ${_w}/rigid_plate_bad_input)
 set_tests_properties(verification.rigid_plate_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# one initial-stress entry, three tools: the K0 column of
+# parameter_files/verification/initial_stress/column.inc stays at rest in
+# every family (against the stress-free release), sigma_xx / sigma_yy = K0, and
+# the shared entry's refusals
+add_test(NAME verification.initial_stress_families
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_initial_stress_families.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/initial_stress_families)
+set_tests_properties(verification.initial_stress_families PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

@@ -1,6 +1,5 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
-#include <talus/loads/k0.h>
 #include <talus/loads/settings.h>
 
 #include <deal.II/base/utilities.h>
@@ -328,9 +327,6 @@ namespace talus::loads
   {
     if (staged)
       return true;
-    for (const auto &k : k0)
-      if (k.enabled)
-        return true;
     for (const auto &s : stages)
       if (!s.friction_ids.empty() || !s.tractions.empty() || !s.velocities.empty() || s.damping > 0 ||
           s.viscous_damping > 0 || s.mass_scaling != 1.0 || s.convergence.enabled)
@@ -339,8 +335,7 @@ namespace talus::loads
   }
 
   void
-  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim,
-                     const unsigned int n_bodies)
+  declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim)
   {
     prm.enter_subsection("boundary conditions");
     prm.declare_entry("friction", "", Anything(),
@@ -353,23 +348,6 @@ namespace talus::loads
     prm.leave_subsection();
     declare_loads(prm, prm_file, "loads", dim);
     declare_switches(prm, false);
-
-    for (unsigned int k = 0; k < n_bodies; ++k)
-      {
-        prm.enter_subsection("body " + std::to_string(k));
-        prm.enter_subsection("initial stress");
-        prm.declare_entry("K0 procedure", "false", Bool(),
-                          "Initial geostatic stresses at setup: sigma_v = -(rho |g| (surface level - z) + surcharge) "
-                          "along the gravity direction, sigma_h = K0 sigma_v (all other normal components).");
-        prm.declare_entry("K0", "auto", Anything(),
-                          "Lateral stress ratio; 'auto' = 1 - sin(phi) for Mohr-Coulomb materials (error otherwise).");
-        prm.declare_entry("surface level", "", Anything(),
-                          "Level of the free surface along -g [m]; empty = top of this body.");
-        prm.declare_entry("surcharge", "0", Double(0),
-                          "Vertical pressure on the surface [Pa] (overburden of layers above).");
-        prm.leave_subsection();
-        prm.leave_subsection();
-      }
 
     declare_stage_parameters(prm, prm_file, dim, true);
   }
@@ -511,48 +489,6 @@ namespace talus::loads
           top.damping = a2;
         }
     }
-
-    // K0 per body
-    for (unsigned int k = 0; k < bodies.size(); ++k)
-      {
-        const std::string where = "body " + std::to_string(k) + "/initial stress";
-        prm.enter_subsection("body " + std::to_string(k));
-        prm.enter_subsection("initial stress");
-        K0Stress z;
-        z.enabled            = prm.get_bool("K0 procedure");
-        const std::string k0 = prm.get("K0"), level = prm.get("surface level");
-        z.surcharge = prm.get_double("surcharge");
-        if (!level.empty())
-          z.surface_level = parse_doubles(level, where + "/surface level").at(0);
-        prm.leave_subsection();
-        prm.leave_subsection();
-        if (z.enabled)
-          {
-            require(gravity.norm() > 0, where, "the K0 procedure needs a non-zero gravity/acceleration");
-            if (k0 == "auto")
-              {
-                const std::string mat = "material " + std::to_string(bodies[k].material_id);
-                prm.enter_subsection(mat);
-                const std::string model = prm.get("model");
-                double            phi   = -1;
-                if (model == "mohr coulomb" || model == "hencky mohr coulomb")
-                  {
-                    prm.enter_subsection(model);
-                    phi = prm.get_double("friction angle");
-                    prm.leave_subsection();
-                  }
-                prm.leave_subsection();
-                require(phi >= 0, where + "/K0",
-                        "'auto' (1 - sin phi) needs a Mohr-Coulomb material; " + mat + " is '" + model +
-                          "': give K0 as a number");
-                z.K0 = jaky_k0(phi);
-              }
-            else
-              z.K0 = parse_doubles(k0, where + "/K0").at(0);
-            require(z.K0 >= 0, where + "/K0", "must be >= 0");
-          }
-        s.k0.push_back(z);
-      }
 
     s.stages = parse_stages<dim>(prm, top, bodies, true);
     s.staged = !s.stages.empty();

@@ -1,6 +1,5 @@
 // talus — .prm settings of loads, boundary friction, prescribed velocities,
-// local damping, quasi-static convergence, mass scaling, K0 initial stresses
-// and staged calculations of the explicit solver (seed 000 §4.3.2, §5.2, §6.2,
+// local damping, quasi-static convergence, mass scaling and staged calculations of the explicit solver (seed 000 §4.3.2, §5.2, §6.2,
 // §6.3-§6.5). Pure data plus declaration/parsing; the run-time logic is in
 // formulations/explicit/load_control.h.
 #pragma once
@@ -93,20 +92,11 @@ namespace talus::loads
     unsigned int n_global_tractions = 0, n_global_velocities = 0;
   };
 
-  struct K0Stress
-  {
-    bool   enabled       = false;
-    double K0            = 0.5;
-    double surface_level = std::numeric_limits<double>::quiet_NaN(); ///< NaN: top of the body
-    double surcharge     = 0; ///< vertical pressure at the surface [Pa], compression positive
-  };
-
   template <int dim>
   struct Settings
   {
     bool                    staged = false;
     std::vector<Stage<dim>> stages;            ///< at least one
-    std::vector<K0Stress>   k0;                ///< per body
     unsigned int            max_tractions = 0; ///< point-force slots needed per material point
 
     /// Whether the run needs the load controller (false: the solver runs its
@@ -115,9 +105,9 @@ namespace talus::loads
   };
 
   /// Declare the entries (loads, damping, mass scaling, convergence, friction
-  /// in 'boundary conditions', 'initial stress' in every body, stages).
-  void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
-                          unsigned int n_bodies);
+  /// in 'boundary conditions', stages). 'body k/initial stress' is the
+  /// scene's (formulations/common/initial_stress.h).
+  void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim);
 
   /// Only the 'loads' subsection with its 'traction k' entries and, with
   /// `with_velocities`, its 'velocity k' conditions (families without stages

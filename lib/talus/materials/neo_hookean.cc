@@ -80,38 +80,56 @@ namespace talus::materials
   }
 
   void
-  NeoHookean::initialize_history(const Stress &sigma, ArrayView<double> h) const
+  NeoHookean::initialize_history(const Stress &sigma_cauchy, ArrayView<double> h) const
   {
-    Stress b;
-    if (energy_form == Energy::coupled)
+    // The elastic b whose Cauchy stress tau(b) / J(b) is the given one: b of
+    // the Kirchhoff stress tau = J sigma, a fixed point in J = sqrt(det b)
+    // (|J - 1| is the elastic volume strain: a few passes reach round-off).
+    // Taking sigma itself as tau would leave the first update's stress off by
+    // the factor 1 / J (a K0 column then moved by 1e-3 of its settlement).
+    const auto b_of_kirchhoff = [this](const Stress &sigma) {
+      Stress b;
+      if (energy_form == Energy::coupled)
+        {
+          // tau = lambda s I + mu (b - I), s = ln J = 1/2 ln det b: scalar Newton in s.
+          double s = 0.0;
+          for (int it = 0; it < 60; ++it)
+            {
+              b = dealii::unit_symmetric_tensor<3>() + (sigma - lambda * s * dealii::unit_symmetric_tensor<3>()) / mu;
+              const double det = determinant(b);
+              require(det > 0, name.empty() ? "neo hookean" : name,
+                      "initial stress not reachable by the Neo-Hookean law");
+              const double g  = s - 0.5 * std::log(det);
+              const double dg = 1.0 + 0.5 * lambda / mu * trace(invert(b));
+              s -= g / dg;
+              if (std::abs(g) < 1e-15)
+                break;
+            }
+          b = dealii::unit_symmetric_tensor<3>() + (sigma - lambda * s * dealii::unit_symmetric_tensor<3>()) / mu;
+        }
+      else
+        {
+          const double K  = bulk_modulus();
+          const double sm = trace(sigma) / 3.0; // = J p = K (J^2 - 1)/2
+          require(1.0 + 2.0 * sm / K > 0, name.empty() ? "neo hookean" : name,
+                  "initial mean stress not reachable by the Neo-Hookean law");
+          const double J    = std::sqrt(1.0 + 2.0 * sm / K);
+          const Stress D    = deviator(sigma) / mu;
+          const double c    = unimodular_shift(D);
+          const Stress bbar = D + c * dealii::unit_symmetric_tensor<3>();
+          b                 = std::pow(J, 2.0 / 3.0) * bbar;
+        }
+      return b;
+    };
+    double J = 1.0;
+    Stress b = b_of_kirchhoff(sigma_cauchy);
+    for (int pass = 0; pass < 30; ++pass)
       {
-        // tau = lambda s I + mu (b - I), s = ln J = 1/2 ln det b: scalar Newton in s.
-        double s = 0.0;
-        for (int it = 0; it < 60; ++it)
-          {
-            b = dealii::unit_symmetric_tensor<3>() + (sigma - lambda * s * dealii::unit_symmetric_tensor<3>()) / mu;
-            const double det = determinant(b);
-            require(det > 0, name.empty() ? "neo hookean" : name,
-                    "initial stress not reachable by the Neo-Hookean law");
-            const double g  = s - 0.5 * std::log(det);
-            const double dg = 1.0 + 0.5 * lambda / mu * trace(invert(b));
-            s -= g / dg;
-            if (std::abs(g) < 1e-15)
-              break;
-          }
-        b = dealii::unit_symmetric_tensor<3>() + (sigma - lambda * s * dealii::unit_symmetric_tensor<3>()) / mu;
-      }
-    else
-      {
-        const double K  = bulk_modulus();
-        const double sm = trace(sigma) / 3.0; // = J p = K (J^2 - 1)/2
-        require(1.0 + 2.0 * sm / K > 0, name.empty() ? "neo hookean" : name,
-                "initial mean stress not reachable by the Neo-Hookean law");
-        const double J    = std::sqrt(1.0 + 2.0 * sm / K);
-        const Stress D    = deviator(sigma) / mu;
-        const double c    = unimodular_shift(D);
-        const Stress bbar = D + c * dealii::unit_symmetric_tensor<3>();
-        b                 = std::pow(J, 2.0 / 3.0) * bbar;
+        const double J_b = std::sqrt(determinant(b));
+        if (std::abs(J_b - J) <= 1e-15 * J_b)
+          break;
+        J = J_b;
+        b = b_of_kirchhoff(J * sigma_cauchy);
       }
     fs::store_sym(b, h, 0);
   }

@@ -47,8 +47,8 @@ namespace talus::materials
       return 6;
     }
     std::vector<std::string> history_names() const override;
-    /// Sets b such that tau(b) = sigma (J = 1 reference, i.e. the given stress is
-    /// taken as Kirchhoff stress of a pre-strained state); sigma = 0 gives b = I.
+    /// Sets b such that the Cauchy stress tau(b) / J(b) is sigma (the given
+    /// stress is that of the initial state); sigma = 0 gives b = I.
     void initialize_history(const Stress &sigma, ArrayView<double> history) const override;
 
     /// Rate form: dF = I + d_eps + d_omega, then the finite-strain update; the

@@ -159,6 +159,7 @@ namespace talus
                           "(muparser syntax, e.g. '0.1*sin(pi*x/2); 0'); overrides 'initial velocity'.");
         prm.declare_entry("function constants", "", Anything(),
                           "Constants for the function, 'name=value, name=value'.");
+        declare_initial_stress(prm);
         prm.leave_subsection();
       }
   }
@@ -402,6 +403,7 @@ namespace talus
         prm.leave_subsection();
         p.bodies.push_back(b);
       }
+    p.initial_stress = parse_initial_stress<dim>(prm, p.bodies, p.gravity);
   }
 
   template <int dim>

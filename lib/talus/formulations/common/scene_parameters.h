@@ -7,6 +7,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/initial_stress.h>
 #include <talus/grid/background_grid.h>
 #include <talus/io/grid_mesh.h>
 #include <talus/loads/rigid_plate.h>
@@ -40,7 +41,9 @@ namespace talus
     dealii::Tensor<1, dim>                                  gravity;
     std::vector<std::shared_ptr<const materials::Material>> materials;
     std::vector<BodyDescription<dim>>                       bodies;
-    ShapeFunction                                           shape_function = ShapeFunction::linear;
+    /// 'body k/initial stress' of every body (initial_stress.h)
+    std::vector<InitialStress> initial_stress;
+    ShapeFunction              shape_function = ShapeFunction::linear;
     bool
     bspline() const
     {

@@ -66,7 +66,7 @@ namespace talus::explicit_mpm
     // the explicit family's own subsections
     declare_numerics_parameters(prm, default_integration);
     declare_liquid_output(prm);
-    loads::declare_parameters(prm, prm_file, counts.dim, counts.n_bodies);
+    loads::declare_parameters(prm, prm_file, counts.dim);
   }
 
   template <int dim>
@@ -100,6 +100,16 @@ namespace talus::explicit_mpm
         prm.enter_subsection(where);
         p.liquid.tractions.push_back(parse_body_traction<dim>(prm, where));
         prm.leave_subsection();
+      }
+    // a water level of the K0 procedure: the pore water of coupled 2-phase points only
+    for (unsigned int k = 0; k < p.bodies.size(); ++k)
+      {
+        const auto &z = p.initial_stress[k];
+        require(!z.enabled || !z.water_level_given ||
+                  p.liquid.pore_liquid[p.bodies[k].material_id].drainage == Drainage::coupled,
+                "body " + std::to_string(k) + "/initial stress/water level",
+                "talus-explicit cannot honour it for material " + std::to_string(p.bodies[k].material_id) +
+                  ", whose points carry no pore water (allowed: empty, or 'pore liquid/drainage = coupled')");
       }
     const unsigned int n_bodies = p.bodies.size();
     p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);

@@ -92,7 +92,7 @@ namespace talus::explicit_mpm
     for (const auto &m : prm.materials)
       n_history = std::max(n_history, m->n_history());
     points.layout.n_history = n_history;
-    if (prm.loads.active() || !prm.rigid_plates.empty())
+    if (prm.loads.active() || !prm.rigid_plates.empty() || any_initial_stress(prm.initial_stress))
       {
         control = std::make_unique<loads::LoadControl<dim>>(prm.loads);
         control->extend_layout(points.layout);

@@ -2,7 +2,7 @@
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/with_kernel.h>
-#include <talus/loads/k0.h>
+#include <talus/formulations/common/initial_stress.h>
 #include <talus/loads/rigid_plate_nodes.h>
 #include <talus/loads/kinematics.h>
 #include <talus/loads/local_damping.h>
@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -55,66 +56,43 @@ namespace talus::loads
     // the stage-0 baselines below (potential energy of both masses) are right
     if (s.two_phase)
       s.two_phase->initialize_particles();
-    const auto             g  = settings.stages[0].gravity;
-    const double           gn = g.norm();
-    dealii::Tensor<1, dim> e; // up: against gravity
-    if (gn > 0)
-      e = -g / gn;
-    unsigned int up_axis = 0;
-    for (unsigned int d = 1; d < dim; ++d)
-      if (std::abs(e[d]) > std::abs(e[up_axis]))
-        up_axis = d;
-    const unsigned int n_bodies = settings.k0.size();
-    // top of every body along e (material point + half its spacing)
-    std::vector<double> top(n_bodies, -std::numeric_limits<double>::max());
-    for (const auto &pt : s.points.handler)
-      {
-        const auto         P = pt.get_properties();
-        const unsigned int b = static_cast<unsigned int>(P[L::body]);
-        if (b >= n_bodies || !settings.k0[b].enabled)
-          continue;
-        const auto  &cc = s.grid.cells[pt.get_surrounding_cell()->active_cell_index()];
-        const double z  = pt.get_location() * e;
-        top[b]          = std::max(top[b], z + 0.5 * cc.h[up_axis] / s.prm.bodies[b].particles_per_direction);
-      }
-    {
-      std::vector<double> all(top.size());
-      dealii::Utilities::MPI::max(dealii::ArrayView<const double>(top), s.comm, dealii::ArrayView<double>(all));
-      top = all;
-    }
+    // the K0 procedure (body k/initial stress, formulations/common/initial_stress.h)
+    GeostaticState<dim> geo(s.prm.initial_stress, settings.stages[0].gravity);
+    geo.find_body_tops({&s.points}, s.grid, s.prm.bodies, s.comm);
+    const double gn = geo.gravity_norm();
+    // the coupled points are saturated: none may lie above the water level
+    unsigned int dry_body = std::numeric_limits<unsigned int>::max();
     for (auto &pt : s.points.handler)
       {
         auto               P = pt.get_properties();
         const unsigned int b = static_cast<unsigned int>(P[L::body]);
-        if (b >= n_bodies || !settings.k0[b].enabled)
+        if (!geo.applies(b))
           continue;
-        const auto  &k     = settings.k0[b];
-        const double level = std::isnan(k.surface_level) ? top[b] : k.surface_level;
-        double       rho   = P[L::mass] / P[L::volume];
-        const double depth = std::max(0.0, level - pt.get_location() * e);
-        // 2-phase point (solid grains + pore liquid, saturated up to the surface
-        // level): K0 gives the effective stress from the buoyant weight
-        // (1 - n0)(rho_S - rho_L) g depth, the pore pressure is hydrostatic
-        // rho_L g depth (compression positive); total stress sigma' - p I.
+        // 2-phase point (solid grains + pore liquid, saturated up to the water
+        // level at or above the surface): K0 gives the effective stress from the
+        // buoyant weight (1 - n0)(rho_S - rho_L) g depth, the pore pressure is
+        // hydrostatic rho_L g (water level - z) (compression positive); total
+        // stress sigma' - p I.
         const unsigned int mat = static_cast<unsigned int>(P[L::material]);
         if (s.two_phase && s.two_phase->coupled &&
             s.prm.liquid.pore_liquid[mat].drainage == explicit_mpm::Drainage::coupled)
           {
-            const auto &pl                = s.prm.liquid.pore_liquid[mat];
-            rho                           = (1 - pl.porosity) * (s.prm.materials[mat]->density() - pl.density);
-            P[s.two_phase->pore_pressure] = pl.density * gn * depth;
+            const auto  &pl               = s.prm.liquid.pore_liquid[mat];
+            const auto   depth            = geo.depths(b, pt.get_location());
+            const double buoyant          = (1 - pl.porosity) * (s.prm.materials[mat]->density() - pl.density);
+            P[s.two_phase->pore_pressure] = pl.density * gn * depth.water;
+            if (depth.dry > 0)
+              dry_body = std::min(dry_body, b);
+            L::set_stress(geo.stress(b, -(buoyant * gn * depth.depth + geo.of(b).surcharge)), P.data());
           }
-        const auto                    k0 = k0_stress(rho * gn, depth, k.surcharge, k.K0);
-        const double                  sv = k0.vertical, sh = k0.horizontal;
-        dealii::SymmetricTensor<2, 3> sigma;
-        for (unsigned int i = 0; i < 3; ++i)
-          for (unsigned int j = i; j < 3; ++j)
-            {
-              const double ei = i < dim ? e[i] : 0.0, ej = j < dim ? e[j] : 0.0;
-              sigma[i][j] = (i == j ? sh : 0.0) + (sv - sh) * ei * ej;
-            }
-        L::set_stress(sigma, P.data());
+        else
+          L::set_stress(geo.one_phase_stress(b, pt.get_location(), P[L::mass] / P[L::volume]), P.data());
       }
+    dry_body = dealii::Utilities::MPI::min(dry_body, s.comm);
+    require(dry_body == std::numeric_limits<unsigned int>::max(),
+            "body " + std::to_string(dry_body) + "/initial stress/water level",
+            "lies below the body's surface level: talus-explicit's coupled 2-phase points are saturated (allowed: "
+            "at or above the surface level, or empty = the surface level)");
     begin_stage(s, 0, false);
   }
 

@@ -374,6 +374,8 @@ namespace talus::implicit_mpm
       loads::refuse_boundary_tractions(st.tractions, "talus-implicit",
                                        "its tractions are carried by material points; allowed: 'body face' or "
                                        "'region' (docs/boundary-conditions.md)");
+    refuse_water_level(p.initial_stress, "talus-implicit",
+                       "its points are one-phase, without pore water (allowed: empty)");
     if (!p.staged)
       {
         require(p.time_step > 0, "time/time step", "must be > 0 (the implicit step is chosen by the user)");

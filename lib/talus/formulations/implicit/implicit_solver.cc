@@ -172,6 +172,18 @@ namespace talus::implicit_mpm
       {
         seed_scene_bodies(grid, prm.bodies, material_densities(prm), points, "material point", &prm);
         using L = PropertyLayout<dim>;
+        if (any_initial_stress(prm.initial_stress)) // the K0 procedure (formulations/common/initial_stress.h)
+          {
+            GeostaticState<dim> geo(prm.initial_stress, prm.gravity);
+            geo.find_body_tops({&points}, grid, prm.bodies, comm);
+            for (auto &pt : points.handler)
+              {
+                auto               P = pt.get_properties();
+                const unsigned int b = static_cast<unsigned int>(P[L::body]);
+                if (geo.applies(b))
+                  L::set_stress(geo.one_phase_stress(b, pt.get_location(), P[L::mass] / P[L::volume]), P.data());
+              }
+          }
         initialize_point_histories(prm.materials, points, L::history);
         for (auto &pt : points.handler)
           {

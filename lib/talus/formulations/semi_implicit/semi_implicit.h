@@ -85,11 +85,6 @@ namespace talus::semi_implicit
     /// rigid skeleton: v_s = 0 at every node, the soil's terms dropped from the
     /// pressure equation (seepage through a fixed soil)
     bool rigid_skeleton = false;
-    // 'initial state' subsection: geostatic water pressure and effective stress
-    bool   geostatic    = false;
-    double water_level  = 0; ///< vertical coordinate of the free water surface
-    double soil_surface = 0; ///< vertical coordinate of the soil surface
-    double K0           = 1;
     /// seed 002 App. B.4: for t < initialisation time gravity ramps from 0, the
     /// soil models are elastic, the water rides on the soil and every soil point
     /// has the conductivity below; at its end the Nor-Sand references are reset

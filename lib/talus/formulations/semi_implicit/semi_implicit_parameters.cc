@@ -118,15 +118,6 @@ namespace talus::semi_implicit
     prm.leave_subsection();
     prm.enter_subsection("initial state");
     {
-      prm.declare_entry("geostatic", "false", Bool(),
-                        "Start from the geostatic state of a horizontally layered scene: pore pressure "
-                        "-rho_w g (water level - y) at water points below the water level, effective "
-                        "vertical stress -(1-n)(rho_s - rho_w) g depth (buoyant below the water level, "
-                        "(1-n) rho_s g above) and horizontal K0 times it at soil points (g = |gravity|).");
-      prm.declare_entry("water level", "0", Double(-1e300, 1e300),
-                        "Vertical coordinate of the free water surface [m].");
-      prm.declare_entry("soil surface", "0", Double(-1e300, 1e300), "Vertical coordinate of the soil surface [m].");
-      prm.declare_entry("K0", "1", Double(0), "Horizontal / vertical effective stress ratio.");
       prm.declare_entry("initialisation time", "0", Double(-1e300, 1e300),
                         "Seed 002 App. B.4 (0: none). For t below this time [s] gravity grows linearly from 0 "
                         "to full, the soil models are elastic (nor sand without plasticity; linear elastic and "
@@ -262,16 +253,13 @@ namespace talus::semi_implicit
       prm.leave_subsection();
     }
 
-    /// 'initial state': geostatic state and the App. B.4 initialisation
+    /// 'initial state': the App. B.4 initialisation (the geostatic start is
+    /// 'body k/initial stress', formulations/common/initial_stress.h)
     template <int dim>
     void
     parse_initial_state(dealii::ParameterHandler &prm, Parameters<dim> &p)
     {
       prm.enter_subsection("initial state");
-      p.geostatic                   = prm.get_bool("geostatic");
-      p.water_level                 = prm.get_double("water level");
-      p.soil_surface                = prm.get_double("soil surface");
-      p.K0                          = prm.get_double("K0");
       p.initialisation_time         = prm.get_double("initialisation time");
       p.initialisation_conductivity = prm.get_double("initialisation conductivity");
       require(std::isfinite(p.initialisation_time) && p.initialisation_time >= 0 && p.initialisation_time <= p.end_time,
@@ -351,6 +339,14 @@ namespace talus::semi_implicit
           require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
                   "single needs every body to carry soil points (the water rides on them), but body " +
                     std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
+      // a soil body has no pore water: its K0 state is the dry weight
+      for (unsigned int b = 0; b < p.bodies.size(); ++b)
+        require(p.phase_of_body[b] != Phase::soil || !p.initial_stress[b].enabled ||
+                  !p.initial_stress[b].water_level_given,
+                "body " + std::to_string(b) + "/initial stress/water level",
+                "body " + std::to_string(b) +
+                  " has phase = soil (soil points only, no pore water: the K0 state takes the dry weight); "
+                  "allowed: empty, or phase = saturated");
       // a dry scene (soil points only) is a single-phase solid: allowed
       (void)any_water;
       require(any_soil, phases,

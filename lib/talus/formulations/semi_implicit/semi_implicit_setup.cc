@@ -164,7 +164,7 @@ namespace talus::semi_implicit
       }
     seed();
     bloads.assign(soil, prm.bodies); // the loaded points' forces and face offsets
-    if (prm.geostatic)
+    if (any_initial_stress(prm.initial_stress))
       geostatic_state();
     initialize_point_histories(prm.materials, soil, soil.layout.history);
     dt = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
@@ -339,30 +339,44 @@ namespace talus::semi_implicit
   void
   Solver<dim>::geostatic_state()
   {
-    const double g = prm.gravity.norm();
+    // 'body k/initial stress' (formulations/common/initial_stress.h): the
+    // water points of a body below its water level hydrostatic, its soil
+    // points the K0 state of the dry weight above the water level and the
+    // buoyant weight below it
+    GeostaticState<dim> geo(prm.initial_stress, prm.gravity);
+    geo.find_body_tops({&soil, &water}, grid, prm.bodies, comm);
+    const double g = geo.gravity_norm();
     for (auto &pt : water.handler)
       {
-        auto         P                    = pt.get_properties();
-        const double y                    = pt.get_location()[dim - 1];
-        P[fw.pressure]                    = -prm.water_density * g * std::max(0.0, prm.water_level - y);
-        P[fw.pressure_gradient + dim - 1] = y < prm.water_level ? prm.water_density * g : 0.0;
+        auto               P = pt.get_properties();
+        const unsigned int b = static_cast<unsigned int>(P[L::body]);
+        if (!geo.applies(b))
+          continue;
+        const double depth = geo.depths(b, pt.get_location()).water;
+        P[fw.pressure]     = -prm.water_density * g * depth;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double up_d           = geo.up_direction()[d];
+            P[fw.pressure_gradient + d] = depth > 0 && up_d != 0 ? prm.water_density * g * up_d : 0.0;
+          }
       }
     for (auto &pt : soil.handler)
       {
-        auto               P  = pt.get_properties();
-        const double       y  = pt.get_location()[dim - 1];
-        const unsigned int m  = static_cast<unsigned int>(P[L::material]);
-        const double       n  = P[fs.porosity];
-        const double       rs = prm.materials[m]->density();
-        // dry unit weight above the water level, buoyant below
-        const double                  above = std::max(0.0, prm.soil_surface - std::max(y, prm.water_level));
-        const double                  below = std::max(0.0, std::min(prm.soil_surface, prm.water_level) - y);
-        const double                  sv    = -(1 - n) * g * (rs * above + (rs - prm.water_density) * below);
-        dealii::SymmetricTensor<2, 3> s;
-        for (unsigned int d = 0; d < 3; ++d)
-          s[d][d] = prm.K0 * sv;
-        s[dim - 1][dim - 1] = sv;
-        L::set_stress(s, P.data());
+        auto               P = pt.get_properties();
+        const unsigned int b = static_cast<unsigned int>(P[L::body]);
+        if (!geo.applies(b))
+          continue;
+        const unsigned int m     = static_cast<unsigned int>(P[L::material]);
+        const double       n     = P[fs.porosity];
+        const double       rs    = prm.materials[m]->density();
+        const auto         depth = geo.depths(b, pt.get_location());
+        // dry unit weight above the water level, buoyant below; a soil body
+        // (no pore water) dry throughout
+        const double sv =
+          prm.phase_of_body[b] == Phase::soil
+            ? -(1 - n) * g * rs * depth.depth - geo.of(b).surcharge
+            : -(1 - n) * g * (rs * depth.dry + (rs - prm.water_density) * depth.submerged) - geo.of(b).surcharge;
+        L::set_stress(geo.stress(b, sv), P.data());
       }
   }
 
