@@ -4,7 +4,13 @@
 // balance for the nodal displacement increment, and the converged increment is
 // carried back to the points (Algorithm 1). Static analysis drops the inertia.
 // The time loop (formulations/common/time_loop.h) drives it; a step whose
-// Newton iteration fails is cut back by the loop.
+// Newton iteration fails is cut back by the loop. The Solver's parts:
+// implicit_parameters.cc (the .prm), implicit_setup.cc (set-up, stages,
+// plates' DoFs, description; instantiates the Solver), implicit_step.cc
+// (advance_by: a driver of the step's phases), implicit_assembly.cc (residual,
+// tangent, linear solves), implicit_constraints.cc (contact walls on the
+// nodes, the step's constraints, prescribed DoFs and reactions),
+// implicit_output.cc (series, files, checkpoints, summary).
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
@@ -21,6 +27,7 @@
 #include <talus/loads/rigid_plate.h>
 #include <talus/loads/settings.h>
 #include <talus/particles/material_point_set.h>
+#include <talus/shape/with_kernel.h>
 #include <talus/solvers/linear_solver.h>
 #include <talus/transfer/active_set.h>
 
@@ -30,6 +37,7 @@
 
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <type_traits>
 #include <string>
 #include <vector>
@@ -243,6 +251,43 @@ namespace talus::implicit_mpm
     void grid_changed() override;
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
+    /// What the phases of one step (advance_by) share.
+    struct StepState
+    {
+      double                 h = 0;
+      dealii::Tensor<1, dim> g;         ///< the body force at t + h (apply_loads_at)
+      double                 f_ext = 0; ///< the load scale of Newton's residual test
+      NewtonResult           result;    ///< the last Newton solve, its iterations those of all passes
+      /// Newton solves (contact passes) of the step, nodes released and put in contact over them
+      unsigned int       passes = 0, released = 0, added = 0;
+      unsigned int       linear_iterations     = 0;
+      double             worst_linear_residual = 0;
+      bool               any_contact           = false; ///< contact nodes on some rank
+      std::ostringstream pass_log;                      ///< the passes that changed the active set
+    };
+    /// The step's start: Newmark's step, the footing's time, prepare_step(), the
+    /// body force at t + h, the damping stiffness ('rayleigh beta'), the external
+    /// force scale and the force plates' targets at t + h.
+    StepState begin_step(const double h);
+    /// The first iterate: du = 0, the lifted predictor of the prescribed DoFs
+    /// (collective), mixed u-p: the pressure predictor. false: the predictor
+    /// failed (the step is cut back).
+    bool predict(const StepState &s);
+    /// Newton, then (contact walls on the nodes) the active set from the
+    /// converged state's reactions and penetrations; a change re-solves from
+    /// there. false: the contact reactions failed (the step is cut back).
+    bool solve_newton(StepState &s);
+    /// The step's StepReport (last) and the run's totals.
+    void report_newton(const StepState &s);
+    /// A converged step: the reactions of the prescribed nodes and plates, the
+    /// shift of the velocity regions, the plates' displacements. false: the
+    /// reactions failed (the step is cut back).
+    bool apply_reactions(const StepState &s);
+    /// The converged increment to the points: the contact state of the points,
+    /// the convective phase (CommitUpdatedLagrangian), relocation.
+    void convective_phase(const StepState &s);
+    /// The step's log line.
+    void log_step(const StepState &s);
     /// The wall constraints (fixed/roller walls, prescribed DoFs with `values`,
     /// and the contact nodes now in contact) merged with the inactive pins.
     dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values          = nullptr,
@@ -306,15 +351,21 @@ namespace talus::implicit_mpm
         f(std::integral_constant<unsigned int, dim>());
     }
     /// f(K()) with K the shape kernel of 'numerics/shape function'
-    /// (defined in implicit_solver.cc, its only user)
     template <class F>
-    void with_kernel(F &&f) const;
+    void
+    with_kernel(F &&f) const
+    {
+      shape::with_kernel<dim>(prm.bspline(), std::forward<F>(f));
+    }
     /// 'rayleigh beta' > 0: damping_stiffness = the force tangent at du = 0 (the step's start)
     void assemble_damping_stiffness(const dealii::Tensor<1, dim> &g);
     /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
     void nodal_acceleration(Vector &a) const;
     /// The newest valid checkpoint into the state (false: none). Collective.
     bool restore_checkpoint();
+    /// axisymmetric, a fresh start: the seeded points' volume, mass and traction
+    /// forces become those of their rings (docs/implicit.md, "Axisymmetry")
+    void ring_measure();
 
     unsigned int acceleration_offset = 0;
     unsigned int pressure_offset     = dealii::numbers::invalid_unsigned_int; ///< mixed u-p: p_p

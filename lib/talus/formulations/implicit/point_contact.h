@@ -6,7 +6,7 @@
 // point touched the wall: a stick anchor per point and wall), frictionless, or
 // Coulomb friction (stick/slip return with mu). The contact point moves with
 // the material instead of jumping between grid nodes (the node-based
-// 'contact' walls of implicit_solver.cc). The same law serves a rigid
+// 'contact' walls of implicit_constraints.cc). The same law serves a rigid
 // footing: a plane of finite span moving at a prescribed rate (docs/implicit.md,
 // "Rigid footing on the points").
 //
