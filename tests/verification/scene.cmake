@@ -20,3 +20,11 @@ add_test(NAME verification.rigid_plate_bad_input
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_rigid_plate_input.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
                  ${_w}/rigid_plate_bad_input)
 set_tests_properties(verification.rigid_plate_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# one .prm vocabulary (issue 37 item 2): the same 'damping' / 'material k/pore liquid'
+# fragment (parameter_files/verification/vocabulary/*.inc) accepted by the tools that
+# honour it (the value seen in the run) and refused with exit 2 by the others
+add_test(NAME verification.vocabulary_fragments
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_vocabulary.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/vocabulary_fragments)
+set_tests_properties(verification.vocabulary_fragments PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
