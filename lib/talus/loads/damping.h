@@ -32,8 +32,7 @@ namespace talus::loads
   /// Reads the subsection 'damping' at the current level; `path` is the
   /// prefix of the entries in messages ("" or "stage 1"); `base` (a stage's):
   /// the values an entry of -1 inherits. Checks the ranges (InputError).
-  Damping parse_damping(dealii::ParameterHandler &prm, const std::string &path = "",
-                        const Damping *base = nullptr);
+  Damping parse_damping(dealii::ParameterHandler &prm, const std::string &path = "", const Damping *base = nullptr);
 
   /// InputError naming 'damping/<entry>' when `value` is not 0: the family
   /// `tool` cannot honour it, for `reason` (which should say what is allowed).
