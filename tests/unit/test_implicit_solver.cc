@@ -261,8 +261,11 @@ namespace
   // alpha_R M v) and in the tangent (coef M) on the free DoFs. With h = 0.01 s
   // the inertia (1/(beta h^2) m_p ~ 6e5 N/m per point) is as large as the
   // stiffness, so a wrong factor or a wrong block shows.
-  const std::string consistent        = " set mass matrix = consistent\n";
-  const std::string consistent_damped = " set mass matrix = consistent\n set rayleigh alpha = 1.5\n";
+  const std::string consistent = " set mass matrix = consistent\n";
+  // (the implicit_extra text sits inside 'subsection implicit': the shared
+  // 'damping' section is closed and reopened around it)
+  const std::string viscous_damping = "end\nsubsection damping\n set viscous damping = 1.5\nend\nsubsection implicit\n";
+  const std::string consistent_damped = " set mass matrix = consistent\n" + viscous_damping;
   TEST(ImplicitTangent, ConsistentMassDynamic2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent), 1e-6);
@@ -286,18 +289,19 @@ namespace
     EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, consistent, 1.0, point_floor), 1e-6);
   }
 
-  // 'rayleigh beta': C = beta_R K_n, K_n the force tangent at the step's start (du = 0),
+  // 'damping/stiffness damping' (Rayleigh beta): C = beta_R K_n, K_n the force tangent at the step's start (du = 0),
   // held for the step: r += beta_R K_n v^{n+1}(du), tangent += beta_R gamma/(beta h) K_n.
   // With h = 0.01 s, gamma/(beta h) = 200, so beta_R = 0.01 doubles the stiffness part of
   // the tangent: a missing or wrong damping term shows at order 1.
-  const std::string rayleigh_beta = " set rayleigh beta = 0.01\n";
+  const std::string rayleigh_beta =
+    "end\nsubsection damping\n set stiffness damping = 0.01\nend\nsubsection implicit\n";
   TEST(ImplicitTangent, RayleighBetaDynamic2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "dynamic", 1e-2, 0, 9.81, rayleigh_beta), 1e-6);
   }
   TEST(ImplicitTangent, RayleighBetaJ2AfterSteps2D)
   {
-    EXPECT_LT(tangent_error<2>(j2, "dynamic", 1e-2, 2, 9.81, rayleigh_beta + " set rayleigh alpha = 1.5\n"), 1e-5);
+    EXPECT_LT(tangent_error<2>(j2, "dynamic", 1e-2, 2, 9.81, rayleigh_beta + viscous_damping), 1e-5);
   }
   TEST(ImplicitTangent, RayleighBetaDynamic3D)
   {

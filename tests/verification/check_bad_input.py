@@ -91,13 +91,23 @@ cases.update({
                    "boundary conditions/rigid plate 0/direction", "y"),
         ["boundary conditions/rigid plate 0", "holds its direction component at every one of its 41 node(s)"]),
 })
+# the shared 'damping' (loads/damping.h; issue 37): stiffness damping needs a stiffness matrix
+cases.update({
+    "stiffness damping": (tv.prm_set(base, "damping/stiffness damping", "1e-3"),
+                          ["damping/stiffness damping", "is 0.001", "talus-explicit cannot honour it", "allowed: 0"]),
+    "local damping 1": (tv.prm_set(base, "damping/local damping", "1"), ["damping/local damping", "[0, 1)"]),
+    "stage stiffness damping": (tv.prm_set(tv.prm_set(base, "number of stages", "1"),
+                                           "stage 0/damping/stiffness damping", "1e-3"),
+                                ["stiffness damping"]),
+})
 for name, (text, needles) in cases.items():
     rc, out, err = tv.run_tool(tool, text, work, name.replace(" ", "_"), expect_rc=None)
     msg = err.strip()
     ok = rc == 2 and all(n in msg for n in needles) and msg.count("\n") < 6 and \
         msg.startswith(os.path.basename(tool) + ": error:")
     tv.check(ok, f"{name}: exit {rc}, message: {msg[:300]}")
-    if name in ("output directory cannot be created", "box partly outside grid", "grid too large for the memory"):
+    if name in ("output directory cannot be created", "box partly outside grid", "grid too large for the memory",
+                "stiffness damping"):
         # --check refuses it too (before any heavy work)
         prm = os.path.join(work, name.replace(" ", "_") + ".prm")
         p = subprocess.run([os.path.abspath(tool), "--check", prm], cwd=work, capture_output=True, text=True,

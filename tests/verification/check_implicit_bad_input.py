@@ -6,6 +6,9 @@ the right exit code, no NaN written.
     mixed u-p without the split Neo-Hookean energy or with a pressure-dependent
     yield (hencky mohr coulomb), in a dynamic run or with an
     iterative solver, a traction with both 'traction' and 'total force';
+    the shared 'damping' it cannot honour (local damping; any damping in a
+    static run; stiffness damping with mixed u-p) and a pore liquid other than
+    drained;
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
@@ -60,14 +63,22 @@ cases = {
     "feature not built yet": (tv.prm_set(base, "output/probes", "4, 0.5"), ["output/probes", "not available"]),
     "mass matrix misspelt": (tv.prm_set(base, "implicit/mass matrix", "consistant"),
                              ["mass matrix", "consistant", "lumped|consistent"]),
-    "damping in a static run": (tv.prm_set(base, "implicit/rayleigh alpha", "1"), ["rayleigh alpha", "dynamic"]),
-    "stiffness damping in a static run": (tv.prm_set(base, "implicit/rayleigh beta", "0.01"),
-                                          ["rayleigh beta", "dynamic"]),
+    # the shared 'damping' (loads/damping.h) and 'material k/pore liquid' (materials/pore_liquid.h)
+    "damping in a static run": (tv.prm_set(base, "damping/viscous damping", "1"),
+                                ["damping/viscous damping", "talus-implicit cannot honour it", "dynamic"]),
+    "stiffness damping in a static run": (tv.prm_set(base, "damping/stiffness damping", "0.01"),
+                                          ["damping/stiffness damping", "dynamic"]),
     "stiffness damping with mixed up": (
         tv.prm_set_args(base, ["implicit/analysis=dynamic", "implicit/formulation=mixed up",
-                               "material 0/neo hookean/volumetric energy=split", "implicit/rayleigh beta=0.01"]),
-        ["implicit/rayleigh beta", "irreducible", "mixed up"]),
-    "negative stiffness damping": (tv.prm_set(base, "implicit/rayleigh beta", "-1"), ["rayleigh beta", "-1"]),
+                               "material 0/neo hookean/volumetric energy=split", "damping/stiffness damping=0.01"]),
+        ["damping/stiffness damping", "irreducible", "mixed up"]),
+    "negative stiffness damping": (tv.prm_set(base, "damping/stiffness damping", "-1"), ["stiffness damping", "-1"]),
+    "local damping": (tv.prm_set_args(base, ["implicit/analysis=dynamic", "damping/local damping=0.7"]),
+                      ["damping/local damping", "talus-implicit cannot honour it", "allowed: 0"]),
+    "coupled pore liquid": (tv.prm_set(base, "material 0/pore liquid/drainage", "coupled"),
+                            ["material 0/pore liquid/drainage", "is 'coupled'", "1-phase", "allowed: drained"]),
+    "undrained pore liquid": (tv.prm_set(base, "material 0/pore liquid/drainage", "undrained"),
+                              ["material 0/pore liquid/drainage", "is 'undrained'"]),
     "static without supports": (tv.prm_set(base, "boundary conditions/fixed", ""), ["boundary conditions", "static",
                                                                                    "singular"]),
     "mixed up without the split energy": (tv.prm_set(base, "implicit/formulation", "mixed up"),

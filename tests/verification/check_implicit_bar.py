@@ -27,7 +27,7 @@ tools, prm_path, work = args[1:4]
 text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 text = tv.prm_set_args(text, args[4:])  # entry=value: e.g. the same bar in mixed u-p
 if rayleigh_beta > 0:
-    text = tv.prm_set(text, "implicit/rayleigh beta", str(rayleigh_beta))
+    text = tv.prm_set(text, "damping/stiffness damping", str(rayleigh_beta))
 _, out, _ = tv.run_tool(f"{tools}/talus-implicit", text, work, "bar")
 print(out.strip().splitlines()[-2])
 E, rho, L, h, dt = 100.0, 1.0, 1.0, 1.25 / 40, 0.03125

@@ -13,11 +13,29 @@ import talus_verify as tv
 tool, prm_path, work = sys.argv[1:4]
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 cases = [
-    ("porosity above 1", [("material 0/soil/porosity", "1.2")], "material 0/soil/porosity"),
-    ("porosity 0", [("material 0/soil/porosity", "0")], "material 0/soil/porosity"),
-    ("zero conductivity", [("material 0/soil/hydraulic conductivity", "0")], "material 0/soil/hydraulic conductivity"),
-    ("negative conductivity", [("material 0/soil/hydraulic conductivity", "-1e-5")],
-     "material 0/soil/hydraulic conductivity"),
+    # the shared 'material k/pore liquid' (materials/pore_liquid.h; issue 37)
+    ("porosity above 1", [("material 0/pore liquid/porosity", "1.2")], "material 0/pore liquid/porosity"),
+    ("porosity 0", [("material 0/pore liquid/porosity", "0")], "material 0/pore liquid/porosity"),
+    ("zero conductivity", [("material 0/pore liquid/hydraulic conductivity", "0"),
+                           ("material 0/pore liquid/intrinsic permeability", "0")],
+     "material 0/pore liquid/intrinsic permeability"),
+    ("negative conductivity", [("material 0/pore liquid/hydraulic conductivity", "-1e-5")],
+     "hydraulic conductivity"),
+    ("undrained pore liquid", [("material 0/pore liquid/drainage", "undrained")],
+     "material 0/pore liquid/drainage: is 'undrained'"),
+    ("liquid density other than the water's", [("material 0/pore liquid/liquid density", "1100")],
+     "material 0/pore liquid/liquid density: is 1100 kg/m^3: talus-semi-implicit has one water"),
+    ("liquid bulk modulus", [("material 0/pore liquid/liquid bulk modulus", "2.2e7")],
+     "material 0/pore liquid/liquid bulk modulus: is 2.2e+07 Pa: talus-semi-implicit's water is incompressible"),
+    ("zero liquid viscosity", [("material 0/pore liquid/liquid viscosity", "0")],
+     "material 0/pore liquid/liquid viscosity"),
+    # the shared 'damping' (loads/damping.h): the family has no damping term
+    ("local damping", [("damping/local damping", "0.7")],
+     "damping/local damping: is 0.7: talus-semi-implicit cannot honour it: talus-semi-implicit has no damping term"),
+    ("viscous damping", [("damping/viscous damping", "1.5")],
+     "damping/viscous damping: is 1.5: talus-semi-implicit cannot honour it"),
+    ("stiffness damping", [("damping/stiffness damping", "1e-3")],
+     "damping/stiffness damping: is 0.001: talus-semi-implicit cannot honour it"),
     # a water body alone: no soil, so no skeleton for the drag and the mixture
     ("water without soil", [("body 0/phase", "water")], "body 0/phase = water"),
     # (soil without water is a single-phase solid and allowed: the strip footing)

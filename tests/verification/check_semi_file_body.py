@@ -103,7 +103,7 @@ mesh_m1 = mesh_prm.replace("output/mesh/semi_column_2d", "files_m1").replace("se
                                                                               "set material             = 1")
 tv.run_tool(os.path.join(tools, "talus-mesh"), mesh_m1, work, "mesh_m1")
 start = base.index("subsection material 0")
-end = base.index("\nend\n", base.index("subsection soil", start)) + len("\nend\n")
+end = base.index("\nend\n", base.index("subsection pore liquid", start)) + len("\nend\n")
 column_material = base[start:end]
 other = column_material.replace("set porosity               = 0.3", "set porosity               = 0.45")
 other = other.replace("set density = 2650", "set density = 2000")

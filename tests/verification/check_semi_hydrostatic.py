@@ -32,7 +32,7 @@ if end_time:
     base = tv.prm_set(base, "time/end time", end_time)
 dts = {}
 for k in ("1e-3", "1e-7"):
-    text = tv.prm_set(base, "material 0/soil/hydraulic conductivity", k)
+    text = tv.prm_set(base, "material 0/pore liquid/hydraulic conductivity", k)
     name = f"k{k}"
     _, out, _ = tv.run_tool(tool, text, f"{work}/{name}", name)
     m = re.search(r"time step ([0-9.eE+-]+) s", out)

@@ -25,7 +25,7 @@ base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 if linear:
     base = tv.prm_set(base, "numerics/shape function", "linear")
 for k in ("1e-3", "1e-7"):
-    text = tv.prm_set(base, "material 0/soil/hydraulic conductivity", k)
+    text = tv.prm_set(base, "material 0/pore liquid/hydraulic conductivity", k)
     name = f"k{k}"
     _, out, err = tv.run_tool(tool, text, f"{work}/{name}", name)
     w = tv.read_csv(f"{work}/{name}/out/water_final.csv")

@@ -23,7 +23,7 @@ tool, prm_path, work = sys.argv[1:4]
 L, dh = 1.0, 1.2
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")
 for k, shape in (("1e-3", "quadratic bspline"), ("1e-4", "quadratic bspline"), ("1e-3", "linear")):
-    text = tv.prm_set(base, "material 0/soil/hydraulic conductivity", k)
+    text = tv.prm_set(base, "material 0/pore liquid/hydraulic conductivity", k)
     text = tv.prm_set(text, "numerics/shape function", shape)
     name = f"k{k}_" + shape.split()[-1]
     tv.run_tool(tool, text, f"{work}/{name}", name)

@@ -157,7 +157,7 @@ add_test(NAME verification.semi_implicit_large_consolidation_fast
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_large_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_large_consolidation.prm
                  ${_w}/semi_implicit_large_consolidation_fast 0.01 hencky,hencky@top,hencky+kc,small-strain
-                 "--set=material 0/soil/hydraulic conductivity=1e-2" "--set=time/end time=1.962"
+                 "--set=material 0/pore liquid/hydraulic conductivity=1e-2" "--set=time/end time=1.962"
                  "--set=output/series interval=0.01")
 set_tests_properties(verification.semi_implicit_large_consolidation_fast PROPERTIES LABELS "fast"
                      ENVIRONMENT "${_env}" TIMEOUT 900)

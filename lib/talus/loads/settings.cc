@@ -1,5 +1,6 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
+#include <talus/loads/damping.h>
 #include <talus/loads/settings.h>
 
 #include <deal.II/base/utilities.h>
@@ -220,16 +221,7 @@ namespace talus::loads
     void
     declare_switches(dealii::ParameterHandler &prm, const bool stage)
     {
-      prm.enter_subsection("damping");
-      prm.declare_entry("local damping", stage ? "-1" : "0", Double(stage ? -1 : 0, 1),
-                        "Local damping factor alpha of seed 000 §6.3 (Eq. 6.23): nodal f_damp = -alpha |f| sign(v); "
-                        "0 = off; 0.7-0.8 for quasi-static runs." +
-                          std::string(stage ? " -1: as the top-level 'damping'." : ""));
-      prm.declare_entry("viscous damping", stage ? "-1" : "0", Double(stage ? -1 : 0),
-                        "Mass-proportional (Rayleigh alpha) damping [1/s]: nodal f_damp = -alpha_v m_i v_i (the "
-                        "damping of the granular column collapse of seed 001 §6.1, alpha = 1.5 1/s); 0 = off." +
-                          std::string(stage ? " -1: as the top-level 'damping'." : ""));
-      prm.leave_subsection();
+      declare_damping(prm, stage); // the shared section (loads/damping.h)
       prm.enter_subsection("mass scaling");
       prm.declare_entry("factor", stage ? "-1" : "1", Double(stage ? -1 : 0),
                         "Mass scaling factor beta of seed 000 §6.5: inertia beta m (gravity keeps m); the critical "
@@ -259,15 +251,15 @@ namespace talus::loads
     parse_switches(dealii::ParameterHandler &prm, const std::string &path, Stage<dim> &s, const Stage<dim> *base)
     {
       const std::string pre = path.empty() ? "" : path + "/";
-      prm.enter_subsection("damping");
-      const double a = prm.get_double("local damping");
-      s.damping      = (a < 0 && base) ? base->damping : a;
-      require(s.damping >= 0 && s.damping < 1, pre + "damping/local damping", "must be in [0, 1)");
-      const double av   = prm.get_double("viscous damping");
-      s.viscous_damping = (av < 0 && base) ? base->viscous_damping : av;
-      require(s.viscous_damping >= 0 && std::isfinite(s.viscous_damping), pre + "damping/viscous damping",
-              "must be >= 0 [1/s]");
-      prm.leave_subsection();
+      Damping           inherited; // a stage's -1 entries: the top level's values
+      if (base)
+        {
+          inherited.local   = base->damping;
+          inherited.viscous = base->viscous_damping;
+        }
+      const Damping d   = parse_damping(prm, path, base ? &inherited : nullptr);
+      s.damping         = d.local;
+      s.viscous_damping = d.viscous;
       prm.enter_subsection("mass scaling");
       const double b = prm.get_double("factor");
       s.mass_scaling = (b < 0 && base) ? base->mass_scaling : b;

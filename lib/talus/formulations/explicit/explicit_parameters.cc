@@ -9,6 +9,7 @@
 #include <talus/formulations/explicit/input_checks.h>
 #include <talus/formulations/explicit/load_control.h>
 #include <talus/io/png_snapshots.h>
+#include <talus/loads/damping.h>
 #include <talus/loads/kinematics.h>
 #include <talus/shape/bspline2.h>
 
@@ -54,7 +55,7 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < counts.n_materials; ++k)
       {
         prm.enter_subsection("material " + std::to_string(k));
-        declare_pore_liquid(prm);
+        materials::declare_pore_liquid(prm); // the shared section
         prm.leave_subsection();
       }
     for (unsigned int k = 0; k < counts.n_bodies; ++k)
@@ -118,6 +119,11 @@ namespace talus::explicit_mpm
       loads::refuse_boundary_tractions(st.tractions, "talus-explicit",
                                        "its tractions are carried by material points; allowed: 'body face' or "
                                        "'region' (docs/boundary-conditions.md)");
+    // the shared 'damping' section (loads/damping.h): local and viscous damping
+    // are read into the stages by loads::parse_parameters
+    loads::refuse_damping(loads::parse_damping(prm).stiffness, "stiffness damping", "talus-explicit",
+                          "the explicit step has no stiffness matrix to damp with; allowed: 0 (damp with 'viscous "
+                          "damping' or 'local damping')");
     if (p.loads.staged)
       {
         p.end_time = 0; // the sum of the stage durations

@@ -137,70 +137,28 @@ namespace talus::explicit_mpm
   } // namespace
 
   // ================================================================ parameters
-  void
-  declare_pore_liquid(dealii::ParameterHandler &prm)
-  {
-    prm.enter_subsection("pore liquid");
-    prm.declare_entry("drainage", "drained", Selection("drained|undrained|coupled"),
-                      "Pore liquid of this material (seed 000 §4.3.8, §4.5): 'drained' (1-phase, no pore "
-                      "pressure; 'density' is the bulk density), 'undrained' (1-phase effective-stress "
-                      "analysis: excess pore pressure dp = -(K_L/n) tr(d eps), total stress = effective - p I; "
-                      "'density' is the saturated bulk density), 'coupled' (2-phase single point, §4.5: "
-                      "'density' is the density of the solid grains rho_S).");
-    prm.declare_entry("porosity", "0.3", Double(0), "Initial porosity n_0, 0 < n_0 < 1 (undrained, coupled).");
-    prm.declare_entry("liquid density", "1000", Double(0), "Density of the pore liquid rho_L [kg/m^3] (coupled).");
-    prm.declare_entry("liquid bulk modulus", "2.2e9", Double(0),
-                      "Bulk modulus of the pore liquid K_L [Pa] (undrained, coupled).");
-    prm.declare_entry("liquid viscosity", "1e-3", Double(0),
-                      "Dynamic viscosity of the pore liquid mu_d [Pa s] (coupled).");
-    prm.declare_entry("intrinsic permeability", "1e-10", Double(0),
-                      "Intrinsic permeability kappa [m^2] (coupled); the Darcy permeability is "
-                      "k = kappa rho_L g / mu_d (Eq. 3.25).");
-    prm.declare_entry("hydraulic conductivity", "0", Double(0),
-                      "Alternative to 'intrinsic permeability': the Darcy permeability k [m/s]; when > 0, "
-                      "kappa = k mu_d / (rho_L g).");
-    prm.declare_entry("permeability gravity", "9.81", Double(0),
-                      "g of Eq. 3.25 [m/s^2], independent of the gravity vector (a consolidation test "
-                      "without body force still has k = kappa rho_L g / mu_d).");
-    prm.leave_subsection();
-  }
-
   PoreLiquid
   parse_pore_liquid(dealii::ParameterHandler &prm, const std::string &where_m,
                     std::shared_ptr<const materials::Material> &material)
   {
-    prm.enter_subsection("pore liquid");
     const std::string where = where_m + "/pore liquid";
-    PoreLiquid        p;
-    const std::string d = prm.get("drainage");
-    p.drainage     = d == "coupled" ? Drainage::coupled : d == "undrained" ? Drainage::undrained : Drainage::drained;
-    p.porosity     = prm.get_double("porosity");
-    p.density      = prm.get_double("liquid density");
-    p.bulk_modulus = prm.get_double("liquid bulk modulus");
-    p.viscosity    = prm.get_double("liquid viscosity");
-    p.intrinsic_permeability = prm.get_double("intrinsic permeability");
-    p.gravity                = prm.get_double("permeability gravity");
-    const double k           = prm.get_double("hydraulic conductivity");
-    prm.leave_subsection();
+    PoreLiquid        p     = materials::read_pore_liquid(prm);
     if (p.drainage == Drainage::drained)
       return p;
     require(!is_liquid_model(*material), where + "/drainage",
-            "'" + d + "' needs a soil skeleton model; model '" + material->model_name() +
-              "' is a liquid (allowed for liquids: drained)");
-    require(p.porosity > 0 && p.porosity < 1, where + "/porosity", "must satisfy 0 < n < 1");
+            "'" + materials::drainage_name(p.drainage) + "' needs a soil skeleton model; model '" +
+              material->model_name() + "' is a liquid (allowed for liquids: drained)");
+    materials::check_porosity(p, where);
     require(p.bulk_modulus > 0, where + "/liquid bulk modulus", "must be > 0");
     if (p.drainage == Drainage::undrained)
       {
         material = std::make_shared<UndrainedEffectiveStress>(material, p.bulk_modulus, p.porosity);
         return p;
       }
-    require(p.density > 0, where + "/liquid density", "must be > 0");
-    require(p.viscosity > 0, where + "/liquid viscosity", "must be > 0");
-    require(p.gravity > 0, where + "/permeability gravity", "must be > 0");
-    if (k > 0)
-      p.intrinsic_permeability = k * p.viscosity / (p.density * p.gravity);
-    require(p.intrinsic_permeability > 0, where + "/intrinsic permeability",
-            "must be > 0 (or give 'hydraulic conductivity' > 0)");
+    materials::check_seepage(p, where);
+    // the 2-phase step's drag n mu_d / kappa uses kappa (Eq. 3.25)
+    if (p.conductivity > 0)
+      p.intrinsic_permeability = p.conductivity * p.viscosity / (p.density * p.gravity);
     return p;
   }
 
@@ -294,7 +252,8 @@ namespace talus::explicit_mpm
           {
             // seed 000 §4.6.3. rho_S = 'density', E_c of the skeleton.
             const double n = pl.porosity, rS = m.density(), rL = pl.density, KL = pl.bulk_modulus;
-            const double Ec = m.constrained_modulus(), g = pl.gravity, k_d = pl.darcy_permeability();
+            const double Ec = m.constrained_modulus(), g = pl.gravity,
+                         k_d = pl.intrinsic_permeability * pl.density * pl.gravity / pl.viscosity;
             const double rho = (1 - n) * rS + n * rL;           // Eq. 4.127
             const double Ecu = Ec + KL / n;                     // Eq. 4.126
             c.wave_speed     = std::sqrt(Ecu / rho);            // Eq. 4.125

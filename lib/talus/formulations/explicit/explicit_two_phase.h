@@ -14,6 +14,7 @@
 #include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/explicit/forward.h>
 #include <talus/materials/material.h>
+#include <talus/materials/pore_liquid.h>
 #include <talus/particles/material_points.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -25,30 +26,9 @@
 
 namespace talus::explicit_mpm
 {
-  enum class Drainage
-  {
-    drained,   ///< 1-phase, no pore pressure (dry, or drained with zero excess pressure)
-    undrained, ///< 1-phase effective-stress analysis, Eq. 4.52 (pore pressure from the volumetric strain)
-    coupled    ///< 2-phase, single material point (§3.4, §4.5)
-  };
-
-  /// Pore liquid of one material ("material k/pore liquid" in the .prm).
-  struct PoreLiquid
-  {
-    Drainage drainage               = Drainage::drained;
-    double   porosity               = 0.3;   ///< n_0 [-]
-    double   density                = 1000;  ///< rho_L [kg/m^3]
-    double   bulk_modulus           = 2.2e9; ///< K_L [Pa]
-    double   viscosity              = 1e-3;  ///< mu_d [Pa s]
-    double   intrinsic_permeability = 1e-10; ///< kappa [m^2]
-    double   gravity                = 9.81;  ///< g of Eq. 3.25 [m/s^2]
-    /// Darcy permeability k = kappa rho_L g / mu_d (Eq. 3.25) [m/s]
-    double
-    darcy_permeability() const
-    {
-      return intrinsic_permeability * density * gravity / viscosity;
-    }
-  };
+  // the shared 'material k/pore liquid' (materials/pore_liquid.h)
+  using materials::Drainage;
+  using materials::PoreLiquid;
 
   /// "body k/traction face", "body k/traction": an alias of a constant global
   /// loads/traction on that face of a box body (added by loads::parse_parameters);
@@ -71,14 +51,15 @@ namespace talus::explicit_mpm
     bool                           any_traction() const;
   };
 
-  /// .prm declarations: inside a "material k" subsection, inside a "body k"
-  /// subsection, and the top-level "liquid" subsection.
-  void declare_pore_liquid(dealii::ParameterHandler &prm);
+  /// .prm declarations: inside a "body k" subsection, and the top-level
+  /// "liquid" subsection ('material k/pore liquid': materials::declare_pore_liquid).
   void declare_body_traction(dealii::ParameterHandler &prm, const unsigned int dim);
   void declare_liquid_output(dealii::ParameterHandler &prm);
 
-  /// Read "pore liquid" of the current material subsection. For undrained
-  /// materials `material` is replaced by the effective-stress wrapper.
+  /// Read "pore liquid" of the current material subsection and check what
+  /// talus-explicit needs of it; a given hydraulic conductivity becomes kappa =
+  /// k mu_d / (rho_L g). For undrained materials `material` is replaced by the
+  /// effective-stress wrapper.
   PoreLiquid parse_pore_liquid(dealii::ParameterHandler &prm, const std::string &where,
                                std::shared_ptr<const materials::Material> &material);
   template <int dim>

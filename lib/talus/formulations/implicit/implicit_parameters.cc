@@ -7,7 +7,9 @@
 #include <talus/formulations/common/run_formulation.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/implicit/implicit_solver.h>
+#include <talus/loads/damping.h>
 #include <talus/loads/kinematics.h>
+#include <talus/materials/pore_liquid.h>
 
 #include <cmath>
 #include <limits>
@@ -67,6 +69,14 @@ namespace talus::implicit_mpm
                         "material, V_p its volume, h the cell size normal to the wall).");
     }
     prm.leave_subsection();
+    loads::declare_damping(prm); // the shared 'damping' (loads/damping.h)
+    for (unsigned int k = 0; k < counts.n_materials; ++k)
+      {
+        // the shared 'pore liquid' (materials/pore_liquid.h): drained only
+        prm.enter_subsection("material " + std::to_string(k));
+        materials::declare_pore_liquid(prm);
+        prm.leave_subsection();
+      }
     loads::declare_stage_parameters(prm, prm_file, counts.dim, false, [](dealii::ParameterHandler &p) {
       p.declare_entry("time step", "0", Double(0),
                       "Time step of the stage [s] (static: its load step); 0 = the top-level time/time step.");
@@ -79,16 +89,9 @@ namespace talus::implicit_mpm
       prm.declare_entry("newmark gamma", "0.5", Double(0.5, 1), "Newmark gamma in [1/2, 1] (thesis: 1/2).");
       prm.declare_entry("newmark beta", "0.25", Double(0, 0.5),
                         "Newmark beta in (0, 1/2] (thesis: 1/4, the trapezoidal rule).");
-      prm.declare_entry("rayleigh alpha", "0", Double(0),
-                        "Mass-proportional Rayleigh damping C = alpha M [1/s] (dynamic only; the column "
-                        "collapse of thesis §6.1 uses 1.5).");
-      prm.declare_entry("rayleigh beta", "0", Double(0),
-                        "Stiffness-proportional Rayleigh damping C += beta K [s] (dynamic, irreducible form): K the "
-                        "material + geometric tangent at the start of each step, held for the step so that Newton's "
-                        "tangent stays exact; a mode of frequency omega gets the damping ratio beta omega / 2. "
-                        "Rows and columns of constrained DoFs carry no damping force.");
       prm.declare_entry("mass matrix", "lumped", Selection("lumped|consistent"),
-                        "dynamic: the mass matrix of the inertia M a and of the damping alpha M v. lumped: "
+                        "dynamic: the mass matrix of the inertia M a and of the damping alpha_v M v ('damping/viscous "
+                        "damping'). lumped: "
                         "M_ii = sum_p m_p N_i(x_p) (the default: Kratos MPM's choice, positive for every node "
                         "a point touches); consistent: M_ij = sum_p m_p N_i(x_p) N_j(x_p) per component (thesis "
                         "Eq. 4.36; singular where a lone point is the only support of several nodes). The "
@@ -207,8 +210,6 @@ namespace talus::implicit_mpm
       prm.get("analysis") == "static" ? Parameters<dim>::Analysis::quasi_static : Parameters<dim>::Analysis::dynamic;
     p.gamma                   = prm.get_double("newmark gamma");
     p.beta                    = prm.get_double("newmark beta");
-    p.rayleigh_alpha          = prm.get_double("rayleigh alpha");
-    p.rayleigh_beta           = prm.get_double("rayleigh beta");
     p.consistent_mass         = prm.get("mass matrix") == "consistent";
     p.ramp_loads              = prm.get_bool("ramp loads");
     p.mixed_up                = prm.get("formulation") == "mixed up";
@@ -495,13 +496,39 @@ namespace talus::implicit_mpm
                 "restarting an 'axisymmetric' run with tractions is not available yet (the ring weights of the "
                 "traction point forces are set on the seeded state)");
       }
-    require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_alpha == 0, "implicit/rayleigh alpha",
-            "damping needs 'analysis = dynamic'");
-    require(p.analysis == Parameters<dim>::Analysis::dynamic || p.rayleigh_beta == 0, "implicit/rayleigh beta",
-            "damping needs 'analysis = dynamic'");
-    require(!p.mixed_up || p.rayleigh_beta == 0, "implicit/rayleigh beta",
-            "stiffness-proportional damping is for 'formulation = irreducible' (the u-p tangent's pressure blocks are "
-            "not a stiffness); allowed with 'mixed up': 0 (use 'rayleigh alpha')");
+    {
+      // the shared 'damping' (loads/damping.h): viscous = Rayleigh alpha, stiffness = Rayleigh beta
+      const loads::Damping d = loads::parse_damping(prm);
+      p.rayleigh_alpha       = d.viscous;
+      p.rayleigh_beta        = d.stiffness;
+      loads::refuse_damping(d.local, "local damping", "talus-implicit",
+                            "local damping acts on the unbalanced nodal force of an explicit step (seed 000 §6.3); "
+                            "allowed: 0 (damp with 'viscous damping' or 'stiffness damping', analysis = dynamic)");
+      const bool        dyn = p.analysis == Parameters<dim>::Analysis::dynamic;
+      const std::string static_reason =
+        "damping needs 'implicit/analysis = dynamic' (a static analysis has no velocity); allowed: 0";
+      if (!dyn)
+        {
+          loads::refuse_damping(d.viscous, "viscous damping", "talus-implicit", static_reason);
+          loads::refuse_damping(d.stiffness, "stiffness damping", "talus-implicit", static_reason);
+        }
+      if (p.mixed_up)
+        loads::refuse_damping(d.stiffness, "stiffness damping", "talus-implicit",
+                              "stiffness-proportional damping is for 'implicit/formulation = irreducible' (the u-p "
+                              "tangent's pressure blocks are not a stiffness); allowed with 'mixed up': 0 (use "
+                              "'viscous damping')");
+    }
+    for (unsigned int k = 0; k < p.materials.size(); ++k)
+      {
+        const std::string where = "material " + std::to_string(k);
+        prm.enter_subsection(where);
+        const materials::PoreLiquid pl = materials::read_pore_liquid(prm);
+        prm.leave_subsection();
+        require(pl.drainage == materials::Drainage::drained, where + "/pore liquid/drainage",
+                "is '" + materials::drainage_name(pl.drainage) +
+                  "': talus-implicit is a 1-phase solid family (no pore pressure, no liquid phase; undrained and "
+                  "coupled analyses are talus-explicit's, saturated soil talus-semi-implicit's); allowed: drained");
+      }
     for (unsigned int k = 0; k < p.stages.size(); ++k)
       require(p.analysis == Parameters<dim>::Analysis::dynamic || !p.stages[k].boundary_conditions.empty(),
               p.staged ? "stage " + std::to_string(k) + "/boundary conditions" : std::string("boundary conditions"),

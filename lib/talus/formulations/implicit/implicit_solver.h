@@ -69,9 +69,10 @@ namespace talus::implicit_mpm
     // 'numerics/shape function' (SceneParameters::bspline()): the kernel of every grid transfer
     double time_step = 0; ///< > 0 (required)
     double gamma = 0.5, beta = 0.25;
-    double rayleigh_alpha = 0; ///< C = alpha M (mass-proportional Rayleigh damping)
-    /// C += beta K: stiffness-proportional Rayleigh damping [s], K the material + geometric
-    /// tangent at the start of the step (frozen within it)
+    /// 'damping/viscous damping': C = alpha M (mass-proportional Rayleigh damping) [1/s]
+    double rayleigh_alpha = 0;
+    /// 'damping/stiffness damping': C += beta K, stiffness-proportional Rayleigh damping [s], K the
+    /// material + geometric tangent at the start of the step (frozen within it)
     double rayleigh_beta = 0;
     /// 'implicit/mass matrix = consistent': the inertia and damping with
     /// M_ij = sum_p m_p N_i N_j (per component) instead of its row sums; the
@@ -357,7 +358,7 @@ namespace talus::implicit_mpm
     {
       shape::with_kernel<dim>(prm.bspline(), std::forward<F>(f));
     }
-    /// 'rayleigh beta' > 0: damping_stiffness = the force tangent at du = 0 (the step's start)
+    /// 'damping/stiffness damping' > 0: damping_stiffness = the force tangent at du = 0 (the step's start)
     void assemble_damping_stiffness(const dealii::Tensor<1, dim> &g);
     /// Newmark a^{n+1} at the owned DoFs from du (dynamic only), ghosts updated.
     void nodal_acceleration(Vector &a) const;
@@ -479,7 +480,7 @@ namespace talus::implicit_mpm
     /// each r[k] replaced by x solving tangent x = -r[k] (direct: one factorisation)
     LinearSolveInfo                        solve_several(std::vector<Vector> &r);
     dealii::TrilinosWrappers::SparseMatrix tangent;
-    /// 'rayleigh beta' > 0: the stiffness K_n of the step's start (du = 0), whose beta K_n v^{n+1}
+    /// 'damping/stiffness damping' > 0: the stiffness K_n of the step's start (du = 0), whose beta K_n v^{n+1}
     /// is the damping force of the step (assemble_damping_stiffness)
     dealii::TrilinosWrappers::SparseMatrix damping_stiffness;
     bool   assembling_damping = false; ///< assemble() stops after the points' force (K_n for the damping)

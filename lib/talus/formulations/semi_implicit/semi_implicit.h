@@ -29,11 +29,12 @@ namespace talus::semi_implicit
     water      ///< water points only (free water)
   };
 
-  /// The soil's pore data of one material (material k/soil).
+  /// The soil's pore data of one material, from 'material k/pore liquid'
+  /// (materials/pore_liquid.h).
   struct SoilData
   {
-    double porosity     = 0.3;  ///< n_0 [-]
-    double conductivity = 1e-3; ///< hydraulic conductivity k_0 [m/s]
+    double porosity     = 0.3; ///< n_0 [-] ('porosity')
+    double conductivity = 0;   ///< hydraulic conductivity k_0 [m/s] (PoreLiquid::hydraulic_conductivity())
   };
 
   /// Volumetric-locking stabilisation of the soil (seed 002 §4.4.2).

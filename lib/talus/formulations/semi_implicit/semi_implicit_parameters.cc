@@ -9,9 +9,11 @@
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/semi_implicit/boundary_loads.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
+#include <talus/loads/damping.h>
 #include <talus/loads/rigid_plate.h>
 #include <talus/loads/rigid_plate_nodes.h>
 #include <talus/materials/material.h>
+#include <talus/materials/pore_liquid.h>
 #include <talus/particles/material_points.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -137,14 +139,12 @@ namespace talus::semi_implicit
     declare_boundary_load_parameters(prm, prm_file, counts.dim);
     for (unsigned int k = 0; k < counts.n_materials; ++k)
       {
+        // the shared 'pore liquid' (materials/pore_liquid.h): the soil's n0 and k0
         prm.enter_subsection("material " + std::to_string(k));
-        prm.enter_subsection("soil");
-        prm.declare_entry("porosity", "0.3", Double(-1e300, 1e300), "Initial porosity n0 of the soil, in (0, 1).");
-        prm.declare_entry("hydraulic conductivity", "1e-3", Double(-1e300, 1e300),
-                          "Hydraulic conductivity k0 [m/s], > 0.");
-        prm.leave_subsection();
+        materials::declare_pore_liquid(prm);
         prm.leave_subsection();
       }
+    loads::declare_damping(prm); // the shared 'damping' (loads/damping.h): refused
     for (unsigned int k = 0; k < counts.n_bodies; ++k)
       {
         prm.enter_subsection("body " + std::to_string(k));
@@ -282,28 +282,56 @@ namespace talus::semi_implicit
       prm.leave_subsection();
     }
 
-    /// 'material k/soil' of every material: porosity and conductivity
+    /// 'material k/pore liquid' of every material (materials/pore_liquid.h):
+    /// the soil's porosity n0 and hydraulic conductivity k0; what this family
+    /// cannot honour is refused
     template <int dim>
     void
-    parse_soil_data(dealii::ParameterHandler &prm, Parameters<dim> &p)
+    parse_pore_liquid(dealii::ParameterHandler &prm, Parameters<dim> &p)
     {
+      const materials::PoreLiquid defaults;
       for (unsigned int k = 0; k < p.materials.size(); ++k)
         {
-          const std::string where = "material " + std::to_string(k) + "/soil/";
+          const std::string where = "material " + std::to_string(k) + "/pore liquid";
           prm.enter_subsection("material " + std::to_string(k));
-          prm.enter_subsection("soil");
+          const materials::PoreLiquid pl = materials::read_pore_liquid(prm);
+          prm.leave_subsection();
+          require(pl.drainage != materials::Drainage::undrained, where + "/drainage",
+                  "is 'undrained': talus-semi-implicit seeds what each body's 'phase' says (saturated: soil and "
+                  "water points) and has no undrained 1-phase analysis (that is talus-explicit's); allowed: "
+                  "drained or coupled (read alike)");
+          materials::check_porosity(pl, where);
+          require(pl.density == p.water_density, where + "/liquid density",
+                  "is " + number_text(pl.density) +
+                    " kg/m^3: talus-semi-implicit has one water, of 'semi "
+                    "implicit/water density' = " +
+                    number_text(p.water_density) +
+                    " kg/m^3; allowed: the same value (or leave both at their default 1000)");
+          require(pl.bulk_modulus == defaults.bulk_modulus, where + "/liquid bulk modulus",
+                  "is " + number_text(pl.bulk_modulus) +
+                    " Pa: talus-semi-implicit's water is incompressible (its pressure equation has no storage "
+                    "term), so it cannot honour a bulk modulus; allowed: leave it at its default " +
+                    number_text(defaults.bulk_modulus));
+          materials::check_seepage(pl, where);
           SoilData s;
-          s.porosity     = prm.get_double("porosity");
-          s.conductivity = prm.get_double("hydraulic conductivity");
-          prm.leave_subsection();
-          prm.leave_subsection();
-          std::ostringstream n0, k0;
-          n0 << s.porosity;
-          k0 << s.conductivity;
-          require(s.porosity > 0 && s.porosity < 1, where + "porosity", "is " + n0.str() + "; must lie in (0, 1)");
-          require(s.conductivity > 0, where + "hydraulic conductivity", "is " + k0.str() + "; must be > 0 m/s");
+          s.porosity     = pl.porosity;
+          s.conductivity = pl.hydraulic_conductivity();
+          require(std::isfinite(s.conductivity) && s.conductivity > 0, where + "/hydraulic conductivity",
+                  "the conductivity is " + number_text(s.conductivity) + "; must be > 0 m/s");
           p.soil_of_material.push_back(s);
         }
+    }
+
+    /// The shared 'damping' (loads/damping.h): every entry refused
+    void
+    refuse_damping(dealii::ParameterHandler &prm)
+    {
+      const loads::Damping d = loads::parse_damping(prm);
+      const std::string    why =
+        "talus-semi-implicit has no damping term (its momentum equations have the Darcy drag only); allowed: 0";
+      loads::refuse_damping(d.local, "local damping", "talus-semi-implicit", why);
+      loads::refuse_damping(d.viscous, "viscous damping", "talus-semi-implicit", why);
+      loads::refuse_damping(d.stiffness, "stiffness damping", "talus-semi-implicit", why);
     }
 
     /// 'body k': phase, the material ids of its points; the
@@ -382,7 +410,8 @@ namespace talus::semi_implicit
     prm.leave_subsection();
     parse_semi_implicit(prm, p);
     parse_initial_state(prm, p);
-    parse_soil_data(prm, p);
+    parse_pore_liquid(prm, p);
+    refuse_damping(prm);
     parse_bodies(prm, p);
     require(p.grid_mesh == nullptr, "grid/source", "talus-semi-implicit needs a box grid (source = box)");
     parse_boundary_load_parameters(prm, p); // tractions, velocity and drainage conditions
