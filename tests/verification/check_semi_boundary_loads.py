@@ -26,19 +26,23 @@ Modes (one ctest each):
                 0.2 s every water point's pressure within 1 % of it, half of it at
                 0.05 s (5 %), no effective stress (< 1 % of 5 kPa), no settlement.
   dry_face      the layer under dry cells (grid to 1.25 m), a sudden q = 1 kPa on
-                the body face y+: impermeable by default (no drainage condition):
-                at t = 0.05 s the mean pore pressure of the water points within
-                5 % of the undrained -q and the settlement below 5 % of the
-                drained one; with the surface drained ('drainage 0' on a region
-                around it): mean pore pressure within 0.05 q of Terzaghi's
-                average -(1 - U(T_v)) q (single drainage upwards) at 0.05 s, and
-                the pressure of the top row of water points near 0 (< 0.2 q)
-                where the impermeable run's is near -q (> 0.8 q).
+                the body face y+. Sealed by default (no drainage condition): nothing
+                drains (base and sides impermeable, the face sealed) and grains and
+                water are incompressible, so at t = 0.05 s the pore pressure carries
+                the whole load: mean pore pressure and the top water row's within 2 %
+                of the undrained -q (tension positive), settlement below 1 % of the
+                drained run's, the top water row within 0.01 h of the top soil row and
+                no water point above it (no water leaves through the face). With the
+                surface drained ('drainage 0' on a region around it): mean pore
+                pressure within 0.05 q of Terzaghi's average -(1 - U(T_v)) q (single
+                drainage upwards), the top row's pressure near 0 (< 0.2 q) and the
+                water risen above the soil's top row (> 0.002 h).
   refuse        a traction on a grid boundary id in talus-explicit and
                 talus-implicit (they carry tractions by material points): exit
-                2 naming 'loads/traction 0/apply to', nothing written; the dry
-                face sealed with linear shape functions (no pressure reference in
-                a closed sealed box): exit 2 naming 'loads/traction 0'.
+                2 naming 'loads/traction 0/apply to', nothing written; a sealed
+                closed box (the layer filling the grid, its top face impermeable
+                under a boundary traction: no free surface, no pressure reference):
+                exit 2 naming 'loads/traction 0'.
 Usage: check_semi_boundary_loads.py MODE TOOLS_DIR PRM PRM_DIR WORKDIR
 """
 import math
@@ -172,6 +176,16 @@ elif mode in ("dry_face", "refuse"):
     dry = tv.prm_set_args(base, ["grid/upper corner=1, 1.25", "grid/cells=8, 10", "time/end time=0.05",
                                  "output/series interval=0.01",
                                  "loads/number of tractions=1", "loads/traction 0/traction=0, -1e3"])
+    h = 0.125  # the grid's cell
+
+    def rows(points):
+        """(initial y of each point row, its mean current y, its mean pore pressure)"""
+        by = {}
+        for y, u, p in zip(points["pos_y"], points["displacement_y"],
+                           points.get("pore_pressure", [0.0] * len(points["pos_y"]))):
+            by.setdefault(round(y - u, 6), []).append((y, p))
+        return [(y0, mean([a for a, _ in v]), mean([b for _, b in v])) for y0, v in sorted(by.items())]
+
     if mode == "dry_face":
         t_check = 0.05
         res = {}
@@ -182,26 +196,35 @@ elif mode in ("dry_face", "refuse"):
             run(name, dry, **entries)
             s, soil, water = series(name), final(name, "soil"), final(name, "water")
             p = water["pore_pressure"]
-            Y0 = [y - u for y, u in zip(water["pos_y"], water["displacement_y"])]
-            top = max(Y0)
-            p_top = mean([pp for pp, y0 in zip(p, Y0) if y0 > top - 1e-9])
+            wr, sr = rows(water), rows(soil)
             S = H * (1 - s["soil_volume"][-1] / s["soil_volume"][0])
-            res[name] = (mean(p), p_top, S)
-            print(f"{name}: mean pore pressure {mean(p):.5g} Pa, top row {p_top:.5g} Pa, settlement {S:.4e} m")
-        # impermeable: the pressure builds under the load (the face is not the
-        # free surface's p = 0); its size is not the undrained -q yet (the
-        # gradient-form pressure force lacks the face term, docs/semi-implicit.md
-        # 'Boundary conditions and loads'), so only the contrast is checked
-        pm, pt, S = res["impermeable"]
-        tv.check(abs(pt) > 0.8 * q, f"impermeable loaded face: top row pore pressure {pt:.5g} Pa (> 0.8 q in size)")
-        tv.check(abs(pm) > abs(res["drained"][0]) and abs(pt) > 5 * abs(res["drained"][1]),
-                 f"impermeable loaded face: pressure builds, mean {pm:.5g} / top row {pt:.5g} Pa against "
-                 f"{res['drained'][0]:.5g} / {res['drained'][1]:.5g} Pa drained")
-        pm, pt, S = res["drained"]
+            rise = max(water["pos_y"]) - sr[-1][1]  # the water's highest point above the soil's top row
+            res[name] = (mean(p), wr[-1][2], S, wr[-1][1] - sr[-1][1], rise)
+            print(f"{name}: mean pore pressure {mean(p):.5g} Pa, top row {wr[-1][2]:.5g} Pa, settlement {S:.4e} m, "
+                  f"top water row - top soil row {wr[-1][1] - sr[-1][1]:+.3e} m, highest water point above the "
+                  f"soil's top row {rise:+.3e} m")
+        # impermeable (sealed, the default): the undrained answer. Grains and water are
+        # incompressible and nothing drains (base and sides impermeable, the face sealed),
+        # so the skeleton cannot compress: no settlement, no effective stress, and the pore
+        # pressure carries the whole load, p = -q everywhere (tension positive), also at
+        # the face (the pore pressure's surface term, docs/semi-implicit.md 'A sealed
+        # surface'); no water leaves through the face
+        pm, pt, S, gap, rise = res["impermeable"]
+        tv.check(abs(pm / -q - 1) < 0.02, f"sealed loaded face: mean pore pressure {pm:.6g} Pa vs the undrained -q = "
+                 f"{-q:g} Pa ({100 * (pm / -q - 1):+.3f} %, 2 %)")
+        tv.check(abs(pt / -q - 1) < 0.02, f"sealed loaded face: top water row {pt:.6g} Pa vs -q ({100 * (pt / -q - 1):+.3f} %, 2 %)")
+        tv.check(abs(S) < 0.01 * res["drained"][2], f"sealed loaded face: settlement {S:.3e} m (< 1 % of the drained "
+                 f"run's {res['drained'][2]:.3e} m)")
+        tv.check(abs(gap) < 0.01 * h and rise < 0.01 * h,
+                 f"sealed loaded face: the water stays in the soil: top water row - top soil row {gap:+.3e} m, highest "
+                 f"water point {rise:+.3e} m above the soil's top row (both within 0.01 h = {0.01 * h:g} m)")
+        pm, pt, S, gap, rise = res["drained"]
         ref = -(1 - U(c_v * t_check / H**2)) * q
         tv.check(abs(pm - ref) < 0.05 * q, f"drained loaded face: mean pore pressure {pm:.5g} Pa vs Terzaghi "
                  f"-(1 - U) q = {ref:.5g} Pa (T_v = {c_v * t_check:.4f})")
         tv.check(abs(pt) < 0.2 * q, f"drained loaded face: top row pore pressure {pt:.5g} Pa (< 0.2 q in size)")
+        tv.check(gap > 0.002 * h, f"drained loaded face: the water left through it (top water row {gap:+.3e} m above "
+                 f"the top soil row, > 0.002 h)")
     else:
         # talus-explicit and talus-implicit carry tractions by material points
         layer_dir = os.path.join(prm_dir, "verification", "rigid_plate")
@@ -218,8 +241,12 @@ elif mode in ("dry_face", "refuse"):
             tv.check(rc == 2 and "loads/traction 0/apply to" in out + err and "cannot honour" in out + err
                      and not os.path.exists(os.path.join(wd, "out")),
                      f"talus-{fam}: a traction on a boundary id: exit {rc}, refused naming the entry, nothing written")
-        # a sealed closed box (linear shape functions: no dry node touches the water)
-        rc, out, err = run("sealed_linear", dry, expect_rc=None, **{"numerics/shape function": "linear"})
+        # a sealed closed box: the layer fills the grid (no free surface, so no sealed
+        # surface either), a traction on its top face (boundary id 3) made impermeable
+        rc, out, err = run("sealed_box", base, expect_rc=None, **{
+            "boundary conditions/drainage 0/condition": "impermeable", "time/end time": "0.01",
+            "loads/number of tractions": "1", "loads/traction 0/apply to": "boundary",
+            "loads/traction 0/boundary id": "3", "loads/traction 0/traction": "0, -1e3"})
         tv.check(rc == 2 and "loads/traction 0" in out + err and "no pressure reference" in out + err,
                  f"sealed closed box: exit {rc}, the traction named")
 else:

@@ -255,8 +255,9 @@ set_tests_properties(verification.semi_implicit_rigid_plate_layer verification.s
 # within 1 % of E_oed d / H; traction: q on grid boundary id 3 and on the body face,
 # drained settlement within 1 % of q H / E_oed; pressure: a prescribed pore pressure on the
 # top face reaches every water point (1 %), the skeleton unloaded; dry_face: a loaded face beside dry cells
-# impermeable by default (undrained pore pressure) and drained when a drainage region says
-# so (Terzaghi's mean pore pressure); refuse: talus-explicit and talus-implicit refuse a
+# sealed by default (the undrained -q within 2 %, no settlement, no water leaving) and
+# drained when a drainage region says so (Terzaghi's mean pore pressure); refuse:
+# talus-explicit and talus-implicit refuse a
 # traction on a boundary id, a sealed closed box is refused
 foreach(_mode displacement traction pressure dry_face refuse)
   add_test(NAME verification.semi_implicit_boundary_loads_${_mode}

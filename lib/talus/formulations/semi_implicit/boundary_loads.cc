@@ -370,52 +370,84 @@ namespace talus::semi_implicit
                                    const bool plate_sealed, const double wet, const double dry, const double near_wet,
                                    const double p)
   {
-    const auto row = decide_row(i, has_water, plate_drained, plate_sealed, wet, dry, near_wet, p);
-    if (row.first && has_water)
+    const Row row = decide_row(i, has_water, plate_drained, plate_sealed, wet, dry, near_wet, p);
+    // the references of the pressure: its Dirichlet rows at water, and the
+    // sealed surface's rows at a dry cell (the surface term fixes the
+    // pressure's level; a candidate inside the water is none)
+    if ((row.dirichlet || (row.sealed && dry > 0)) && has_water)
       ++n_water_rows;
-    return row;
+    return {row.dirichlet, row.dp};
   }
 
   template <int dim>
-  std::pair<bool, double>
+  bool
+  BoundaryLoads<dim>::sealed_surface(const unsigned int i, const bool has_water, const bool plate_drained,
+                                     const bool plate_sealed, const double wet, const double dry,
+                                     const double near_wet) const
+  {
+    return decide_row(i, has_water, plate_drained, plate_sealed, wet, dry, near_wet, 0.0).sealed;
+  }
+
+  template <int dim>
+  bool
+  BoundaryLoads<dim>::may_seal_surface() const
+  {
+    if (!prm.tractions.empty())
+      return true;
+    for (const auto &c : prm.drainage)
+      if (c.target == loads::Drainage<dim>::Target::region && c.kind == loads::Drainage<dim>::Kind::impermeable)
+        return true;
+    return false;
+  }
+
+  template <int dim>
+  typename BoundaryLoads<dim>::Row
   BoundaryLoads<dim>::decide_row(const unsigned int i, const bool has_water, const bool plate_drained,
                                  const bool plate_sealed, const double wet, const double dry, const double near_wet,
                                  const double p) const
   {
     using Kind = typename loads::Drainage<dim>::Kind;
     if (!has_water) // no water: Delta p = 0 (A2, A4)
-      return {true, 0.0};
+      return {true, 0.0, false};
     if (plate_drained) // a permeable plate: p^{t+1} = 0
-      return {true, -p};
+      return {true, -p, false};
     // a boundary condition holds every water node of its face
     const unsigned int a = drain_all[i];
     if (a != none && prm.drainage[a].kind == Kind::drained)
-      return {true, -p};
+      return {true, -p, false};
     if (a != none && prm.drainage[a].kind == Kind::pressure)
-      return {true, prm.drainage[a].pressure_at(time_end) - p};
-    if (!(dry > 0) || plate_sealed) // inside the water, or under an impermeable plate: solved
-      return {false, 0.0};
+      return {true, prm.drainage[a].pressure_at(time_end) - p, false};
+    if (plate_sealed) // under an impermeable plate: solved
+      return {false, 0.0, false};
+    // the surface's kind: a region's condition; else (at a vertex of a wet and
+    // a dry cell) a boundary's impermeable one; else sealed where a load acts
+    // (a loaded face drains only where the user says so), drained elsewhere (A6)
+    const unsigned int r      = drain_surface[i];
+    const bool         load   = loaded.local_element(i) > 0;
+    const bool         region = r != none;
+    if (!(dry > 0)) // inside the water: solved; a candidate of the seal under a sealed surface (sealed_surface)
+      return {false, 0.0, region ? prm.drainage[r].kind == Kind::impermeable : load};
     if (wet > 0)
       {
-        // the free surface (a vertex of a wet and a dry cell): a region's
-        // condition; else a boundary's impermeable one; else sealed where a
-        // load acts (a loaded face drains only where the user says so), drained
-        // elsewhere (A6)
-        const unsigned int r    = drain_surface[i];
-        const Kind         kind = r != none                     ? prm.drainage[r].kind
-                                  : a != none                   ? Kind::impermeable
-                                  : loaded.local_element(i) > 0 ? Kind::impermeable
-                                                                : Kind::drained;
-        if (kind == Kind::impermeable)
-          return {false, 0.0};
+        const Kind kind = region      ? prm.drainage[r].kind
+                          : a != none ? Kind::impermeable
+                          : load      ? Kind::impermeable
+                                      : Kind::drained;
+        if (kind == Kind::impermeable) // solved; a sealed surface node of a region or a load
+          return {false, 0.0, region || (a == none && load)};
         if (kind == Kind::pressure)
-          return {true, prm.drainage[r].pressure_at(time_end) - p};
-        return {true, -p};
+          return {true, prm.drainage[r].pressure_at(time_end) - p, false};
+        return {true, -p, false};
       }
     // all-dry nodes touched by water (A6): those next to a wet cell keep the
-    // mapped p^t (Delta p = 0), the others p^{t+1} = 0
+    // mapped p^t (Delta p = 0), the others p^{t+1} = 0; next to a wet cell
+    // under a sealed surface (a region's impermeable condition or a load)
+    // they are solved with the surface's force (docs/semi-implicit.md 'A
+    // sealed surface')
     const bool keep = near_wet > 0;
-    return {true, keep ? 0.0 : -p};
+    if (keep && (region ? prm.drainage[r].kind == Kind::impermeable : load))
+      return {false, 0.0, true};
+    return {true, keep ? 0.0 : -p, false};
   }
 
   template <int dim>

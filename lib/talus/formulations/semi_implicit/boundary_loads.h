@@ -134,6 +134,12 @@ namespace talus::semi_implicit
       if (!water_free[i])
         vw = Mw > 0 ? velocity_value[i] : 0.0;
     }
+    /// Whether local DoF i has a prescribed velocity.
+    bool
+    prescribed(const unsigned int i) const
+    {
+      return !velocity_of.empty() && velocity_of[i] != none;
+    }
     /// MUSL remap at local DoF i: the prescribed value (as the walls' zero, A11).
     void
     remap(const unsigned int i, double &vs) const
@@ -158,6 +164,18 @@ namespace talus::semi_implicit
     /// loaded face, a prescribed velocity, an impermeable drainage), an
     /// InputError naming it: the pressure has no reference. Collective.
     void check_pressure_reference() const;
+    /// Whether the node of local DoF i (component 0) is a node of a sealed
+    /// surface (the same arguments as pressure_row): a solved free-surface
+    /// node, or a dry node next to the water, whose surface is impermeable by a
+    /// region's condition or by a load; a node inside the water (no dry cell)
+    /// that a load reaches or an impermeable region holds is a candidate, a
+    /// node of the seal where it shares a cell with a sealed surface node. The Solver gives these the surface
+    /// term of the pore pressure (docs/semi-implicit.md 'A sealed surface').
+    bool sealed_surface(unsigned int i, bool has_water, bool plate_drained, bool plate_sealed, double wet, double dry,
+                        double near_wet) const;
+    /// Whether this file can seal a surface at all (a traction, or a region's
+    /// impermeable drainage); without, no node is ever sealed_surface.
+    bool may_seal_surface() const;
 
     /// series.csv: the reactions of the velocity conditions
     /// (velocity_k_reaction_x, ... of their prescribed components).
@@ -168,8 +186,14 @@ namespace talus::semi_implicit
     void settlement_weights(const double *P, double &force_dot_u, double &force) const;
 
   private:
-    std::pair<bool, double> decide_row(unsigned int i, bool has_water, bool plate_drained, bool plate_sealed,
-                                       double wet, double dry, double near_wet, double p) const;
+    struct Row
+    {
+      bool   dirichlet; ///< a Dirichlet row with the increment dp
+      double dp;
+      bool   sealed; ///< solved, a node of a sealed surface
+    };
+    Row decide_row(unsigned int i, bool has_water, bool plate_drained, bool plate_sealed, double wet, double dry,
+                   double near_wet, double p) const;
 
     const Parameters<dim>     &prm;
     const BackgroundGrid<dim> &grid;

@@ -106,6 +106,8 @@ namespace talus::semi_implicit
       dealii::Tensor<1, dim> g;                     ///< gravity, ramped during the initialisation
       /// nodal soil / water masses at or below these count as empty (A3)
       double ms_cut = 0, mw_cut = 0;
+      /// mark_free_surface ran (sealed_surface, before the predictors)
+      bool surface_marked = false;
       /// per rigid plate: its velocity over the step (force control: found by
       /// plate_balance at the end of the step, 0 until then)
       std::vector<double> plate_v;
@@ -130,6 +132,18 @@ namespace talus::semi_implicit
     /// the smoothed pore pressure of the water points; Gpw, Gps
     template <class K>
     void pore_pressure_forces();
+    /// The nodes of a sealed surface (BoundaryLoads::sealed_surface) and their
+    /// surface vectors beta_J = sum_s V grad N_J (its held components 0):
+    /// the lumped surface term -beta_J p_J of the pore pressure on the soil in
+    /// the predictor (p^t), the correction and the Poisson rows (the
+    /// increment); docs/semi-implicit.md 'A sealed surface'
+    template <class K>
+    void sealed_surface(StepState &this_step);
+    /// The sealed surface's terms of the Poisson system (before its
+    /// compress): the matrix entries of the surface force's increment and the
+    /// surface's flux beta_J . v_s*_J on the right-hand side
+    template <class K>
+    void add_sealed_surface_terms(const dealii::AffineConstraints<double> &constraints);
     /// (3)-(4): the water and the mixture predictor, the drag implicit in both:
     /// v_s*, v_w* per node (a 2 x 2 system), the plates' unit responses
     void water_and_mixture_predictors(const StepState &this_step);
@@ -252,9 +266,13 @@ namespace talus::semi_implicit
     Vector n_node, Q_node, Mw_node; // nodal porosity n_I, drag Q_I, water mass M_wI
     Vector vs_t, vw_t, vs_star, vw_star, vs_new, vw_new;
     Vector p_node, dp_node, gs, gw, wet, dry, near_wet;
-    std::vector<double> cell_water_volume;
-    Vector              Mdj; // F-bar: sum N m dJ of the soil points
-    Vector              Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
+    Vector beta;                                   // per DoF: the sealed surface's sum_s V grad N (0 elsewhere)
+    std::vector<unsigned char> sealed;             // per node (component-0 DoF): a node of a sealed surface this step
+    bool                       any_sealed = false; // some rank has a sealed node this step
+    double                     sealed_h   = 0;     // the step's size (the Poisson terms of the seal)
+    std::vector<double>        cell_water_volume;
+    Vector                     Mdj; // F-bar: sum N m dJ of the soil points
+    Vector                     Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
     // modified F-bar patches: a fixed square tiling from the grid's lower corner
     PatchTiling<dim>    patches;
     std::vector<double> patch_mass, patch_mass_Je;

@@ -161,6 +161,7 @@ namespace talus::semi_implicit
   {
     StepState this_step = begin_step(h);
     particles_to_nodes<K>(this_step);
+    sealed_surface<K>(this_step);
     add_lap(phase.p2n);
     water_and_mixture_predictors(this_step);
     add_lap(phase.grid);
@@ -410,8 +411,11 @@ namespace talus::semi_implicit
         const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j);
         const double       Q = Q_node.local_element(j), n = n_node.local_element(j);
         const double       b = g[component[i]];
-        const double rs      = Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i));
-        const double rwv     = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
+        // a sealed surface's node: the surface term -beta_J p_J^t of the pore pressure (sealed_surface)
+        const double surface = any_sealed ? beta.local_element(i) * p_node.local_element(j) : 0.0;
+        const double rs =
+          Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i) - surface);
+        const double rwv = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
         double       vw = 0, vs = 0;
         const bool   has_soil = Msi > ms_cut, has_water = Mwi > 0;
         if (prm.rigid_skeleton) // v_s = 0: the water alone, its drag implicit
@@ -469,7 +473,8 @@ namespace talus::semi_implicit
         return;
       }
     const bool new_pattern = update_pressure_pattern<K>();
-    mark_free_surface();
+    if (!this_step.surface_marked)
+      mark_free_surface();
     dealii::AffineConstraints<double> dirichlet, dirichlet_homogeneous; // the second: a plate's unit response
     pressure_dirichlet_values(this_step, dirichlet, dirichlet_homogeneous);
     const auto constraints = active.constraints_with(dirichlet);
@@ -645,8 +650,149 @@ namespace talus::semi_implicit
       transfer::AssembleSystem<dim, K, 1, PoissonWithFlux> assembly(active, constraints, terms[0], &A, &rhs);
       transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
                                            [&](const unsigned int k) { assembly.integrand = terms[k]; });
+      if (any_sealed)
+        add_sealed_surface_terms<K>(constraints);
       transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, &A, &rhs);
     }
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::sealed_surface(StepState &this_step)
+  {
+    using Stencil = transfer::PointStencil<dim, K>;
+    using It      = transfer::PointIterator<dim>;
+    // (the same answer on every rank: collective below)
+    any_sealed = false;
+    sealed_h   = this_step.h;
+    if (water.handler.n_global_particles() == 0 || !bloads.may_seal_surface() || prm.rigid_skeleton)
+      return;
+    mark_free_surface();
+    this_step.surface_marked = true;
+    const unsigned int nl = n_local(), owned = grid.partitioner->locally_owned_size();
+    sealed.assign(nl, 0);
+    // the surface's nodes (at a dry cell), and the candidates inside the
+    // water: of the seal where they share a cell with a surface node of it
+    // (the nodes whose support crosses the sealed surface)
+    std::vector<unsigned char> candidate(nl, 0);
+    grid.reinit_vector(beta); // first: per node, the cells it shares with a sealed surface node
+    unsigned int n_sealed = 0;
+    for (unsigned int i = 0; i < nl; ++i)
+      if (component[i] == 0 && Ms.local_element(i) > this_step.ms_cut)
+        {
+          const bool has_water = Mw.local_element(i) > this_step.mw_cut;
+          const bool s         = bloads.sealed_surface(i, has_water, drained[i], plate_sealed[i], wet.local_element(i),
+                                                       dry.local_element(i), near_wet.local_element(i));
+          (dry.local_element(i) > 0 ? sealed : candidate)[i] = s;
+          n_sealed += s && dry.local_element(i) > 0 && i < owned ? 1 : 0;
+        }
+    any_sealed = dealii::Utilities::MPI::sum(n_sealed, comm) > 0;
+    if (!any_sealed)
+      return;
+    {
+      double *ns = at(beta);
+      for (unsigned int c = 0; c < grid.cells.size(); ++c)
+        if (grid.cells[c].locally_owned)
+          {
+            bool touches = false;
+            for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+              touches = touches || sealed[grid.cells[c].dofs[v * dim]];
+            if (touches)
+              for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+                ns[grid.cells[c].dofs[v * dim]] += 1;
+          }
+      exchange({&beta});
+      for (unsigned int i = 0; i < nl; ++i)
+        if (candidate[i] && beta.local_element(i) > 0)
+          sealed[i] = 1;
+    }
+    // beta_J = sum_s V grad N_J over the soil points: the point quadrature of
+    // the surface integral of N_J n (the divergence theorem; zero inside)
+    beta = 0;
+    {
+      double *bt = at(beta);
+      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                               [&](unsigned int, It &it, const Stencil &s) {
+                                                 const double V = it->get_properties()[L::volume];
+                                                 for (unsigned int w = 0; w < s.n; ++w)
+                                                   if (sealed[s.dof[w][0]])
+                                                     for (unsigned int d = 0; d < dim; ++d)
+                                                       bt[s.dof[w][d]] += V * s.G[w][d];
+                                               });
+    }
+    exchange({&beta});
+    // the held components (walls, prescribed velocities, plates) take no surface force
+    for (unsigned int i = 0; i < nl; ++i)
+      if (!sealed[node_of[i]] || constrained[i] || bloads.prescribed(i) || plate_of[i] != no_plate)
+        beta.local_element(i) = 0;
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::add_sealed_surface_terms(const dealii::AffineConstraints<double> &constraints)
+  {
+    using Stencil = transfer::PointStencil<dim, K>;
+    using It      = transfer::PointIterator<dim>;
+    // The sealed surface in the Poisson rows (docs/semi-implicit.md 'A sealed
+    // surface'). The soil's correction at a sealed node J adds
+    // -h beta_J dp_J / M_sJ; row I of the continuity sees it through the
+    // points' flux (sum_s V (1 - n_J) grad N_I N_J) and, at a sealed row, loses
+    // the surface's flux beta_I . v_s^{t+1}_I. Both together: the symmetric
+    //   A_IJ += -h (1 - n_J) / M_sJ sum_s V N_J grad N_I . beta_J  (and A_JI),
+    //   A_JJ += h |beta_J|^2 / M_sJ,   f_J += beta_J . v_s*_J.
+    // A Dirichlet row is skipped, a Dirichlet column moves its value to f.
+    const double h     = sealed_h;
+    const auto   entry = [&](const dealii::types::global_dof_index r, const dealii::types::global_dof_index c,
+                           const double v) {
+      if (constraints.is_constrained(r))
+        return;
+      if (constraints.is_constrained(c))
+        rhs(r) -= v * constraints.get_inhomogeneity(c);
+      else
+        A.add(r, c, v);
+    };
+    const double *bt = at(beta);
+    transfer::for_each_point_stencil<dim, K>(
+      grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+        const double V = it->get_properties()[L::volume];
+        for (unsigned int j = 0; j < s.n; ++j)
+          {
+            const unsigned int J = s.dof[j][0];
+            if (!sealed[J])
+              continue;
+            const double c  = -h * (1 - n_node.local_element(J)) / Ms.local_element(J) * V * s.N[j];
+            const auto   gJ = pspace.node_dof(J, 0);
+            for (unsigned int i = 0; i < s.n; ++i)
+              {
+                double gb = 0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  gb += s.G[i][d] * bt[s.dof[j][d]];
+                const auto gI = pspace.node_dof(s.dof[i][0], 0);
+                entry(gI, gJ, c * gb);
+                entry(gJ, gI, c * gb);
+              }
+          }
+      });
+    // the nodal terms once, by the node's owner
+    const unsigned int  nl = n_local(), owned = grid.partitioner->locally_owned_size();
+    std::vector<double> bb(nl, 0.0), bv(nl, 0.0);
+    for (unsigned int i = 0; i < nl; ++i)
+      if (const unsigned int J = node_of[i]; J < owned && sealed[J])
+        {
+          bb[J] += bt[i] * bt[i];
+          bv[J] += bt[i] * vs_star.local_element(i);
+        }
+    for (unsigned int J = 0; J < owned; ++J)
+      if (component[J] == 0 && sealed[J])
+        {
+          const auto gJ = pspace.node_dof(J, 0);
+          if (constraints.is_constrained(gJ))
+            continue;
+          A.add(gJ, gJ, h * bb[J] / Ms.local_element(J));
+          rhs(gJ) += bv[J];
+        }
   }
 
   template <int dim>
@@ -783,8 +929,10 @@ namespace talus::semi_implicit
     const double       ms_cut = this_step.ms_cut;
     const unsigned int j      = node_of[i];
     const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
-    vw = Mwi > 0 ? vws + h * n * gwi / Mwi : 0.0;
-    vs = Msi > ms_cut && !prm.rigid_skeleton ? vss + h * (1 - n) * gsi / Msi : 0.0;
+    // a sealed surface's node: the surface term -beta_J dp_J (sealed_surface)
+    const double surface = any_sealed ? beta.local_element(i) * dp_node.local_element(j) : 0.0;
+    vw                   = Mwi > 0 ? vws + h * n * gwi / Mwi : 0.0;
+    vs                   = Msi > ms_cut && !prm.rigid_skeleton ? vss + h * ((1 - n) * gsi - surface) / Msi : 0.0;
     if (constrained[i])
       vs = 0;
     if (water_constrained[i])
