@@ -25,7 +25,7 @@ namespace talus::loads
     using Kind = typename NodeTarget<dim>::Kind;
     NodeTarget<dim>   t;
     const std::string a = prm.get("apply to");
-    t.kind = a == "boundary" ? Kind::boundary : a == "region" ? Kind::region : Kind::body;
+    t.kind              = a == "boundary" ? Kind::boundary : a == "region" ? Kind::region : Kind::body;
     if (t.kind == Kind::boundary)
       {
         const unsigned int b    = prm.get_integer("boundary id");

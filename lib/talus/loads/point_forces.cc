@@ -202,12 +202,15 @@ namespace talus::loads
           for (unsigned int d = 0; d < dim; ++d)
             P[force_offset + j * dim + d] = t.traction[d];
         }
-    std::ostringstream x;
+    std::ostringstream x, f;
     for (unsigned int d = 0; d < dim; ++d)
-      x << (d ? ", " : "") << b[1 + d];
+      {
+        x << (d ? ", " : "") << b[1 + d];
+        f << (d ? ", " : "") << t.traction[d];
+      }
     log() << "  " << t.where << ": " << (kept != invalid_particle ? "kept on" : "on") << " the material point "
-          << chosen << " at (" << x.str() << ") (initial position), " << b[0] << " m from the position, force "
-          << t.traction << (dim == 2 ? " N (per unit thickness)" : " N") << ", f(t) = " << t.function.text()
+          << chosen << " at (" << x.str() << ") (initial position), " << b[0] << " m from the position, force ("
+          << f.str() << (dim == 2 ? ") N (per unit thickness)" : ") N") << ", f(t) = " << t.function.text()
           << std::endl;
   }
 
