@@ -37,3 +37,17 @@ add_test(NAME verification.vocabulary_fragments
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_vocabulary.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
                  ${_w}/vocabulary_fragments)
 set_tests_properties(verification.vocabulary_fragments PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+
+# point loads (loads/point load k) in every family: the block of
+# parameter_files/verification/point_load/block.inc, its base reaction equal to
+# the point load (implicit static 1e-8, explicit at rest and semi-implicit at the
+# end of consolidation 1 %), the same point chosen on 1 and 2 ranks (implicit
+# series 1e-10); bad entries refused alike (exit 2 naming the entry, nothing written)
+add_test(NAME verification.point_load_families
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_point_load_families.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/point_load_families 0.01)
+set_tests_properties(verification.point_load_families PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+add_test(NAME verification.point_load_bad_input
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_point_load_input.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/point_load_bad_input)
+set_tests_properties(verification.point_load_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

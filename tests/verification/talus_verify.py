@@ -151,6 +151,28 @@ def run_tool(tool, prm_text, workdir, name, np=1, expect_rc=0, extra_env=None, t
     return p.returncode, p.stdout, p.stderr
 
 
+def check_refused(tool, text, label, expected, workdir):
+    """Bad input refused alike with --check and with a run: `text` (a .prm) with its
+    output/directory set to <workdir>_check|_run/out is run by `tool` (a path) both ways;
+    each must exit 2, print every string of `expected` and write no output directory."""
+    for with_check in (True, False):
+        d = workdir + ("_check" if with_check else "_run")
+        out = os.path.join(d, "out")
+        os.makedirs(d, exist_ok=True)
+        prm = os.path.join(d, "bad.prm")
+        with open(prm, "w") as f:
+            f.write(prm_set(text, "output/directory", out))
+        p = subprocess.run([tool] + (["--check"] if with_check else []) + [prm], capture_output=True, text=True,
+                           env=child_env(), cwd=d, timeout=300)
+        both = p.stdout + p.stderr
+        missing = [e for e in expected if e not in both]
+        last = (both.strip().splitlines() or [""])[-1]
+        refused = p.returncode == 2 and not missing and not os.path.exists(out)
+        check(refused, f"{os.path.basename(tool)}{' --check' if with_check else ''}: {label}: exit {p.returncode}, "
+                        f"{'named ' + str(expected) if not missing else 'MISSING ' + str(missing)}, "
+                        f"{'no output' if not os.path.exists(out) else 'OUTPUT WRITTEN'} ({last[:150]})")
+
+
 def read_csv(path):
     """Columns of a CSV file as a dict name -> list of floats."""
     with open(path) as f:

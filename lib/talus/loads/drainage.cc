@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/loads/drainage.h>
+#include <talus/loads/node_target.h>
 
 #include <deal.II/base/utilities.h>
 
@@ -15,7 +16,17 @@ namespace talus::loads
   namespace
   {
     constexpr unsigned int max_drainage = 16;
-  }
+
+    const NodeTargetEntries drainage_target{
+      "boundary|region",
+      "boundary",
+      "'boundary': every grid node of the faces with 'boundary id' that carries water; 'region': the grid nodes on "
+      "the material's free surface (a vertex of a wet and of a dry cell) inside the region box, e.g. a loaded face "
+      "beside dry cells.",
+      "",
+      /*flat_region=*/false,
+      /*grid_file_ids=*/true};
+  } // namespace
 
   template <int dim>
   bool
@@ -56,13 +67,7 @@ namespace talus::loads
     for (unsigned int k = 0; k < n; ++k)
       {
         prm.enter_subsection("drainage " + std::to_string(k));
-        prm.declare_entry("apply to", "boundary", Selection("boundary|region"),
-                          "'boundary': every grid node of the faces with 'boundary id' that carries water; "
-                          "'region': the grid nodes on the material's free surface (a vertex of a wet and of a "
-                          "dry cell) inside the region box, e.g. a loaded face beside dry cells.");
-        prm.declare_entry("boundary id", "0", Integer(0), "Grid boundary id (apply to = boundary).");
-        prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
-        prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
+        declare_node_target(prm, dim, drainage_target);
         prm.declare_entry("condition", "drained", Selection("drained|impermeable|pressure"),
                           "drained: the pore pressure is 0 there and the water leaves or enters freely (at a "
                           "boundary its velocity normal to the face is not held by the wall); impermeable: no "
@@ -90,25 +95,10 @@ namespace talus::loads
         Drainage<dim> c;
         c.where = "boundary conditions/drainage " + std::to_string(k);
         prm.enter_subsection("drainage " + std::to_string(k));
-        if (prm.get("apply to") == "boundary")
-          {
-            const unsigned int b = prm.get_integer("boundary id");
-            require(!box_grid || b < 2 * dim, c.where + "/boundary id",
-                    "boundary id " + std::to_string(b) + " does not exist in the grid (a " + std::to_string(dim) +
-                      "D box grid has ids 0.." + std::to_string(2 * dim - 1) + ")");
-            require(b < 256, c.where + "/boundary id", "boundary ids are 0..255");
-            c.target   = Drainage<dim>::Target::boundary;
-            c.boundary = static_cast<dealii::types::boundary_id>(b);
-          }
-        else
-          {
-            c.target = Drainage<dim>::Target::region;
-            c.lower  = parse_point<dim>(prm.get("region lower corner"), c.where + "/region lower corner");
-            c.upper  = parse_point<dim>(prm.get("region upper corner"), c.where + "/region upper corner");
-            for (unsigned int d = 0; d < dim; ++d)
-              require(c.upper[d] > c.lower[d], c.where + "/region upper corner",
-                      "must exceed 'region lower corner' in every direction");
-          }
+        const auto t = parse_node_target<dim>(prm, c.where, drainage_target, box_grid);
+        copy_node_target(t, c);
+        c.target =
+          t.kind == NodeTarget<dim>::Kind::boundary ? Drainage<dim>::Target::boundary : Drainage<dim>::Target::region;
         const std::string kind = prm.get("condition"), value = prm.get("pressure");
         c.kind = kind == "drained"       ? Drainage<dim>::Kind::drained
                  : kind == "impermeable" ? Drainage<dim>::Kind::impermeable

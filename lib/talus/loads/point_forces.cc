@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <sstream>
 
 namespace talus::loads
 {
@@ -36,6 +37,11 @@ namespace talus::loads
     // to the selected points' area instead, so the total is the given force.
     using L                = PropertyLayout<dim>;
     const unsigned int off = force_offset;
+    // a point load already on a point (a later stage, a restart) stays there
+    std::vector<dealii::types::particle_index> kept(tractions.size(), invalid_particle);
+    for (unsigned int j = 0; j < tractions.size(); ++j)
+      if (tractions[j].target == Traction<dim>::Target::point)
+        kept[j] = carrier(tractions[j], j, points, comm);
     for (auto &pt : points.handler)
       {
         auto P = pt.get_properties();
@@ -48,6 +54,11 @@ namespace talus::loads
         const auto &t = tractions[j];
         if (t.target == Traction<dim>::Target::boundary) // grid nodal forces: no point carries it
           continue;
+        if (t.target == Traction<dim>::Target::point)
+          {
+            assign_point_load(t, j, kept[j], points, comm);
+            continue;
+          }
         const auto initial = [&](const auto &pt) {
           auto X = pt.get_location();
           for (unsigned int d = 0; d < dim; ++d)
@@ -112,6 +123,95 @@ namespace talus::loads
               << (t.total ? area_sum : area_sum * scale) << (dim == 2 ? " m (per unit thickness)" : " m^2")
               << (t.total ? " (total force given)" : "") << ", f(t) = " << t.function.text() << std::endl;
       }
+  }
+
+  template <int dim>
+  dealii::types::particle_index
+  PointForces<dim>::carrier(const Traction<dim> &t, const unsigned int j, const MaterialPointSet<dim> &points,
+                            MPI_Comm comm) const
+  {
+    // the marker: exactly one point of all ranks carries the force in slot j
+    unsigned long long            mine = 0;
+    dealii::types::particle_index id   = 0;
+    if (t.traction.norm() > 0)
+      for (const auto &pt : points.handler)
+        {
+          const auto P     = pt.get_properties();
+          bool       equal = true;
+          for (unsigned int d = 0; d < dim; ++d)
+            equal = equal && P[force_offset + j * dim + d] == t.traction[d];
+          if (equal)
+            {
+              ++mine;
+              id = pt.get_id();
+            }
+        }
+    if (dealii::Utilities::MPI::sum(mine, comm) != 1)
+      return invalid_particle;
+    return dealii::Utilities::MPI::max(mine > 0 ? id : dealii::types::particle_index(0), comm);
+  }
+
+  template <int dim>
+  void
+  PointForces<dim>::assign_point_load(const Traction<dim> &t, const unsigned int j,
+                                      const dealii::types::particle_index kept, MaterialPointSet<dim> &points,
+                                      MPI_Comm comm)
+  {
+    using L = PropertyLayout<dim>;
+    // candidates by initial position X = x - u; per rank the nearest as
+    // (distance, X, id), then the smallest over all ranks. Ties go to the
+    // smaller X (x, then y, then z), which no partition changes (particle ids
+    // follow the seeding order of the ranks' cells), then to the smaller id.
+    constexpr unsigned int n = 2 + dim;
+    const auto less = [](const double *a, const double *b) { return std::lexicographical_compare(a, a + n, b, b + n); };
+    std::vector<double> mine(n, std::numeric_limits<double>::max()), cand(n);
+    for (const auto &pt : points.handler)
+      {
+        const auto         P    = pt.get_properties();
+        const unsigned int body = static_cast<unsigned int>(P[L::body]);
+        if (kept != invalid_particle ? pt.get_id() != kept : t.body != Traction<dim>::any_body && body != t.body)
+          continue;
+        auto X = pt.get_location();
+        for (unsigned int d = 0; d < dim; ++d)
+          X[d] -= P[L::displacement + d];
+        cand[0] = X.distance(t.position);
+        for (unsigned int d = 0; d < dim; ++d)
+          cand[1 + d] = X[d];
+        cand[1 + dim] = static_cast<double>(pt.get_id());
+        if (less(cand.data(), mine.data()))
+          mine = cand;
+      }
+    int n_ranks = 1;
+    MPI_Comm_size(comm, &n_ranks);
+    std::vector<double> all(n_ranks * n);
+    MPI_Allgather(mine.data(), n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, comm);
+    const double *b = all.data();
+    for (int r = 1; r < n_ranks; ++r)
+      if (less(&all[r * n], b))
+        b = &all[r * n];
+    require(b[0] < std::numeric_limits<double>::max(), t.body == Traction<dim>::any_body ? t.where : t.where + "/body",
+            t.body == Traction<dim>::any_body
+              ? std::string("no material point exists to carry the point load (the scene has none here)")
+              : "body " + std::to_string(t.body) +
+                  " has no material point to carry the point load; allowed: a body that holds points, or any");
+    const auto chosen = static_cast<dealii::types::particle_index>(b[1 + dim]);
+    for (auto &pt : points.handler)
+      if (pt.get_id() == chosen)
+        {
+          auto P = pt.get_properties();
+          for (unsigned int d = 0; d < dim; ++d)
+            P[force_offset + j * dim + d] = t.traction[d];
+        }
+    std::ostringstream x, f;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        x << (d ? ", " : "") << b[1 + d];
+        f << (d ? ", " : "") << t.traction[d];
+      }
+    log() << "  " << t.where << ": " << (kept != invalid_particle ? "kept on" : "on") << " the material point "
+          << chosen << " at (" << x.str() << ") (initial position), " << b[0] << " m from the position, force ("
+          << f.str() << (dim == 2 ? ") N (per unit thickness)" : ") N") << ", f(t) = " << t.function.text()
+          << std::endl;
   }
 
   template <int dim>

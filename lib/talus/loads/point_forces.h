@@ -14,6 +14,7 @@
 
 #include <mpi.h>
 
+#include <limits>
 #include <vector>
 
 namespace talus::loads
@@ -43,7 +44,10 @@ namespace talus::loads
     /// to the face; for a body face normalised to the box face, so the total is
     /// exactly traction x area) and store t_j A_p in slot j; other slots 0.
     /// A traction on a grid boundary id (nodal forces) selects no point: its
-    /// slot stays 0.
+    /// slot stays 0. A point load (Target::point) puts its whole force on the
+    /// one point nearest its position (assign_point_load); a point that
+    /// carries exactly that force in its slot already keeps it, so a later
+    /// stage or a restart does not move the load to another point.
     /// Logs one line per traction; a traction selecting no point is an
     /// InputError. Collective.
     void assign(const std::vector<Traction<dim>> &tractions, MaterialPointSet<dim> &points,
@@ -105,6 +109,20 @@ namespace talus::loads
     }
 
   private:
+    static constexpr dealii::types::particle_index invalid_particle =
+      std::numeric_limits<dealii::types::particle_index>::max();
+    /// The particle id of the one point of all ranks that carries point load
+    /// `t` in slot j already (a later stage, a restart), else invalid_particle.
+    /// Collective.
+    dealii::types::particle_index carrier(const Traction<dim> &t, unsigned int j, const MaterialPointSet<dim> &points,
+                                          MPI_Comm comm) const;
+    /// Point load `t` into slot j of one point: `kept`, or the point of its body
+    /// (any body) nearest its position by initial position, ties to the smaller
+    /// initial position (x, then y, then z), then to the smaller particle id,
+    /// over all ranks; logs the choice. Collective.
+    void assign_point_load(const Traction<dim> &t, unsigned int j, dealii::types::particle_index kept,
+                           MaterialPointSet<dim> &points, MPI_Comm comm);
+
     unsigned int        slots = 0, force_offset = 0;
     bool                have_tractions = false;
     std::vector<double> factor; ///< time factors of the tractions at t

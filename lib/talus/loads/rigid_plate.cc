@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/loads/kinematics.h>
+#include <talus/loads/node_target.h>
 #include <talus/loads/rigid_plate.h>
 #include <talus/loads/rigid_plate_nodes.h>
 
@@ -21,6 +22,15 @@ namespace talus::loads
   namespace
   {
     constexpr unsigned int max_rigid_plates = 4;
+
+    const NodeTargetEntries plate_target{
+      "boundary|region",
+      "boundary",
+      "'boundary': every grid node of the faces with 'boundary id'; 'region': the grid nodes inside the region box "
+      "(e.g. a footing on the material's surface).",
+      "",
+      /*flat_region=*/true,
+      /*grid_file_ids=*/true};
 
     // the errors of the node checks, worded once for the box check (parse) and
     // the grid check (setup)
@@ -84,12 +94,7 @@ namespace talus::loads
     for (unsigned int k = 0; k < n; ++k)
       {
         prm.enter_subsection("rigid plate " + std::to_string(k));
-        prm.declare_entry("apply to", "boundary", Selection("boundary|region"),
-                          "'boundary': every grid node of the faces with 'boundary id'; 'region': the grid nodes "
-                          "inside the region box (e.g. a footing on the material's surface).");
-        prm.declare_entry("boundary id", "0", Integer(0), "Boundary id (apply to = boundary).");
-        prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
-        prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
+        declare_node_target(prm, dim, plate_target);
         prm.declare_entry("direction", dim == 2 ? "y" : "z", Selection(dim == 2 ? "x|y" : "x|y|z"),
                           "The grid axis along which the plate moves.");
         prm.declare_entry("surface", "frictionless", Selection("frictionless|rough"),
@@ -124,25 +129,10 @@ namespace talus::loads
         RigidPlate<dim> p;
         p.where = "boundary conditions/rigid plate " + std::to_string(k);
         prm.enter_subsection("rigid plate " + std::to_string(k));
-        if (prm.get("apply to") == "boundary")
-          {
-            p.target             = RigidPlate<dim>::Target::boundary;
-            const unsigned int b = prm.get_integer("boundary id");
-            require(!box_grid || b < 2 * dim, p.where + "/boundary id",
-                    "boundary id " + std::to_string(b) + " does not exist in the grid (a " + std::to_string(dim) +
-                      "D box grid has ids 0.." + std::to_string(2 * dim - 1) + ")");
-            require(b < 256, p.where + "/boundary id", "boundary ids are 0..255");
-            p.boundary = static_cast<dealii::types::boundary_id>(b);
-          }
-        else
-          {
-            p.target = RigidPlate<dim>::Target::region;
-            p.lower  = parse_point<dim>(prm.get("region lower corner"), p.where + "/region lower corner");
-            p.upper  = parse_point<dim>(prm.get("region upper corner"), p.where + "/region upper corner");
-            for (unsigned int d = 0; d < dim; ++d)
-              require(p.upper[d] >= p.lower[d], p.where + "/region upper corner",
-                      "must not be below 'region lower corner'");
-          }
+        const auto t = parse_node_target<dim>(prm, p.where, plate_target, box_grid);
+        copy_node_target(t, p);
+        p.target                = t.kind == NodeTarget<dim>::Kind::boundary ? RigidPlate<dim>::Target::boundary
+                                                                            : RigidPlate<dim>::Target::region;
         p.axis                  = static_cast<unsigned int>(prm.get("direction")[0] - 'x');
         p.rough                 = prm.get("surface") == "rough";
         const std::string force = prm.get("total force"), disp = prm.get("displacement");

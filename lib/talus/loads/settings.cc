@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/loads/damping.h>
+#include <talus/loads/node_target.h>
 #include <talus/loads/settings.h>
 
 #include <deal.II/base/utilities.h>
@@ -37,16 +38,37 @@ namespace talus::loads
 
     const char *face_names = "x-|x+|y-|y+|z-|z+";
 
+    const NodeTargetEntries traction_target{
+      "body face|region|boundary",
+      "body face",
+      "'body face': the outermost layer of material points of a box body on 'face'; 'region': the points whose "
+      "initial position lies in the region box, loaded on the face normal to the axis of 'face'; 'boundary': the grid "
+      "nodes of the faces with 'boundary id' (nodal forces on the material touching that grid face; "
+      "talus-semi-implicit only, docs/boundary-conditions.md).",
+      "body face",
+      /*flat_region=*/false,
+      /*grid_file_ids=*/false};
+    const NodeTargetEntries velocity_target{
+      "boundary|region|body",
+      "boundary",
+      "'boundary': every grid node of 'boundary id'; 'region': the grid nodes inside the region box; 'body': the "
+      "material points of 'body'.",
+      "body",
+      /*flat_region=*/true,
+      /*grid_file_ids=*/false};
+
+    /// 'loads' of the top level (`path` "loads") or of a stage; point loads are
+    /// global loads only (`with_point_loads`: the top level)
     void
     declare_loads(dealii::ParameterHandler &prm, const std::string &prm_file, const std::string &path,
-                  const unsigned int dim, const bool with_velocities = true)
+                  const unsigned int dim, const bool with_velocities = true, const bool with_point_loads = false)
     {
-      const unsigned int n_tr =
-        dealii::Utilities::string_to_int(peek_entry(prm_file, path, "number of tractions", "0", Integer(0, 16)));
-      const unsigned int n_v = with_velocities
-                                 ? dealii::Utilities::string_to_int(
-                                     peek_entry(prm_file, path, "number of velocity conditions", "0", Integer(0, 16)))
-                                 : 0;
+      const auto count = [&](const char *entry, const bool on) {
+        return on ? dealii::Utilities::string_to_int(peek_entry(prm_file, path, entry, "0", Integer(0, 16))) : 0;
+      };
+      const unsigned int n_tr = count("number of tractions", true);
+      const unsigned int n_v  = count("number of velocity conditions", with_velocities);
+      const unsigned int n_p  = count("number of point loads", with_point_loads);
       prm.enter_subsection("loads");
       prm.declare_entry("number of tractions", "0", Integer(0, 16),
                         "Number of 'traction k' subsections: surface tractions carried by boundary material "
@@ -55,21 +77,16 @@ namespace talus::loads
         prm.declare_entry(
           "number of velocity conditions", "0", Integer(0, 16),
           "Number of 'velocity k' subsections: prescribed velocities on grid nodes or material points.");
+      if (with_point_loads)
+        prm.declare_entry("number of point loads", "0", Integer(0, 16),
+                          "Number of 'point load k' subsections: a force carried by the one material point nearest "
+                          "a position (global loads, absolute time; docs/boundary-conditions.md).");
       for (unsigned int k = 0; k < n_tr; ++k)
         {
           prm.enter_subsection("traction " + std::to_string(k));
-          prm.declare_entry("apply to", "body face", Selection("body face|region|boundary"),
-                            "'body face': the outermost layer of material points of a box body on 'face'; "
-                            "'region': the points whose initial position lies in the region box, loaded on the "
-                            "face normal to the axis of 'face'; 'boundary': the grid nodes of the faces with "
-                            "'boundary id' (nodal forces on the material touching that grid face; "
-                            "talus-semi-implicit only, docs/boundary-conditions.md).");
-          prm.declare_entry("boundary id", "0", Integer(0), "Grid boundary id (apply to = boundary).");
-          prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body face).");
+          declare_node_target(prm, dim, traction_target);
           prm.declare_entry("face", dim == 2 ? "y+" : "z+", Selection(face_names),
                             "Loaded face: its outward normal axis and side.");
-          prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
-          prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
           prm.declare_entry("traction", zeros_text(dim), Anything(),
                             "Traction vector [Pa], force per unit initial area of the face (e.g. 0, -1e4 pushes down); "
                             "direction and size do not follow the deformation (seed 000 §5.2).");
@@ -85,26 +102,82 @@ namespace talus::loads
       for (unsigned int k = 0; k < n_v; ++k)
         {
           prm.enter_subsection("velocity " + std::to_string(k));
-          prm.declare_entry("apply to", "boundary", Selection("boundary|region|body"),
-                            "'boundary': every grid node of 'boundary id'; 'region': the grid nodes inside the "
-                            "region box; 'body': the material points of 'body'.");
-          prm.declare_entry("boundary id", "0", Integer(0), "Boundary id (apply to = boundary).");
-          prm.declare_entry("region lower corner", zeros_text(dim), Anything(), "Region: lower corner [m].");
-          prm.declare_entry("region upper corner", zeros_text(dim), Anything(), "Region: upper corner [m].");
-          prm.declare_entry("body", "0", Integer(0), "Body id (apply to = body).");
+          declare_node_target(prm, dim, velocity_target);
           prm.declare_entry("components", "all", Anything(), "Prescribed components: 'all' or a list of x, y, z.");
           prm.declare_entry("velocity", zeros_text(dim), Anything(),
                             "Velocity vector [m/s] (unprescribed components ignored).");
           prm.declare_entry("time function", "constant", Anything(), "Factor f(t), as for tractions.");
           prm.leave_subsection();
         }
+      for (unsigned int k = 0; k < n_p; ++k)
+        {
+          prm.enter_subsection("point load " + std::to_string(k));
+          prm.declare_entry("position", "", Anything(),
+                            "The point [m] (dim numbers, inside the grid): the material point nearest to it at setup "
+                            "(by initial position; ties: the smaller initial position, then particle id) carries the "
+                            "whole force and moves with the material.");
+          prm.declare_entry("force", "", Anything(),
+                            "Force vector [N; per unit thickness in 2D] (dim numbers); it keeps its direction.");
+          prm.declare_entry("time function", "constant", Anything(),
+                            "Factor f(t) at the absolute time: constant | step T | ramp T1 | ramp T0 T1 | "
+                            "table t0:f0, t1:f1, ... | table file NAME.csv.");
+          prm.declare_entry("body", "any", Anything(),
+                            "The body whose points are candidates: a body id, or 'any' (also -1): every body's.");
+          prm.leave_subsection();
+        }
       prm.leave_subsection();
+    }
+
+    /// the 'point load k' subsections (in 'loads') as point tractions
+    template <int dim>
+    void
+    parse_point_loads(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies,
+                      const dealii::Point<dim> &grid_lower, const dealii::Point<dim> &grid_upper,
+                      std::vector<Traction<dim>> &tractions)
+    {
+      const unsigned int n = prm.get_integer("number of point loads");
+      for (unsigned int k = 0; k < n; ++k)
+        {
+          Traction<dim> t;
+          t.where  = "loads/point load " + std::to_string(k);
+          t.target = Traction<dim>::Target::point;
+          t.total  = true;
+          prm.enter_subsection("point load " + std::to_string(k));
+          t.position = parse_point<dim>(prm.get("position"), t.where + "/position");
+          std::string extent;
+          bool        inside = true;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              inside = inside && t.position[d] >= grid_lower[d] && t.position[d] <= grid_upper[d];
+              extent += std::string(d ? ", " : "") + char('x' + d) + " " + std::to_string(grid_lower[d]) + " .. " +
+                        std::to_string(grid_upper[d]);
+            }
+          require(inside, t.where + "/position",
+                  "'" + prm.get("position") + "' lies outside the grid (grid extent " + extent +
+                    "); allowed: a point inside the grid");
+          t.traction          = parse_point<dim>(prm.get("force"), t.where + "/force");
+          t.function          = TimeFunction::parse(prm.get("time function"), t.where + "/time function");
+          const std::string b = dealii::Utilities::trim(prm.get("body"));
+          if (b == "any" || b == "-1")
+            t.body = Traction<dim>::any_body;
+          else
+            {
+              const auto v = parse_doubles(b, t.where + "/body");
+              require(v.size() == 1 && v[0] >= 0 && v[0] == std::floor(v[0]) && v[0] < bodies.size(), t.where + "/body",
+                      "'" + b + "' is not a body; allowed: any (or -1) or a body id 0.." +
+                        std::to_string(bodies.size() - 1));
+              t.body = static_cast<unsigned int>(v[0]);
+            }
+          prm.leave_subsection();
+          tractions.push_back(t);
+        }
     }
 
     template <int dim>
     void
     parse_loads(dealii::ParameterHandler &prm, const std::string &path, const std::vector<BodyDescription<dim>> &bodies,
-                std::vector<Traction<dim>> &tractions, std::vector<PrescribedVelocity<dim>> *velocities)
+                std::vector<Traction<dim>> &tractions, std::vector<PrescribedVelocity<dim>> *velocities,
+                const dealii::Point<dim> *grid_lower = nullptr, const dealii::Point<dim> *grid_upper = nullptr)
     {
       prm.enter_subsection("loads");
       const std::string  base = path.empty() ? "loads" : path + "/loads";
@@ -120,37 +193,23 @@ namespace talus::loads
           t.axis              = static_cast<unsigned int>(f[0] - 'x');
           t.side              = f[1] == '+' ? +1 : -1;
           require(t.axis < dim, where + "/face", "'" + f + "' does not exist in " + std::to_string(dim) + "D");
-          const std::string a = prm.get("apply to");
-          t.target            = a == "region"     ? Traction<dim>::Target::region
-                                : a == "boundary" ? Traction<dim>::Target::boundary
-                                                  : Traction<dim>::Target::body_face;
+          using Kind        = typename NodeTarget<dim>::Kind;
+          const auto target = parse_node_target<dim>(prm, where, traction_target, true, bodies.size());
+          copy_node_target(target, t);
+          t.target = target.kind == Kind::region     ? Traction<dim>::Target::region
+                     : target.kind == Kind::boundary ? Traction<dim>::Target::boundary
+                                                     : Traction<dim>::Target::body_face;
           if (t.target == Traction<dim>::Target::boundary)
             {
               // the face's normal is the boundary's; 'face' is not used
-              const unsigned int b = prm.get_integer("boundary id");
-              require(b < 2 * dim, where + "/boundary id",
-                      "boundary id " + std::to_string(b) + " does not exist (box grid ids 0.." +
-                        std::to_string(2 * dim - 1) + ")");
-              t.boundary = static_cast<dealii::types::boundary_id>(b);
-              t.axis     = b / 2;
-              t.side     = b % 2 ? +1 : -1;
+              t.axis = t.boundary / 2;
+              t.side = t.boundary % 2 ? +1 : -1;
             }
           else if (t.target == Traction<dim>::Target::body_face)
             {
-              t.body = prm.get_integer("body");
-              require(t.body < bodies.size(), where + "/body",
-                      "body " + std::to_string(t.body) +
-                        " is not defined (number of bodies = " + std::to_string(bodies.size()) + ")");
+              t.body = target.body;
               require(bodies[t.body].shape == BodyDescription<dim>::Shape::box, where + "/apply to",
                       "'body face' needs a box body (body " + std::to_string(t.body) + " is not a box); use 'region'");
-            }
-          else
-            {
-              t.lower = parse_point<dim>(prm.get("region lower corner"), where + "/region lower corner");
-              t.upper = parse_point<dim>(prm.get("region upper corner"), where + "/region upper corner");
-              for (unsigned int d = 0; d < dim; ++d)
-                require(t.upper[d] > t.lower[d], where + "/region upper corner",
-                        "must exceed 'region lower corner' in every direction");
             }
           t.traction            = parse_point<dim>(prm.get("traction"), where + "/traction");
           const std::string tot = prm.get("total force");
@@ -170,34 +229,14 @@ namespace talus::loads
           const std::string where = base + "/velocity " + std::to_string(k);
           prm.enter_subsection("velocity " + std::to_string(k));
           PrescribedVelocity<dim> v;
-          v.where             = where;
-          const std::string a = prm.get("apply to");
-          if (a == "boundary")
-            {
-              v.target             = PrescribedVelocity<dim>::Target::boundary;
-              const unsigned int b = prm.get_integer("boundary id");
-              require(b < 2 * dim, where + "/boundary id",
-                      "boundary id " + std::to_string(b) + " does not exist (box grid ids 0.." +
-                        std::to_string(2 * dim - 1) + ")");
-              v.boundary = static_cast<dealii::types::boundary_id>(b);
-            }
-          else if (a == "region")
-            {
-              v.target = PrescribedVelocity<dim>::Target::region;
-              v.lower  = parse_point<dim>(prm.get("region lower corner"), where + "/region lower corner");
-              v.upper  = parse_point<dim>(prm.get("region upper corner"), where + "/region upper corner");
-              for (unsigned int d = 0; d < dim; ++d)
-                require(v.upper[d] >= v.lower[d], where + "/region upper corner",
-                        "must not be below 'region lower corner'");
-            }
-          else
-            {
-              v.target = PrescribedVelocity<dim>::Target::body;
-              v.body   = prm.get_integer("body");
-              require(v.body < bodies.size(), where + "/body",
-                      "body " + std::to_string(v.body) +
-                        " is not defined (number of bodies = " + std::to_string(bodies.size()) + ")");
-            }
+          v.where           = where;
+          using Kind        = typename NodeTarget<dim>::Kind;
+          const auto target = parse_node_target<dim>(prm, where, velocity_target, true, bodies.size());
+          copy_node_target(target, v);
+          v.body                  = target.body;
+          v.target                = target.kind == Kind::boundary ? PrescribedVelocity<dim>::Target::boundary
+                                    : target.kind == Kind::region ? PrescribedVelocity<dim>::Target::region
+                                                                  : PrescribedVelocity<dim>::Target::body;
           const std::string comps = prm.get("components");
           for (unsigned int d = 0; d < dim; ++d)
             v.component[d] = comps == "all";
@@ -214,6 +253,8 @@ namespace talus::loads
           prm.leave_subsection();
           velocities->push_back(v);
         }
+      if (grid_lower) // the top level: its point loads after the tractions
+        parse_point_loads<dim>(prm, bodies, *grid_lower, *grid_upper, tractions);
       prm.leave_subsection();
     }
 
@@ -338,7 +379,7 @@ namespace talus::loads
     prm.declare_entry("adhesion", "0", Double(0),
                       "Adhesion a [Pa] of the 'friction' boundaries (Eq. 6.19: f_adh = a A_k).");
     prm.leave_subsection();
-    declare_loads(prm, prm_file, "loads", dim);
+    declare_loads(prm, prm_file, "loads", dim, true, true);
     declare_switches(prm, false);
 
     declare_stage_parameters(prm, prm_file, dim, true);
@@ -446,7 +487,8 @@ namespace talus::loads
   Settings<dim>
   parse_parameters(dealii::ParameterHandler &prm, const double end_time, const dealii::Tensor<1, dim> &gravity,
                    const std::vector<BoundaryCondition>    &boundary_conditions,
-                   const std::vector<BodyDescription<dim>> &bodies)
+                   const std::vector<BodyDescription<dim>> &bodies, const dealii::Point<dim> &grid_lower,
+                   const dealii::Point<dim> &grid_upper)
   {
     Settings<dim> s;
     Stage<dim>    top;
@@ -463,7 +505,7 @@ namespace talus::loads
         require(bc.id != id, "boundary conditions/friction",
                 "boundary " + std::to_string(id) + " is also fixed/roller; give each boundary one condition");
     prm.leave_subsection();
-    parse_loads<dim>(prm, "", bodies, top.tractions, &top.velocities);
+    parse_loads<dim>(prm, "", bodies, top.tractions, &top.velocities, &grid_lower, &grid_upper);
     parse_two_phase_aliases<dim>(prm, bodies, top.tractions);
     top.n_global_tractions  = top.tractions.size();
     top.n_global_velocities = top.velocities.size();
@@ -495,16 +537,17 @@ namespace talus::loads
   declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, const unsigned int dim,
                               const bool with_velocities)
   {
-    declare_loads(prm, prm_file, "loads", dim, with_velocities);
+    declare_loads(prm, prm_file, "loads", dim, with_velocities, true);
   }
 
   template <int dim>
   std::vector<Traction<dim>>
   parse_traction_parameters(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies,
+                            const dealii::Point<dim> &grid_lower, const dealii::Point<dim> &grid_upper,
                             std::vector<PrescribedVelocity<dim>> *velocities)
   {
     std::vector<Traction<dim>> t;
-    parse_loads<dim>(prm, "", bodies, t, velocities);
+    parse_loads<dim>(prm, "", bodies, t, velocities, &grid_lower, &grid_upper);
     return t;
   }
 
@@ -522,9 +565,11 @@ namespace talus::loads
   template void refuse_boundary_tractions(const std::vector<Traction<3>> &, const std::string &, const std::string &);
   template std::vector<Traction<2>> parse_traction_parameters<2>(dealii::ParameterHandler &,
                                                                  const std::vector<BodyDescription<2>> &,
+                                                                 const dealii::Point<2> &, const dealii::Point<2> &,
                                                                  std::vector<PrescribedVelocity<2>> *);
   template std::vector<Traction<3>> parse_traction_parameters<3>(dealii::ParameterHandler &,
                                                                  const std::vector<BodyDescription<3>> &,
+                                                                 const dealii::Point<3> &, const dealii::Point<3> &,
                                                                  std::vector<PrescribedVelocity<3>> *);
   template std::vector<Stage<2>>    parse_stages<2>(dealii::ParameterHandler &, const Stage<2> &,
                                                  const std::vector<BodyDescription<2>> &, const bool);
@@ -534,8 +579,10 @@ namespace talus::loads
   template struct Settings<3>;
   template Settings<2> parse_parameters<2>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 2> &,
                                            const std::vector<BoundaryCondition> &,
-                                           const std::vector<BodyDescription<2>> &);
+                                           const std::vector<BodyDescription<2>> &, const dealii::Point<2> &,
+                                           const dealii::Point<2> &);
   template Settings<3> parse_parameters<3>(dealii::ParameterHandler &, const double, const dealii::Tensor<1, 3> &,
                                            const std::vector<BoundaryCondition> &,
-                                           const std::vector<BodyDescription<3>> &);
+                                           const std::vector<BodyDescription<3>> &, const dealii::Point<3> &,
+                                           const dealii::Point<3> &);
 } // namespace talus::loads

@@ -28,18 +28,22 @@ namespace talus::loads
     {
       body_face, ///< the outermost layer of points of a box body on one face
       region,    ///< the points whose initial position lies in a box region
-      boundary   ///< the grid nodes of the faces with `boundary` (nodal forces; not every family)
+      boundary,  ///< the grid nodes of the faces with `boundary` (nodal forces; not every family)
+      point      ///< 'loads/point load k': the one material point nearest `position` carries `traction` (a force)
     };
-    Target                     target   = Target::body_face;
-    dealii::types::boundary_id boundary = 0; ///< apply to = boundary
-    unsigned int               body     = 0;
-    unsigned int               axis     = dim - 1; ///< normal axis of the face
-    int                        side     = +1;      ///< +1: upper face, -1: lower face
-    dealii::Point<dim>         lower, upper;       ///< region
-    dealii::Tensor<1, dim>     traction;           ///< [Pa] (force per area); with `total`: the resultant [N]
-    bool                       total = false;      ///< `traction` is the resultant over the selected points
-    TimeFunction               function;
-    std::string                where;
+    /// point: any body's points are candidates
+    static constexpr unsigned int any_body = static_cast<unsigned int>(-1);
+    Target                        target   = Target::body_face;
+    dealii::types::boundary_id    boundary = 0;       ///< apply to = boundary
+    unsigned int                  body     = 0;       ///< body face; point: the candidates' body or any_body
+    unsigned int                  axis     = dim - 1; ///< normal axis of the face
+    int                           side     = +1;      ///< +1: upper face, -1: lower face
+    dealii::Point<dim>            lower, upper;       ///< region
+    dealii::Point<dim>            position;           ///< point: where the user put it
+    dealii::Tensor<1, dim> traction; ///< [Pa] (force per area); with `total` (always for a point): the resultant [N]
+    bool                   total = false; ///< `traction` is the resultant over the selected points
+    TimeFunction           function;
+    std::string            where;
   };
 
   /// Prescribed velocity on grid nodes (boundary id or region) or on the
@@ -104,14 +108,14 @@ namespace talus::loads
     bool active() const;
   };
 
-  /// Declare the entries (loads, damping, mass scaling, convergence, friction
-  /// in 'boundary conditions', stages). 'body k/initial stress' is the
-  /// scene's (formulations/common/initial_stress.h).
+  /// Declare the entries (loads with point loads, damping, mass scaling,
+  /// convergence, friction in 'boundary conditions', stages). 'body k/initial
+  /// stress' is the scene's (formulations/common/initial_stress.h).
   void declare_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim);
 
-  /// Only the 'loads' subsection with its 'traction k' entries and, with
-  /// `with_velocities`, its 'velocity k' conditions (families without stages
-  /// or damping: talus-implicit).
+  /// Only the 'loads' subsection with its 'traction k' and 'point load k'
+  /// entries and, with `with_velocities`, its 'velocity k' conditions
+  /// (families without stages or damping: talus-implicit).
   void declare_traction_parameters(dealii::ParameterHandler &prm, const std::string &prm_file, unsigned int dim,
                                    bool with_velocities = false);
   /// InputError naming 'loads/traction k/apply to' of the first traction on a
@@ -122,11 +126,14 @@ namespace talus::loads
                                  const std::string &reason);
 
   /// The tractions of declare_traction_parameters (global loads, absolute
-  /// time) and, if `velocities` is given, the velocity conditions.
+  /// time), the point loads after them (Target::point; a position outside the
+  /// grid [grid_lower, grid_upper] is an InputError) and, if `velocities` is
+  /// given, the velocity conditions.
   template <int dim>
-  std::vector<Traction<dim>> parse_traction_parameters(dealii::ParameterHandler                &prm,
-                                                       const std::vector<BodyDescription<dim>> &bodies,
-                                                       std::vector<PrescribedVelocity<dim>>    *velocities = nullptr);
+  std::vector<Traction<dim>>
+  parse_traction_parameters(dealii::ParameterHandler &prm, const std::vector<BodyDescription<dim>> &bodies,
+                            const dealii::Point<dim> &grid_lower, const dealii::Point<dim> &grid_upper,
+                            std::vector<PrescribedVelocity<dim>> *velocities = nullptr);
 
   /// 'number of stages' and the 'stage k' subsections: name, duration, gravity,
   /// fixed/roller boundaries and the stage's own loads; `explicit_entries`
@@ -145,10 +152,12 @@ namespace talus::loads
                                        const std::vector<BodyDescription<dim>> &bodies, bool explicit_entries);
 
   /// Parse after the solver has read its own entries (end time, gravity, the
-  /// fixed/roller boundaries and the bodies, which are passed in).
+  /// fixed/roller boundaries, the bodies and the grid's extent, which are
+  /// passed in). The point loads are global tractions after the top-level ones.
   template <int dim>
   Settings<dim> parse_parameters(dealii::ParameterHandler &prm, const double end_time,
                                  const dealii::Tensor<1, dim>            &gravity,
                                  const std::vector<BoundaryCondition>    &boundary_conditions,
-                                 const std::vector<BodyDescription<dim>> &bodies);
+                                 const std::vector<BodyDescription<dim>> &bodies, const dealii::Point<dim> &grid_lower,
+                                 const dealii::Point<dim> &grid_upper);
 } // namespace talus::loads

@@ -113,7 +113,8 @@ namespace talus::explicit_mpm
                   ", whose points carry no pore water (allowed: empty, or 'pore liquid/drainage = coupled')");
       }
     const unsigned int n_bodies = p.bodies.size();
-    p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies);
+    p.loads = loads::parse_parameters<dim>(prm, p.end_time, p.gravity, p.boundary_conditions, p.bodies, p.grid_lower,
+                                           p.grid_upper);
     // a traction on a grid boundary id (nodal forces): talus-semi-implicit only
     for (const auto &st : p.loads.stages)
       loads::refuse_boundary_tractions(st.tractions, "talus-explicit",
@@ -156,6 +157,9 @@ namespace talus::explicit_mpm
                 "load balancing" + why + "interval = 0, or velocity transfer = flip");
         for (const auto &st : p.loads.stages)
           {
+            for (const auto &t : st.tractions)
+              require(t.target != loads::Traction<dim>::Target::point, t.where,
+                      "point loads" + why + "no point loads, or velocity transfer = flip");
             require(st.tractions.empty(), "loads/traction",
                     "tractions" + why + "no traction conditions, or velocity transfer = flip");
             require(st.friction_ids.empty(), "boundary conditions/friction",

@@ -352,7 +352,7 @@ namespace talus::implicit_mpm
       require(p.contact_penalty == 1, "boundary conditions/contact penalty",
               "applies to 'contact method = points' only; remove it or set 'contact method = points'");
     prm.leave_subsection();
-    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
+    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, p.grid_lower, p.grid_upper, &p.velocities);
     p.traction_stage.assign(p.tractions.size(), -1);
     {
       // the stages; without 'number of stages' one from the top-level entries
@@ -488,6 +488,10 @@ namespace talus::implicit_mpm
                   p.staged ? "stage " + std::to_string(k) + "/gravity/acceleration"
                            : std::string("gravity/acceleration"),
                   "with 'axisymmetric' the body force must act along the axis (y): its x (radial) component must be 0");
+        for (const auto &t : p.tractions)
+          require(t.target != loads::Traction<dim>::Target::point, t.where,
+                  "a point load is not available with 'axisymmetric' (a material point off the axis stands for a "
+                  "ring, so its force would be a ring load); allowed: plane strain, or a traction in Pa");
         for (const auto &t : p.tractions)
           require(!t.total, t.where,
                   "'total force' is not available with 'axisymmetric' (give the traction in Pa; it is applied per "

@@ -63,7 +63,7 @@ namespace talus::semi_implicit
   void
   parse_boundary_load_parameters(dealii::ParameterHandler &prm, Parameters<dim> &p)
   {
-    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, &p.velocities);
+    p.tractions = loads::parse_traction_parameters<dim>(prm, p.bodies, p.grid_lower, p.grid_upper, &p.velocities);
     prm.enter_subsection("boundary conditions");
     for (const auto &c : loads::parse_drainage_parameters<dim>(prm, /*box_grid=*/true))
       p.drainage.push_back(c); // after the alias 'semi implicit/drained boundaries': the later wins
@@ -82,6 +82,11 @@ namespace talus::semi_implicit
                   "body " + std::to_string(t.body) +
                     " has phase = water; a traction is carried by soil points (allowed: a body with phase "
                     "saturated or soil, or apply to = boundary)");
+        if (t.target == loads::Traction<dim>::Target::point && t.body != loads::Traction<dim>::any_body)
+          require(p.phase_of_body[t.body] != Phase::water, t.where + "/body",
+                  "body " + std::to_string(t.body) +
+                    " has phase = water; a point load is carried by soil points (allowed: a body with phase "
+                    "saturated or soil, or any)");
         if (t.target == loads::Traction<dim>::Target::region)
           require(region_meets_grid(t.lower, t.upper, p), t.where + "/region lower corner",
                   "the region lies outside the grid " + grid_extent(p));
@@ -163,9 +168,9 @@ namespace talus::semi_implicit
                 bool loaded_by_j = false;
                 for (unsigned int d = 0; d < dim; ++d)
                   loaded_by_j = loaded_by_j || P[off + j * dim + d] != 0.0;
-                if (!loaded_by_j)
+                const auto &t = prm.tractions[j];
+                if (!loaded_by_j || t.target == loads::Traction<dim>::Target::point) // a point load: at the point
                   continue;
-                const auto        &t     = prm.tractions[j];
                 const auto        &cc    = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
                 const unsigned int b     = static_cast<unsigned int>(P[L::body]);
                 P[offset_field + t.axis] = t.side * 0.5 * cc.h[t.axis] / bodies[b].particles_per_direction;
