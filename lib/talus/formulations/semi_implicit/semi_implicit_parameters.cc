@@ -303,8 +303,7 @@ namespace talus::semi_implicit
           materials::check_porosity(pl, where);
           require(pl.density == p.water_density, where + "/liquid density",
                   "is " + number_text(pl.density) +
-                    " kg/m^3: talus-semi-implicit has one water, of 'semi "
-                    "implicit/water density' = " +
+                    " kg/m^3: talus-semi-implicit has one water, of 'semi implicit/water density' = " +
                     number_text(p.water_density) +
                     " kg/m^3; allowed: the same value (or leave both at their default 1000)");
           require(pl.bulk_modulus == defaults.bulk_modulus, where + "/liquid bulk modulus",
