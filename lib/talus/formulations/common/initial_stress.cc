@@ -22,13 +22,15 @@ namespace talus
                       "|g| above it, and the hydrostatic pore pressure rho_L |g| (water level - z).");
     prm.declare_entry("K0", "auto", Anything(),
                       "Lateral stress ratio; 'auto' = 1 - sin(phi) for Mohr-Coulomb materials (error otherwise).");
-    prm.declare_entry("surface level", "", Anything(), "Level of the free surface along -g [m]; empty = top of this body.");
+    prm.declare_entry("surface level", "", Anything(),
+                      "Level of the free surface along -g [m]; empty = top of this body.");
     prm.declare_entry("water level", "", Anything(),
                       "Level of the free water along -g [m] (two-phase points: talus-semi-implicit, and talus-explicit "
                       "with 'pore liquid/drainage = coupled'); empty = the surface level (saturated to the surface). "
                       "Above the surface it ponds (pore pressure at the surface rho_L |g| (water level - surface)); "
                       "below it the soil above is dry. One-phase bodies refuse it.");
-    prm.declare_entry("surcharge", "0", Double(0), "Vertical pressure on the surface [Pa] (overburden of layers above).");
+    prm.declare_entry("surcharge", "0", Double(0),
+                      "Vertical pressure on the surface [Pa] (overburden of layers above).");
     prm.leave_subsection();
   }
 
@@ -104,8 +106,7 @@ namespace talus
   }
 
   template <int dim>
-  GeostaticState<dim>::GeostaticState(const std::vector<InitialStress> &settings,
-                                      const dealii::Tensor<1, dim>     &gravity)
+  GeostaticState<dim>::GeostaticState(const std::vector<InitialStress> &settings, const dealii::Tensor<1, dim> &gravity)
       : settings(settings)
       , g(gravity.norm())
   {
@@ -126,11 +127,11 @@ namespace talus
   template <int dim>
   void
   GeostaticState<dim>::find_body_tops(const std::vector<const MaterialPointSet<dim> *> &sets,
-                                      const BackgroundGrid<dim>                        &grid,
-                                      const std::vector<BodyDescription<dim>> &bodies, MPI_Comm comm)
+                                      const BackgroundGrid<dim> &grid, const std::vector<BodyDescription<dim>> &bodies,
+                                      MPI_Comm comm)
   {
-    using L                = PropertyLayout<dim>;
-    const unsigned int n   = settings.size();
+    using L               = PropertyLayout<dim>;
+    const unsigned int  n = settings.size();
     std::vector<double> top(n, -std::numeric_limits<double>::max());
     for (const auto *set : sets)
       for (const auto &pt : set->handler)
@@ -197,9 +198,9 @@ namespace talus
     return stress(body, -(density * g * depths(body, x).depth + settings[body].surcharge));
   }
 
-#define TALUS_INSTANTIATE(dim)                                                                                        \
-  template std::vector<InitialStress> parse_initial_stress<dim>(                                                      \
-    dealii::ParameterHandler &, const std::vector<BodyDescription<dim>> &, const dealii::Tensor<1, dim> &);           \
+#define TALUS_INSTANTIATE(dim)                                                                              \
+  template std::vector<InitialStress> parse_initial_stress<dim>(                                            \
+    dealii::ParameterHandler &, const std::vector<BodyDescription<dim>> &, const dealii::Tensor<1, dim> &); \
   template class GeostaticState<dim>;
   TALUS_INSTANTIATE(2)
   TALUS_INSTANTIATE(3)

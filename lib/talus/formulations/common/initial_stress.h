@@ -30,10 +30,10 @@ namespace talus
   /// 'body k/initial stress' of one body (seed 000 §6.4, the K0 procedure).
   struct InitialStress
   {
-    bool   enabled       = false;
-    double K0            = 0.5;
-    double surface_level = std::numeric_limits<double>::quiet_NaN(); ///< along -g [m]; NaN: top of the body
-    double water_level   = std::numeric_limits<double>::quiet_NaN(); ///< NaN: the surface level
+    bool   enabled           = false;
+    double K0                = 0.5;
+    double surface_level     = std::numeric_limits<double>::quiet_NaN(); ///< along -g [m]; NaN: top of the body
+    double water_level       = std::numeric_limits<double>::quiet_NaN(); ///< NaN: the surface level
     bool   water_level_given = false; ///< 'water level' was set (families without pore water refuse it)
     double surcharge         = 0;     ///< vertical pressure on the surface [Pa], compression positive
   };
