@@ -176,6 +176,12 @@ namespace talus::semi_implicit
     void
     check_scene(const Parameters<dim> &p)
     {
+      // shared output entries this family does not write yet: refused, not ignored
+      for (const auto &[used, entry] : {std::pair<bool, const char *>{!p.results_file.empty(), "output/results file"},
+                                        {!p.probes.empty(), "output/probes"},
+                                        {p.write_grid, "output/write grid"}})
+        require(!used, entry,
+                "not written by talus-semi-implicit yet (talus-explicit and talus-fem write it); remove the entry");
       SceneCheckOptions o;
       o.cell_memory_factor = 2;              // the pressure space, its matrix and the two-phase nodal vectors
       for (const Phase ph : p.phase_of_body) // a saturated body seeds soil and water points
