@@ -77,9 +77,7 @@ namespace talus::loads
         prm.declare_entry("pressure", "", Anything(),
                           "condition = pressure: the pore pressure [Pa] in the family's sign convention "
                           "(talus-semi-implicit: tension positive, so a water pressure of 10 kPa is -1e4).");
-        prm.declare_entry("time function", "constant", Anything(),
-                          "Factor f(t) of the pressure (absolute time): constant | step T | ramp T1 | ramp T0 T1 "
-                          "| table t0:f0, t1:f1, ... | table file NAME.csv.");
+        declare_time_function(prm, "the pressure", "the absolute time");
         prm.leave_subsection();
       }
   }
@@ -113,7 +111,7 @@ namespace talus::loads
         else
           require(dealii::Utilities::trim(value).empty(), c.where + "/pressure",
                   "is given but the condition is '" + kind + "'; allowed: a pressure with condition = pressure only");
-        c.function = TimeFunction::parse(prm.get("time function"), c.where + "/time function");
+        c.function = parse_time_function(prm, c.where);
         prm.leave_subsection();
         out.push_back(c);
       }

@@ -107,9 +107,7 @@ namespace talus::loads
         prm.declare_entry("displacement", "", Anything(),
                           "Displacement control: the plate's displacement along +direction [m], times the time "
                           "function; its reaction is reported. Give this or 'total force'.");
-        prm.declare_entry("time function", "constant", Anything(),
-                          "Factor f(t) of the force or displacement (absolute time): constant | step T | ramp T1 | "
-                          "ramp T0 T1 | table t0:f0, t1:f1, ... | table file NAME.csv.");
+        declare_time_function(prm, "the force or displacement", "the absolute time");
         prm.declare_entry(
           "drainage", "impermeable", Selection("impermeable|permeable"),
           "Two-phase families: 'permeable': the pore pressure is zero at the plate's nodes (the "
@@ -153,7 +151,7 @@ namespace talus::loads
             p.control      = RigidPlate<dim>::Control::displacement;
             p.displacement = v[0];
           }
-        p.function  = TimeFunction::parse(prm.get("time function"), p.where + "/time function");
+        p.function  = parse_time_function(prm, p.where);
         p.permeable = prm.get("drainage") == "permeable";
         prm.leave_subsection();
         plates.push_back(p);

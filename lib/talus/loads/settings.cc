@@ -94,9 +94,7 @@ namespace talus::loads
                             "Instead of 'traction': the resultant force [N; per unit thickness in 2D] spread over "
                             "the selected points in proportion to their area shares (traction = total force / loaded "
                             "area: exact totals where the seeded points do not fill the face exactly); empty = off.");
-          prm.declare_entry("time function", "constant", Anything(),
-                            "Factor f(t): constant | step T | ramp T1 | ramp T0 T1 | table t0:f0, t1:f1, ... | "
-                            "table file NAME.csv (time of the stage for stage loads).");
+          declare_time_function(prm, "the traction", "the stage's time for a stage load, else the absolute time");
           prm.leave_subsection();
         }
       for (unsigned int k = 0; k < n_v; ++k)
@@ -106,7 +104,7 @@ namespace talus::loads
           prm.declare_entry("components", "all", Anything(), "Prescribed components: 'all' or a list of x, y, z.");
           prm.declare_entry("velocity", zeros_text(dim), Anything(),
                             "Velocity vector [m/s] (unprescribed components ignored).");
-          prm.declare_entry("time function", "constant", Anything(), "Factor f(t), as for tractions.");
+          declare_time_function(prm, "the velocity", "the stage's time for a stage load, else the absolute time");
           prm.leave_subsection();
         }
       for (unsigned int k = 0; k < n_p; ++k)
@@ -118,9 +116,7 @@ namespace talus::loads
                             "whole force and moves with the material.");
           prm.declare_entry("force", "", Anything(),
                             "Force vector [N; per unit thickness in 2D] (dim numbers); it keeps its direction.");
-          prm.declare_entry("time function", "constant", Anything(),
-                            "Factor f(t) at the absolute time: constant | step T | ramp T1 | ramp T0 T1 | "
-                            "table t0:f0, t1:f1, ... | table file NAME.csv.");
+          declare_time_function(prm, "the force", "the absolute time");
           prm.declare_entry("body", "any", Anything(),
                             "The body whose points are candidates: a body id, or 'any' (also -1): every body's.");
           prm.leave_subsection();
@@ -156,7 +152,7 @@ namespace talus::loads
                   "'" + prm.get("position") + "' lies outside the grid (grid extent " + extent +
                     "); allowed: a point inside the grid");
           t.traction          = parse_point<dim>(prm.get("force"), t.where + "/force");
-          t.function          = TimeFunction::parse(prm.get("time function"), t.where + "/time function");
+          t.function          = parse_time_function(prm, t.where);
           const std::string b = dealii::Utilities::trim(prm.get("body"));
           if (b == "any" || b == "-1")
             t.body = Traction<dim>::any_body;
@@ -220,7 +216,7 @@ namespace talus::loads
               t.traction = parse_point<dim>(tot, where + "/total force");
               t.total    = true;
             }
-          t.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
+          t.function = parse_time_function(prm, where);
           prm.leave_subsection();
           tractions.push_back(t);
         }
@@ -249,7 +245,7 @@ namespace talus::loads
                 v.component[c[0] - 'x'] = true;
               }
           v.velocity = parse_point<dim>(prm.get("velocity"), where + "/velocity");
-          v.function = TimeFunction::parse(prm.get("time function"), where + "/time function");
+          v.function = parse_time_function(prm, where);
           prm.leave_subsection();
           velocities->push_back(v);
         }

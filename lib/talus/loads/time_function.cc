@@ -1,6 +1,8 @@
 #include <talus/base/errors.h>
 #include <talus/loads/time_function.h>
 
+#include <deal.II/base/parameter_handler.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -179,5 +181,20 @@ namespace talus::loads
           return times.back();
       }
     return 0.0;
+  }
+
+  void
+  declare_time_function(dealii::ParameterHandler &prm, const std::string &what, const std::string &time_base)
+  {
+    prm.declare_entry("time function", "constant", dealii::Patterns::Anything(),
+                      "Factor f(t) of " + what + " (" + time_base +
+                        "): constant | step T | ramp T1 | ramp T0 T1 | table t0:f0, t1:f1, ... | table file "
+                        "NAME.csv (two columns t,f).");
+  }
+
+  TimeFunction
+  parse_time_function(dealii::ParameterHandler &prm, const std::string &where)
+  {
+    return TimeFunction::parse(prm.get("time function"), where + "/time function");
   }
 } // namespace talus::loads

@@ -5,6 +5,11 @@
 #include <string>
 #include <vector>
 
+namespace dealii
+{
+  class ParameterHandler;
+}
+
 namespace talus::loads
 {
   /// f(t), dimensionless factor multiplying a load or a prescribed velocity.
@@ -45,4 +50,12 @@ namespace talus::loads
     std::vector<double> times, values;
     std::string         source = "constant";
   };
+
+  /// Declare the entry 'time function' (default constant) in the current
+  /// subsection: "Factor f(t) of <what> (<time base>): <the forms>". The one
+  /// declaration of the entry for every load, velocity, plate and drainage.
+  void declare_time_function(dealii::ParameterHandler &prm, const std::string &what, const std::string &time_base);
+  /// Parse the current subsection's 'time function'; `where` names the
+  /// subsection in errors (where + "/time function").
+  TimeFunction parse_time_function(dealii::ParameterHandler &prm, const std::string &where);
 } // namespace talus::loads

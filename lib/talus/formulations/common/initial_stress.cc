@@ -52,10 +52,7 @@ namespace talus
         if (!level.empty())
           z.surface_level = parse_doubles(level, where + "/surface level").at(0);
         if (!water.empty())
-          {
-            z.water_level       = parse_doubles(water, where + "/water level").at(0);
-            z.water_level_given = true;
-          }
+          z.water_level = parse_doubles(water, where + "/water level").at(0);
         prm.leave_subsection();
         prm.leave_subsection();
         if (z.enabled)
@@ -101,7 +98,7 @@ namespace talus
   refuse_water_level(const std::vector<InitialStress> &settings, const std::string &tool, const std::string &reason)
   {
     for (unsigned int k = 0; k < settings.size(); ++k)
-      require(!settings[k].enabled || !settings[k].water_level_given,
+      require(!settings[k].enabled || !settings[k].has_water_level(),
               "body " + std::to_string(k) + "/initial stress/water level", tool + " cannot honour it: " + reason);
   }
 

@@ -30,12 +30,18 @@ namespace talus
   /// 'body k/initial stress' of one body (seed 000 §6.4, the K0 procedure).
   struct InitialStress
   {
-    bool   enabled           = false;
-    double K0                = 0.5;
-    double surface_level     = std::numeric_limits<double>::quiet_NaN(); ///< along -g [m]; NaN: top of the body
-    double water_level       = std::numeric_limits<double>::quiet_NaN(); ///< NaN: the surface level
-    bool   water_level_given = false; ///< 'water level' was set (families without pore water refuse it)
-    double surcharge         = 0;     ///< vertical pressure on the surface [Pa], compression positive
+    bool   enabled       = false;
+    double K0            = 0.5;
+    double surface_level = std::numeric_limits<double>::quiet_NaN(); ///< along -g [m]; NaN: top of the body
+    double water_level   = std::numeric_limits<double>::quiet_NaN(); ///< NaN: the surface level
+    double surcharge     = 0; ///< vertical pressure on the surface [Pa], compression positive
+
+    /// 'water level' was set (families without pore water refuse it)
+    bool
+    has_water_level() const
+    {
+      return !std::isnan(water_level);
+    }
   };
 
   /// Declare 'initial stress' in the current 'body k' subsection.

@@ -106,7 +106,7 @@ namespace talus::explicit_mpm
     for (unsigned int k = 0; k < p.bodies.size(); ++k)
       {
         const auto &z = p.initial_stress[k];
-        require(!z.enabled || !z.water_level_given ||
+        require(!z.enabled || !z.has_water_level() ||
                   p.liquid.pore_liquid[p.bodies[k].material_id].drainage == Drainage::coupled,
                 "body " + std::to_string(k) + "/initial stress/water level",
                 "talus-explicit cannot honour it for material " + std::to_string(p.bodies[k].material_id) +

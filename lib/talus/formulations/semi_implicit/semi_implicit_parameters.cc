@@ -375,7 +375,7 @@ namespace talus::semi_implicit
       // a soil body has no pore water: its K0 state is the dry weight
       for (unsigned int b = 0; b < p.bodies.size(); ++b)
         require(p.phase_of_body[b] != Phase::soil || !p.initial_stress[b].enabled ||
-                  !p.initial_stress[b].water_level_given,
+                  !p.initial_stress[b].has_water_level(),
                 "body " + std::to_string(b) + "/initial stress/water level",
                 "body " + std::to_string(b) +
                   " has phase = soil (soil points only, no pore water: the K0 state takes the dry weight); "
