@@ -3,6 +3,7 @@
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/with_kernel.h>
+#include <talus/materials/strain_increments.h>
 #include <talus/shape/q1.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/move_point.h>
@@ -392,10 +393,61 @@ namespace talus::explicit_mpm
     s.with_kernel([&](auto kernel) { step_with<decltype(kernel)>(h); });
   }
 
+  // ---------------------------------------------------------------- the step
+  // One step of §4.5.7 (docs/explicit-liquid-two-phase.md, "One step"): a
+  // driver of the phases below, in the order of the algorithm, with the loads'
+  // hooks (load_control.h) at the places of the 1-phase step. Three passes over
+  // the points (P2G, G2P of the velocities with the momenta, the update), the
+  // rest on the nodes.
   template <int dim>
   template <class K>
   void
   TwoPhase<dim>::step_with(const double h)
+  {
+    auto *const control = s.control.get();
+    const auto  t0      = std::chrono::steady_clock::now();
+    particles_to_nodes<K>(); // 1
+    // loads: tractions on the mixture, nodal v^t (the solid momentum of this
+    // P2G), friction lift; convergence ratios of both phases
+    if (control)
+      {
+        control->before_nodal_solve(s, h, &s.nodal_p);
+        control->nodal_forces_two_phase(s);
+      }
+    nodal_accelerations(); // 2-3
+    if (control)           // prescribed velocities and rigid-wall friction, both phases
+      control->nodal_accelerations(s);
+    update_ghosts(s.nodal_a, a_liquid);
+    g2p_velocity_p2g_momentum<K>(h); // 4, and the momenta of 5
+    if (control)
+      control->particle_velocities(s); // prescribed point velocities (both phases)
+    nodal_velocities();                // 5
+    if (control)
+      control->nodal_velocities(s); // prescribed values, no penetration at friction walls
+    update_ghosts(s.nodal_p, p_liquid);
+    s.timings.p2g += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    const auto t1 = std::chrono::steady_clock::now();
+    g2p_update<K>(h); // 6-11
+    s.timings.g2p += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+
+    const auto t2 = std::chrono::steady_clock::now();
+    s.points.relocate();
+    s.p2g_ready = false;
+    s.collect_active_dofs();
+    s.timings.relocation += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+  }
+
+  // Step 1, P2G at time t (Eqs. 4.97-4.103), one pass over the points: lumped
+  // solid mass M_S and momentum P_S, the mixture force f (total stress sigma' -
+  // p I, the weight of both phases), and for the points of coupled materials
+  // the liquid masses M_L (rho_L V) and Mbar_L (n rho_L V), the drag Q, the
+  // liquid force f_L and momentum P_L. The traction point forces of the loads
+  // are scattered in the same pass (no pass of their own).
+  template <int dim>
+  template <class K>
+  void
+  TwoPhase<dim>::particles_to_nodes()
   {
     using L = PropertyLayout<dim>;
     // each point reads and writes the nodes of its kernel stencil (Q1: the
@@ -403,16 +455,14 @@ namespace talus::explicit_mpm
     constexpr unsigned int nv      = K::n_point_nodes;
     const auto            &pl      = s.prm.liquid.pore_liquid;
     const auto             g       = s.gravity; // of the running stage
-    const auto             t0      = std::chrono::steady_clock::now();
     auto *const            control = s.control.get();
 
-    // ---- 1. P2G at time t: masses, drag, forces, momenta of both phases
     Vector &MSv = s.nodal_mass, &FSv = s.nodal_a, &PSv = s.nodal_p;
     // local (owned + ghost) indices, as in the cell cache
     double *const MS = MSv.begin(), *const FS = FSv.begin(), *const PS = PSv.begin();
     double *const mLt_ = coupled ? m_liquid.begin() : nullptr, *const mLn_ = coupled ? m_liquid_n.begin() : nullptr;
     double *const Q_ = coupled ? drag.begin() : nullptr, *const FL_ = coupled ? f_liquid.begin() : nullptr;
-    double *const PL_ = coupled ? p_liquid.begin() : nullptr, *const AL_ = coupled ? a_liquid.begin() : nullptr;
+    double *const PL_ = coupled ? p_liquid.begin() : nullptr;
     s.zero_on_active(MSv);
     s.zero_on_active(FSv);
     s.zero_on_active(PSv);
@@ -481,62 +531,84 @@ namespace talus::explicit_mpm
         v->compress(dealii::VectorOperation::add);
     if (control)
       control->end_traction_scatter();
+  }
 
-    // loads (load_control.h): tractions on the mixture, nodal v^t (the solid
-    // momentum of this P2G), friction lift; convergence ratios of both phases
-    if (control)
+  // Steps 2-3, per free DoF: the liquid's acceleration a_L from its own
+  // equation (Eq. 4.106, drag with the velocities at t), then the solid's a_S
+  // from the mixture equation with the liquid's inertia moved to the right
+  // (4.107); both 0 on constrained DoFs (a fixed/roller wall is impermeable).
+  // The solid's a_S is left in the solver's nodal_a (the 1-phase step's
+  // place), a_L in a_liquid; the ghosts are updated by the caller, after the
+  // loads' prescribed accelerations.
+  template <int dim>
+  void
+  TwoPhase<dim>::nodal_accelerations()
+  {
+    const double *const MS = s.nodal_mass.begin(), *const PS = s.nodal_p.begin();
+    double *const       FS   = s.nodal_a.begin();
+    const double *const mLt_ = coupled ? m_liquid.begin() : nullptr, *const mLn_ =
+                                                                       coupled ? m_liquid_n.begin() : nullptr;
+    const double *const Q_ = coupled ? drag.begin() : nullptr, *const FL_ = coupled ? f_liquid.begin() : nullptr;
+    const double *const PL_     = coupled ? p_liquid.begin() : nullptr;
+    double *const       AL_     = coupled ? a_liquid.begin() : nullptr;
+    const auto         *control = s.control.get();
+    const auto         &con     = s.constrained;
+    const double        alpha   = control ? control->local_damping() : 0.0;
+    const double        av      = control ? control->viscous_damping() : 0.0;
+    const double        beta    = s.mass_scaling;
+    // local damping, 2-phase form of §6.3.2 (Eqs. 6.24-6.28): water
+    // f_w^damp = -alpha |f_w| sign(v_L) with f_w its unbalanced force (traction,
+    // gravity, internal; no drag); solid f_s^damp = -alpha |f - n f_w| sign(v_S);
+    // the mixture receives f_s^damp + n f_w^damp (the liquid equation here is the
+    // one divided by n, so its forces enter the mixture with the nodal n = Mbar_L / M_L).
+    // Viscous damping -alpha_v m v acts on each phase's own mass the same way
+    // (liquid: -alpha_v M_L v_L in the equation divided by n). Mass scaling
+    // (Eq. 6.31): the inertia of both phases is beta M, the forces and the drag
+    // keep their size.
+    const auto damping = [alpha](const double f, const double v) {
+      return (alpha > 0 && v != 0) ? -alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : 0.0;
+    };
+    for (const unsigned int i : s.active_dofs)
       {
-        control->before_nodal_solve(s, h, &PSv);
-        control->nodal_forces_two_phase(s);
+        double       aL = 0, n_i = 0, dL = 0;
+        const double vS = MS[i] > 0 ? PS[i] / MS[i] : 0.0;
+        if (coupled)
+          {
+            if (mLt_[i] > 0 && !con[i])
+              {
+                const double vL = PL_[i] / mLn_[i];
+                n_i             = mLn_[i] / mLt_[i];
+                dL              = damping(FL_[i], vL) - av * mLt_[i] * vL;
+                aL              = (FL_[i] - Q_[i] * (vL - vS) + dL) / (beta * mLt_[i]);
+              }
+            AL_[i] = aL;
+          }
+        const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS) - av * MS[i] * vS;
+        FS[i]           = (MS[i] > 0 && !con[i])
+                            ? (FS[i] - (coupled ? beta * mLn_[i] * aL : 0.0) + dS + n_i * dL) / (beta * MS[i])
+                            : 0.0;
       }
+  }
 
-    // ---- 2-3. nodal accelerations: liquid (Eq. 4.106), then solid (4.107)
-    {
-      const auto  &con   = s.constrained;
-      const double alpha = control ? control->local_damping() : 0.0;
-      const double av    = control ? control->viscous_damping() : 0.0;
-      const double beta  = s.mass_scaling;
-      // local damping, 2-phase form of §6.3.2 (Eqs. 6.24-6.28): water
-      // f_w^damp = -alpha |f_w| sign(v_L) with f_w its unbalanced force (traction,
-      // gravity, internal; no drag); solid f_s^damp = -alpha |f - n f_w| sign(v_S);
-      // the mixture receives f_s^damp + n f_w^damp (the liquid equation here is the
-      // one divided by n, so its forces enter the mixture with the nodal n = Mbar_L / M_L).
-      // Viscous damping -alpha_v m v acts on each phase's own mass the same way
-      // (liquid: -alpha_v M_L v_L in the equation divided by n). Mass scaling
-      // (Eq. 6.31): the inertia of both phases is beta M, the forces and the drag
-      // keep their size.
-      const auto damping = [alpha](const double f, const double v) {
-        return (alpha > 0 && v != 0) ? -alpha * std::abs(f) * (v > 0 ? 1.0 : -1.0) : 0.0;
-      };
-      for (const unsigned int i : s.active_dofs)
-        {
-          double       aL = 0, n_i = 0, dL = 0;
-          const double vS = MS[i] > 0 ? PS[i] / MS[i] : 0.0;
-          if (coupled)
-            {
-              if (mLt_[i] > 0 && !con[i])
-                {
-                  const double vL = PL_[i] / mLn_[i];
-                  n_i             = mLn_[i] / mLt_[i];
-                  dL              = damping(FL_[i], vL) - av * mLt_[i] * vL;
-                  aL              = (FL_[i] - Q_[i] * (vL - vS) + dL) / (beta * mLt_[i]);
-                }
-              AL_[i] = aL;
-            }
-          const double dS = damping(FS[i] - (coupled ? n_i * FL_[i] : 0.0), vS) - av * MS[i] * vS;
-          FS[i]           = (MS[i] > 0 && !con[i])
-                              ? (FS[i] - (coupled ? beta * mLn_[i] * aL : 0.0) + dS + n_i * dL) / (beta * MS[i])
-                              : 0.0;
-        }
-      if (control) // prescribed velocities and rigid-wall friction, both phases
-        control->nodal_accelerations(s);
-      FSv.update_ghost_values();
-      if (coupled)
-        a_liquid.update_ghost_values();
-    }
-
-    // ---- 4-5. point velocities (4.108-4.109), nodal momenta (4.110-4.111)
-    s.zero_on_active(PSv);
+  // Step 4 and the momenta of step 5, one pass over the points: the point
+  // velocities of both phases updated with the interpolated nodal
+  // accelerations (Eqs. 4.108-4.109, FLIP), and right away their new momenta
+  // m_S v_S, Mbar_L v_L scattered back to the nodes (the numerators of
+  // 4.110-4.111). The loads' prescribed point velocities act after this pass
+  // (LoadControl::particle_velocities), before nodal_velocities().
+  template <int dim>
+  template <class K>
+  void
+  TwoPhase<dim>::g2p_velocity_p2g_momentum(const double h)
+  {
+    using L                    = PropertyLayout<dim>;
+    constexpr unsigned int nv  = K::n_point_nodes;
+    const auto            &pl  = s.prm.liquid.pore_liquid;
+    const double *const    FS  = s.nodal_a.begin();
+    double *const          PS  = s.nodal_p.begin();
+    const double *const    AL_ = coupled ? a_liquid.begin() : nullptr;
+    double *const          PL_ = coupled ? p_liquid.begin() : nullptr;
+    s.zero_on_active(s.nodal_p);
     if (coupled)
       s.zero_on_active(p_liquid);
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
@@ -569,11 +641,23 @@ namespace talus::explicit_mpm
             }
         }
     });
-    PSv.compress(dealii::VectorOperation::add);
+    s.nodal_p.compress(dealii::VectorOperation::add);
     if (coupled)
       p_liquid.compress(dealii::VectorOperation::add);
-    if (control)
-      control->particle_velocities(s); // prescribed point velocities (both phases)
+  }
+
+  // Step 5: the nodal velocities v_S = P_S / M_S, v_L = P_L / Mbar_L of the
+  // new momenta (Eqs. 4.110-4.111), in place of the momenta (nodal_p,
+  // p_liquid); 0 on constrained DoFs. The ghosts are updated by the caller,
+  // after the loads' prescribed nodal velocities.
+  template <int dim>
+  void
+  TwoPhase<dim>::nodal_velocities()
+  {
+    const double *const MS   = s.nodal_mass.begin();
+    double *const       PS   = s.nodal_p.begin();
+    const double *const mLn_ = coupled ? m_liquid_n.begin() : nullptr;
+    double *const       PL_  = coupled ? p_liquid.begin() : nullptr;
     for (const unsigned int i : s.active_dofs)
       {
         const bool free = !s.constrained[i];
@@ -581,15 +665,86 @@ namespace talus::explicit_mpm
         if (coupled)
           PL_[i] = (mLn_[i] > 0 && free) ? PL_[i] / mLn_[i] : 0.0;
       }
-    if (control)
-      control->nodal_velocities(s); // prescribed values, no penetration at friction walls
-    PSv.update_ghost_values();
-    if (coupled)
-      p_liquid.update_ghost_values();
-    s.timings.p2g += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
 
-    // ---- 6-11. strains, effective stress, pore pressure, volume, porosity, positions
-    const auto                  t1 = std::chrono::steady_clock::now();
+  // The nodal values of a phase pair (solid vector of the solver, the
+  // liquid's own) made visible to the ghost DoFs of the next pass.
+  template <int dim>
+  void
+  TwoPhase<dim>::update_ghosts(Vector &solid, Vector &liquid)
+  {
+    solid.update_ghost_values();
+    if (coupled)
+      liquid.update_ghost_values();
+  }
+
+  // Steps 8 and 10 at one point of a coupled material: the storage equation
+  // updates the pore pressure (Eqs. 4.115-4.116, compression positive) with
+  // the volumetric strains of both phases; the porosity follows from the
+  // solid's mass conservation (1 - n) V = const (Eq. 3.19). Adds the pore
+  // pressure's energy to the sums when asked, flags a non-finite state.
+  // Returns the liquid mass n rho_L V at the new volume (for the point sums).
+  template <int dim>
+  inline double
+  TwoPhase<dim>::pore_liquid_update(double *P, const PoreLiquid &pl, const double dvS, const double div_uL,
+                                    diagnostics::PointSums<dim> &sums, bool &bad) const
+  {
+    using L        = PropertyLayout<dim>;
+    const double n = P[porosity];
+    P[pore_pressure] -= pl.bulk_modulus / n * ((1 - n) * dvS + n * div_uL);
+    P[porosity]      = 1.0 - (1.0 - n) / (1.0 + dvS);
+    const double mL  = P[porosity] * pl.density * P[L::volume] * (1.0 + dvS);
+    double       vl2 = 0;
+    for (unsigned int d = 0; d < dim; ++d)
+      vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
+    if (s.need_strain_energy)
+      sums.add_strain(P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
+                      (2 * pl.bulk_modulus));
+    if (!std::isfinite(P[pore_pressure] + vl2) || !(P[porosity] > 0 && P[porosity] < 1))
+      bad = true;
+    return mL;
+  }
+
+  // The probe values of the point `id` if it is a probe: displacement,
+  // velocity, stress (the 1-phase update pass records the same).
+  template <int dim>
+  inline void
+  TwoPhase<dim>::record_probe(const dealii::types::particle_index id, const double *P)
+  {
+    using L = PropertyLayout<dim>;
+    for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
+      if (id == s.probe_ids[k2])
+        {
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
+              s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
+            }
+          for (unsigned int q = 0; q < L::n_stress; ++q)
+            s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
+        }
+  }
+
+  // Steps 6-11, one pass over the points: the solid's strain and spin
+  // increments and the liquid's volumetric strain from the nodal velocities
+  // (Eqs. 4.112-4.114), the effective stress by the skeleton model (Jaumann
+  // rotation inside), pore pressure and porosity (pore_liquid_update), the
+  // volume (4.118, at most the cell's) and the position (4.119); then the
+  // point sums (energies, momentum), the finiteness check, the probes and the
+  // work of the tractions over the step (f_p . dx_p), and the move to the
+  // point's new cell (the relocation follows in step_with).
+  template <int dim>
+  template <class K>
+  void
+  TwoPhase<dim>::g2p_update(const double h)
+  {
+    using L                             = PropertyLayout<dim>;
+    constexpr unsigned int      nv      = K::n_point_nodes;
+    const auto                 &pl      = s.prm.liquid.pore_liquid;
+    const auto                  g       = s.gravity; // of the running stage
+    auto *const                 control = s.control.get();
+    const double *const         PS      = s.nodal_p.begin();
+    const double *const         PL_     = coupled ? p_liquid.begin() : nullptr;
     diagnostics::PointSums<dim> sums;
     bool                        bad    = false;
     double                      work   = 0; // of the tractions over this step
@@ -622,35 +777,13 @@ namespace talus::explicit_mpm
           }
       materials::Strain d_eps;
       materials::Spin   d_omega;
-      for (unsigned int d = 0; d < dim; ++d)
-        for (unsigned int k2 = 0; k2 < dim; ++k2)
-          {
-            if (k2 >= d)
-              d_eps[d][k2] = 0.5 * (gu[d][k2] + gu[k2][d]);
-            d_omega[d][k2] = 0.5 * (gu[d][k2] - gu[k2][d]);
-          }
+      materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
       const materials::Material &m     = *s.prm.materials[mat];
       auto                       sigma = L::get_stress(P);
       m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
       L::set_stress(sigma, P);
       const double dvS = trace(d_eps);
-      double       mL = 0, vl2 = 0;
-      if (cp)
-        {
-          // storage equation (Eqs. 4.115-4.116), pore pressure compression positive
-          const double n = P[porosity];
-          P[pore_pressure] -= pl[mat].bulk_modulus / n * ((1 - n) * dvS + n * div_uL);
-          // solid mass conservation (1 - n) V = const (Eq. 3.19)
-          P[porosity] = 1.0 - (1.0 - n) / (1.0 + dvS);
-          mL          = P[porosity] * pl[mat].density * P[L::volume] * (1.0 + dvS);
-          for (unsigned int d = 0; d < dim; ++d)
-            vl2 += P[liquid_velocity + d] * P[liquid_velocity + d];
-          if (s.need_strain_energy)
-            sums.add_strain(P[L::volume] * (1.0 + dvS) * P[porosity] * P[pore_pressure] * P[pore_pressure] /
-                            (2 * pl[mat].bulk_modulus));
-          if (!std::isfinite(P[pore_pressure] + vl2) || !(P[porosity] > 0 && P[porosity] < 1))
-            bad = true;
-        }
+      const double mL  = cp ? pore_liquid_update(P, pl[mat], dvS, div_uL, sums, bad) : 0.0;
       P[L::volume] *= (1.0 + dvS); // Eq. 4.118
       if (P[L::volume] > cell_volume)
         P[L::volume] = cell_volume;
@@ -675,17 +808,7 @@ namespace talus::explicit_mpm
       if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
           !(P[L::volume] > 0))
         bad = true;
-      for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
-        if (pt->get_id() == s.probe_ids[k2])
-          {
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
-                s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
-              }
-            for (unsigned int q = 0; q < L::n_stress; ++q)
-              s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
-          }
+      record_probe(pt->get_id(), P);
       dealii::Point<dim> xi_new;
       transfer::place_moved_point(s.points, s.grid, c, pt, x, xi_new);
     });
@@ -693,13 +816,6 @@ namespace talus::explicit_mpm
     s.local_bad  = bad;
     if (loaded)
       s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
-    s.timings.g2p += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-
-    const auto t2 = std::chrono::steady_clock::now();
-    s.points.relocate();
-    s.p2g_ready = false;
-    s.collect_active_dofs();
-    s.timings.relocation += std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
   }
 
   // ================================================================ free surface

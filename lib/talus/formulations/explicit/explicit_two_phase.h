@@ -115,6 +115,22 @@ namespace talus::explicit_mpm
 
   private:
     friend class loads::LoadControl<dim>;
+    // the phases of step_with() (§4.5.7), in their order; the loads' hooks
+    // are called between them by step_with()
+    template <class K>
+    void particles_to_nodes();
+    void nodal_accelerations();
+    template <class K>
+    void g2p_velocity_p2g_momentum(const double dt);
+    void nodal_velocities();
+    template <class K>
+    void g2p_update(const double dt);
+    // pieces of the phases
+    void   update_ghosts(Vector &solid, Vector &liquid);
+    double pore_liquid_update(double *P, const PoreLiquid &pl, const double dvS, const double div_uL,
+                              diagnostics::PointSums<dim> &sums, bool &bad) const;
+    void   record_probe(const dealii::types::particle_index id, const double *P);
+
     Solver<dim> &s;
     // lumped nodal quantities: liquid mass without / with porosity, drag,
     // liquid force and momentum (solid: the solver's nodal_mass, nodal_a, nodal_p)
