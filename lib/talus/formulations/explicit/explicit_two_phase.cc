@@ -594,8 +594,7 @@ namespace talus::explicit_mpm
     bool                        bad    = false;
     double                      work   = 0; // of the tractions over this step
     const bool                  loaded = control && control->any_traction();
-    std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
-    std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
+    s.probes.clear_values();
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
       const auto &cc          = s.grid.cells[c];
       double      cell_volume = 1.0;
@@ -675,17 +674,7 @@ namespace talus::explicit_mpm
       if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
           !(P[L::volume] > 0))
         bad = true;
-      for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
-        if (pt->get_id() == s.probe_ids[k2])
-          {
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
-                s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
-              }
-            for (unsigned int q = 0; q < L::n_stress; ++q)
-              s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
-          }
+      s.probes.record(pt->get_id(), P);
       dealii::Point<dim> xi_new;
       transfer::place_moved_point(s.points, s.grid, c, pt, x, xi_new);
     });
