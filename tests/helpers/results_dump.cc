@@ -25,12 +25,12 @@ main(int argc, char **argv)
     {
       if (argc < 4)
         throw std::runtime_error("usage: results_dump FILE OUT.csv [--attributes] NAME...");
-      talus::io::H5File        f(argv[1], talus::io::H5File::Mode::read, MPI_COMM_SELF);
-      std::ofstream            out(argv[2]);
-      std::vector<std::string> header;
+      talus::io::H5File                f(argv[1], talus::io::H5File::Mode::read, MPI_COMM_SELF);
+      std::ofstream                    out(argv[2]);
+      std::vector<std::string>         header;
       std::vector<std::vector<double>> data;
       std::vector<unsigned int>        cols;
-      std::uint64_t                    rows = 0;
+      std::uint64_t                    rows  = 0;
       bool                             first = true;
       for (int i = 3; i < argc; ++i)
         {

@@ -101,7 +101,8 @@ namespace talus
   PointProbes<dim>::read_ids(const io::H5File &f, const std::string &where, const std::string &name)
   {
     require(f.exists(name), where,
-            "has no '" + name + "' (the ids of the tracked points of 'output/probes'); allowed: a checkpoint of the "
+            "has no '" + name +
+              "' (the ids of the tracked points of 'output/probes'); allowed: a checkpoint of the "
               "same scene");
     ids.clear();
     for (const double id : f.read_all(name))

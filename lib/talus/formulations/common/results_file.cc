@@ -19,8 +19,8 @@ namespace talus
   write_point_table(io::H5File &out, const std::string &group, const MaterialPointSet<dim> &set,
                     const bool position_is_origin)
   {
-    using L                    = PropertyLayout<dim>;
-    constexpr unsigned int nst = L::n_stress;
+    using L                        = PropertyLayout<dim>;
+    constexpr unsigned int     nst = L::n_stress;
     std::vector<std::uint64_t> id;
     std::vector<double>        x, X, u, vel, sig, vol, mass, mat, body;
     for (const auto &pt : set.handler)
