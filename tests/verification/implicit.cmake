@@ -111,7 +111,8 @@ set_tests_properties(verification.implicit_bad_input PROPERTIES LABELS "fast" EN
 # the point nearest at t = 0 (a tie: lowest id), talus-compare reads it, 1 = 2 ranks to 1e-10
 add_test(NAME verification.implicit_results_file
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_results_file.py ${TALUS_TOOLS_DIR} ${CMAKE_BINARY_DIR}/tests/results_dump
-                 implicit ${TALUS_PRM_DIR}/implicit/block_top_traction.prm ${_w}/implicit_results_file)
+                 implicit ${TALUS_PRM_DIR}/implicit/block_top_traction.prm ${_w}/implicit_results_file
+                 ${TALUS_PRM_DIR}/verification/oedometer_gravity.prm)
 set_tests_properties(verification.implicit_results_file PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
                      PROCESSORS 2)
 
