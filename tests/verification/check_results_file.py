@@ -16,7 +16,9 @@ id) and checks
   (c) talus-compare reads the file: against itself every item is 0 (linf, tolerance 0:
       exit 0); against a run with 1 % more load (implicit) or half the time
       (semi-implicit), final particle displacements, relative Linf 1e-3: exit 1;
-  (d) implicit only: the same run on 2 ranks gives the same file content to 1e-10
+  (d) semi-implicit: the same run on 2 ranks, talus-compare of probes, grid and particle
+      fields and two series columns: relative Linf <= 1e-10;
+      implicit: the same run on 2 ranks gives the same file content to 1e-10
       (series columns relative to their largest value, a probe's components relative
       to the largest of that field, the Newton residual columns left out: round-off; particles matched by id, grid nodes by coordinates, each
       field relative to its largest value).
@@ -301,4 +303,12 @@ if family == "implicit":
         worst = max(worst, (d, "grid/" + f))
     tv.check(worst[0] <= 1e-10, f"(d) 1 and 2 ranks: largest relative difference {worst[0]:.2e} ({worst[1]}) "
                                 f"<= 1e-10")
+if family == "semi-implicit":  # through talus-compare: the soil's probes, grid and particle fields
+    c = run("np2", np=2)
+    p = subprocess.run([f"{tools}/talus-compare", "--quantities=probes,grid:displacement,grid:stress,"
+                        "particles:displacement,particles:stress,kinetic_energy_soil,min_pore_pressure",
+                        "--norm=relative-linf", "--tolerance=1e-10", f"{c}/results.h5", h5], capture_output=True,
+                       text=True, env=tv.child_env())
+    print(p.stdout.strip())
+    tv.check(p.returncode == 0, f"(d) 1 and 2 ranks: talus-compare exit {p.returncode} (0: within 1e-10 relative Linf)")
 tv.finish()
