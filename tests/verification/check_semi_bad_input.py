@@ -42,8 +42,6 @@ cases = [
     ("modified f-bar without b_e", [("semi implicit/volumetric stabilisation", "modified f-bar")],
      "semi implicit/volumetric stabilisation"),
     ("bad stabilisation", [("semi implicit/volumetric stabilisation", "f bar")], "volumetric stabilisation"),
-    ("results file", [("output/results file", "results.h5")], "output/results file"),
-    ("probes", [("output/probes", "0.03, 0.5")], "output/probes"),
     ("write grid", [("output/write grid", "true")], "output/write grid"),
     ("patch size", [("semi implicit/patch size", "0.1")], "semi implicit/patch size"),
     ("single point with a water body", [("semi implicit/point sets", "single"), ("number of bodies", "2"),

@@ -59,7 +59,9 @@ for k, v in {"time/end time": "0.06", "time/time step": "3e-4", "output/vtu inte
              # the AMG hierarchy kept between steps, rebuilt every 30 steps: the
              # restart step 100 is no multiple, so only the rebuild at the
              # checkpoint write keeps the runs alike
-             "semi implicit/pressure preconditioner rebuild interval": "30"}.items():
+             "semi implicit/pressure preconditioner rebuild interval": "30",
+             # tracked points (soil ids and water ids in the checkpoint): series.csv byte for byte
+             "output/probes": "0.075, 0.99; 0.02, 0.1"}.items():
     base = tv.prm_set(base, k, v)
 
 
@@ -141,7 +143,8 @@ for k, v in {"dimension": "3", "grid/lower corner": "0, 0, 0", "grid/upper corne
              # the traction on the upper face (z+ in 3D) and the drained region in 3D
              "loads/traction 0/face": "z+", "loads/traction 0/traction": "0, 0, -1e4",
              "boundary conditions/drainage 0/region lower corner": "0, 0, 0",
-             "boundary conditions/drainage 0/region upper corner": "1e3, 1e3, 1e3"}.items():
+             "boundary conditions/drainage 0/region upper corner": "1e3, 1e3, 1e3",
+             "output/probes": "0.075, 0.075, 0.99"}.items():
     text3 = tv.prm_set(text3, k, v)
 run("three_d", text=text3)
 shutil.copytree(os.path.join(work, "three_d", "checkpoints"), os.path.join(work, "dim", "checkpoints"))

@@ -107,6 +107,15 @@ add_test(NAME verification.implicit_bad_input
                  ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_bad_input)
 set_tests_properties(verification.implicit_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 
+# the shared results file and probes (issue 37): file series = series.csv, each probe =
+# the point nearest at t = 0 (a tie: lowest id), talus-compare reads it, 1 = 2 ranks to 1e-10
+add_test(NAME verification.implicit_results_file
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_results_file.py ${TALUS_TOOLS_DIR} ${CMAKE_BINARY_DIR}/tests/results_dump
+                 implicit ${TALUS_PRM_DIR}/implicit/block_top_traction.prm ${_w}/implicit_results_file
+                 ${TALUS_PRM_DIR}/verification/oedometer_gravity.prm)
+set_tests_properties(verification.implicit_results_file PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
+
 # talus-critical-dt on implicit scenes: not CFL-limited, the explicit step and the
 # ratio beside it; the Newmark limit when 2 beta < gamma (and a run inside it)
 add_test(NAME verification.critical_dt_implicit

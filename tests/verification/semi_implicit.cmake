@@ -267,3 +267,13 @@ foreach(_mode displacement traction pressure dry_face refuse)
   set_tests_properties(verification.semi_implicit_boundary_loads_${_mode} PROPERTIES LABELS "fast"
                        ENVIRONMENT "${_env}" TIMEOUT 600)
 endforeach()
+
+# the shared results file and probes (issue 37): file series = series.csv, each probe =
+# the soil point nearest at t = 0, its pore pressure column = the nearest water point's
+# (water/ group), talus-compare reads it, 1 = 2 ranks to 1e-10
+add_test(NAME verification.semi_implicit_results_file
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_results_file.py ${TALUS_TOOLS_DIR} ${CMAKE_BINARY_DIR}/tests/results_dump
+                 semi-implicit ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm
+                 ${_w}/semi_implicit_results_file)
+set_tests_properties(verification.semi_implicit_results_file PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600 PROCESSORS 2)

@@ -1,5 +1,5 @@
-// talus — reading HDF5 results files (written by the explicit solver's
-// `output/results file`, layout in docs/fem.md) and comparing two of them
+// talus — reading HDF5 results files (written by every family's
+// `output/results file`, formulations/common/results_file.h; layout in docs/fem.md) and comparing two of them
 // (talus-compare): differences of chosen quantities as norms.
 #pragma once
 

@@ -202,14 +202,18 @@ namespace talus
                         "Simulated time between particle VTU/PVTU outputs (PVD series); 0 = first and last only.");
       prm.declare_entry("series interval", "0", Double(0),
                         "Simulated time between rows of series.csv (energies, momentum, probes); 0 = every step.");
-      prm.declare_entry("write grid", "false", Bool(), "Also write the background grid with nodal mass and velocity.");
+      prm.declare_entry("write grid", "false", Bool(),
+                        "Also write the background grid with nodal mass and velocity (talus-explicit and "
+                        "talus-fem; refused by talus-implicit and talus-semi-implicit).");
       prm.declare_entry("final particles csv", "false", Bool(),
                         "Write particles_final.csv (id, position, displacement, velocity, stress, volume), "
                         "gathered on rank 0 and sorted by id: for tests and comparisons of small runs.");
       prm.declare_entry("progress", "true", Bool(), "Print progress with an ETA every few seconds.");
       prm.declare_entry("probes", "", Anything(),
                         "Points 'x,y[,z]; x,y[,z]; ...': the material point nearest to each at t = 0 is tracked; "
-                        "its displacement, velocity and stress go to series.csv (and the results file).");
+                        "its displacement, velocity and stress go to series.csv (and the results file); "
+                        "talus-semi-implicit: the nearest soil point, and the pore pressure of the nearest water "
+                        "point.");
       prm.declare_entry("results file", "", Anything(),
                         "HDF5 results written at the end of the run (for talus-compare and post-processing), "
                         "relative to the output directory unless absolute; empty = none. Holds the columns of "

@@ -149,8 +149,7 @@ namespace talus::explicit_mpm
 
     write_pvd_times(f, "output/pvd", pvd_records);
     write_pvd_times(f, "output/grid_pvd", grid_pvd_records);
-    std::vector<double> probes(probe_ids.begin(), probe_ids.end());
-    f.write_global("probes/ids", probes, 1);
+    probes.write_ids(f);
     if (!prm.rigid_plates.empty()) // the plates' state (the same on every rank)
       f.write_global("plates/state", control->rigid_plate_state(), loads::LoadControl<dim>::rigid_plate_state_size);
     balance.write(f); // the partition of the last rebalance
@@ -241,11 +240,7 @@ namespace talus::explicit_mpm
 
     pvd_records      = read_pvd_records(f, "output/pvd", "particles");
     grid_pvd_records = read_pvd_records(f, "output/grid_pvd", "grid");
-    probe_ids.clear();
-    for (const double id : f.read_all("probes/ids"))
-      probe_ids.push_back(static_cast<dealii::types::particle_index>(id));
-    probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
-    probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
+    probes.read_ids(f, "checkpoint " + f.path());
     if (!prm.rigid_plates.empty())
       {
         require(f.exists("plates/state"), where,

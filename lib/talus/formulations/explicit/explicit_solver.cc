@@ -164,16 +164,8 @@ namespace talus::explicit_mpm
       dt = prm.courant * dt_cr;
 
     // probes: nearest particle at t = 0 (ties: lowest id); restored: saved ids
-    for (const auto &q : restored ? std::vector<dealii::Point<dim>>() : prm.probes)
-      {
-        std::pair<double, dealii::types::particle_index> best{std::numeric_limits<double>::max(), 0};
-        for (const auto &pt : points.handler)
-          best = std::min(best, std::make_pair(pt.get_location().distance(q), pt.get_id()));
-        const auto all = dealii::Utilities::MPI::all_gather(comm, best);
-        probe_ids.push_back(std::min_element(all.begin(), all.end())->second);
-      }
-    probe_values.assign(probe_ids.size() * 2 * dim, 0.0);
-    probe_stress.assign(probe_ids.size() * PropertyLayout<dim>::n_stress, 0.0);
+    if (!restored)
+      probes.select(points, prm.probes, comm);
 
     // energy scale for the instability floor: sum m c^2
     double local_scale = 0;
@@ -409,9 +401,7 @@ namespace talus::explicit_mpm
       Contact<dim>                                                  *contact;
       const StrainSmoothing<dim>                                    *smoothing;
       const bool                                                     need_strain_energy;
-      const std::vector<dealii::types::particle_index>              &probe_ids;
-      std::vector<double>                                           &probe_values;
-      std::vector<double>                                           &probe_stress;
+      PointProbes<dim>                                              &probes;
 
       diagnostics::PointSums<dim> sums = {};
       bool                        bad  = false;
@@ -529,18 +519,8 @@ namespace talus::explicit_mpm
         if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
             !(P[L::volume] > 0))
           bad = true;
-        if (!probe_ids.empty())
-          for (unsigned int k = 0; k < probe_ids.size(); ++k)
-            if (it->get_id() == probe_ids[k])
-              {
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    probe_values[k * 2 * dim + d]       = P[L::displacement + d];
-                    probe_values[k * 2 * dim + dim + d] = P[L::velocity + d];
-                  }
-                for (unsigned int q = 0; q < L::n_stress; ++q)
-                  probe_stress[k * L::n_stress + q] = P[L::stress + q];
-              }
+        if (!probes.ids.empty())
+          probes.record(it->get_id(), P);
       }
     };
 
@@ -574,10 +554,9 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::g2p_update_with(K, const double h)
   {
-    std::fill(probe_values.begin(), probe_values.end(), 0.0);
-    std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
-    ExplicitPointUpdate<dim, K> physics{prm.materials,   points.layout.history, h,         gravity,      contact.get(),
-                                        smoothing.get(), need_strain_energy,    probe_ids, probe_values, probe_stress};
+    probes.clear_values();
+    ExplicitPointUpdate<dim, K> physics{prm.materials,   points.layout.history, h,     gravity, contact.get(),
+                                        smoothing.get(), need_strain_energy,    probes};
     // the mass and force of the next step are accumulated here, at the updated
     // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
     // the next cycle fused into this pass) and for every particle that entered
@@ -608,11 +587,9 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::g2p_update_apic_with(K, const double h)
   {
-    std::fill(probe_values.begin(), probe_values.end(), 0.0);
-    std::fill(probe_stress.begin(), probe_stress.end(), 0.0);
-    ApicPointUpdate<dim, K> physics{{prm.materials, points.layout.history, h, gravity, nullptr, nullptr,
-                                     need_strain_energy, probe_ids, probe_values, probe_stress},
-                                    affine_offset};
+    probes.clear_values();
+    ApicPointUpdate<dim, K> physics{
+      {prm.materials, points.layout.history, h, gravity, nullptr, nullptr, need_strain_energy, probes}, affine_offset};
     // as g2p_update_with: the update pass with the next step's mass and force fused
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
@@ -956,20 +933,9 @@ namespace talus::explicit_mpm
   Solver<dim>::prepare_output()
   {
     // probe values at the start (after a step, the update pass fills them)
-    using L = PropertyLayout<dim>;
-    if (!probe_ids.empty())
+    if (!probes.ids.empty())
       for (const auto &pt : points.handler)
-        for (unsigned int k = 0; k < probe_ids.size(); ++k)
-          if (pt.get_id() == probe_ids[k])
-            {
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  probe_values[k * 2 * dim + d]       = pt.get_properties()[L::displacement + d];
-                  probe_values[k * 2 * dim + dim + d] = pt.get_properties()[L::velocity + d];
-                }
-              for (unsigned int q = 0; q < L::n_stress; ++q)
-                probe_stress[k * L::n_stress + q] = pt.get_properties()[L::stress + q];
-            }
+        probes.record(pt.get_id(), pt.get_properties());
   }
 
   template <int dim>
@@ -998,18 +964,7 @@ namespace talus::explicit_mpm
             c.push_back(std::string("extent_") + ax[d] + "_max");
           }
       }
-    for (unsigned int k = 0; k < probe_ids.size(); ++k)
-      {
-        for (unsigned int d = 0; d < dim; ++d)
-          c.push_back("probe" + std::to_string(k) + "_u" + ax[d]);
-        for (unsigned int d = 0; d < dim; ++d)
-          c.push_back("probe" + std::to_string(k) + "_v" + ax[d]);
-      }
-    // probe stresses after all displacement/velocity columns
-    const auto names = points.layout.names();
-    for (unsigned int k = 0; k < probe_ids.size(); ++k)
-      for (unsigned int q = 0; q < PropertyLayout<dim>::n_stress; ++q)
-        c.push_back("probe" + std::to_string(k) + "_" + names[PropertyLayout<dim>::stress + q]);
+    probes.add_columns(c, points.layout);
     for (const auto &name : loads::rigid_plate_series_columns(prm.rigid_plates))
       c.push_back(name);
     return c;
@@ -1040,14 +995,6 @@ namespace talus::explicit_mpm
       }
     if (free_surface)
       free_surface->update();
-    std::vector<double> probes(probe_values.size()), probe_sigma(probe_stress.size());
-    if (!probe_values.empty())
-      {
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_values), comm,
-                                    dealii::ArrayView<double>(probes));
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(probe_stress), comm,
-                                    dealii::ArrayView<double>(probe_sigma));
-      }
     std::vector<double> r = {e.kinetic, e.strain, e.gravity_potential, e.external_work, e.total()};
     for (unsigned int d = 0; d < dim; ++d)
       r.push_back(p[d]);
@@ -1065,8 +1012,7 @@ namespace talus::explicit_mpm
         for (const double x : free_surface->extent)
           r.push_back(x);
       }
-    r.insert(r.end(), probes.begin(), probes.end());
-    r.insert(r.end(), probe_sigma.begin(), probe_sigma.end());
+    probes.add_values(r, comm);
     if (!prm.rigid_plates.empty())
       {
         const auto v = control->rigid_plate_series();

@@ -5,6 +5,7 @@
 
 #include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/probes.h>
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/explicit/fem.h>
@@ -258,8 +259,6 @@ namespace talus::explicit_mpm
     /// the PVD records of the points (the Simulation's) and of the grid
     std::vector<std::pair<double, std::string>> &pvd_records;
     std::vector<std::pair<double, std::string>>  grid_pvd_records;
-    std::vector<dealii::types::particle_index>   probe_ids;
-    std::vector<double>                          probe_values; // local, (u, v) per probe
-    std::vector<double>                          probe_stress; // local, n_stress per probe
+    PointProbes<dim>                             probes; // output/probes
   };
 } // namespace talus::explicit_mpm

@@ -705,26 +705,6 @@ namespace talus::explicit_mpm
     return mL;
   }
 
-  // The probe values of the point `id` if it is a probe: displacement,
-  // velocity, stress (the 1-phase update pass records the same).
-  template <int dim>
-  inline void
-  TwoPhase<dim>::record_probe(const dealii::types::particle_index id, const double *P)
-  {
-    using L = PropertyLayout<dim>;
-    for (unsigned int k2 = 0; k2 < s.probe_ids.size(); ++k2)
-      if (id == s.probe_ids[k2])
-        {
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              s.probe_values[k2 * 2 * dim + d]       = P[L::displacement + d];
-              s.probe_values[k2 * 2 * dim + dim + d] = P[L::velocity + d];
-            }
-          for (unsigned int q = 0; q < L::n_stress; ++q)
-            s.probe_stress[k2 * L::n_stress + q] = P[L::stress + q];
-        }
-  }
-
   // Steps 6-11, one pass over the points: the solid's strain and spin
   // increments and the liquid's volumetric strain from the nodal velocities
   // (Eqs. 4.112-4.114), the effective stress by the skeleton model (Jaumann
@@ -749,8 +729,7 @@ namespace talus::explicit_mpm
     bool                        bad    = false;
     double                      work   = 0; // of the tractions over this step
     const bool                  loaded = control && control->any_traction();
-    std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
-    std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
+    s.probes.clear_values();
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
       const auto &cc          = s.grid.cells[c];
       double      cell_volume = 1.0;
@@ -808,7 +787,7 @@ namespace talus::explicit_mpm
       if (!std::isfinite(sigma[0][0] + sigma[1][1] + sigma[0][1] + x[0] + x[1] + v2 + P[L::volume]) ||
           !(P[L::volume] > 0))
         bad = true;
-      record_probe(pt->get_id(), P);
+      s.probes.record(pt->get_id(), P);
       dealii::Point<dim> xi_new;
       transfer::place_moved_point(s.points, s.grid, c, pt, x, xi_new);
     });

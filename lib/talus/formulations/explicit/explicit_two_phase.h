@@ -129,7 +129,6 @@ namespace talus::explicit_mpm
     void   update_ghosts(Vector &solid, Vector &liquid);
     double pore_liquid_update(double *P, const PoreLiquid &pl, const double dvS, const double div_uL,
                               diagnostics::PointSums<dim> &sums, bool &bad) const;
-    void   record_probe(const dealii::types::particle_index id, const double *P);
 
     Solver<dim> &s;
     // lumped nodal quantities: liquid mass without / with porosity, drag,

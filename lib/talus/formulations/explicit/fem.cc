@@ -195,17 +195,15 @@ namespace talus::explicit_mpm
   void
   FemIntegration<dim>::update(const double h)
   {
-    using L                         = PropertyLayout<dim>;
-    constexpr unsigned int      nst = L::n_stress;
-    const double *const         Vn  = s.nodal_p.begin();
-    const auto                  g   = s.gravity;
-    double *const               M   = s.nodal_mass.begin();
-    double *const               F   = s.nodal_a.begin();
+    using L                        = PropertyLayout<dim>;
+    const double *const         Vn = s.nodal_p.begin();
+    const auto                  g  = s.gravity;
+    double *const               M  = s.nodal_mass.begin();
+    double *const               F  = s.nodal_a.begin();
     diagnostics::PointSums<dim> point_sums;
     bool                        bad          = false;
-    const bool                  track_probes = !s.probe_ids.empty();
-    std::fill(s.probe_values.begin(), s.probe_values.end(), 0.0);
-    std::fill(s.probe_stress.begin(), s.probe_stress.end(), 0.0);
+    const bool                  track_probes = !s.probes.ids.empty();
+    s.probes.clear_values();
     s.zero_on_active(s.nodal_mass);
     s.zero_on_active(s.nodal_a);
     // the cell's vertices at the start and end of the step, the nodal
@@ -271,17 +269,7 @@ namespace talus::explicit_mpm
           !(P[L::volume] > 0) || !(det1 > 0))
         bad = true;
       if (track_probes)
-        for (unsigned int q = 0; q < s.probe_ids.size(); ++q)
-          if (pt->get_id() == s.probe_ids[q])
-            {
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  s.probe_values[q * 2 * dim + d]       = P[L::displacement + d];
-                  s.probe_values[q * 2 * dim + dim + d] = P[L::velocity + d];
-                }
-              for (unsigned int j = 0; j < nst; ++j)
-                s.probe_stress[q * nst + j] = P[L::stress + j];
-            }
+        s.probes.record(pt->get_id(), P);
 
       // next step's mass and internal force at the updated state
       double t[dim][dim];

@@ -7,6 +7,7 @@
 #include <talus/formulations/common/diagnostics.h>
 #include <talus/formulations/common/point_checkpoint.h>
 #include <talus/formulations/common/point_output.h>
+#include <talus/formulations/common/results_file.h>
 #include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/io/output.h>
 #include <talus/loads/rigid_plate.h>
@@ -49,6 +50,7 @@ namespace talus::implicit_mpm
         c.push_back(std::string("prescribed_force_") + ax[d]);
     for (const auto &n : loads::rigid_plate_series_columns(prm.rigid_plates))
       c.push_back(n);
+    probes.add_columns(c, points.layout);
     balance.add_series_column(c);
     return c;
   }
@@ -105,6 +107,8 @@ namespace talus::implicit_mpm
             v.push_back(after_step ? std::sqrt(t2) : 0.0);
           }
       }
+    probes.sample(points);
+    probes.add_values(v, comm);
     balance.add_series_value(v);
     return v;
   }
@@ -144,6 +148,7 @@ namespace talus::implicit_mpm
               f.set_attribute("plate " + std::to_string(k) + " reaction " + std::to_string(d), plate_reaction[k][d]);
           }
         write_points(f, points);
+        probes.write_ids(f);
         write_pvd_times(f, "output/pvd", pvd_records);
         balance.write(f); // the partition of the last rebalance
       });
@@ -175,16 +180,33 @@ namespace talus::implicit_mpm
       }
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, points, grid, "checkpoint " + fp->path());
+    if (!prm.probes.empty()) // the points the run tracked (its ids saved)
+      {
+        probes.read_ids(*fp, "checkpoint " + fp->path());
+        require(probes.ids.size() == prm.probes.size(), "output/probes",
+                "the checkpoint " + fp->path() + " tracks " + std::to_string(probes.ids.size()) +
+                  " probe(s), the .prm lists " + std::to_string(prm.probes.size()) +
+                  "; allowed: the probes of the checkpointed run");
+      }
     pvd_records = read_pvd_records(*fp, "output/pvd", "particles");
     return true;
   }
 
   template <int dim>
   void
-  Solver<dim>::finish(const std::string &)
+  Solver<dim>::finish(const std::string &series_csv)
   {
     if (prm.final_particles_csv)
       write_final_points_csv(points, prm.output_directory, comm);
+    if (!prm.results_file.empty())
+      {
+        ResultsFileInfo info;
+        info.path        = prm.results_file;
+        info.integration = "implicit";
+        info.time        = time;
+        info.steps       = step_number;
+        write_results_file(info, grid, points, probes.ids, series_csv, comm);
+      }
   }
 
   template <int dim>

@@ -464,9 +464,10 @@ namespace talus::implicit_mpm
     const auto not_yet = [](const bool used, const std::string &entry) {
       require(!used, entry, "not available in talus-implicit yet (issue 13); remove the entry");
     };
-    not_yet(!p.results_file.empty(), "output/results file");
-    not_yet(!p.probes.empty(), "output/probes");
-    not_yet(p.write_grid, "output/write grid");
+    require(!p.write_grid, "output/write grid",
+            "not written by talus-implicit (its nodal fields live on the step's NodalSpace, not on the grid "
+            "vectors talus-explicit writes; the results file's grid/ group holds the final fields on the nodes); "
+            "remove the entry");
     not_yet(bool(p.grid_mesh), "grid/source");
     require(!p.moving_velocity_regions || p.restart == Parameters<dim>::Restart::no, "implicit/velocity regions follow",
             "restarting with moving velocity regions is not available yet (the region shifts are not in the "

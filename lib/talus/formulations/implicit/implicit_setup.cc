@@ -138,6 +138,7 @@ namespace talus::implicit_mpm
         if (point_contact)
           point_contact->initialize_points(points);
         dt = prm.stage_time_steps[0];
+        probes.select(points, prm.probes, comm); // the nearest points at t = 0
       }
     require(current_stage < prm.stages.size(), "checkpoint/restart",
             "the checkpoint is in stage " + std::to_string(current_stage) + " but the .prm has " +

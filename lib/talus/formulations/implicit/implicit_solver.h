@@ -14,6 +14,7 @@
 #pragma once
 
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/probes.h>
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/common/scene_parameters.h>
 #include <talus/formulations/implicit/newmark.h>
@@ -492,6 +493,7 @@ namespace talus::implicit_mpm
     /// ones), ghosts updated, the field the inertia integrand reads
     Vector                                       inertia_field;
     std::vector<std::pair<double, std::string>> &pvd_records; ///< the Simulation's, of the points
+    PointProbes<dim>                             probes;      ///< output/probes (series.csv, results file)
     // totals for the summary
     unsigned long long total_iterations = 0, total_linear_iterations = 0;
     double             seconds_assembly = 0, seconds_solve = 0, seconds_commit = 0;

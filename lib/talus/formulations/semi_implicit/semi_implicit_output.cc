@@ -5,7 +5,9 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/common/diagnostics.h>
+#include <talus/formulations/common/results_file.h>
 #include <talus/formulations/semi_implicit/semi_implicit_solver.h>
+#include <talus/io/hdf5.h>
 #include <talus/io/output.h>
 #include <talus/io/vtu.h>
 #include <talus/loads/rigid_plate.h>
@@ -59,6 +61,9 @@ namespace talus::semi_implicit
       }
     for (const auto &name : bloads.series_columns()) // velocity_k_reaction_x, ...
       c.push_back(name);
+    probes.add_columns(c, soil.layout); // probe<k>_ux, ..., probe<k>_stress_xx, ... of the soil
+    for (unsigned int k = 0; k < water_probes.ids.size(); ++k)
+      c.push_back("probe" + std::to_string(k) + "_pore_pressure");
     balance.add_series_column(c);
     return c;
   }
@@ -117,6 +122,18 @@ namespace talus::semi_implicit
         v.push_back(plate_state[k].node_slip);
       }
     bloads.series_values(v);
+    probes.sample(soil);
+    probes.add_values(v, comm);
+    if (!water_probes.ids.empty())
+      {
+        std::vector<double> p(water_probes.ids.size(), 0.0), sum(p.size());
+        for (const auto &pt : water.handler)
+          for (unsigned int k = 0; k < p.size(); ++k)
+            if (pt.get_id() == water_probes.ids[k])
+              p[k] = pt.get_properties()[fw.pressure];
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(p), comm, dealii::ArrayView<double>(sum));
+        v.insert(v.end(), sum.begin(), sum.end());
+      }
     balance.add_series_value(v);
     return v;
   }
@@ -137,8 +154,28 @@ namespace talus::semi_implicit
 
   template <int dim>
   void
-  Solver<dim>::finish(const std::string &)
+  Solver<dim>::finish(const std::string &series_csv)
   {
+    if (!prm.results_file.empty())
+      {
+        // the soil set as particles/ (probes, grid/ likewise), the water set as
+        // water/ with its pore pressure (docs/fem.md, "Results file")
+        ResultsFileInfo info;
+        info.path        = prm.results_file;
+        info.integration = "semi-implicit";
+        info.time        = time;
+        info.steps       = step_number;
+        write_results_file(info, grid, soil, probes.ids, series_csv, comm, [&](io::H5File &out) {
+          if (water.handler.n_global_particles() == 0)
+            return;
+          write_point_table(out, "water", water);
+          std::vector<double> p;
+          for (const auto &pt : water.handler)
+            p.push_back(pt.get_properties()[fw.pressure]);
+          out.write_rows("water/pore_pressure", p, 1);
+          out.set_attribute("water points", std::int64_t(water.handler.n_global_particles()));
+        });
+      }
     if (!prm.final_particles_csv)
       return;
     // <set>_final.csv: x, (y, z,) then the properties; rank 0 gathers, writes

@@ -168,8 +168,18 @@ namespace talus::semi_implicit
       geostatic_state();
     initialize_point_histories(prm.materials, soil, soil.layout.history);
     dt = prm.time_step > 0 ? prm.time_step : prm.courant * dt_soil_critical;
+    select_probes();
     // load balancing: partition by the points of both sets from the start
     balance.initial();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::select_probes()
+  {
+    probes.select(soil, prm.probes, comm);
+    if (water.handler.n_global_particles() > 0)
+      water_probes.select(water, prm.probes, comm);
   }
 
   template <int dim>
@@ -239,6 +249,8 @@ namespace talus::semi_implicit
                                      }
                                    write_points(f, soil, "soil");
                                    write_points(f, water, "water");
+                                   probes.write_ids(f, "probes/soil_ids");
+                                   water_probes.write_ids(f, "probes/water_ids");
                                    write_pvd_times(f, "output/soil_pvd", this->point_set_records[0]);
                                    write_pvd_times(f, "output/water_pvd", this->point_set_records[1]);
                                    balance.write(f); // the partition of the last rebalance
@@ -275,6 +287,15 @@ namespace talus::semi_implicit
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, soil, grid, where, "soil");
     read_points(*fp, water, grid, where, "water");
+    if (!prm.probes.empty()) // the points the run tracked (their ids saved)
+      {
+        probes.read_ids(*fp, where, "probes/soil_ids");
+        water_probes.read_ids(*fp, where, "probes/water_ids");
+        require(probes.ids.size() == prm.probes.size(), "output/probes",
+                "the checkpoint " + fp->path() + " tracks " + std::to_string(probes.ids.size()) +
+                  " probe(s), the .prm lists " + std::to_string(prm.probes.size()) +
+                  "; allowed: the probes of the checkpointed run");
+      }
     this->point_set_records[0] = read_pvd_records(*fp, "output/soil_pvd", soil.name());
     this->point_set_records[1] = read_pvd_records(*fp, "output/water_pvd", water.name());
     return true;

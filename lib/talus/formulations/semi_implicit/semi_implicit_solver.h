@@ -14,6 +14,7 @@
 
 #include <talus/base/tool.h>
 #include <talus/formulations/common/formulation.h>
+#include <talus/formulations/common/probes.h>
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/semi_implicit/boundary_loads.h>
 #include <talus/formulations/semi_implicit/fbar.h>
@@ -230,6 +231,12 @@ namespace talus::semi_implicit
     /// issue 37: the shared tractions, prescribed velocities and drainage
     /// conditions (boundary_loads.h); its hooks are called from the phases
     BoundaryLoads<dim> bloads;
+    /// output/probes: the soil points tracked (displacement, velocity,
+    /// effective stress) and the water points nearest to the same places at
+    /// t = 0 (their pore pressure); no water points: none of the latter
+    PointProbes<dim> probes, water_probes;
+    /// probes at t = 0 (a fresh start)
+    void select_probes();
     /// Everything of the grid's partition that lives across steps: the
     /// pressure space, the per-DoF node maps and wall/drained flags, the nodal
     /// vectors, the sets' cell lists; the next step rebuilds the active set and
