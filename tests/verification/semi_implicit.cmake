@@ -267,3 +267,22 @@ foreach(_mode displacement traction pressure dry_face refuse)
   set_tests_properties(verification.semi_implicit_boundary_loads_${_mode} PROPERTIES LABELS "fast"
                        ENVIRONMENT "${_env}" TIMEOUT 600)
 endforeach()
+
+# Mandel's problem (issue 40; docs/semi-implicit.md 'Mandel's problem'),
+# parameter_files/verification/mandel/mandel_semi_implicit.prm: the quarter of a
+# saturated rectangle under an impermeable rigid plate (force control, ramp 0.2 s),
+# drained at its free side, against the series solution (mandel_series.py) at
+# T = 0.12, 0.24, 0.49: the centre's pore pressure within 0.05 p0 (verify, h = a / 20:
+# 0.025 p0), the profile's normalised L2 error < 0.08 (0.03), the spread along y < 0.01 p0
+# (both)
+foreach(_mode fast verify)
+  if(_mode STREQUAL "fast")
+    set(_name verification.semi_implicit_mandel_fast)
+  else()
+    set(_name verification.semi_implicit_mandel)
+  endif()
+  add_test(NAME ${_name}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_mandel.py ${_mode} ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                   ${TALUS_PRM_DIR}/verification/mandel/mandel_semi_implicit.prm ${_w}/${_name})
+  set_tests_properties(${_name} PROPERTIES LABELS "${_mode}" ENVIRONMENT "${_env}" TIMEOUT 600)
+endforeach()
