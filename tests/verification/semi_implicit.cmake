@@ -287,3 +287,11 @@ foreach(_mode fast verify)
                    ${TALUS_PRM_DIR}/verification/mandel/mandel_semi_implicit.prm ${_w}/${_name})
   set_tests_properties(${_name} PROPERTIES LABELS "${_mode}" ENVIRONMENT "${_env}" TIMEOUT 600)
 endforeach()
+
+# consolidation through a drained base (a fixed wall, drainage on boundary id 2) under
+# a sealed loaded face against Terzaghi's one-way series (issue 40; docs/semi-implicit.md
+# 'A drained face on a wall'): normalised L2 error < 0.10 at T_v = 0.1, < 0.03 at T_v = 0.2
+add_test(NAME verification.semi_implicit_drained_base
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_drained_base.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_boundary_loads.prm ${_w}/semi_implicit_drained_base)
+set_tests_properties(verification.semi_implicit_drained_base PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

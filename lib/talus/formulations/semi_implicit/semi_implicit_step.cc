@@ -435,6 +435,12 @@ namespace talus::semi_implicit
           vs = 0;
         if (water_constrained[i])
           vw = 0;
+        // a wall holds the soil while a drained face frees the water: the
+        // water's own row with v_s = 0 (the 2 x 2 solve gave it the mixture's
+        // velocity, i.e. the momentum of the wall's reaction; docs/semi-implicit.md
+        // 'A drained face on a wall')
+        if (has_soil && has_water && constrained[i] && !water_constrained[i] && !prm.rigid_skeleton)
+          vw = rwv / (Mwi + h * Q);
         bloads.predictor(i, has_soil, has_water, Mwi, Q, h, rwv, vs, vw); // prescribed velocities
         if (const unsigned int k = plate_of[i]; k != no_plate)
           {
