@@ -16,7 +16,9 @@ Modes:
            (T = 0.122, 0.245, 0.489; the load is ramped over 0.2 s): |centre| < 0.05, profile < 0.08,
            y spread < 0.01 at every time (measured 0.027, 0.044, 0.002 at worst); and the
            variant drained through the grid's face x = a (grid_face below): |centre| < 0.03,
-           profile < 0.03, y spread < 0.01 (measured 0.0074, 0.013, 0.003).
+           profile < 0.03, y spread < 0.01 (measured 0.0074, 0.013, 0.003); both variants
+           on 1 and 2 ranks to t = 0.6 s: every water point's position and pore pressure
+           within 1e-8 (of a, of p0; measured 0 and 2e-12).
   verify   h = a / 20 (the grid 28 x 10), courant 0.8, the same times:
            |centre| < 0.025, profile < 0.03, y spread < 0.01 (measured 0.013,
            0.020, 0.002 at worst); the grid-face variant: |centre| < 0.015, profile < 0.015,
@@ -57,15 +59,30 @@ def grid_face(t, cells_x):
     return tv.prm_set(t, "grid/cells", "%d, %d" % (cells_x, cells_x // 2))
 
 
-def run(name, t_end, courant, cells):
+def run(name, t_end, courant, cells, np=1):
     t = tv.prm_set(text, "output/directory", os.path.join(work, name))
     t = tv.prm_set(t, "time/end time", repr(t_end))
     t = tv.prm_set(t, "time/courant number", repr(courant))
     t = tv.prm_set(t, "grid/cells", cells)
     if name.startswith("face"):  # the same h: the grid's 1.4 a shortened to a
         t = grid_face(t, int(cells.split(",")[0]) * 10 // 14)
-    tv.run_tool(tool, t, work, name)
+    tv.run_tool(tool, t, work, name, np=np)
     return tv.read_csv(os.path.join(work, name, "water_final.csv"))
+
+
+def ranks(label, cells):
+    """1 vs 2 ranks to t = 0.6 s: every water point's position and pore pressure (sorted by
+    position) within 1e-8 (of a, of p0)"""
+    pts = {}
+    for np in (1, 2):
+        w = run("%s_np%d" % (label, np), 0.6, 0.8, cells, np=np)
+        pts[np] = sorted(zip(w["pos_x"], w["pos_y"], w["pore_pressure"]))
+    a1, a2 = pts[1], pts[2]
+    tv.check(len(a1) == len(a2), "%s: the same number of water points on 1 and 2 ranks" % label)
+    dx = max(max(abs(u[0] - v[0]), abs(u[1] - v[1])) for u, v in zip(a1, a2)) / a
+    dp = max(abs(u[2] - v[2]) for u, v in zip(a1, a2)) / p0
+    print("%s: 1 vs 2 ranks: position %.2g a, pore pressure %.2g p0" % (label, dx, dp))
+    tv.check(dx < 1e-8 and dp < 1e-8, "%s: 1 vs 2 ranks within 1e-8" % label)
 
 
 def measures(w, t, h):
@@ -108,6 +125,8 @@ if mode == "fast":
         tv.check(abs(centre) < 0.03, "grid face: centre error %.4f p0 < 0.03" % centre)
         tv.check(prof < 0.03, "grid face: profile L2 error %.4f < 0.03" % prof)
         tv.check(spread < 0.01, "grid face: y spread %.4f p0 < 0.01" % spread)
+    ranks("h0.1", "14, 5")
+    ranks("face_h0.1", "14, 5")
 elif mode == "verify":
     for centre, _, prof, spread in case("h0.05_c0.8", 0.8, "28, 10", 0.05, times):
         tv.check(abs(centre) < 0.025, "centre error %.4f p0 < 0.025" % centre)
