@@ -277,3 +277,33 @@ add_test(NAME verification.semi_implicit_results_file
                  ${_w}/semi_implicit_results_file)
 set_tests_properties(verification.semi_implicit_results_file PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
+
+# Mandel's problem (issue 40; docs/semi-implicit.md 'Mandel's problem'),
+# parameter_files/verification/mandel/mandel_semi_implicit.prm: the quarter of a
+# saturated rectangle under an impermeable rigid plate (force control, ramp 0.2 s),
+# drained at its free side, against the series solution (mandel_series.py) at
+# T = 0.12, 0.24, 0.49: the centre's pore pressure within 0.05 p0 (verify, h = a / 20:
+# 0.025 p0), the profile's normalised L2 error < 0.08 (0.03), the spread along y < 0.01 p0
+# (both); the same checks on the variant drained through the grid's face x = a (boundary id 1)
+# in place of the free surface: 0.03 p0, 0.03, 0.01 (verify 0.015 p0, 0.015, 0.01); fast: both
+# variants on 1 and 2 ranks to 1e-8
+foreach(_mode fast verify)
+  if(_mode STREQUAL "fast")
+    set(_name verification.semi_implicit_mandel_fast)
+  else()
+    set(_name verification.semi_implicit_mandel)
+  endif()
+  add_test(NAME ${_name}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_mandel.py ${_mode} ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                   ${TALUS_PRM_DIR}/verification/mandel/mandel_semi_implicit.prm ${_w}/${_name})
+  set_tests_properties(${_name} PROPERTIES LABELS "${_mode}" ENVIRONMENT "${_env}" TIMEOUT 600)
+endforeach()
+set_tests_properties(verification.semi_implicit_mandel_fast PROPERTIES PROCESSORS 2)
+
+# consolidation through a drained base (a fixed wall, drainage on boundary id 2) under
+# a sealed loaded face against Terzaghi's one-way series (issue 40; docs/semi-implicit.md
+# 'A drained face on a wall'): normalised L2 error < 0.10 at T_v = 0.1, < 0.03 at T_v = 0.2
+add_test(NAME verification.semi_implicit_drained_base
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_drained_base.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_boundary_loads.prm ${_w}/semi_implicit_drained_base)
+set_tests_properties(verification.semi_implicit_drained_base PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)

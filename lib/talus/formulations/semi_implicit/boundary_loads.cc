@@ -416,14 +416,18 @@ namespace talus::semi_implicit
       return {true, 0.0, false};
     if (plate_drained) // a permeable plate: p^{t+1} = 0
       return {true, -p, false};
+    // under an impermeable plate: solved, also where the plate's edge lies on
+    // a draining face (the plate covers the surface over its node's support:
+    // p = 0 there drained the plate's edge cell, Mandel's problem 14 % too
+    // fast; docs/semi-implicit.md 'Mandel's problem')
+    if (plate_sealed)
+      return {false, 0.0, false};
     // a boundary condition holds every water node of its face
     const unsigned int a = drain_all[i];
     if (a != none && prm.drainage[a].kind == Kind::drained)
       return {true, -p, false};
     if (a != none && prm.drainage[a].kind == Kind::pressure)
       return {true, prm.drainage[a].pressure_at(time_end) - p, false};
-    if (plate_sealed) // under an impermeable plate: solved
-      return {false, 0.0, false};
     // the surface's kind: a region's condition; else (at a vertex of a wet and
     // a dry cell) a boundary's impermeable one; else sealed where a load acts
     // (a loaded face drains only where the user says so), drained elsewhere (A6)

@@ -145,6 +145,16 @@ namespace talus::semi_implicit
     /// surface's flux beta_J . v_s*_J on the right-hand side
     template <class K>
     void add_sealed_surface_terms(const dealii::AffineConstraints<double> &constraints);
+    /// The surface vectors of the impermeable rigid plates: beta_plate at a
+    /// plate's axis DoF = sum_s V grad N_J (the surface integral of N_J n):
+    /// the pore pressure's push on the plate (+beta p^{t+1} in the plate's
+    /// residual) and the flux of the moving impermeable surface beta . V in
+    /// the continuity rows (docs/semi-implicit.md 'An impermeable plate')
+    template <class K>
+    void plate_surface();
+    /// the plate surface's flux beta_plate_J . v_J on the right-hand side of
+    /// the Poisson rows (v: v_s* of the step or a plate's unit velocity)
+    void add_plate_surface_flux(const dealii::AffineConstraints<double> &constraints, const Vector &v, Vector &f) const;
     /// (3)-(4): the water and the mixture predictor, the drag implicit in both:
     /// v_s*, v_w* per node (a 2 x 2 system), the plates' unit responses
     void water_and_mixture_predictors(const StepState &this_step);
@@ -276,7 +286,9 @@ namespace talus::semi_implicit
     Vector beta;                                   // per DoF: the sealed surface's sum_s V grad N (0 elsewhere)
     std::vector<unsigned char> sealed;             // per node (component-0 DoF): a node of a sealed surface this step
     bool                       any_sealed = false; // some rank has a sealed node this step
-    double                     sealed_h   = 0;     // the step's size (the Poisson terms of the seal)
+    Vector                     beta_plate; // per DoF: an impermeable plate's axis DoF: sum_s V grad N (0 elsewhere)
+    bool                       any_plate_sealed = false; // the scene has an impermeable rigid plate
+    double                     sealed_h         = 0;     // the step's size (the Poisson terms of the seal)
     std::vector<double>        cell_water_volume;
     Vector                     Mdj; // F-bar: sum N m dJ of the soil points
     Vector                     Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points

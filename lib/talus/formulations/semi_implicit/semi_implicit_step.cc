@@ -162,6 +162,7 @@ namespace talus::semi_implicit
     StepState this_step = begin_step(h);
     particles_to_nodes<K>(this_step);
     sealed_surface<K>(this_step);
+    plate_surface<K>();
     add_lap(phase.p2n);
     water_and_mixture_predictors(this_step);
     add_lap(phase.grid);
@@ -434,6 +435,12 @@ namespace talus::semi_implicit
           vs = 0;
         if (water_constrained[i])
           vw = 0;
+        // a wall holds the soil while a drained face frees the water: the
+        // water's own row with v_s = 0 (the 2 x 2 solve gave it the mixture's
+        // velocity, i.e. the momentum of the wall's reaction; docs/semi-implicit.md
+        // 'A drained face on a wall')
+        if (has_soil && has_water && constrained[i] && !water_constrained[i] && !prm.rigid_skeleton)
+          vw = rwv / (Mwi + h * Q);
         bloads.predictor(i, has_soil, has_water, Mwi, Q, h, rwv, vs, vw); // prescribed velocities
         if (const unsigned int k = plate_of[i]; k != no_plate)
           {
@@ -652,6 +659,8 @@ namespace talus::semi_implicit
                                            [&](const unsigned int k) { assembly.integrand = terms[k]; });
       if (any_sealed)
         add_sealed_surface_terms<K>(constraints);
+      if (any_plate_sealed)
+        add_plate_surface_flux(constraints, vs_star, rhs);
       transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, &A, &rhs);
     }
   }
@@ -678,14 +687,27 @@ namespace talus::semi_implicit
     std::vector<unsigned char> candidate(nl, 0);
     grid.reinit_vector(beta); // first: per node, the cells it shares with a sealed surface node
     unsigned int n_sealed = 0;
+    // a node on a face of the grid box is a node of the body's surface where
+    // the body reaches that face (no dry cell beyond it: the grid ends): a
+    // loaded face there is sealed as at a free surface
+    const auto on_box_face = [&](const unsigned int i) {
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double tol = 1e-9 * (prm.grid_upper[d] - prm.grid_lower[d]);
+          if (std::abs(node_x[i][d] - prm.grid_lower[d]) < tol || std::abs(node_x[i][d] - prm.grid_upper[d]) < tol)
+            return true;
+        }
+      return false;
+    };
     for (unsigned int i = 0; i < nl; ++i)
       if (component[i] == 0 && Ms.local_element(i) > this_step.ms_cut)
         {
           const bool has_water = Mw.local_element(i) > this_step.mw_cut;
           const bool s         = bloads.sealed_surface(i, has_water, drained[i], plate_sealed[i], wet.local_element(i),
                                                        dry.local_element(i), near_wet.local_element(i));
-          (dry.local_element(i) > 0 ? sealed : candidate)[i] = s;
-          n_sealed += s && dry.local_element(i) > 0 && i < owned ? 1 : 0;
+          const bool surface   = dry.local_element(i) > 0 || on_box_face(i);
+          (surface ? sealed : candidate)[i] = s;
+          n_sealed += s && surface && i < owned ? 1 : 0;
         }
     any_sealed = dealii::Utilities::MPI::sum(n_sealed, comm) > 0;
     if (!any_sealed)
@@ -796,6 +818,65 @@ namespace talus::semi_implicit
   }
 
   template <int dim>
+  template <class K>
+  void
+  Solver<dim>::plate_surface()
+  {
+    using Stencil = transfer::PointStencil<dim, K>;
+    using It      = transfer::PointIterator<dim>;
+    // An impermeable rigid plate covers the surface: the pore pressure under
+    // it pushes on it (the gradient form of the pressure force lacks the
+    // surface integral -integral N_J p n, as at a sealed surface) and the
+    // continuity rows of its nodes see the surface move with the plate
+    // (integral grad N_J . q = surface integral N_J V . n). beta_plate at the
+    // plate's axis DoFs only (the plate holds them: no correction there).
+    any_plate_sealed = false;
+    for (const auto &pl : prm.rigid_plates)
+      any_plate_sealed = any_plate_sealed || !pl.permeable;
+    if (!any_plate_sealed || water.handler.n_global_particles() == 0)
+      {
+        any_plate_sealed = false;
+        return;
+      }
+    const unsigned int nl = n_local();
+    grid.reinit_vector(beta_plate);
+    {
+      double *bt = at(beta_plate);
+      transfer::for_each_point_stencil<dim, K>(
+        grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+          const double V = it->get_properties()[L::volume];
+          for (unsigned int w = 0; w < s.n; ++w)
+            for (unsigned int d = 0; d < dim; ++d)
+              if (const unsigned int k = plate_of[s.dof[w][d]]; k != no_plate && !prm.rigid_plates[k].permeable)
+                bt[s.dof[w][d]] += V * s.G[w][d];
+        });
+    }
+    exchange({&beta_plate});
+    for (unsigned int i = 0; i < nl; ++i)
+      if (const unsigned int k = plate_of[i]; k == no_plate || prm.rigid_plates[k].permeable)
+        beta_plate.local_element(i) = 0;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::add_plate_surface_flux(const dealii::AffineConstraints<double> &constraints, const Vector &v,
+                                      Vector &f) const
+  {
+    const unsigned int  nl = n_local(), owned = grid.partitioner->locally_owned_size();
+    std::vector<double> bv(nl, 0.0);
+    for (unsigned int i = 0; i < nl; ++i)
+      if (const unsigned int J = node_of[i]; J < owned)
+        bv[J] += beta_plate.local_element(i) * v.local_element(i);
+    for (unsigned int J = 0; J < owned; ++J)
+      if (component[J] == 0 && bv[J] != 0)
+        {
+          const auto gJ = pspace.node_dof(J, 0);
+          if (!constraints.is_constrained(gJ))
+            f(gJ) += bv[J];
+        }
+  }
+
+  template <int dim>
   void
   Solver<dim>::solve_pressure(const dealii::AffineConstraints<double> &constraints)
   {
@@ -868,6 +949,8 @@ namespace talus::semi_implicit
                                                                         &rhs1);
         transfer::for_each_cell_of_sets<dim>(grid, {&soil, &water}, assembly,
                                              [&](const unsigned int k) { assembly.integrand = terms[k]; });
+        if (any_plate_sealed)
+          add_plate_surface_flux(constraints_h, r.es, rhs1);
         transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, nullptr, &rhs1);
         const auto          t0 = Clock::now();
         LinearSolverOptions options;
@@ -1033,7 +1116,7 @@ namespace talus::semi_implicit
     // R0 (the V = 0 step, displacement plates at their velocities) and R1
     std::vector<double> R(n_plates * (1 + nf), 0.0);
     const auto add_residual = [&](const unsigned int column, const Vector &vsn, const Vector &vwn, const Vector &gsv,
-                                  const Vector &gwv, const bool base) {
+                                  const Vector &gwv, const Vector &dpv, const bool base) {
       for (unsigned int i = 0; i < owned; ++i)
         if (const unsigned int k = plate_of[i]; k != no_plate)
           {
@@ -1044,10 +1127,14 @@ namespace talus::semi_implicit
             if (base)
               r -= (Msi * vs_t.local_element(i) + Mwi * vw_t.local_element(i)) / h + Fs.local_element(i) +
                    Mwi * g[component[i]] + (1 - n) * Gps.local_element(i) + n * Gpw.local_element(i);
+            // an impermeable plate: the pore pressure's push on it, the
+            // surface term -beta p^{t+1} of the force on the material
+            if (any_plate_sealed)
+              r += beta_plate.local_element(i) * ((base ? p_node.local_element(j) : 0.0) + dpv.local_element(j));
             R[column * n_plates + k] += r;
           }
     };
-    add_residual(0, vs_new, vw_new, gs, gw, true);
+    add_residual(0, vs_new, vw_new, gs, gw, dp_node, true);
     for (unsigned int r = 0; r < nf; ++r)
       {
         PlateResponse      &u = plate_response[r];
@@ -1056,7 +1143,7 @@ namespace talus::semi_implicit
         for (unsigned int i = 0; i < nl; ++i)
           correct_velocities(this_step, i, u.es.local_element(i), u.ew.local_element(i), u.gs.local_element(i),
                              u.gw.local_element(i), unit.data(), u.vs.local_element(i), u.vw.local_element(i));
-        add_residual(1 + r, u.vs, u.vw, u.gs, u.gw, false);
+        add_residual(1 + r, u.vs, u.vw, u.gs, u.gw, u.dp, false);
       }
     // the same sums, so the same V, on every rank
     MPI_Allreduce(MPI_IN_PLACE, R.data(), static_cast<int>(R.size()), MPI_DOUBLE, MPI_SUM, comm);
