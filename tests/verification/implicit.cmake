@@ -116,6 +116,25 @@ add_test(NAME verification.implicit_results_file
 set_tests_properties(verification.implicit_results_file PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
                      PROCESSORS 2)
 
+# 'implicit/negligible nodal mass' reports and refuses (issue 39): the held
+# DoFs and the force they carry in series.csv; the cantilever's free-end corners
+# held (0.3) carry its weight -> exit 3 with the figures; none held (0.2) ->
+# bitwise the run without the option.
+add_test(NAME verification.implicit_negligible_mass
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_negligible_mass.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_negligible_mass)
+set_tests_properties(verification.implicit_negligible_mass PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# a cut-back changes the problem it retries (issue 39): the cantilever under
+# constant loads with 'newton/max iterations = 4' fails its full-load step and
+# retries at smaller load levels up to 1: exit 0 (before: exit 3 after six
+# replays), the one-step answer within 1 %
+add_test(NAME verification.implicit_constant_load_cutback
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_constant_load_cutback.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_constant_load_cutback)
+set_tests_properties(verification.implicit_constant_load_cutback PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+
 # talus-critical-dt on implicit scenes: not CFL-limited, the explicit step and the
 # ratio beside it; the Newmark limit when 2 beta < gamma (and a run inside it)
 add_test(NAME verification.critical_dt_implicit

@@ -4,6 +4,7 @@
 // step (walls, contact, prescribed DoFs, nodes of negligible mass, the inactive
 // pins), the prescribed increments and the reactions of the prescribed nodes
 // and the rigid plates.
+#include <talus/base/errors.h>
 #include <talus/formulations/implicit/implicit_solver.h>
 #include <talus/loads/kinematics.h>
 
@@ -11,7 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 
 namespace talus::implicit_mpm
 {
@@ -65,7 +68,7 @@ namespace talus::implicit_mpm
   template <int dim>
   dealii::AffineConstraints<double>
   Solver<dim>::step_constraints(const std::vector<double> *values, const bool with_contact, const bool with_prescribed,
-                                const bool hold_plates) const
+                                const bool hold_plates, const bool hold_negligible) const
   {
     // the contact nodes now in contact: their normal DoF, with no slip all
     std::vector<dealii::types::global_dof_index> held;
@@ -79,7 +82,8 @@ namespace talus::implicit_mpm
             if (d == c.axis || prm.contact_no_slip)
               held.push_back(space.node_dof(c.node, d));
         }
-    held.insert(held.end(), negligible_dofs.begin(), negligible_dofs.end());
+    if (hold_negligible)
+      held.insert(held.end(), negligible_dofs.begin(), negligible_dofs.end());
     if (hold_plates) // the force plates' axis DoFs at zero increment (the predictor)
       for (const auto &p : plate_nodes)
         if (force_plate(p.condition) && p.component == prm.rigid_plates[p.condition].axis)
@@ -263,20 +267,87 @@ namespace talus::implicit_mpm
     residual = kept;
   }
 
+  template <int dim>
+  void
+  Solver<dim>::measure_held_load(const StepState &s)
+  {
+    // the residual assembled with no hold at all (only the pins of the inactive
+    // DoFs): at a constrained DoF (wall, prescribed, contact, held) it is the
+    // force the constraint exerts, at a free one ~0. The held DoFs' share of
+    // all the forces on the nodes, loads and reactions, says how much of the
+    // answer the hold decides: with it small the answer is the posed problem's.
+    last.held_dofs       = 0;
+    last.held_load_share = 0;
+    if (dealii::Utilities::MPI::sum(negligible_dofs.size(), comm) == 0) // collective: the same on every rank
+      return;
+    Vector                            kept(residual);
+    dealii::AffineConstraints<double> bare; // (no copy constructor in 9.4)
+    bare.copy_from(active.constraints());
+    std::swap(constraints, bare);
+    try
+      {
+        assemble(false, s.g);
+      }
+    catch (...)
+      {
+        std::swap(constraints, bare);
+        residual = kept;
+        throw;
+      }
+    std::swap(constraints, bare);
+    std::vector<dealii::types::global_dof_index> held(negligible_dofs); // relevant DoFs: a node once
+    std::sort(held.begin(), held.end());
+    held.erase(std::unique(held.begin(), held.end()), held.end());
+    const auto  &owned   = space.locally_owned_dofs();
+    const auto  &pins    = active.constraints();
+    double       sums[2] = {0, 0}; // held, all
+    unsigned int n       = 0;
+    for (unsigned int k = 0; k < residual.locally_owned_size(); ++k)
+      if (space.component(k) < dim && !pins.is_constrained(owned.nth_index_in_set(k)))
+        sums[1] += std::abs(residual.local_element(k));
+    // a light node's DoF that a wall, a prescribed line or contact holds keeps
+    // that line (find_negligible_nodes): its force is that condition's reaction
+    const auto unheld = step_constraints(nullptr, true, true, false, false);
+    for (const auto i : held)
+      if (owned.is_element(i) && space.component(owned.index_within_set(i)) < dim && !unheld.is_constrained(i))
+        {
+          sums[0] += std::abs(residual(i));
+          ++n;
+        }
+    residual = kept;
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 2), comm, dealii::ArrayView<double>(sums, 2));
+    last.held_dofs       = dealii::Utilities::MPI::sum(n, comm);
+    last.held_load_share = sums[0] / std::max(s.f_ext_sum + sums[1], 1e-300);
+    if (last.held_load_share > prm.negligible_load_limit)
+      {
+        std::ostringstream os;
+        os << "step " << step_number + 1 << " (t = " << time + s.h << "): the " << last.held_dofs
+           << " displacement DoFs held by 'implicit/negligible nodal mass = " << prm.negligible_mass << "' carry "
+           << std::setprecision(3) << last.held_load_share << " of the forces on the nodes (loads " << s.f_ext_sum
+           << " N, reactions " << sums[1]
+           << " N, summed magnitudes; limit 'implicit/negligible mass load limit' = " << prm.negligible_load_limit
+           << "): the converged answer is not that of the posed problem. Lower 'negligible nodal mass' (0 = off), "
+              "refine the load steps, or raise the limit knowingly.";
+        throw RunStopped(os.str());
+      }
+  }
+
   template void                                  Solver<2>::measure_contact_gaps();
   template dealii::AffineConstraints<double>     Solver<2>::step_constraints(const std::vector<double> *, const bool,
-                                                                             const bool, const bool) const;
+                                                                             const bool, const bool, const bool) const;
   template void                                  Solver<2>::find_negligible_nodes();
   template std::pair<unsigned int, unsigned int> Solver<2>::update_contact(const dealii::Tensor<1, 2> &, const double);
   template dealii::Tensor<1, 2>                  Solver<2>::condition_increment(const unsigned int, const double) const;
   template double Solver<2>::prescribed_increment(const loads::PrescribedNodeDof &, const double) const;
   template void   Solver<2>::prescribed_reaction(const dealii::Tensor<1, 2> &);
+  template void   Solver<2>::measure_held_load(const StepState &);
   template void   Solver<3>::measure_contact_gaps();
   template dealii::AffineConstraints<double>     Solver<3>::step_constraints(const std::vector<double> *, const bool,
-                                                                             const bool, const bool) const;
+                                                                             const bool, const bool, const bool) const;
   template void                                  Solver<3>::find_negligible_nodes();
   template std::pair<unsigned int, unsigned int> Solver<3>::update_contact(const dealii::Tensor<1, 3> &, const double);
   template dealii::Tensor<1, 3>                  Solver<3>::condition_increment(const unsigned int, const double) const;
   template double Solver<3>::prescribed_increment(const loads::PrescribedNodeDof &, const double) const;
   template void   Solver<3>::prescribed_reaction(const dealii::Tensor<1, 3> &);
+  template void   Solver<3>::measure_held_load(const StepState &);
 } // namespace talus::implicit_mpm

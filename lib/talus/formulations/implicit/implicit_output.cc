@@ -50,6 +50,9 @@ namespace talus::implicit_mpm
         c.push_back(std::string("prescribed_force_") + ax[d]);
     for (const auto &n : loads::rigid_plate_series_columns(prm.rigid_plates))
       c.push_back(n);
+    if (prm.negligible_mass > 0)
+      for (const char *n : {"held_dofs", "held_load_share"})
+        c.push_back(n);
     probes.add_columns(c, points.layout);
     balance.add_series_column(c);
     return c;
@@ -107,6 +110,11 @@ namespace talus::implicit_mpm
             v.push_back(after_step ? std::sqrt(t2) : 0.0);
           }
       }
+    if (prm.negligible_mass > 0)
+      {
+        v.push_back(after_step ? double(last.held_dofs) : 0.0);
+        v.push_back(after_step ? last.held_load_share : 0.0);
+      }
     probes.sample(points);
     probes.add_values(v, comm);
     balance.add_series_value(v);
@@ -140,6 +148,7 @@ namespace talus::implicit_mpm
         f.set_attribute("newton iterations", std::int64_t(total_iterations));
         f.set_attribute("linear iterations", std::int64_t(total_linear_iterations));
         f.set_attribute("cut-backs", std::int64_t(cut_backs));
+        f.set_attribute("load level", load_level);
         for (unsigned int k = 0; k < plate_displacement.size(); ++k)
           {
             // the plate's state, and its last reaction for the series
@@ -172,6 +181,8 @@ namespace talus::implicit_mpm
     total_iterations        = fp->get_int("newton iterations");
     total_linear_iterations = fp->get_int("linear iterations");
     cut_backs               = fp->get_int("cut-backs");
+    // (absent in checkpoints written before the constant-load level: full)
+    load_level = fp->has_attribute("load level") ? fp->get_double("load level") : 1.0;
     for (unsigned int k = 0; k < plate_displacement.size(); ++k)
       {
         plate_displacement[k] = fp->get_double("plate " + std::to_string(k) + " displacement");

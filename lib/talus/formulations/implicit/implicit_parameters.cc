@@ -125,7 +125,14 @@ namespace talus::implicit_mpm
                         "The DoFs (displacement and, in mixed u-p, pressure) of an active node whose lumped mass is "
                         "below this fraction of the largest nodal mass of the step are held at zero increment (nodes "
                         "touched by the corner "
-                        "of a point's support only, e.g. at a heaving free surface); 0 = off.");
+                        "of a point's support only, e.g. at a heaving free surface); 0 = off. The number of held "
+                        "DoFs and the force they carry go to series.csv and the log ('negligible mass load limit').");
+      prm.declare_entry("negligible mass load limit", "0.01", Double(0, 1),
+                        "With 'negligible nodal mass' > 0: the largest share the held DoFs may carry, at a "
+                        "converged step, of all the forces on the nodes (summed magnitudes: the loads |f_ext| "
+                        "and the reactions of walls, prescribed DoFs, contact and the hold); above it the run "
+                        "stops with exit 3 and the figures (the answer would not be that of the posed problem). "
+                        "In [0, 1].");
       prm.declare_entry("geometry", "plane strain", Selection("plane strain|axisymmetric"),
                         "2D only. plane strain: dF_zz = 1. axisymmetric: the scene is the r-z half-plane of a "
                         "body of revolution about the y axis (x = radius, grid lower x >= 0; seed 001 App. C): a "
@@ -218,6 +225,7 @@ namespace talus::implicit_mpm
     p.axisymmetric            = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
+    p.negligible_load_limit   = prm.get_double("negligible mass load limit");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair

@@ -232,18 +232,46 @@ namespace talus::implicit_mpm
   double
   Solver<dim>::load_factor(const double t) const
   {
-    if (dynamic() || !prm.ramp_loads)
+    if (dynamic())
       return 1.0;
+    if (!prm.ramp_loads)
+      return load_level;
     if (!prm.staged)
       return std::min(1.0, t / prm.end_time);
     return std::min(1.0, (t - stage_start_time) / prm.stages[current_stage].duration);
   }
 
   template <int dim>
-  dealii::Tensor<1, dim>
-  Solver<dim>::apply_loads_at(const double t)
+  double
+  Solver<dim>::step_load_level(const double h) const
   {
-    const double r = load_factor(t);
+    if (dynamic() || prm.ramp_loads)
+      return load_factor(time + h);
+    const double stage_end = prm.staged ? stage_start_time + prm.stages[current_stage].duration : prm.end_time;
+    const double full_step = std::min(dt, stage_end - time);
+    if (h >= full_step * (1 - 1e-12))
+      return 1.0;
+    return load_level + (1.0 - load_level) * h / full_step;
+  }
+
+  template <int dim>
+  bool
+  Solver<dim>::cut_back_replays(const double h) const
+  {
+    if (dynamic() || prm.ramp_loads || load_level < 1.0 || any_velocity_condition() || !prm.rigid_plates.empty() ||
+        prm.footing.enabled || point_contact)
+      return false;
+    for (const auto &t : prm.tractions)
+      if (t.function.settle_time() > time)
+        return false;
+    (void)h;
+    return true;
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  Solver<dim>::apply_loads_at(const double t, const double r)
+  {
     if (!prm.staged) // the ramp scales gravity and every traction alike
       {
         point_forces.update_factors(prm.tractions, prm.tractions.size(), t, 0.0);
@@ -365,6 +393,7 @@ namespace talus::implicit_mpm
       {
         stage_start_time = time;
         dt               = prm.stage_time_steps[k];
+        load_level       = 0; // constant loads: the stage's load still to apply
       }
     enter_stage(k);
     if (!prm.staged)

@@ -137,7 +137,11 @@ namespace talus::implicit_mpm
     /// 'implicit/negligible nodal mass': the DoFs (displacement and, in u-p,
     /// pressure) of an active node whose lumped mass is below this fraction of
     /// the largest nodal mass are held at zero increment for the step (0: off)
-    double              negligible_mass = 0;
+    double negligible_mass = 0;
+    /// The largest share of all the forces on the nodes (loads and reactions,
+    /// summed magnitudes) the held negligible-mass DoFs may carry at a converged
+    /// step; above it the run stops (exit 3) with the figures.
+    double              negligible_load_limit = 0.01;
     NewtonSettings      newton;
     LinearSolverOptions linear;
   };
@@ -168,6 +172,10 @@ namespace talus::implicit_mpm
     /// at the converged step (the residual f_int - f_ext at their DoFs), summed
     /// over the nodes of all conditions, per component
     double prescribed_force[3] = {0, 0, 0};
+    /// 'implicit/negligible nodal mass': displacement DoFs held this step and
+    /// their share of all the forces on the nodes at the converged step
+    unsigned int held_dofs       = 0;
+    double       held_load_share = 0;
   };
 
   template <int dim>
@@ -237,10 +245,24 @@ namespace talus::implicit_mpm
     /// The ramp of the current stage at time t (static with 'ramp loads': the
     /// fraction of the stage's duration elapsed, at most 1; else 1).
     double load_factor(const double t) const;
+    /// Static analysis with constant loads ('ramp loads = false'): the load
+    /// level reached at the stage's last converged step (0 at the stage's
+    /// start, 1 once a step of the full size has converged). Not a function of
+    /// time: a cut-back step must apply less load, or it retries the same problem.
+    double load_level = 0;
+    /// The level a step of size h goes to: the ramp at t + h; with constant
+    /// loads the full load for a step of the full size (min(dt, the stage's
+    /// rest)), else load_level + (1 - load_level) h / that size (a cut-back
+    /// step takes that share of the rest of the load).
+    double step_load_level(const double h) const;
+    /// With constant loads at the full level and nothing else depending on the
+    /// step (no prescribed motion, plates, footing or traction time function
+    /// still changing): a cut-back would replay the failed step exactly.
+    bool cut_back_replays(const double h) const;
     /// The body force at time t, and the traction factors of point_forces set
     /// for t (a static ramp takes the gravity from the previous stage's to this
     /// stage's and the stage's own tractions from 0 to full over the stage).
-    dealii::Tensor<1, dim> apply_loads_at(const double t);
+    dealii::Tensor<1, dim> apply_loads_at(const double t, const double r);
     /// Walls, prescribed nodes and the condition report of stage k.
     void enter_stage(const unsigned int k);
     /// The wall flags, contact nodes and prescribed nodes of stage k on the current partition.
@@ -257,9 +279,12 @@ namespace talus::implicit_mpm
     struct StepState
     {
       double                 h = 0;
-      dealii::Tensor<1, dim> g;         ///< the body force at t + h (apply_loads_at)
-      double                 f_ext = 0; ///< the load scale of Newton's residual test
-      NewtonResult           result;    ///< the last Newton solve, its iterations those of all passes
+      dealii::Tensor<1, dim> g;              ///< the body force at t + h (apply_loads_at)
+      double                 f_ext      = 0; ///< the load scale of Newton's residual test
+      double                 load_level = 1; ///< the static load level of the step (step_load_level)
+      /// sum of |f_ext| over the DoFs (the magnitude of the load the nodes carry)
+      double       f_ext_sum = 0;
+      NewtonResult result; ///< the last Newton solve, its iterations those of all passes
       /// Newton solves (contact passes) of the step, nodes released and put in contact over them
       unsigned int       passes = 0, released = 0, added = 0;
       unsigned int       linear_iterations     = 0;
@@ -271,6 +296,9 @@ namespace talus::implicit_mpm
     /// body force at t + h, the damping stiffness ('rayleigh beta'), the external
     /// force scale and the force plates' targets at t + h.
     StepState begin_step(const double h);
+    /// A failed step: the cut-back (the loop halves h), or RunStopped when the
+    /// retry would replay the same problem (cut_back_replays).
+    StepOutcome cut_back(const StepState &s);
     /// The first iterate: du = 0, the lifted predictor of the prescribed DoFs
     /// (collective), mixed u-p: the pressure predictor. false: the predictor
     /// failed (the step is cut back).
@@ -295,7 +323,8 @@ namespace talus::implicit_mpm
     dealii::AffineConstraints<double> step_constraints(const std::vector<double> *values          = nullptr,
                                                        const bool                 with_contact    = true,
                                                        const bool                 with_prescribed = true,
-                                                       const bool                 hold_plates     = false) const;
+                                                       const bool                 hold_plates     = false,
+                                                       const bool                 hold_negligible = true) const;
     /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
     /// normal DoF of each node, decided by the owner, ghosts updated.
     std::vector<loads::ContactNode> contact_nodes;
@@ -337,6 +366,12 @@ namespace talus::implicit_mpm
     void add_consistent_inertia(const bool with_tangent);
     /// negligible_dofs from the step's lumped masses (prm.negligible_mass)
     void find_negligible_nodes();
+    /// At a converged step: the force the held negligible-mass DoFs carry (the
+    /// residual assembled without constraints, summed |r| over their
+    /// displacement components) as a share of all the forces on the nodes
+    /// (summed |f_ext| plus the reactions), into `last`; RunStopped above
+    /// 'negligible mass load limit'. Collective.
+    void measure_held_load(const StepState &s);
     /// Residual (and tangent) at the iterate du (ghosts up to date); returns |r|.
     double assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g);
     /// Mixed u-p: the nodal pressure predictor of Eq. 5.20 into the pressure

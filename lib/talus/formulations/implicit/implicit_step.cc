@@ -26,7 +26,7 @@ namespace talus::implicit_mpm
   {
     StepState s = begin_step(h);
     if (!predict(s) || !solve_newton(s))
-      return StepOutcome::cut_back;
+      return cut_back(s);
     report_newton(s);
     const NewtonResult &result = s.result;
     if (!result.converged)
@@ -34,13 +34,35 @@ namespace talus::implicit_mpm
         log() << "  step " << step_number + 1 << " (t = " << time + h << "): Newton " << to_string(result.status)
               << " after " << result.iterations << " iterations (|r|: " << last.history << "); " << result.message
               << std::endl;
-        return StepOutcome::cut_back;
+        return cut_back(s);
       }
+    if (prm.negligible_mass > 0)
+      measure_held_load(s);
     if (!apply_reactions(s))
-      return StepOutcome::cut_back;
+      return cut_back(s);
     convective_phase(s);
     log_step(s);
+    load_level = s.load_level;
     return StepOutcome::done;
+  }
+
+  template <int dim>
+  StepOutcome
+  Solver<dim>::cut_back(const StepState &s)
+  {
+    // a static step under constant loads: the retry's smaller step takes a
+    // smaller share of the load still to apply (step_load_level); once the full
+    // load is on and nothing else depends on the step size, the retry would
+    // replay this failure exactly: stop instead
+    if (cut_back_replays(s.h))
+      throw RunStopped("step " + std::to_string(step_number + 1) + " (t = " + std::to_string(time + s.h) +
+                       " s) failed under the full constant load ('implicit/ramp loads = false'), with nothing "
+                       "else depending on the step size: a cut-back would retry the same problem, so the run "
+                       "stops here (ramp the loads, or refine the grid or the Newton settings)");
+    if (!dynamic() && !prm.ramp_loads)
+      log() << "  step " << step_number + 1 << ": constant loads: the retry goes from load level " << load_level
+            << " by half the share of this step (it went to " << s.load_level << ")" << std::endl;
+    return StepOutcome::cut_back;
   }
 
   template <int dim>
@@ -51,18 +73,23 @@ namespace talus::implicit_mpm
     if (point_contact) // a footing's base to where it is at the step's start and end
       point_contact->set_time(time, time + h);
     prepare_step();
-    const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
+    const double                 level = step_load_level(h);
+    const dealii::Tensor<1, dim> g     = apply_loads_at(time + h, level);
     if (dynamic() && prm.rayleigh_beta > 0)
       assemble_damping_stiffness(g);
     // the external force scale |f_ext| (lumped nodal masses times g)
-    double f2 = 0;
+    double f2 = 0, f1 = 0;
     for (unsigned int k = 0; k < mass.locally_owned_size(); ++k)
       {
         const unsigned int c = space.component(k);
         if (c < dim)
-          f2 += std::pow(mass.local_element(k) * g[c], 2);
+          {
+            f2 += std::pow(mass.local_element(k) * g[c], 2);
+            f1 += std::abs(mass.local_element(k) * g[c]);
+          }
       }
     double f_ext = std::sqrt(dealii::Utilities::MPI::sum(f2, comm));
+    f1           = dealii::Utilities::MPI::sum(f1, comm);
     if (point_forces.any())
       {
         // the scale of gravity plus tractions: |sum_p N_i (m_p g + lambda f_p)|
@@ -75,6 +102,7 @@ namespace talus::implicit_mpm
           });
         });
         f_ext = residual.l2_norm();
+        f1    = residual.l1_norm();
       }
     // the plates' forces at t + h (their own time functions) join the scale
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
@@ -83,11 +111,14 @@ namespace talus::implicit_mpm
         plate_step[k]   = 0.0;
         plate_c[k]      = 0.0;
         f_ext           = std::sqrt(f_ext * f_ext + plate_target[k] * plate_target[k]);
+        f1 += std::abs(plate_target[k]);
       }
     StepState s;
-    s.h     = h;
-    s.g     = g;
-    s.f_ext = f_ext;
+    s.h          = h;
+    s.g          = g;
+    s.f_ext      = f_ext;
+    s.f_ext_sum  = f1;
+    s.load_level = level;
     return s;
   }
 
@@ -348,6 +379,8 @@ namespace talus::implicit_mpm
             << last.point_contact.max_penetration_ratio;
     if (prm.footing.enabled)
       log() << "; footing force " << last.point_contact.footing_force;
+    if (prm.negligible_mass > 0)
+      log() << "; held (negligible mass) " << last.held_dofs << " DoFs carrying " << last.held_load_share << " |f_ext|";
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
       log() << "; plate " << k << " displacement " << std::setprecision(8) << plate_displacement[k] << ", force "
             << (force_plate(k) ? plate_sum[k] : plate_reaction[k][prm.rigid_plates[k].axis]) << std::setprecision(6);
@@ -474,7 +507,7 @@ namespace talus::implicit_mpm
   {
     newmark.set_time_step(h);
     prepare_step();
-    const dealii::Tensor<1, dim> g = apply_loads_at(time + h);
+    const dealii::Tensor<1, dim> g = apply_loads_at(time + h, step_load_level(h));
     if (dynamic() && prm.rayleigh_beta > 0)
       assemble_damping_stiffness(g);
     const auto &owned = space.locally_owned_dofs();
