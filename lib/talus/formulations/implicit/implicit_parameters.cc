@@ -99,7 +99,8 @@ namespace talus::implicit_mpm
                         "in a static analysis.");
       prm.declare_entry("ramp loads", "true", Bool(),
                         "static: body forces grow linearly from 0 at t = 0 to their full value at the end "
-                        "time (load stepping); false: full loads from the first step.");
+                        "time (load stepping); false: full loads from the first step (a cut-back step applies "
+                        "that share of the load still to apply; docs/implicit.md).");
       prm.declare_entry("formulation", "irreducible", Selection("irreducible|mixed up"),
                         "irreducible: the nodal displacement only; mixed up: displacement and the nodal pressure "
                         "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
