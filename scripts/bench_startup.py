@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""make bench, first section: the start-up of a tool's process (docs/scaling.md, "Start-up").
+
+Wall time of whole processes (median of N runs, started from here): talus-explicit --help,
+--check of the demo scene, and a single-rank run of the demo scene cut to 1 ms of simulated
+time (png snapshots off), whose own "start-up:" line gives the time from the process start to
+the first step. Then the same --check
+with MPI started (TALUS_ALWAYS_START_MPI=1), with Open MPI's defaults and with the project's
+single-node settings, shows what the MPI start costs.
+
+Usage: bench_startup.py BUILD_DIR [RUNS]
+"""
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+build = sys.argv[1]
+runs = int(sys.argv[2]) if len(sys.argv) > 2 else 7
+tool = os.path.join(build, "tools", "talus-explicit")
+demo = os.path.join("parameter_files", "demo", "column_collapse_2d.prm")
+base_env = dict(os.environ)
+
+
+def timed(cmd, env_changes=None, drop=()):
+    env = {k: v for k, v in base_env.items() if k not in drop}
+    env.update(env_changes or {})
+    walls, text = [], ""
+    for i in range(runs + 1):  # the first is a warm-up
+        t0 = time.perf_counter()
+        p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+        dt = time.perf_counter() - t0
+        if p.returncode != 0:
+            sys.exit(f"bench: {' '.join(cmd)} failed (exit {p.returncode}): {p.stderr[-400:]}")
+        if i:
+            walls.append(dt)
+            text += p.stdout
+    return statistics.median(walls), min(walls), max(walls), text
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    prm = os.path.join(tmp, "demo_short.prm")
+    text = open(demo).read()
+    text = re.sub(r"set end time *= *[^\n#]*", "set end time = 0.001", text)
+    text = re.sub(r"set png snapshots *= *[^\n#]*", "set png snapshots = none", text)
+    text = re.sub(r"set directory *= *[^\n#]*", f"set directory = {tmp}/out", text)
+    open(prm, "w").write(text)
+    mca = ("OMPI_MCA_pml", "OMPI_MCA_btl")
+    print(f"bench: start-up of a tool's process (wall s, median of {runs} [min, max]; "
+          f"OMPI_MCA_pml={base_env.get('OMPI_MCA_pml', '(unset)')}, "
+          f"OMPI_MCA_btl={base_env.get('OMPI_MCA_btl', '(unset)')})")
+    rows = [("talus-explicit --help (no MPI start)", [tool, "--help"], None, ()),
+            ("talus-explicit --check demo (no MPI start)", [tool, "--check", demo], None, ()),
+            ("  the same with MPI started, Open MPI's defaults", [tool, "--check", demo],
+             {"TALUS_ALWAYS_START_MPI": "1", "TALUS_KEEP_MPI_DEFAULTS": "1"}, mca),
+            ("  the same with MPI started, single-node settings", [tool, "--check", demo],
+             {"TALUS_ALWAYS_START_MPI": "1"}, ()),
+            ("demo cut to 1 ms, 1 rank (whole process)", [tool, prm], None, ())]
+    first_step = []
+    for name, cmd, env, drop in rows:
+        med, lo, hi, out = timed(cmd, env, drop)
+        print(f"  {name:52s} {med:6.3f} [{lo:.3f}, {hi:.3f}]")
+        if cmd[-1] == prm:
+            first_step = [float(x) for x in re.findall(r"start-up: ([\d.]+) s from the process start", out)]
+    if first_step:
+        print(f"  {'demo, 1 rank: process start to the first step':52s} {statistics.median(first_step):6.3f} "
+              f"[{min(first_step):.3f}, {max(first_step):.3f}] (the run's own 'start-up:' line)")
