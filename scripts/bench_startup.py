@@ -2,11 +2,10 @@
 """make bench, first section: the start-up of a tool's process (docs/scaling.md, "Start-up").
 
 Wall time of whole processes (median of N runs, started from here): talus-explicit --help,
---check of the demo scene, and a single-rank run of the demo scene cut to 1 ms of simulated
-time (png snapshots off), whose own "start-up:" line gives the time from the process start to
-the first step. Then the same --check
-with MPI started (TALUS_ALWAYS_START_MPI=1), with Open MPI's defaults and with the project's
-single-node settings, shows what the MPI start costs.
+--check of the demo scene, the same --check with MPI started (TALUS_ALWAYS_START_MPI=1) under
+Open MPI's defaults and under the project's single-node settings (what the MPI start costs),
+and a single-rank run of the demo scene cut to 1 ms of simulated time (png snapshots off),
+whose own "start-up:" line gives the time from the process start to the first step.
 
 Usage: bench_startup.py BUILD_DIR [RUNS]
 """
