@@ -24,20 +24,21 @@ demo = os.path.join("parameter_files", "demo", "column_collapse_2d.prm")
 base_env = dict(os.environ)
 
 
-def timed(cmd, env_changes=None, drop=()):
+def run_once(cmd, env_changes=None, drop=()):
+    """(wall s, cpu s = user + system of the child, stdout) of one process."""
     env = {k: v for k, v in base_env.items() if k not in drop}
     env.update(env_changes or {})
-    walls, text = [], ""
-    for i in range(runs + 1):  # the first is a warm-up
+    with tempfile.TemporaryFile("w+") as out:
         t0 = time.perf_counter()
-        p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-        dt = time.perf_counter() - t0
-        if p.returncode != 0:
-            sys.exit(f"bench: {' '.join(cmd)} failed (exit {p.returncode}): {p.stderr[-400:]}")
-        if i:
-            walls.append(dt)
-            text += p.stdout
-    return statistics.median(walls), min(walls), max(walls), text
+        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, env=env)
+        _, status, usage = os.wait4(p.pid, 0)
+        wall = time.perf_counter() - t0
+        p.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        text = out.read()
+    if p.returncode != 0:
+        sys.exit(f"bench: {' '.join(cmd)} failed (exit {p.returncode}): {text[-400:]}")
+    return wall, usage.ru_utime + usage.ru_stime, text
 
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -48,7 +49,7 @@ with tempfile.TemporaryDirectory() as tmp:
     text = re.sub(r"set directory *= *[^\n#]*", f"set directory = {tmp}/out", text)
     open(prm, "w").write(text)
     mca = ("OMPI_MCA_pml", "OMPI_MCA_btl")
-    print(f"bench: start-up of a tool's process (wall s, median of {runs} [min, max]; "
+    print(f"bench: start-up of a tool's process (s, median of {runs} rounds; "
           f"OMPI_MCA_pml={base_env.get('OMPI_MCA_pml', '(unset)')}, "
           f"OMPI_MCA_btl={base_env.get('OMPI_MCA_btl', '(unset)')})")
     rows = [("talus-explicit --help (no MPI start)", [tool, "--help"], None, ()),
@@ -58,12 +59,23 @@ with tempfile.TemporaryDirectory() as tmp:
             ("  the same with MPI started, single-node settings", [tool, "--check", demo],
              {"TALUS_ALWAYS_START_MPI": "1"}, ()),
             ("demo cut to 1 ms, 1 rank (whole process)", [tool, prm], None, ())]
+    # round-robin: each round runs every command once (a drifting machine load hits all alike);
+    # round 0 is a warm-up
+    results = [[] for _ in rows]
     first_step = []
-    for name, cmd, env, drop in rows:
-        med, lo, hi, out = timed(cmd, env, drop)
-        print(f"  {name:52s} {med:6.3f} [{lo:.3f}, {hi:.3f}]")
-        if cmd[-1] == prm:
-            first_step = [float(x) for x in re.findall(r"start-up: ([\d.]+) s from the process start", out)]
+    for r in range(runs + 1):
+        for i, (name, cmd, env, drop) in enumerate(rows):
+            wall, cpu, out = run_once(cmd, env, drop)
+            if r == 0:
+                continue
+            results[i].append((wall, cpu))
+            if cmd[-1] == prm:
+                first_step += [float(x) for x in re.findall(r"start-up: ([\d.]+) s from the process start", out)]
+    print(f"  {'':52s} {'wall':>6s} [min, max]      cpu")
+    for (name, *_), res in zip(rows, results):
+        walls = [w for w, _ in res]
+        print(f"  {name:52s} {statistics.median(walls):6.3f} [{min(walls):.3f}, {max(walls):.3f}]  "
+              f"{statistics.median(c for _, c in res):6.3f}")
     if first_step:
         print(f"  {'demo, 1 rank: process start to the first step':52s} {statistics.median(first_step):6.3f} "
               f"[{min(first_step):.3f}, {max(first_step):.3f}] (the run's own 'start-up:' line)")
