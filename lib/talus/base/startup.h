@@ -23,6 +23,9 @@ namespace talus
   /// resolution 1/CLK_TCK = 10 ms) to now: dynamic loading and static
   /// initialisation included. Negative if /proc is not readable.
   double seconds_since_process_start();
+  /// seconds_since_process_start() when run_tool() was entered (dynamic loading and
+  /// static initialisation done); negative outside run_tool().
+  double startup_seconds_until_main();
   /// seconds_since_process_start() when run_tool() had MPI started (or had
   /// decided to run without it); negative outside run_tool().
   double startup_seconds_until_mpi();

@@ -337,8 +337,9 @@ namespace talus
 
   namespace
   {
-    double startup_seconds_mpi = -1;
-  }
+    double startup_seconds_main = -1;
+    double startup_seconds_mpi  = -1;
+  } // namespace
 
   double
   seconds_since_process_start()
@@ -364,6 +365,12 @@ namespace talus
   }
 
   double
+  startup_seconds_until_main()
+  {
+    return startup_seconds_main;
+  }
+
+  double
   startup_seconds_until_mpi()
   {
     return startup_seconds_mpi;
@@ -372,6 +379,7 @@ namespace talus
   int
   run_tool(int argc, char **argv, const ToolDescription &tool)
   {
+    startup_seconds_main = seconds_since_process_start();
     std::vector<std::string> args(argv + 1, argv + argc);
     given_options.clear();
     check_flag = false;

@@ -36,7 +36,8 @@ namespace talus
     s.setup();
     std::ostringstream startup; // its own stream: log()'s precision stays as it is
     startup << std::fixed << std::setprecision(2) << "  start-up: " << seconds_since_process_start()
-            << " s from the process start to the first step (MPI started at " << startup_seconds_until_mpi() << " s)\n";
+            << " s from the process start to the first step (main entered at " << startup_seconds_until_main()
+            << " s, MPI started at " << startup_seconds_until_mpi() << " s)\n";
     log() << startup.str();
     TimeLoop(s, loop_settings(p), comm).run();
   }
