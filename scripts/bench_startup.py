@@ -70,12 +70,18 @@ with tempfile.TemporaryDirectory() as tmp:
                 continue
             results[i].append((wall, cpu))
             if cmd[-1] == prm:
-                first_step += [float(x) for x in re.findall(r"start-up: ([\d.]+) s from the process start", out)]
+                first_step += [tuple(map(float, m)) for m in re.findall(
+                    r"start-up: ([\d.]+) s from the process start to the first step "
+                    r"\(main entered at ([\d.]+) s, MPI started at ([\d.]+) s\)", out)]
     print(f"  {'':52s} {'wall':>6s} [min, max]      cpu")
     for (name, *_), res in zip(rows, results):
         walls = [w for w, _ in res]
         print(f"  {name:52s} {statistics.median(walls):6.3f} [{min(walls):.3f}, {max(walls):.3f}]  "
               f"{statistics.median(c for _, c in res):6.3f}")
     if first_step:
-        print(f"  {'demo, 1 rank: process start to the first step':52s} {statistics.median(first_step):6.3f} "
-              f"[{min(first_step):.3f}, {max(first_step):.3f}] (the run's own 'start-up:' line)")
+        med = [statistics.median(f[i] for f in first_step) for i in range(3)]
+        print(f"  {'demo, 1 rank: process start to the first step':52s} {med[0]:6.3f} "
+              f"[{min(f[0] for f in first_step):.3f}, {max(f[0] for f in first_step):.3f}] "
+              f"(the run's own 'start-up:' line)")
+        print(f"    of which: dynamic loading {med[1]:.3f}, MPI start {med[2] - med[1]:.3f}, "
+              f".prm and set-up {med[0] - med[2]:.3f} (medians; 10 ms resolution)")
