@@ -12,6 +12,7 @@ probe can see an MPI start. Then, under the probe:
   * --check of a scene whose body is read from a talus-mesh particle file (the HDF5 file
     is opened serially without MPI): exit 0; with a file body id the file does not have:
     exit 2 naming 'body 0/file body id' (the file was read);
+  * talus-mesh --check of a shipped mesh .prm (its group checks run on "rank 0"): exit 0;
   * a run (not --check) still starts MPI: it fails under the probe.
 
 Usage: check_startup_no_mpi.py TOOLS_DIR REPO_DIR WORKDIR
@@ -60,6 +61,12 @@ with open(bad, "w") as f:
     f.write(tv.prm_set(demo_text, "grid/cells", "160, 0"))
 rc, out = run([T("talus-explicit"), "--check", bad], probe)
 tv.check(rc == 2 and "grid/cells" in out, f"--check of a bad demo without MPI: exit {rc}, names grid/cells")
+
+# talus-mesh --check (gmsh grid, its groups checked on "rank 0")
+p = subprocess.run([T("talus-mesh"), "--check", os.path.join("parameter_files", "mesh", "cantilever_2d.prm")],
+                   cwd=repo, capture_output=True, text=True, env=tv.child_env(probe), timeout=600)
+tv.check(p.returncode == 0 and "is valid" in p.stdout + p.stderr,
+         f"talus-mesh --check of parameter_files/mesh/cantilever_2d.prm without MPI: exit {p.returncode}")
 
 # a body read from a particle file (made by talus-mesh, a normal run with MPI)
 mesh_prm = open(os.path.join(repo, "parameter_files", "mesh", "semi_column_2d.prm")).read()
