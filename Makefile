@@ -10,6 +10,12 @@ export OMPI_ALLOW_RUN_AS_ROOT=1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export OMP_NUM_THREADS=1
+# Open MPI start-up of the runs started here (one node): the ob1 messaging layer
+# with the self and shared-memory transports, no probing of network libraries
+# (docs/scaling.md, "Start-up"); a value set in the environment is kept.
+OMPI_MCA_pml ?= ob1
+OMPI_MCA_btl ?= self,vader
+export OMPI_MCA_pml OMPI_MCA_btl
 
 .PHONY: all deps format configure build demo test verify verify-paper campaign sanitize bench clean
 

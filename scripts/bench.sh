@@ -17,6 +17,7 @@
 # with k = 1e-7 m/s by talus-explicit 2-phase and talus-semi-implicit to the
 # same simulated time (the explicit wall time extrapolated from a fixed number
 # of steps).
+# First of all, the start-up of a tool's process (scripts/bench_startup.py).
 # Build type must be Release (the Makefile's default).
 set -euo pipefail
 BUILD=${1:-build}
@@ -24,6 +25,10 @@ LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 grep -q "CMAKE_BUILD_TYPE:STRING=Release" "$BUILD/CMakeCache.txt" || {
   echo "bench: $BUILD is not a Release build; refusing to benchmark the debug library" >&2; exit 2; }
+# ---- start-up of a tool's process (issue 41): --help, --check, time to the first step
+python3 scripts/bench_startup.py "$BUILD"
+echo
+
 for PRM in parameter_files/bench/block_spreading_3d.prm parameter_files/bench/block_spreading_3d_bspline.prm; do
 echo "bench: $PRM (single rank)"
 "$BUILD/tools/talus-explicit" "$PRM" | tee "$LOG"

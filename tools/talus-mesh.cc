@@ -2,6 +2,7 @@
 // .geo/.msh recombined into quads/hexes) -> grid file (MSH 2.2 ASCII) and the
 // material points of the bodies -> particle file (HDF5). See docs/mesh.md.
 #include <talus/base/errors.h>
+#include <talus/base/startup.h>
 #include <talus/base/tool.h>
 #include <talus/mesh/prepare.h>
 
@@ -314,6 +315,11 @@ namespace
   void
   on_root(MPI_Comm comm, F &&f)
   {
+    if (!mpi_started()) // --check of a singleton (no MPI, base/startup.h)
+      {
+        f();
+        return;
+      }
     const bool  root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
     std::string message;
     int         failed = 0;

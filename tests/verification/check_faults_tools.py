@@ -122,9 +122,11 @@ refused([T("talus-convergence")], tv.prm_set(conv, "output/directory", "/proc/ta
 with open(os.path.join(work, "conv.prm"), "w") as f:
     f.write(conv)
 # an MCA setting that makes every MPI_Init abort (no such point-to-point layer): the children
-# cannot start; that is not the input's fault
+# cannot start; that is not the input's fault. A singleton's --check starts no MPI
+# (docs/scaling.md, "Start-up"): TALUS_ALWAYS_START_MPI=1 makes it start MPI here and below
+mpi_on = {"TALUS_ALWAYS_START_MPI": "1"}
 rc, out, err = run([T("talus-convergence"), "--check", os.path.join(work, "conv.prm")], "startup",
-                   env=tv.child_env({"OMPI_MCA_pml": "no_such_pml"}))
+                   env=tv.child_env({"OMPI_MCA_pml": "no_such_pml", **mpi_on}))
 tv.check(rc == 4 and "could not start" in err and "MPI start-up failure" in err and "refused" not in err,
          f"talus-convergence, solver cannot start MPI: exit {rc} (want 4), message: {err[:400]}")
 rc, out, err = run([T("talus-convergence"), "--check", os.path.join(work, "conv.prm")], "startup ok")
@@ -142,16 +144,16 @@ with open(os.path.join(tmpb, blocker), "w") as f:
 barprm = os.path.join(work, "bar_ok.prm")
 with open(barprm, "w") as f:
     f.write(bar)
-rc, out, err = run([T("talus-explicit"), "--check", barprm], "blocked", env=tv.child_env({"TMPDIR": tmpb}))
+rc, out, err = run([T("talus-explicit"), "--check", barprm], "blocked", env=tv.child_env({"TMPDIR": tmpb, **mpi_on}))
 tv.check(rc == 0, f"talus-explicit starts with the shared session directory blocked: exit {rc} {err[-200:]}")
 rc, out, err = run([T("talus-explicit"), "--check", barprm], "blocked, shared",
-                   env=tv.child_env({"TMPDIR": tmpb, "TALUS_SHARED_MPI_SESSION": "1"}))
+                   env=tv.child_env({"TMPDIR": tmpb, "TALUS_SHARED_MPI_SESSION": "1", **mpi_on}))
 tv.check(tv.startup_failure(rc, out + err),
          f"control: with the shared session directory (TALUS_SHARED_MPI_SESSION=1) it cannot start: exit {rc}")
 # 16 tools starting at once, twice: all start, and nothing is left in TMPDIR
 for r in range(2):
     procs = [subprocess.Popen([T("talus-explicit"), "--check", barprm], cwd=work, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True, env=tv.child_env({"TMPDIR": tmpb}))
+                              stderr=subprocess.PIPE, text=True, env=tv.child_env({"TMPDIR": tmpb, **mpi_on}))
              for _ in range(16)]
     codes = [p.wait() for p in procs]
     tv.check(codes == [0] * 16, f"16 concurrent starts (round {r}): exit codes {sorted(set(codes))}")

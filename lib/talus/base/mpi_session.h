@@ -29,6 +29,33 @@ namespace talus
   /// Construct before MPI_Init, destroy after MPI_Finalize (run_tool() and the
   /// unit-test main do). Header-only so that tests linking only the materials
   /// library can use it too.
+  /// True if a process manager (mpirun, srun, ...) started this process; false
+  /// for a singleton (a tool started directly).
+  inline bool
+  launched_by_process_manager()
+  {
+    for (const char *v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "OMPI_MCA_orte_hnp_uri", "PMI_RANK"})
+      if (std::getenv(v))
+        return true;
+    return false;
+  }
+
+  /// Open MPI settings of a singleton's start-up (docs/scaling.md, "Start-up"):
+  /// a singleton is one process on one node, so the ob1 messaging layer with the
+  /// self and shared-memory transports is all it can use; without them Open MPI
+  /// probes its network libraries (PSM/PSM2, OFI, UCX) first, 0.2-0.3 s on the
+  /// build machine. Each is set only if the user has not set it.
+  inline void
+  set_singleton_mca_defaults()
+  {
+#ifdef OPEN_MPI
+    if (launched_by_process_manager() || std::getenv("TALUS_KEEP_MPI_DEFAULTS"))
+      return;
+    ::setenv("OMPI_MCA_pml", "ob1", 0);
+    ::setenv("OMPI_MCA_btl", "self,vader", 0);
+#endif
+  }
+
   struct PrivateMpiSessionBase
   {
     std::string dir; ///< the private base; empty: nothing was changed
@@ -36,9 +63,9 @@ namespace talus
     PrivateMpiSessionBase()
     {
 #ifdef OPEN_MPI
-      for (const char *v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "OMPI_MCA_orte_hnp_uri", "PMI_RANK"})
-        if (std::getenv(v))
-          return;                                  // launched by mpirun or another process manager
+      if (launched_by_process_manager())
+        return; // launched by mpirun or another process manager
+      set_singleton_mca_defaults();
       if (std::getenv("TALUS_SHARED_MPI_SESSION")) // opt out (diagnosis of the shared case)
         return;
       const char       *env_base = std::getenv("TMPDIR");

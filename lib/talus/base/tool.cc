@@ -1,10 +1,12 @@
 #include <talus/base/errors.h>
 #include <talus/base/mpi_session.h>
+#include <talus/base/startup.h>
 #include <talus/base/tool.h>
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace talus
@@ -332,15 +335,72 @@ namespace talus
   }
 
 
+  namespace
+  {
+    double startup_seconds_main = -1;
+    double startup_seconds_mpi  = -1;
+  } // namespace
+
+  double
+  seconds_since_process_start()
+  {
+    std::ifstream in("/proc/self/stat");
+    std::string   stat;
+    std::getline(in, stat);
+    const auto paren = stat.rfind(')'); // the command name may contain spaces
+    if (paren == std::string::npos)
+      return -1;
+    std::istringstream fields(stat.substr(paren + 2));
+    std::string        f;
+    // fields after the name start at 3 (state); starttime is field 22
+    for (int i = 3; i < 22 && (fields >> f); ++i)
+      ;
+    unsigned long long start_ticks = 0;
+    if (!(fields >> start_ticks))
+      return -1;
+    timespec now{};
+    if (::clock_gettime(CLOCK_BOOTTIME, &now) != 0)
+      return -1;
+    return double(now.tv_sec) + 1e-9 * double(now.tv_nsec) - double(start_ticks) / double(::sysconf(_SC_CLK_TCK));
+  }
+
+  double
+  startup_seconds_until_main()
+  {
+    return startup_seconds_main;
+  }
+
+  double
+  startup_seconds_until_mpi()
+  {
+    return startup_seconds_mpi;
+  }
+
   int
   run_tool(int argc, char **argv, const ToolDescription &tool)
   {
-    // destroyed after `mpi`: the directory is removed after MPI_Finalize
-    const PrivateMpiSessionBase              session_base;
-    dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-    std::vector<std::string>                 args(argv + 1, argv + argc);
+    startup_seconds_main = seconds_since_process_start();
+    std::vector<std::string> args(argv + 1, argv + argc);
     given_options.clear();
     check_flag = false;
+
+    // --help, --print-parameters and --check of a singleton are serial by
+    // nature: no MPI start (0.1-0.3 s, docs/scaling.md "Start-up"). Every MPI
+    // use on their path is guarded (MPI_Initialized; deal.II's Utilities::MPI
+    // functions answer rank 0 of 1 without MPI). Under mpirun every rank
+    // starts MPI as before, so the ranks agree and one of them prints.
+    const bool serial_mode = std::any_of(args.begin(), args.end(), [&](const std::string &a) {
+      return a == "--help" || a == "-h" || (a == "--print-parameters" && tool.reads_prm) || a == "--check";
+    });
+    // session_base destroyed after `mpi`: the directory is removed after MPI_Finalize
+    std::optional<PrivateMpiSessionBase>                    session_base;
+    std::optional<dealii::Utilities::MPI::MPI_InitFinalize> mpi;
+    if (!(serial_mode && !launched_by_process_manager()) || std::getenv("TALUS_ALWAYS_START_MPI"))
+      {
+        session_base.emplace();
+        mpi.emplace(argc, argv, 1);
+      }
+    startup_seconds_mpi = seconds_since_process_start();
 
     const std::string file_arg = tool.reads_prm ? (tool.prm_optional ? " [FILE.prm]" : " FILE.prm") : "";
     const auto        usage    = [&](std::ostream &os) {

@@ -1,5 +1,6 @@
 // talus — parallel HDF5 tables (see hdf5.h).
 #include <talus/base/errors.h>
+#include <talus/base/startup.h>
 #include <talus/io/hdf5.h>
 
 #include <hdf5.h>
@@ -35,7 +36,8 @@ namespace talus::io
     rank_of(MPI_Comm c)
     {
       int r = 0;
-      MPI_Comm_rank(c, &r);
+      if (mpi_started())
+        MPI_Comm_rank(c, &r);
       return r;
     }
   } // namespace
@@ -62,7 +64,8 @@ namespace talus::io
   {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); // errors are reported by us
     const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
+    if (mpi_started())
+      H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
     hid_t f;
     if (writing)
       f = H5Fcreate(tmp_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);

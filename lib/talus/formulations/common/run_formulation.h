@@ -11,6 +11,7 @@
 // keep that reference, have setup(), and be a Formulation.
 #pragma once
 
+#include <talus/base/startup.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/formulations/common/scene_parameters.h>
@@ -21,6 +22,9 @@
 
 #include <mpi.h>
 
+#include <iomanip>
+#include <sstream>
+
 namespace talus
 {
   /// Build, set up and run one Solver of one dimension over `p` (collective).
@@ -30,6 +34,11 @@ namespace talus
   {
     Solver s(p, comm);
     s.setup();
+    std::ostringstream startup; // its own stream: log()'s precision stays as it is
+    startup << std::fixed << std::setprecision(2) << "  start-up: " << seconds_since_process_start()
+            << " s from the process start to the first step (main entered at " << startup_seconds_until_main()
+            << " s, MPI started at " << startup_seconds_until_mpi() << " s)\n";
+    log() << startup.str();
     TimeLoop(s, loop_settings(p), comm).run();
   }
 

@@ -1,4 +1,5 @@
 #include <talus/base/errors.h>
+#include <talus/base/startup.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/common/scene_checks.h>
 #include <talus/io/particle_file.h>
@@ -154,8 +155,9 @@ namespace talus
             }
           n_points_estimate += sets(k) * v / cv * std::pow(double(b.particles_per_direction), dim);
         }
-      int size = 1;
-      MPI_Comm_size(MPI_COMM_WORLD, &size);
+      int size = 1; // a --check without MPI is a singleton (tool.cc)
+      if (mpi_started())
+        MPI_Comm_size(MPI_COMM_WORLD, &size);
       // ranks sharing this node: Open MPI says; otherwise assume all (the conservative case)
       const char        *local   = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
       const unsigned int on_node = local ? std::max(1, std::atoi(local)) : size;
