@@ -256,7 +256,7 @@ namespace talus::implicit_mpm
 
   template <int dim>
   bool
-  Solver<dim>::cut_back_replays(const double h) const
+  Solver<dim>::cut_back_replays() const
   {
     if (dynamic() || prm.ramp_loads || load_level < 1.0 || any_velocity_condition() || !prm.rigid_plates.empty() ||
         prm.footing.enabled || point_contact)
@@ -264,7 +264,6 @@ namespace talus::implicit_mpm
     for (const auto &t : prm.tractions)
       if (t.function.settle_time() > time)
         return false;
-    (void)h;
     return true;
   }
 

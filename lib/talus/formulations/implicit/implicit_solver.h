@@ -258,7 +258,7 @@ namespace talus::implicit_mpm
     /// With constant loads at the full level and nothing else depending on the
     /// step (no prescribed motion, plates, footing or traction time function
     /// still changing): a cut-back would replay the failed step exactly.
-    bool cut_back_replays(const double h) const;
+    bool cut_back_replays() const;
     /// The body force at time t, and the traction factors of point_forces set
     /// for t (a static ramp takes the gravity from the previous stage's to this
     /// stage's and the stage's own tractions from 0 to full over the stage).

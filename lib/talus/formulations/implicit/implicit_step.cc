@@ -54,7 +54,7 @@ namespace talus::implicit_mpm
     // smaller share of the load still to apply (step_load_level); once the full
     // load is on and nothing else depends on the step size, the retry would
     // replay this failure exactly: stop instead
-    if (cut_back_replays(s.h))
+    if (cut_back_replays())
       throw RunStopped("step " + std::to_string(step_number + 1) + " (t = " + std::to_string(time + s.h) +
                        " s) failed under the full constant load ('implicit/ramp loads = false'), with nothing "
                        "else depending on the step size: a cut-back would retry the same problem, so the run "
