@@ -103,6 +103,8 @@ cases = {
                                          ["B-spline", "3 cells", "y"]),
     "negligible nodal mass out of range": (tv.prm_set(base, "implicit/negligible nodal mass", "2"),
                                            ["negligible nodal mass", "2"]),
+    "negligible mass load limit out of range": (tv.prm_set(base, "implicit/negligible mass load limit", "1.5"),
+                                                ["negligible mass load limit", "1.5"]),
     "unknown direct package": (tv.prm_set(base, "linear solver/direct package", "superlu"),
                                ["direct package", "superlu"]),
     "moving velocity regions with restart": (
