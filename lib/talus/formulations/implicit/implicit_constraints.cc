@@ -137,29 +137,42 @@ namespace talus::implicit_mpm
   }
 
   template <int dim>
-  std::pair<unsigned int, unsigned int>
-  Solver<dim>::update_contact(const dealii::Tensor<1, dim> &g, const double force_scale)
+  Vector
+  Solver<dim>::residual_under(dealii::AffineConstraints<double> &other, const dealii::Tensor<1, dim> &g)
   {
-    // the residual assembled without the contact constraints: at a contact
-    // DoF it is the force the wall must exert on the node, r = f_int + m a -
-    // f_ext (the residual of the other DoFs is kept)
+    // r = f_int + m a - f_ext at the iterate du, assembled under `other` in
+    // place of the step's constraints: at a DoF the step holds and `other`
+    // leaves free it is the force that hold exerts (the contact, prescribed and
+    // negligible-mass reactions). The step's constraints and residual are
+    // unchanged on return, also when the assembly throws.
     Vector kept(residual);
-    auto   free_contact = step_constraints(nullptr, false);
-    std::swap(constraints, free_contact);
+    std::swap(constraints, other);
     try
       {
         assemble(false, g);
       }
     catch (...)
       {
-        std::swap(constraints, free_contact);
-        residual = kept;
+        std::swap(constraints, other);
+        residual.swap(kept);
         throw;
       }
-    std::swap(constraints, free_contact);
-    const auto  &owned  = space.locally_owned_dofs();
-    const auto  &pins   = active.constraints();
-    const double du_max = du.linfty_norm();
+    std::swap(constraints, other);
+    residual.swap(kept);
+    return kept;
+  }
+
+  template <int dim>
+  std::pair<unsigned int, unsigned int>
+  Solver<dim>::update_contact(const dealii::Tensor<1, dim> &g, const double force_scale)
+  {
+    // the residual assembled without the contact constraints: at a contact
+    // DoF it is the force the wall must exert on the node, r = f_int + m a - f_ext
+    auto         free_contact = step_constraints(nullptr, false);
+    const Vector r            = residual_under(free_contact, g);
+    const auto  &owned        = space.locally_owned_dofs();
+    const auto  &pins         = active.constraints();
+    const double du_max       = du.linfty_norm();
     // a pull below 1e-8 of the load scale and a penetration below 1e-8 of the
     // largest increment are round-off of the Newton solve, not a change
     const double tol_pull = 1e-8 * force_scale, tol_in = 1e-8 * du_max;
@@ -175,7 +188,7 @@ namespace talus::implicit_mpm
         if (contact_state(in) != 0.0)
           {
             // compressive: the wall pushes the node into the domain, r . n_out < 0
-            if (residual(in) * c.sign > tol_pull)
+            if (r(in) * c.sign > tol_pull)
               {
                 contact_state(in) = 0.0;
                 ++contact_changes[k];
@@ -189,7 +202,6 @@ namespace talus::implicit_mpm
             ++added;
           }
       }
-    residual = kept;
     contact_state.update_ghost_values();
     return {dealii::Utilities::MPI::sum(released, comm), dealii::Utilities::MPI::sum(added, comm)};
   }
@@ -228,22 +240,10 @@ namespace talus::implicit_mpm
     // the residual r = f_int - f_ext assembled without the prescribed lines: at
     // a prescribed DoF it is the force the node exerts on the material (the
     // same device as the contact reactions); the other DoFs keep theirs
-    Vector kept(residual);
-    auto   free_prescribed = step_constraints(nullptr, true, false);
-    std::swap(constraints, free_prescribed);
-    try
-      {
-        assemble(false, g);
-      }
-    catch (...)
-      {
-        std::swap(constraints, free_prescribed);
-        residual = kept;
-        throw;
-      }
-    std::swap(constraints, free_prescribed);
-    const auto &owned = space.locally_owned_dofs();
-    const auto &pins  = active.constraints();
+    auto         free_prescribed = step_constraints(nullptr, true, false);
+    const Vector r               = residual_under(free_prescribed, g);
+    const auto  &owned           = space.locally_owned_dofs();
+    const auto  &pins            = active.constraints();
     // the velocity conditions' sum per component, then each plate's per component
     const unsigned int                           n_vel = n_velocities();
     std::vector<double>                          f(dim * (1 + prm.rigid_plates.size()), 0.0);
@@ -256,7 +256,7 @@ namespace talus::implicit_mpm
           continue;
         seen.push_back(i);
         const unsigned int slot = p.condition < n_vel ? 0 : 1 + p.condition - n_vel;
-        f[slot * dim + p.component] += residual(i);
+        f[slot * dim + p.component] += r(i);
       }
     dealii::Utilities::MPI::sum(f, comm, f);
     for (unsigned int d = 0; d < dim; ++d)
@@ -264,7 +264,6 @@ namespace talus::implicit_mpm
     for (unsigned int k = 0; k < prm.rigid_plates.size(); ++k)
       for (unsigned int d = 0; d < dim; ++d)
         plate_reaction[k][d] = f[(1 + k) * dim + d];
-    residual = kept;
   }
 
   template <int dim>
@@ -280,21 +279,9 @@ namespace talus::implicit_mpm
     last.held_load_share = 0;
     if (dealii::Utilities::MPI::sum(negligible_dofs.size(), comm) == 0) // collective: the same on every rank
       return;
-    Vector                            kept(residual);
     dealii::AffineConstraints<double> bare; // (no copy constructor in 9.4)
     bare.copy_from(active.constraints());
-    std::swap(constraints, bare);
-    try
-      {
-        assemble(false, s.g);
-      }
-    catch (...)
-      {
-        std::swap(constraints, bare);
-        residual = kept;
-        throw;
-      }
-    std::swap(constraints, bare);
+    const Vector                                 r = residual_under(bare, s.g);
     std::vector<dealii::types::global_dof_index> held(negligible_dofs); // relevant DoFs: a node once
     std::sort(held.begin(), held.end());
     held.erase(std::unique(held.begin(), held.end()), held.end());
@@ -302,19 +289,18 @@ namespace talus::implicit_mpm
     const auto  &pins    = active.constraints();
     double       sums[2] = {0, 0}; // held, all
     unsigned int n       = 0;
-    for (unsigned int k = 0; k < residual.locally_owned_size(); ++k)
+    for (unsigned int k = 0; k < r.locally_owned_size(); ++k)
       if (space.component(k) < dim && !pins.is_constrained(owned.nth_index_in_set(k)))
-        sums[1] += std::abs(residual.local_element(k));
+        sums[1] += std::abs(r.local_element(k));
     // a light node's DoF that a wall, a prescribed line or contact holds keeps
     // that line (find_negligible_nodes): its force is that condition's reaction
     const auto unheld = step_constraints(nullptr, true, true, false, false);
     for (const auto i : held)
       if (owned.is_element(i) && space.component(owned.index_within_set(i)) < dim && !unheld.is_constrained(i))
         {
-          sums[0] += std::abs(residual(i));
+          sums[0] += std::abs(r(i));
           ++n;
         }
-    residual = kept;
     dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 2), comm, dealii::ArrayView<double>(sums, 2));
     last.held_dofs       = dealii::Utilities::MPI::sum(n, comm);
     last.held_load_share = sums[0] / std::max(s.f_ext_sum + sums[1], 1e-300);
@@ -341,6 +327,7 @@ namespace talus::implicit_mpm
   template double Solver<2>::prescribed_increment(const loads::PrescribedNodeDof &, const double) const;
   template void   Solver<2>::prescribed_reaction(const dealii::Tensor<1, 2> &);
   template void   Solver<2>::measure_held_load(const StepState &);
+  template Vector Solver<2>::residual_under(dealii::AffineConstraints<double> &, const dealii::Tensor<1, 2> &);
   template void   Solver<3>::measure_contact_gaps();
   template dealii::AffineConstraints<double>     Solver<3>::step_constraints(const std::vector<double> *, const bool,
                                                                              const bool, const bool, const bool) const;
@@ -350,4 +337,5 @@ namespace talus::implicit_mpm
   template double Solver<3>::prescribed_increment(const loads::PrescribedNodeDof &, const double) const;
   template void   Solver<3>::prescribed_reaction(const dealii::Tensor<1, 3> &);
   template void   Solver<3>::measure_held_load(const StepState &);
+  template Vector Solver<3>::residual_under(dealii::AffineConstraints<double> &, const dealii::Tensor<1, 3> &);
 } // namespace talus::implicit_mpm

@@ -431,6 +431,10 @@ namespace talus::implicit_mpm
     dealii::Tensor<1, dim> condition_increment(const unsigned int k, const double h) const;
     /// the reaction of the prescribed nodes at the converged iterate (StepReport)
     void prescribed_reaction(const dealii::Tensor<1, dim> &g);
+    /// The residual at the iterate du assembled under `other` in place of the
+    /// step's constraints (the reactions of what the step holds and `other`
+    /// does not); constraints and residual unchanged on return. Collective.
+    Vector residual_under(dealii::AffineConstraints<double> &other, const dealii::Tensor<1, dim> &g);
 
     // ---- rigid plates ('boundary conditions/rigid plate k'; docs/implicit.md "Rigid plate")
     // A displacement-controlled plate and the held tangential components of a
