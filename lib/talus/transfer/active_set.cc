@@ -162,7 +162,8 @@ namespace talus
   template <int dim>
   template <class K>
   void
-  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings, const Reach reach)
+  ActiveSet<dim>::reinit(const std::vector<MaterialPointSet<dim> *> &sets, const Couplings couplings, const Reach reach,
+                         const ExtraCouplings &extra)
   {
     const auto        &grid     = space.grid;
     const unsigned int nc       = space.n_components();
@@ -254,6 +255,8 @@ namespace talus
         inactive.add_line(i);
     inactive.close();
 
+    if (extra)
+      extra(dsp);
     // every owned row has its diagonal (an inactive row nothing else)
     for (const auto i : owned)
       dsp.add(i, i);
@@ -442,13 +445,17 @@ namespace talus
   template class ActiveSet<2>;
   template class ActiveSet<3>;
   template void ActiveSet<2>::reinit<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &,
-                                                      ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
+                                                      ActiveSet<2>::Couplings, ActiveSet<2>::Reach,
+                                                      const ActiveSet<2>::ExtraCouplings &);
   template void ActiveSet<3>::reinit<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &,
-                                                      ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
+                                                      ActiveSet<3>::Couplings, ActiveSet<3>::Reach,
+                                                      const ActiveSet<3>::ExtraCouplings &);
   template void ActiveSet<2>::reinit<shape::BSpline2Box<2>>(const std::vector<MaterialPointSet<2> *> &,
-                                                            ActiveSet<2>::Couplings, ActiveSet<2>::Reach);
+                                                            ActiveSet<2>::Couplings, ActiveSet<2>::Reach,
+                                                            const ActiveSet<2>::ExtraCouplings &);
   template void ActiveSet<3>::reinit<shape::BSpline2Box<3>>(const std::vector<MaterialPointSet<3> *> &,
-                                                            ActiveSet<3>::Couplings, ActiveSet<3>::Reach);
+                                                            ActiveSet<3>::Couplings, ActiveSet<3>::Reach,
+                                                            const ActiveSet<3>::ExtraCouplings &);
   template bool ActiveSet<2>::couplings_covered<shape::Q1Box<2>>(const std::vector<MaterialPointSet<2> *> &) const;
   template bool ActiveSet<3>::couplings_covered<shape::Q1Box<3>>(const std::vector<MaterialPointSet<3> *> &) const;
   template bool

@@ -25,9 +25,14 @@
 #include <deal.II/lac/affine_constraints.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
+namespace dealii
+{
+  class DynamicSparsityPattern;
+}
 namespace dealii::TrilinosWrappers
 {
   class SparseMatrix;
@@ -68,13 +73,18 @@ namespace talus
       cell
     };
 
+    /// Couplings an assembly adds beyond the points' stencils (the ghost
+    /// penalty's face terms): called with the pattern's rows (the locally
+    /// relevant DoFs) once the active DoFs are known. Collective.
+    using ExtraCouplings = std::function<void(dealii::DynamicSparsityPattern &)>;
+
     /// The active region of the points of `sets` (one pass over each) with the
     /// stencil of kernel K (shape::Q1Box<dim> or shape::BSpline2Box<dim>; the
-    /// latter needs grid.setup_bspline_patches()), its sparsity with `reach`.
-    /// Collective.
+    /// latter needs grid.setup_bspline_patches()), its sparsity with `reach`
+    /// and `extra`. Collective.
     template <class K>
     void reinit(const std::vector<MaterialPointSet<dim> *> &sets, Couplings couplings = Couplings::skip,
-                Reach reach = Reach::point);
+                Reach reach = Reach::point, const ExtraCouplings &extra = {});
 
     /// Whether every point of `sets` on this rank couples only node pairs that
     /// the points (of any rank) coupled at the last reinit<K> (with

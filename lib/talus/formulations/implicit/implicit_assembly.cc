@@ -153,6 +153,15 @@ namespace talus::implicit_mpm
     const bool any_failed = dealii::Utilities::MPI::max(failure.failed ? 1 : 0, comm) > 0;
     if (any_failed)
       throw NewtonFailure(failure.failed ? failure.what : "a material point on another rank failed");
+    if (prm.ghost_penalty > 0)
+      ghost.assemble(ghost_stiffness, space, constraints, du, with_tangent ? &tangent : nullptr, residual);
+    if (carrying_imbalance)
+      {
+        const auto &owned = space.locally_owned_dofs();
+        for (unsigned int k = 0; k < residual.locally_owned_size(); ++k)
+          if (!constraints.is_constrained(owned.nth_index_in_set(k)))
+            residual.local_element(k) -= start_imbalance.local_element(k);
+      }
     if (assembling_damping)
       return 0.0;
     if (dynamic() && prm.rayleigh_beta > 0)

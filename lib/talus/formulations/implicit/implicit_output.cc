@@ -53,6 +53,9 @@ namespace talus::implicit_mpm
     if (prm.negligible_mass > 0)
       for (const char *n : {"held_dofs", "held_load_share"})
         c.push_back(n);
+    if (!dynamic())
+      for (const char *n : {"start_imbalance_norm", "start_imbalance"})
+        c.push_back(n);
     probes.add_columns(c, points.layout);
     balance.add_series_column(c);
     return c;
@@ -114,6 +117,11 @@ namespace talus::implicit_mpm
       {
         v.push_back(after_step ? double(last.held_dofs) : 0.0);
         v.push_back(after_step ? last.held_load_share : 0.0);
+      }
+    if (!dynamic())
+      {
+        v.push_back(after_step ? start_imbalance_norm : 0.0);
+        v.push_back(after_step ? start_imbalance_share : 0.0);
       }
     probes.sample(points);
     probes.add_values(v, comm);

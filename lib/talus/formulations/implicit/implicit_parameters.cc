@@ -122,6 +122,23 @@ namespace talus::implicit_mpm
                         "displacement that condition has prescribed so far, so the prescribed nodes are chosen "
                         "anew each step at the current position of a rigid plate pressed into the material (they "
                         "jump a grid row when the shifted region does); false: the nodes are fixed in space.");
+      prm.declare_entry(
+        "carry start imbalance", "false", Bool(),
+        "Static analyses (no effect in dynamic ones, where the out-of-balance force is inertia): "
+        "true: each step solves r(du) = r(0) at the previous load level, so that "
+        "the out-of-balance force of the converged state re-assembled on the reset grid (the "
+        "change of the grid's test functions, largest at cells the material has just entered) "
+        "is carried instead of being relaxed anew every step (from the run's second step on); "
+        "false: every step rebalances it (the default until the carried force is understood in "
+        "displacement-controlled plastic runs). Its size goes to series.csv either way "
+        "('start_imbalance_norm' [N], 'start_imbalance' = that over |f_ext|). docs/implicit.md 'Load steps'.");
+      prm.declare_entry("ghost penalty", "0", Double(0),
+                        "gamma of the ghost penalty (linear shape functions): on every grid face between two "
+                        "cells whose nodes are all active, one of them at the edge of the material, the term "
+                        "gamma E h int_F [[grad du . n]] . [[grad w . n]] dF ties the step's increment in a partly "
+                        "filled cell to its neighbours (E the largest constrained modulus of the materials, h "
+                        "the cell size; docs/implicit.md 'Ghost penalty'). Regularises the nodes that one point "
+                        "or a few control after a cell crossing; 0 = off.");
       prm.declare_entry("negligible nodal mass", "0", Double(0, 1),
                         "The DoFs (displacement and, in mixed u-p, pressure) of an active node whose lumped mass is "
                         "below this fraction of the largest nodal mass of the step are held at zero increment (nodes "
@@ -226,6 +243,8 @@ namespace talus::implicit_mpm
     p.axisymmetric            = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
+    p.ghost_penalty           = prm.get_double("ghost penalty");
+    p.carry_imbalance         = prm.get_bool("carry start imbalance");
     p.negligible_load_limit   = prm.get_double("negligible mass load limit");
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
@@ -236,6 +255,11 @@ namespace talus::implicit_mpm
     require(!p.fbar || !p.bspline(), "implicit/volumetric stabilisation",
             "'f-bar' (a mean over the points of a cell) is for 'shape function = linear': a B-spline point "
             "reaches beyond its cell; allowed with 'quadratic bspline': none");
+    require(p.ghost_penalty == 0 || !p.bspline(), "implicit/ghost penalty",
+            "the penalty on jumps of the normal derivative is for 'shape function = linear' (a quadratic "
+            "B-spline's derivative has no jump across a face); allowed with 'quadratic bspline': 0");
+    require(p.ghost_penalty == 0 || !p.axisymmetric, "implicit/ghost penalty",
+            "the face integral has no ring measure (2 pi r) yet; allowed with 'geometry = axisymmetric': 0");
     require(!p.bspline() || !p.axisymmetric, "numerics/shape function",
             "'quadratic bspline' is not available with 'geometry = axisymmetric' (the axis is no wall of the "
             "B-spline basis); allowed there: linear");

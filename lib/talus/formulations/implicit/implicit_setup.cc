@@ -437,6 +437,9 @@ namespace talus::implicit_mpm
             : prm.axisymmetric ? ", axisymmetric (x = radius)"
                                : ", plane strain")
         << std::endl;
+    if (prm.ghost_penalty > 0)
+      out << "  ghost penalty: gamma = " << prm.ghost_penalty
+          << " on the faces of cells at the edge of the material (the largest constrained modulus as E)" << std::endl;
     if (!prm.contact_ids.empty())
       {
         out << "  contact walls (unilateral, "

@@ -17,6 +17,7 @@
 #include <talus/formulations/common/probes.h>
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/common/scene_parameters.h>
+#include <talus/formulations/implicit/ghost_penalty.h>
 #include <talus/formulations/implicit/newmark.h>
 #include <talus/formulations/implicit/newton.h>
 #include <talus/formulations/implicit/point_contact.h>
@@ -138,6 +139,11 @@ namespace talus::implicit_mpm
     /// pressure) of an active node whose lumped mass is below this fraction of
     /// the largest nodal mass are held at zero increment for the step (0: off)
     double negligible_mass = 0;
+    /// 'implicit/ghost penalty': gamma of the face term (ghost_penalty.h); 0: off
+    double ghost_penalty = 0;
+    /// 'implicit/carry start imbalance': a static step solves r(du) = r(0) at
+    /// the previous load level
+    bool carry_imbalance = false;
     /// The largest share of all the forces on the nodes (loads and reactions,
     /// summed magnitudes) the held negligible-mass DoFs may carry at a converged
     /// step; above it the run stops (exit 3) with the figures.
@@ -275,6 +281,10 @@ namespace talus::implicit_mpm
     void grid_changed() override;
     /// Active set, constraints and matrix layout of the points' current cells.
     void prepare_step();
+    /// Static steps: start_imbalance (and its norm) from the converged state
+    /// at the previous load level on this step's grid; assemble() subtracts it
+    /// from here on with 'carry start imbalance'. Collective.
+    void measure_start_imbalance();
     /// What the phases of one step (advance_by) share.
     struct StepState
     {
@@ -527,7 +537,17 @@ namespace talus::implicit_mpm
     Vector du, delta, residual, mass, v_n, a_n, a_new;
     /// F-bar: the mean det dF of each active cell at the current du (transfer::CellMeanJacobian)
     std::vector<double> cell_jbar;
-    void                compute_cell_jbar();
+    /// the ghost penalty's faces of the step (prm.ghost_penalty > 0)
+    GhostPenalty<dim> ghost;
+    /// gamma times the largest constrained modulus of the materials
+    double ghost_stiffness = 0;
+    /// the residual of the converged state on this step's grid at the
+    /// previous load level, |.| / |f_ext| of the step (series start_imbalance)
+    Vector start_imbalance;
+    double start_imbalance_norm = 0, start_imbalance_share = 0;
+    /// whether assemble() subtracts start_imbalance (prm.carry_imbalance, once measured)
+    bool carrying_imbalance = false;
+    void compute_cell_jbar();
     /// consistent mass: a^{n+1} + alpha_R v^{n+1} at the free DoFs (0 at constrained
     /// ones), ghosts updated, the field the inertia integrand reads
     Vector                                       inertia_field;

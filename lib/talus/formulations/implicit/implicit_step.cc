@@ -12,6 +12,7 @@
 #include <talus/loads/kinematics.h>
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,8 @@ namespace talus::implicit_mpm
     if (point_contact) // a footing's base to where it is at the step's start and end
       point_contact->set_time(time, time + h);
     prepare_step();
+    if (!dynamic())
+      measure_start_imbalance();
     const double                 level = step_load_level(h);
     const dealii::Tensor<1, dim> g     = apply_loads_at(time + h, level);
     if (dynamic() && prm.rayleigh_beta > 0)
@@ -113,6 +116,8 @@ namespace talus::implicit_mpm
         f_ext           = std::sqrt(f_ext * f_ext + plate_target[k] * plate_target[k]);
         f1 += std::abs(plate_target[k]);
       }
+    if (!dynamic()) // 0 where no load acts (displacement control): the norm is in its own column
+      start_imbalance_share = f_ext > 0 ? start_imbalance_norm / f_ext : 0.0;
     StepState s;
     s.h          = h;
     s.g          = g;
@@ -120,6 +125,35 @@ namespace talus::implicit_mpm
     s.f_ext_sum  = f1;
     s.load_level = level;
     return s;
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::measure_start_imbalance()
+  {
+    // the converged state under the loads it converged with (level load_level
+    // at the step's start time), assembled on this step's grid at du = 0
+    carrying_imbalance             = false;
+    const dealii::Tensor<1, dim> g = apply_loads_at(time, load_level);
+    du                             = 0;
+    du.update_ghost_values();
+    if (prm.mixed_up) // the nodal pressure of the state, as the predictor projects it
+      predict_pressure();
+    assemble(false, g);
+    start_imbalance = residual;
+    // the displacement rows only: a mixed u-p pressure row is the constraint
+    // p = p(J) of this step's projection, not a force
+    if (prm.mixed_up)
+      for (unsigned int k = 0; k < start_imbalance.locally_owned_size(); ++k)
+        if (space.component(k) == dim)
+          start_imbalance.local_element(k) = 0;
+    // relative to the step's load scale |f_ext| (begin_step divides)
+    start_imbalance_norm = start_imbalance.l2_norm();
+    du                   = 0;
+    du.update_ghost_values();
+    // not at the run's first step: there is no earlier grid, and an initial
+    // state out of balance is a load of the problem, not of the grid change
+    carrying_imbalance = prm.carry_imbalance && step_number > 0;
   }
 
   template <int dim>
@@ -412,8 +446,18 @@ namespace talus::implicit_mpm
       }
     // the cell terms (PPP cell means, F-bar's cell mean) couple all the nodes a cell's points touch
     const auto reach = prm.mixed_up || prm.fbar ? ActiveSet<dim>::Reach::cell : ActiveSet<dim>::Reach::point;
-    with_kernel(
-      [&](auto k) { active.template reinit<decltype(k)>({&points}, ActiveSet<dim>::Couplings::skip, reach); });
+    typename ActiveSet<dim>::ExtraCouplings ghost_couplings;
+    if (prm.ghost_penalty > 0)
+      {
+        double modulus = 0;
+        for (const auto &m : prm.materials)
+          modulus = std::max(modulus, m->constrained_modulus());
+        ghost_stiffness = prm.ghost_penalty * modulus;
+        ghost_couplings = [&](dealii::DynamicSparsityPattern &dsp) { ghost.find_faces(active, space, dsp); };
+      }
+    with_kernel([&](auto k) {
+      active.template reinit<decltype(k)>({&points}, ActiveSet<dim>::Couplings::skip, reach, ghost_couplings);
+    });
     active.reinit_matrix(tangent);
     project_to_grid();
     find_negligible_nodes();
