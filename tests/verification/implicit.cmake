@@ -21,6 +21,13 @@ add_test(NAME verification.implicit_load_steps
                  1,5,10,20,50,100 "linear,quadratic bspline" 0.005 100 --without-carry=50
                  "--set=implicit/carry start imbalance=true")
 set_tests_properties(verification.implicit_load_steps PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+# the ghost penalty ('implicit/ghost penalty', docs/implicit.md "Ghost penalty"): the 10-step cantilever at
+# h = 0.0625 stops without it and completes with gamma = 0.01; one step moves < 1e-4; 1 vs 2 ranks 1e-10
+add_test(NAME verification.implicit_ghost_penalty
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ghost_penalty.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_ghost_penalty)
+set_tests_properties(verification.implicit_ghost_penalty PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
 # the same on quadratic B-splines ('numerics/shape function'; docs/implicit.md "Quadratic
 # B-splines"): h = 0.125 m -0.676984 (0.39 %), observed order 2.04, Newton order >= 3.08
 add_test(NAME verification.implicit_cantilever_bspline
