@@ -554,3 +554,11 @@ add_test(NAME verification.implicit_rigid_plate_restart
                  "implicit/ramp loads=false")
 set_tests_properties(verification.implicit_rigid_plate_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+# Coulomb friction on the node contact floor: a block sliding under gravity tilted by 30 deg with
+# mu = 0.2, a = g (sin - mu cos) within 1 % in 2D and 3D; the frictionless mutant fails the check
+# (docs/implicit.md "Contact floor"; fast)
+add_test(NAME verification.implicit_block_coulomb_floor
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_block_coulomb.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/block_coulomb_floor.prm ${_w}/implicit_block_coulomb_floor)
+set_tests_properties(verification.implicit_block_coulomb_floor PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
