@@ -17,6 +17,7 @@ the right exit code, no NaN written.
     plates sharing a node;
   * the rigid footing: its span reversed, with two values in 2D, not a number; normal z in 2D;
     penalty 0; with contact walls on the nodes;
+  * contact walls on the nodes: a negative or infinite Coulomb coefficient;
   * contact walls on the points: a misspelt 'contact method', 'points' without
     contact walls, a penalty <= 0 or not a number, a penalty with the node
     method, a negative or malformed Coulomb coefficient, the node method's
@@ -119,9 +120,13 @@ cases = {
     "velocity of a body": (tv.prm_set(tv.prm_set(base, "loads/number of velocity conditions", "1"),
                                       "loads/velocity 0/apply to", "body"),
                            ["loads/velocity 0/apply to", "boundary | region"]),
-    "contact friction not a choice": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
-                                                 "boundary conditions/contact friction", "0.3"),
-                                      ["boundary conditions/contact friction", "0.3", "no slip | frictionless"]),
+    "contact friction negative (nodes)": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
+                                                     "boundary conditions/contact friction", "-0.3"),
+                                          ["boundary conditions/contact friction", "'-0.3'",
+                                           "no slip | frictionless | a Coulomb coefficient mu >= 0"]),
+    "contact friction infinite (nodes)": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
+                                                     "boundary conditions/contact friction", "inf"),
+                                          ["boundary conditions/contact friction", "'inf'"]),
     "contact friction misspelt": (tv.prm_set(tv.prm_set(base, "boundary conditions/contact", "2"),
                                              "boundary conditions/contact friction", "noslip"),
                                   ["boundary conditions/contact friction", "noslip"]),

@@ -356,6 +356,50 @@ add_test(NAME verification.implicit_rolling_disk_consistent
                  --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm --set "implicit/mass matrix=consistent")
 set_tests_properties(verification.implicit_rolling_disk_consistent PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600)
+# The thesis's setting: the rolling disk on a Coulomb contact floor of grid nodes (rolling_disk_nodes.prm,
+# mu = 1, no point contact) at Table 4.1's three time steps dt1 = 2 dt2 = 4 dt3 (1e-3, 5e-4, 2.5e-4 s):
+# a within 3 % of (2/3) g sin theta at each; dt1 also on 2 ranks (centre of mass within 1e-8 m).
+# docs/implicit.md "Rolling disk", "On the node contact floor" (fast, 5-20 s each)
+foreach(_dt 1e-3 5e-4 2.5e-4)
+  set(_extra "")
+  if(_dt STREQUAL "1e-3")
+    set(_extra "--ranks")
+  endif()
+  add_test(NAME verification.implicit_rolling_disk_nodes_dt${_dt}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                   ${TALUS_PRM_DIR}/implicit/rolling_disk_nodes.prm ${_w}/implicit_rolling_disk_nodes_dt${_dt}
+                   --expect roll-accel ${_extra} --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm
+                   "--set=time/time step=${_dt}")
+  set_tests_properties(verification.implicit_rolling_disk_nodes_dt${_dt} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 600 PROCESSORS 2)
+endforeach()
+# the node floor made frictionless: slides at g sin theta within 1 %, |omega R| < 1 % of v_c (the
+# rolling spin), the rolling checks fail; 1 vs 2 ranks within 1e-8 m (fast)
+add_test(NAME verification.implicit_rolling_disk_nodes_frictionless
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk_nodes.prm ${_w}/implicit_rolling_disk_nodes_frictionless
+                 --expect slide --slide-tol 0.01 --ranks --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm
+                 "--set=boundary conditions/contact friction=frictionless")
+set_tests_properties(verification.implicit_rolling_disk_nodes_frictionless PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 600 PROCESSORS 2)
+# Coulomb mu = 0.1 < tan(theta)/3 on the node floor: the disk slides with friction (nodes slipping under
+# mu |r_n|), a = g (sin - mu cos) within 1 %, the rolling checks fail; 1 vs 2 ranks within 1e-8 m (fast)
+add_test(NAME verification.implicit_rolling_disk_nodes_coulomb
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_rolling_disk.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/rolling_disk_nodes.prm ${_w}/implicit_rolling_disk_nodes_coulomb
+                 --expect coulomb --ranks --disk-mesh ${TALUS_PRM_DIR}/mesh/rolling_disk_polar.prm
+                 "--set=boundary conditions/contact friction=0.1")
+set_tests_properties(verification.implicit_rolling_disk_nodes_coulomb PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 600 PROCESSORS 2)
+# checkpoint/restart with a Coulomb contact floor on the nodes (the nodes' stick/slip state and
+# friction forces are in the checkpoint): the column collapse a = 1.2, bitwise on 1 and 2 ranks (fast)
+add_test(NAME verification.implicit_checkpoint_restart_node_coulomb
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_restart.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/column_collapse_a1.2.prm ${_w}/implicit_checkpoint_restart_node_coulomb
+                 "boundary conditions/fixed=" "boundary conditions/contact=2"
+                 "boundary conditions/contact friction=0.3")
+set_tests_properties(verification.implicit_checkpoint_restart_node_coulomb PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
 # checkpoint/restart with the point contact floor (its stick anchors and contact flags live in the
 # points' properties): the column collapse a = 1.2 on a no-slip point contact floor, bitwise (fast)
 add_test(NAME verification.implicit_checkpoint_restart_point_contact
@@ -528,3 +572,11 @@ add_test(NAME verification.implicit_rigid_plate_restart
                  "implicit/ramp loads=false")
 set_tests_properties(verification.implicit_rigid_plate_restart PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
+# Coulomb friction on the node contact floor: a block sliding under gravity tilted by 30 deg with
+# mu = 0.2, a = g (sin - mu cos) within 1 % in 2D and 3D; the frictionless mutant fails the check
+# (docs/implicit.md "Contact floor"; fast)
+add_test(NAME verification.implicit_block_coulomb_floor
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_block_coulomb.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/block_coulomb_floor.prm ${_w}/implicit_block_coulomb_floor)
+set_tests_properties(verification.implicit_block_coulomb_floor PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)

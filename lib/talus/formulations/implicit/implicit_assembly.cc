@@ -185,6 +185,13 @@ namespace talus::implicit_mpm
       }
     if (point_contact) // the penalty walls on the points (point_contact.h)
       point_contact->assemble(points, active, constraints, du, with_tangent ? &tangent : nullptr, residual);
+    if (coulomb_nodes()) // the slipping contact nodes' friction forces (external, fixed in the solve)
+      {
+        const auto &owned = space.locally_owned_dofs();
+        for (unsigned int k = 0; k < contact_friction.locally_owned_size(); ++k)
+          if (contact_friction.local_element(k) != 0.0 && !constraints.is_constrained(owned.nth_index_in_set(k)))
+            residual.local_element(k) -= contact_friction.local_element(k);
+      }
     if (dynamic() && prm.consistent_mass)
       add_consistent_inertia(with_tangent);
     else if (dynamic())

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 namespace talus::implicit_mpm
@@ -36,12 +37,24 @@ namespace talus::implicit_mpm
         if (prm.axisymmetric)
           V /= 2 * M_PI * std::max(x[0], 1e-300);
         const double half = 0.5 * std::pow(V, 1.0 / dim);
+        const auto   xi   = pt.get_reference_location();
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
           {
             const int k = node_contact[cc.dofs[v * dim]];
             if (k < 0)
               continue;
-            const auto  &c   = contact_nodes[k];
+            const auto &c = contact_nodes[k];
+            // a point counts for the wall node nearest to it along the wall (its
+            // tangential reference coordinates within half a cell of the node's):
+            // counted for every node of its cell it held the material a cell
+            // wide about each node, so that a rolling body rocked over the
+            // held patch (docs/implicit.md, "Rolling disk")
+            bool near = true;
+            for (unsigned int d = 0; d < dim; ++d)
+              if (d != c.axis && std::abs(xi[d] - double((v >> d) & 1)) > 0.5)
+                near = false;
+            if (!near)
+              continue;
             const auto   in  = space.node_dof(c.node, c.axis);
             const double gap = c.sign * (c.wall - x[c.axis]) - half;
             contact_gap(in)  = std::min(contact_gap(in), gap);
@@ -58,10 +71,13 @@ namespace talus::implicit_mpm
         if (owned.is_element(in) && contact_state(in) != 0.0 && contact_gap(in) > contact_gap_tolerance(c))
           {
             contact_state(in) = 0.0;
+            for (unsigned int d = 0; d < dim; ++d)
+              contact_friction(space.node_dof(c.node, d)) = 0.0;
             ++left;
           }
       }
     contact_state.update_ghost_values();
+    contact_friction.update_ghost_values();
     gap_releases += dealii::Utilities::MPI::sum(left, comm);
   }
 
@@ -78,8 +94,11 @@ namespace talus::implicit_mpm
           const auto in = space.node_dof(c.node, c.axis);
           if (contact_state(in) == 0.0)
             continue;
+          // the tangential DoFs: held with no slip and on a sticking Coulomb
+          // node, free when frictionless and on a slipping Coulomb node
+          const bool stick = prm.contact_no_slip || (coulomb_nodes() && contact_state(in) == 1.0);
           for (unsigned int d = 0; d < dim; ++d)
-            if (d == c.axis || prm.contact_no_slip)
+            if (d == c.axis || stick)
               held.push_back(space.node_dof(c.node, d));
         }
     if (hold_negligible)
@@ -176,34 +195,125 @@ namespace talus::implicit_mpm
     // a pull below 1e-8 of the load scale and a penetration below 1e-8 of the
     // largest increment are round-off of the Newton solve, not a change
     const double tol_pull = 1e-8 * force_scale, tol_in = 1e-8 * du_max;
-    unsigned int released = 0, added = 0;
+    // a slip force that changed by less than 1e-6 of the load scale between two
+    // passes has converged
+    const double tol_friction = 1e-6 * force_scale;
+    const bool   coulomb      = coulomb_nodes();
+    const double mu           = prm.contact_mu;
+    unsigned int released = 0, added = 0, friction = 0;
     for (std::size_t k = 0; k < contact_nodes.size(); ++k)
       {
         const auto &c  = contact_nodes[k];
         const auto  in = space.node_dof(c.node, c.axis);
         if (!owned.is_element(in) || pins.is_constrained(in) || free_contact.is_constrained(in) || mass(in) == 0)
           continue;
-        if (contact_changes[k] >= 2) // changed twice in this step: held
-          continue;
-        if (contact_state(in) != 0.0)
+        if (contact_changes[k] < 2) // changed twice in this step: held
           {
-            // compressive: the wall pushes the node into the domain, r . n_out < 0
-            if (r(in) * c.sign > tol_pull)
+            if (contact_state(in) != 0.0)
               {
-                contact_state(in) = 0.0;
+                // compressive: the wall pushes the node into the domain, r . n_out < 0
+                if (r(in) * c.sign > tol_pull)
+                  {
+                    contact_state(in) = 0.0;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      contact_friction(space.node_dof(c.node, d)) = 0.0;
+                    ++contact_changes[k];
+                    ++released;
+                    continue;
+                  }
+              }
+            else if (du(in) * c.sign > tol_in && contact_gap(in) <= contact_gap_tolerance(c))
+              {
+                contact_state(in) = 1.0; // in contact, sticking
                 ++contact_changes[k];
-                ++released;
+                ++added;
+                continue; // its reactions come from the next solve
               }
           }
-        else if (du(in) * c.sign > tol_in && contact_gap(in) <= contact_gap_tolerance(c))
+        if (!coulomb || contact_state(in) == 0.0)
+          continue;
+        // Coulomb: the wall's tangential force on the node is r_t (sticking: the
+        // reaction of the held tangential DoFs; slipping: ~0 plus the friction
+        // force already applied), its normal force -r_n . n_out >= 0
+        const double           normal = std::max(0.0, -r(in) * c.sign);
+        const double           limit  = mu * normal;
+        dealii::Tensor<1, dim> rt, slip, f_old;
+        for (unsigned int d = 0; d < dim; ++d)
+          if (d != c.axis)
+            {
+              const auto i = space.node_dof(c.node, d);
+              rt[d]        = r(i) + contact_friction(i);
+              slip[d]      = du(i);
+              f_old[d]     = contact_friction(i);
+            }
+        dealii::Tensor<1, dim> f_new;
+        if (contact_state(in) == 1.0)
           {
-            contact_state(in) = 1.0;
-            ++contact_changes[k];
-            ++added;
+            if (rt.norm() <= limit + tol_pull || friction_flips[k] >= 4)
+              continue;
+            // sticks no more: slips against the direction the wall had to hold it
+            f_new             = limit * rt / rt.norm();
+            contact_state(in) = 2.0;
+            ++friction_flips[k];
+            ++friction;
           }
+        else
+          {
+            // slipping: the increment's tangential part is the slip; a slip
+            // along the friction force (reversed) sticks again
+            if (slip * f_old > 0 && friction_flips[k] < 4)
+              {
+                contact_state(in) = 1.0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  contact_friction(space.node_dof(c.node, d)) = 0.0;
+                ++friction_flips[k];
+                ++friction;
+                continue;
+              }
+            const double s = slip.norm();
+            f_new          = s > 0 ? -limit * slip / s : (f_old.norm() > 0 ? limit * f_old / f_old.norm() : f_old);
+            // the force follows the normal reaction (a fixed point over the passes)
+            if ((f_new - f_old).norm() > tol_friction)
+              ++friction;
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          if (d != c.axis)
+            contact_friction(space.node_dof(c.node, d)) = f_new[d];
       }
     contact_state.update_ghost_values();
+    contact_friction.update_ghost_values();
+    friction_changes = dealii::Utilities::MPI::sum(friction, comm);
     return {dealii::Utilities::MPI::sum(released, comm), dealii::Utilities::MPI::sum(added, comm)};
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::reset_contact_state()
+  {
+    // every contact node starts in contact and sticking (released in the first
+    // step where the wall would pull on it); a restart takes its saved state
+    contact_state                                                = 1.0;
+    contact_friction                                             = 0.0;
+    const auto                                            &owned = space.locally_owned_dofs();
+    const unsigned int                                     cols  = 2 + dim;
+    std::map<dealii::types::global_dof_index, std::size_t> by_dof; // normal DoF -> contact node
+    if (!restored_contact.empty())
+      for (std::size_t k = 0; k < contact_nodes.size(); ++k)
+        by_dof[space.node_dof(contact_nodes[k].node, contact_nodes[k].axis)] = k;
+    for (std::size_t row = 0; row + cols <= restored_contact.size(); row += cols)
+      {
+        const auto in = static_cast<dealii::types::global_dof_index>(restored_contact[row]);
+        const auto it = by_dof.find(in);
+        if (!owned.is_element(in) || it == by_dof.end())
+          continue;
+        const auto &c     = contact_nodes[it->second];
+        contact_state(in) = restored_contact[row + 1];
+        for (unsigned int d = 0; d < dim; ++d)
+          contact_friction(space.node_dof(c.node, d)) = restored_contact[row + 2 + d];
+      }
+    restored_contact.clear();
+    contact_state.update_ghost_values();
+    contact_friction.update_ghost_values();
   }
 
   template <int dim>
@@ -323,6 +433,7 @@ namespace talus::implicit_mpm
                                                                              const bool, const bool, const bool) const;
   template void                                  Solver<2>::find_negligible_nodes();
   template std::pair<unsigned int, unsigned int> Solver<2>::update_contact(const dealii::Tensor<1, 2> &, const double);
+  template void                                  Solver<2>::reset_contact_state();
   template dealii::Tensor<1, 2>                  Solver<2>::condition_increment(const unsigned int, const double) const;
   template double Solver<2>::prescribed_increment(const loads::PrescribedNodeDof &, const double) const;
   template void   Solver<2>::prescribed_reaction(const dealii::Tensor<1, 2> &);
@@ -333,6 +444,7 @@ namespace talus::implicit_mpm
                                                                              const bool, const bool, const bool) const;
   template void                                  Solver<3>::find_negligible_nodes();
   template std::pair<unsigned int, unsigned int> Solver<3>::update_contact(const dealii::Tensor<1, 3> &, const double);
+  template void                                  Solver<3>::reset_contact_state();
   template dealii::Tensor<1, 3>                  Solver<3>::condition_increment(const unsigned int, const double) const;
   template double Solver<3>::prescribed_increment(const loads::PrescribedNodeDof &, const double) const;
   template void   Solver<3>::prescribed_reaction(const dealii::Tensor<1, 3> &);

@@ -164,6 +164,24 @@ namespace talus::implicit_mpm
             for (unsigned int d = 0; d < dim; ++d)
               f.set_attribute("plate " + std::to_string(k) + " reaction " + std::to_string(d), plate_reaction[k][d]);
           }
+        if (!prm.contact_ids.empty() && !prm.contact_on_points) // (collective)
+          {
+            // the contact walls on the nodes: each owned node's state and friction force
+            // (rows: normal DoF, state, the dim components of the friction force)
+            std::vector<double> rows;
+            const auto         &owned = space.locally_owned_dofs();
+            for (const auto &c : contact_nodes)
+              {
+                const auto in = space.node_dof(c.node, c.axis);
+                if (!owned.is_element(in))
+                  continue;
+                rows.push_back(double(in));
+                rows.push_back(contact_state(in));
+                for (unsigned int d = 0; d < dim; ++d)
+                  rows.push_back(contact_friction(space.node_dof(c.node, d)));
+              }
+            f.write_rows("contact_nodes", rows, 2 + dim);
+          }
         write_points(f, points);
         probes.write_ids(f);
         write_pvd_times(f, "output/pvd", pvd_records);
@@ -197,6 +215,9 @@ namespace talus::implicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           plate_reaction[k][d] = fp->get_double("plate " + std::to_string(k) + " reaction " + std::to_string(d));
       }
+    restored_contact.clear();
+    if (fp->exists("contact_nodes")) // the node walls' state (applied when the vectors are set up)
+      restored_contact = fp->read_all("contact_nodes");
     balance.restore(*fp); // same ranks: the saved partition, before the points go in
     read_points(*fp, points, grid, "checkpoint " + fp->path());
     if (!prm.probes.empty()) // the points the run tracked (its ids saved)
@@ -243,6 +264,10 @@ namespace talus::implicit_mpm
       log() << "  contact walls: " << total_contact_passes << " Newton solves (active-set passes), "
             << total_contact_released << " node releases, " << total_contact_added << " nodes put in contact, "
             << gap_releases << " nodes released because the material left the wall" << std::endl;
+    if (coulomb_nodes())
+      log() << "  contact friction (Coulomb mu = " << prm.contact_mu << ", nodes): " << total_slip_node_steps
+            << " node-steps slipping, " << total_slip_switches << " stick/slip changes or slip-force updates"
+            << std::endl;
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;

@@ -45,9 +45,12 @@ namespace talus::implicit_mpm
                         "(docs/implicit.md, 'Contact floor'). Applies in every stage.");
       prm.declare_entry("contact friction", "no slip", Anything(),
                         "Tangential behaviour of the 'contact' walls: 'no slip' (a node / point in contact sticks), "
-                        "'frictionless' (only the normal component is held / pushed) or, with 'contact method = "
-                        "points' only, a Coulomb coefficient mu >= 0 (stick while the tangential penalty force is at "
-                        "most mu times the normal one, else slip at that force).");
+                        "'frictionless' (only the normal component is held / pushed) or a Coulomb coefficient mu >= "
+                        "0: on the points, stick while the tangential penalty force is at most mu times the normal "
+                        "one, else slip at that force; on the nodes, a node in contact sticks (tangential increment "
+                        "held) while its tangential reaction is at most mu times its normal reaction, else slips "
+                        "under the tangential force mu |normal reaction| opposing its slip (docs/implicit.md, "
+                        "'Contact floor').");
       prm.declare_entry("contact gap", "0.1", Double(0),
                         "A contact node can be held only while the material next to it is at the wall: the gap, "
                         "the smallest (distance to the wall - half the point size V_p^(1/dim)/2) over the points of "
@@ -331,7 +334,7 @@ namespace talus::implicit_mpm
               "interval = 0, or contact method = points");
       const std::string f  = prm.get("contact friction");
       double            mu = -1;
-      if (p.contact_on_points && f != "no slip" && f != "frictionless")
+      if (f != "no slip" && f != "frictionless")
         {
           std::size_t used = 0;
           try
@@ -344,14 +347,8 @@ namespace talus::implicit_mpm
             }
           require(used == f.size() && used > 0 && std::isfinite(mu) && mu >= 0, "boundary conditions/contact friction",
                   "'" + f +
-                    "' is not a contact friction; allowed: no slip | frictionless | a Coulomb coefficient "
-                    "mu >= 0 (contact method = points)");
+                    "' is not a contact friction; allowed: no slip | frictionless | a Coulomb coefficient mu >= 0");
         }
-      else
-        require(f == "no slip" || f == "frictionless", "boundary conditions/contact friction",
-                "'" + f +
-                  "' is not a contact friction; allowed: no slip | frictionless (a Coulomb coefficient "
-                  "needs 'contact method = points')");
       p.contact_no_slip   = f == "no slip";
       p.contact_mu        = f == "no slip" ? std::numeric_limits<double>::infinity() : f == "frictionless" ? 0.0 : mu;
       const std::string k = prm.get("contact penalty");

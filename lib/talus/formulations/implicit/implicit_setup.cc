@@ -150,12 +150,11 @@ namespace talus::implicit_mpm
       point_forces.assign(prm.tractions, points, grid, prm.bodies, comm);
     if (prm.axisymmetric && !restored)
       ring_measure();
-    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap})
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap,
+                      &contact_friction})
       space.reinit_vector(*v);
-    // every contact node starts in contact (released in the first step where
-    // the wall would pull on it); a restart starts so too
-    contact_state = 1.0;
-    contact_state.update_ghost_values();
+    reset_contact_state(); // all in contact; a restart: the saved state
+
     // load balancing: partition by points from the start (a restart on as many
     // ranks has recreated its saved partition instead)
     balance.initial();
@@ -221,10 +220,10 @@ namespace talus::implicit_mpm
     space.setup();
     if (current_stage < prm.stages.size())
       stage_nodes(current_stage);
-    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap})
+    for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap,
+                      &contact_friction})
       space.reinit_vector(*v);
-    contact_state = 1.0; // (load balancing is refused with contact walls on the nodes)
-    contact_state.update_ghost_values();
+    reset_contact_state(); // (load balancing is refused with contact walls on the nodes)
     points.collect_active_cells();
   }
 

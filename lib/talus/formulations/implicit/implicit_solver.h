@@ -103,7 +103,8 @@ namespace talus::implicit_mpm
     /// pull (active set inside the step; docs/implicit.md "Contact floor")
     std::vector<dealii::types::boundary_id> contact_ids;
     /// 'boundary conditions/contact friction': true = no slip (the tangential
-    /// components of a node in contact are held too), false = frictionless
+    /// components of a node in contact are held too), false = frictionless or
+    /// Coulomb (contact_mu > 0: stick / slip per node or point)
     bool contact_no_slip = true;
     /// 'boundary conditions/contact passes': active-set passes per step at most
     unsigned int contact_passes = 10;
@@ -116,7 +117,7 @@ namespace talus::implicit_mpm
     bool contact_on_points = false;
     /// 'boundary conditions/contact penalty': k_n = penalty x M V_p / h^2 (points)
     double contact_penalty = 1;
-    /// points: the Coulomb coefficient of 'contact friction' (+inf: no slip, 0: frictionless)
+    /// the Coulomb coefficient of 'contact friction' (+inf: no slip, 0: frictionless)
     double contact_mu = std::numeric_limits<double>::infinity();
     /// 'rigid footing': a rigid plane of finite span pressed into the material at
     /// a prescribed rate, acting on the points by the contact penalty
@@ -172,6 +173,8 @@ namespace talus::implicit_mpm
     /// contact walls: Newton solves (passes) of the step, nodes released and
     /// put (back) in contact over its passes, nodes in contact at its end
     unsigned int contact_passes = 0, contact_released = 0, contact_added = 0, contact_nodes = 0;
+    /// Coulomb contact walls on the nodes: nodes slipping at the step's end
+    unsigned int contact_slipping = 0;
     /// contact walls on the points: the converged step's contact figures
     PointContactStats point_contact;
     /// 'loads/velocity k': the force the prescribed nodes exert on the material
@@ -335,10 +338,34 @@ namespace talus::implicit_mpm
                                                        const bool                 with_prescribed = true,
                                                        const bool                 hold_plates     = false,
                                                        const bool                 hold_negligible = true) const;
-    /// Contact walls: the nodes and their state (1 = in contact, 0 = free) at the
-    /// normal DoF of each node, decided by the owner, ghosts updated.
+    /// Contact walls: the nodes and their state (1 = in contact and, on a
+    /// Coulomb wall, sticking; 2 = in contact and slipping (Coulomb); 0 = free)
+    /// at the normal DoF of each node, decided by the owner, ghosts updated.
     std::vector<loads::ContactNode> contact_nodes;
     Vector                          contact_state;
+    /// Coulomb walls on the nodes: at the tangential DoFs of a slipping node the
+    /// force the wall exerts on it, mu |normal reaction| against its slip (an
+    /// external force of the step, fixed within a Newton solve, updated between
+    /// the active-set passes); zero elsewhere
+    Vector contact_friction;
+    /// true: 'contact friction' is a Coulomb coefficient mu > 0 (nodes)
+    bool
+    coulomb_nodes() const
+    {
+      return !prm.contact_no_slip && prm.contact_mu > 0 && !prm.contact_on_points;
+    }
+    /// Per contact node: stick/slip changes in the current step (after four the
+    /// node keeps its state for the rest of the step: no cycling)
+    std::vector<unsigned char> friction_flips;
+    /// friction changes of the last update_contact: stick/slip switches and
+    /// slip forces not yet converged (global); the active-set passes go on while > 0
+    unsigned int       friction_changes    = 0;
+    unsigned long long total_slip_switches = 0, total_slip_node_steps = 0;
+    /// a restart's contact state (rows: normal DoF, state, dim friction components)
+    std::vector<double> restored_contact;
+    /// (Re)sets the contact state: all nodes in contact, no friction force, or
+    /// the restored state after a restart
+    void reset_contact_state();
     /// Per contact node: times it changed state in the current step (a node that
     /// changed twice is held in contact for the rest of the step: no cycling).
     std::vector<unsigned char> contact_changes;

@@ -242,9 +242,13 @@ namespace talus::implicit_mpm
           }
         released += changed.first;
         added += changed.second;
-        if (changed.first + changed.second == 0)
+        total_slip_switches += friction_changes;
+        if (changed.first + changed.second + friction_changes == 0)
           break;
-        pass_log << " [pass " << passes << ": " << changed.first << " released, " << changed.second << " in contact]";
+        pass_log << " [pass " << passes << ": " << changed.first << " released, " << changed.second << " in contact";
+        if (coulomb_nodes())
+          pass_log << ", " << friction_changes << " stick/slip changes or slip forces moved";
+        pass_log << "]";
         if (passes >= prm.contact_passes)
           {
             // the last solution keeps the previous set; the new one starts the next step
@@ -310,15 +314,22 @@ namespace talus::implicit_mpm
     total_contact_added += added;
     if (any_contact)
       {
-        unsigned int n = 0;
+        unsigned int n[2] = {0, 0}; // in contact, slipping
         for (const auto &c : contact_nodes)
           {
             const auto in = space.node_dof(c.node, c.axis);
             if (space.locally_owned_dofs().is_element(in) && contact_state(in) != 0.0 && mass(in) > 0 &&
                 !active.constraints().is_constrained(in))
-              ++n;
+              {
+                ++n[0];
+                n[1] += contact_state(in) == 2.0 ? 1 : 0;
+              }
           }
-        last.contact_nodes = dealii::Utilities::MPI::sum(n, comm);
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const unsigned int>(n, 2), comm,
+                                    dealii::ArrayView<unsigned int>(n, 2));
+        last.contact_nodes    = n[0];
+        last.contact_slipping = n[1];
+        total_slip_node_steps += n[1];
       }
   }
 
@@ -420,7 +431,9 @@ namespace talus::implicit_mpm
             << (force_plate(k) ? plate_sum[k] : plate_reaction[k][prm.rigid_plates[k].axis]) << std::setprecision(6);
     if (any_contact)
       log() << "; contact: " << passes << " pass(es), " << released << " released, " << added << " in contact again, "
-            << last.contact_nodes << " nodes in contact" << pass_log.str();
+            << last.contact_nodes << " nodes in contact"
+            << (coulomb_nodes() ? " (" + std::to_string(last.contact_slipping) + " slipping)" : std::string())
+            << pass_log.str();
     log() << std::endl;
   }
 
@@ -464,6 +477,7 @@ namespace talus::implicit_mpm
     // the walls' fixed and roller DoFs as homogeneous constraints on the
     // increment, merged with the pins of the inactive DoFs
     contact_changes.assign(contact_nodes.size(), 0);
+    friction_flips.assign(contact_nodes.size(), 0);
     if (!prm.contact_ids.empty() && !point_contact)
       measure_contact_gaps();
     if (point_contact) // x_n of the points, read by the contact terms of the step
