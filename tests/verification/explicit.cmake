@@ -76,6 +76,10 @@ set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESS
 
 # chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
 talus_verification(explicit_strain_smoothing check_smoothing.py verification/footing_incompressible.prm)
+# issue 38: F-bar (numerics/volumetric stabilisation, transfer/fbar.h) on linear and
+# quadratic B-spline kernels: a strip's flexural period against Rayleigh-Lamb at nu = 0.49,
+# and the B-spline footing settlement with and without it
+talus_verification(explicit_fbar_strip check_fbar_strip.py verification/strip_bending_incompressible.prm)
 
 # issue 6: talus-convergence (bar without cell crossing: order >= 1.8; translating bar
 # with cell crossing: the predicted loss of convergence; bad input)
