@@ -80,6 +80,7 @@ talus_verification(explicit_strain_smoothing check_smoothing.py verification/foo
 # quadratic B-spline kernels: a strip's flexural period against Rayleigh-Lamb at nu = 0.49,
 # and the B-spline footing settlement with and without it
 talus_verification(explicit_fbar_strip check_fbar_strip.py verification/strip_bending_incompressible.prm)
+set_tests_properties(verification.explicit_fbar_strip PROPERTIES PROCESSORS 2)
 
 # issue 6: talus-convergence (bar without cell crossing: order >= 1.8; translating bar
 # with cell crossing: the predicted loss of convergence; bad input)
