@@ -226,7 +226,10 @@ namespace
   // the volume-weighted mean det dF of its cell, so the tangent couples all points
   // of a cell (the rank-one cell term); 2 x 2 points per cell, a random iterate
   // gives the points of a cell different det dF.
-  const std::string fbar = " set volumetric stabilisation = f-bar\n";
+  // (a shared 'numerics' entry: the implicit_extra text sits inside 'subsection
+  // implicit', which is closed and reopened around it)
+  const std::string fbar =
+    "end\nsubsection numerics\n set volumetric stabilisation = f-bar\nend\nsubsection implicit\n";
   TEST(ImplicitTangent, FbarNeoHookeanStatic2D)
   {
     EXPECT_LT(tangent_error<2>(neo_hookean, "static", 1e-2, 0, 9.81, fbar), 1e-6);

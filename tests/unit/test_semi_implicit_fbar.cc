@@ -1,6 +1,6 @@
-// The grid-free F-bar pieces of the semi-implicit family (fbar.h) and the
+// The grid-free F-bar pieces (transfer/fbar.h, shared by the explicit and semi-implicit families) and the
 // J^e = sqrt(det b_e) the modified F-bar reads from the finite-strain models.
-#include <talus/formulations/semi_implicit/fbar.h>
+#include <talus/transfer/fbar.h>
 #include <deal.II/base/symmetric_tensor.h>
 #include <talus/materials/hencky_mohr_coulomb.h>
 
@@ -31,10 +31,10 @@ namespace
 TEST(SemiImplicitFbar, UniformCompressionIsLeftExact)
 {
   const Tensor<2, 3> dF2 = compression(0.01, 0.02, 0);
-  const Tensor<2, 3> a2  = semi_implicit::stabilised_increment<2>(dF2, determinant(dF2));
+  const Tensor<2, 3> a2  = transfer::stabilised_increment<2>(dF2, determinant(dF2));
   EXPECT_LT((a2 - dF2).norm(), 1e-15);
   const Tensor<2, 3> dF3 = compression(0.01, 0.02, 0.005);
-  const Tensor<2, 3> a3  = semi_implicit::stabilised_increment<3>(dF3, determinant(dF3));
+  const Tensor<2, 3> a3  = transfer::stabilised_increment<3>(dF3, determinant(dF3));
   EXPECT_LT((a3 - dF3).norm(), 1e-15);
 }
 
@@ -44,11 +44,11 @@ TEST(SemiImplicitFbar, DeterminantFollowsTheSmoothedIncrement)
 {
   const Tensor<2, 3> dF     = compression(0.01, 0.02, 0);
   const double       dJ_bar = 0.985;
-  const auto         f      = semi_implicit::stabilised_increment<2>(dF, dJ_bar);
+  const auto         f      = transfer::stabilised_increment<2>(dF, dJ_bar);
   EXPECT_NEAR(determinant(f), dJ_bar, 1e-14);
   EXPECT_EQ(f[2][2], 1.0);
   EXPECT_NEAR(f[0][1] / f[1][1], dF[0][1] / dF[1][1], 1e-14); // isochoric part unchanged
-  const auto h = semi_implicit::stabilised_increment<3>(compression(0.01, 0.02, 0.03), dJ_bar);
+  const auto h = transfer::stabilised_increment<3>(compression(0.01, 0.02, 0.03), dJ_bar);
   EXPECT_NEAR(determinant(h), dJ_bar, 1e-14);
 }
 
@@ -61,7 +61,7 @@ TEST(SemiImplicitFbar, ElasticBTakesThePatchMean)
   const double                        Je    = std::sqrt(determinant(b));
   double                              h[6]  = {b[0][0], b[1][1], b[2][2], b[0][1], b[1][2], b[0][2]};
   const double                        Jebar = 1.013;
-  semi_implicit::scale_elastic_b(h, Jebar / Je);
+  transfer::scale_elastic_b(h, Jebar / Je);
   dealii::SymmetricTensor<2, 3> bb;
   bb[0][0] = h[0], bb[1][1] = h[1], bb[2][2] = h[2], bb[0][1] = h[3], bb[1][2] = h[4], bb[0][2] = h[5];
   EXPECT_NEAR(std::sqrt(determinant(bb)), Jebar, 1e-14);
@@ -73,7 +73,7 @@ TEST(SemiImplicitFbar, ElasticBTakesThePatchMean)
 // fastest, positions outside the box clamped to the nearest patch
 TEST(SemiImplicitFbar, PatchTiling)
 {
-  semi_implicit::PatchTiling<2> t;
+  transfer::PatchTiling<2> t;
   t.reinit(dealii::Point<2>(0, -1), dealii::Point<2>(10, 2), std::vector<unsigned int>{10, 6}, 1.5);
   EXPECT_EQ(t.count[0], 7u);
   EXPECT_EQ(t.count[1], 4u);
@@ -85,7 +85,7 @@ TEST(SemiImplicitFbar, PatchTiling)
   EXPECT_EQ(t.index(dealii::Point<2>(1.6, -0.2)), 8u);
   EXPECT_EQ(t.index(dealii::Point<2>(9.99, 1.99)), 27u);
   EXPECT_EQ(t.index(dealii::Point<2>(10.5, 2.5)), 27u);
-  semi_implicit::PatchTiling<2> cellwise; // patch size 1: the cell-wise average of Mast et al.
+  transfer::PatchTiling<2> cellwise; // patch size 1: the cell-wise average of Mast et al.
   cellwise.reinit(dealii::Point<2>(0, 0), dealii::Point<2>(3, 3), std::vector<unsigned int>{3, 3}, 1.0);
   EXPECT_EQ(cellwise.size(), 9u);
 }

@@ -69,6 +69,17 @@ cases.update({
     "unknown velocity transfer": (tv.prm_set(base, "numerics/velocity transfer", "pic"),
                                   ["velocity transfer", "pic", "flip|apic"]),
 })
+# numerics/volumetric stabilisation (issue 38): modified f-bar has no b_e to scale in the rate
+# update; f-bar with the passes that replace the volume change themselves
+fbar = tv.prm_set(base, "numerics/volumetric stabilisation", "f-bar")
+cases.update({
+    "modified f-bar": (tv.prm_set(base, "numerics/volumetric stabilisation", "modified f-bar"),
+                       ["numerics/volumetric stabilisation", "modified f-bar", "allowed: none, f-bar"]),
+    "f-bar with strain smoothing": (tv.prm_set(fbar, "numerics/strain smoothing", "nodal"),
+                                    ["numerics/strain smoothing", "volumetric stabilisation = f-bar"]),
+    "f-bar with mpm-mixed": (tv.prm_set(fbar, "numerics/integration", "mpm-mixed"),
+                             ["numerics/integration", "volumetric stabilisation = f-bar"]),
+})
 # rigid plates (issue 37): each refused before any output, naming the plate
 plate = tv.prm_set(base, "boundary conditions/number of rigid plates", "1")
 plate = tv.prm_set(plate, "boundary conditions/rigid plate 0/boundary id", "1")

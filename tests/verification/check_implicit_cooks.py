@@ -80,7 +80,7 @@ for nu in ("0.33", "0.499999"):
             text = tv.prm_set(text, "material 0/neo hookean/poisson ratio", nu)
             text = tv.prm_set(text, "implicit/formulation", "irreducible" if form == "f-bar" else form)
             if form == "f-bar":
-                text = tv.prm_set(text, "implicit/volumetric stabilisation", "f-bar")
+                text = tv.prm_set(text, "numerics/volumetric stabilisation", "f-bar")
                 # displacement-only at nu -> 0.5: the bulk modulus (K/G = 3e5) reaches the
                 # residual through det dF, so its round-off floor is |r|/|r_0| ~ 2e-7 and
                 # |du|/|Du| ~ 1e-8 (measured, n = 2); the u-p form scales its pressure rows

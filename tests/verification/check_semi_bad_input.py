@@ -39,9 +39,9 @@ cases = [
     # a water body alone: no soil, so no skeleton for the drag and the mixture
     ("water without soil", [("body 0/phase", "water")], "body 0/phase = water"),
     # (soil without water is a single-phase solid and allowed: the strip footing)
-    ("modified f-bar without b_e", [("semi implicit/volumetric stabilisation", "modified f-bar")],
-     "semi implicit/volumetric stabilisation"),
-    ("bad stabilisation", [("semi implicit/volumetric stabilisation", "f bar")], "volumetric stabilisation"),
+    ("modified f-bar without b_e", [("numerics/volumetric stabilisation", "modified f-bar")],
+     "numerics/volumetric stabilisation"),
+    ("bad stabilisation", [("numerics/volumetric stabilisation", "f bar")], "volumetric stabilisation"),
     ("write grid", [("output/write grid", "true")], "output/write grid"),
     ("patch size", [("semi implicit/patch size", "0.1")], "semi implicit/patch size"),
     ("single point with a water body", [("semi implicit/point sets", "single"), ("number of bodies", "2"),

@@ -48,7 +48,7 @@ for k, v in {"time/end time": "0.06", "time/time step": "3e-4", "output/vtu inte
              "material 0/hencky mohr coulomb/cohesion": "1e12",
              "material 0/hencky mohr coulomb/friction angle": "1",
              "material 0/hencky mohr coulomb/dilatancy angle": "0",
-             "semi implicit/volumetric stabilisation": "modified f-bar",
+             "numerics/volumetric stabilisation": "modified f-bar",
              # the sudden 10 kPa on the soil's upper face (the shared traction), its
              # surface drained as the free surface around it
              "loads/number of tractions": "1", "loads/traction 0/traction": "0, -1e4",

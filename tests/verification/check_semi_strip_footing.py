@@ -58,7 +58,7 @@ def settlement(s):
 res = {}
 for st in ("none", "f-bar", "modified f-bar"):
     name = st.replace(" ", "_")
-    _, out, _ = tv.run_tool(tool, tv.prm_set(base, "semi implicit/volumetric stabilisation", st), f"{work}/{name}", name)
+    _, out, _ = tv.run_tool(tool, tv.prm_set(base, "numerics/volumetric stabilisation", st), f"{work}/{name}", name)
     s = tv.read_csv(f"{work}/{name}/out/soil_final.csv")
     res[st] = (zigzag(s), settlement(s))
     print(f"h = {h} m, {st}: zigzag index {res[st][0]:.2e}, settlement {res[st][1] * 1000:.3f} mm")
@@ -70,7 +70,7 @@ tv.check(res["none"][0] > zigzag_none,
          f"no stabilisation: the checkerboard is there (zigzag {res['none'][0]:.2e} > {zigzag_none:.0e})")
 tv.check(ratio < locking, f"no stabilisation locks: settlement ratio {ratio:.3f} < {locking}")
 if np2:
-    text = tv.prm_set(base, "semi implicit/volumetric stabilisation", "modified f-bar")
+    text = tv.prm_set(base, "numerics/volumetric stabilisation", "modified f-bar")
     tv.run_tool(tool, text, f"{work}/np2", "np2", np=2)
     a = tv.read_csv(f"{work}/modified_f-bar/out/soil_final.csv")
     b = tv.read_csv(f"{work}/np2/out/soil_final.csv")

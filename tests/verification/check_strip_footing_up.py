@@ -135,7 +135,7 @@ runs["u hencky"] = runs["u"][:start] + hencky + "\n" + runs["u"][end:]
 # every run, longest first (--jobs at a time); the results are read below
 semi_runs = {"semi_long": tv.prm_set(semi, "time/end time", str(t_long))}
 for st in stabilisations:
-    semi_runs["semi_" + st.replace(" ", "_")] = tv.prm_set(semi, "semi implicit/volumetric stabilisation", st)
+    semi_runs["semi_" + st.replace(" ", "_")] = tv.prm_set(semi, "numerics/volumetric stabilisation", st)
 all_runs = [(f"{tools}/talus-semi-implicit", name, text, "soil_final.csv") for name, text in semi_runs.items()]
 all_runs += [(f"{tools}/talus-implicit", "implicit_" + key.replace(" ", "_").replace("-", ""), text,
               "particles_final.csv") for key, text in runs.items()]

@@ -41,7 +41,7 @@ set_tests_properties(verification.implicit_cantilever_bspline PROPERTIES LABELS 
 add_test(NAME verification.implicit_cantilever_fbar_gmres
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cantilever.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_cantilever_fbar_gmres 0.02 0.5 0.25
-                 "--set=implicit/volumetric stabilisation=f-bar" "--set=linear solver/method=gmres amg")
+                 "--set=numerics/volumetric stabilisation=f-bar" "--set=linear solver/method=gmres amg")
 set_tests_properties(verification.implicit_cantilever_fbar_gmres PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 add_test(NAME verification.implicit_cantilever_full
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cantilever.py ${TALUS_TOOLS_DIR}
@@ -240,7 +240,7 @@ set_tests_properties(verification.implicit_ranks_cooks PROPERTIES LABELS "fast" 
 add_test(NAME verification.implicit_ranks_cooks_fbar
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_ranks_cooks_fbar
-                 "implicit/formulation=irreducible" "implicit/volumetric stabilisation=f-bar"
+                 "implicit/formulation=irreducible" "numerics/volumetric stabilisation=f-bar"
                  "newton/increment relative=1e-7"
                  "material 0/neo hookean/poisson ratio=0.4999")
 set_tests_properties(verification.implicit_ranks_cooks_fbar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"

@@ -114,6 +114,18 @@ namespace talus
                       "carrying the linear extrapolation, so fixed and roller walls hold exactly at the wall; "
                       "needs a uniform box grid with at least 3 cells per direction; docs/shape-functions.md). A "
                       "family refuses the combinations with its own options that it cannot honour, naming them.");
+    prm.declare_entry(
+      "volumetric stabilisation", "none", Selection("none|f-bar|modified f-bar"),
+      "Volumetric-locking stabilisation of the point update, in every family (transfer/fbar.h). none: the "
+      "increment dF as computed. f-bar: the model sees dF scaled by (dJbar / dJ)^(1/dim) (in plane in 2D), "
+      "dJbar a smoothed volume change: talus-explicit and talus-semi-implicit the mass-weighted map of the "
+      "points' dJ to the nodes and back (seed 002 Eqs. 79-80, linear and quadratic B-spline shape functions; "
+      "docs/explicit.md, docs/semi-implicit.md), talus-implicit the volume-weighted mean of det dF over the "
+      "points of a grid cell with its exact tangent (irreducible form, linear shape functions; "
+      "docs/implicit.md). modified f-bar (talus-semi-implicit only): in addition the elastic b_e of the "
+      "last step scaled by (Jebar / J^e)^(2/3), Jebar the mass-weighted mean of J^e = sqrt(det b_e) over "
+      "the soil points of a fixed square patch (Eqs. 81-83; 'semi implicit/patch size'); needs a model "
+      "that keeps b_e (hencky mohr coulomb, nor sand, neo hookean).");
     prm.leave_subsection();
 
     prm.enter_subsection("gravity");
@@ -307,6 +319,11 @@ namespace talus
     prm.enter_subsection("numerics");
     p.shape_function =
       prm.get("shape function") == "quadratic bspline" ? ShapeFunction::quadratic_bspline : ShapeFunction::linear;
+    {
+      using VS                   = transfer::VolumetricStabilisation;
+      const std::string vs       = prm.get("volumetric stabilisation");
+      p.volumetric_stabilisation = vs == "f-bar" ? VS::f_bar : vs == "modified f-bar" ? VS::modified_f_bar : VS::none;
+    }
     prm.leave_subsection();
 
     const unsigned int n_materials = prm.get_integer("number of materials");

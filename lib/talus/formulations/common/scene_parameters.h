@@ -14,6 +14,7 @@
 #include <talus/materials/material.h>
 #include <talus/particles/material_points.h>
 #include <talus/shape/shape_function.h>
+#include <talus/transfer/fbar.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
@@ -44,6 +45,8 @@ namespace talus
     /// 'body k/initial stress' of every body (initial_stress.h)
     std::vector<InitialStress> initial_stress;
     ShapeFunction              shape_function = ShapeFunction::linear;
+    /// 'numerics/volumetric stabilisation' (transfer/fbar.h; each family refuses what it lacks)
+    transfer::VolumetricStabilisation volumetric_stabilisation = transfer::VolumetricStabilisation::none;
     bool
     bspline() const
     {

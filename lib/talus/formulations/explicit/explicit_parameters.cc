@@ -132,6 +132,34 @@ namespace talus::explicit_mpm
           p.end_time += st.duration;
       }
     p.numerics = parse_numerics_parameters(prm, n_bodies);
+    // 'numerics/volumetric stabilisation' is the shared scene's (scene_parameters.cc)
+    require(p.volumetric_stabilisation != transfer::VolumetricStabilisation::modified_f_bar,
+            "numerics/volumetric stabilisation",
+            "modified f-bar scales the elastic left Cauchy-Green tensor b_e that finite-strain models keep "
+            "(seed 002 Eqs. 81-83); talus-explicit updates its models in rate form, without b_e; allowed: "
+            "none, f-bar");
+    p.numerics.fbar = p.volumetric_stabilisation == transfer::VolumetricStabilisation::f_bar;
+    if (p.numerics.fbar)
+      {
+        // the F-bar replaces the update pass's volume change (ExplicitPointUpdate): the
+        // passes with their own update or their own volumetric treatment are refused
+        const std::string why = " is not available with numerics/volumetric stabilisation = f-bar (";
+        require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
+                std::string(p.numerics.integration_name()) + why +
+                  "FEM and MPM-MIXED have their own update or stress averaging); allowed: mpm, or "
+                  "volumetric stabilisation = none");
+        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
+                "strain smoothing" + why +
+                  "both replace the volumetric strain increment: choose one); allowed: none, or volumetric "
+                  "stabilisation = none");
+        require(!p.numerics.contact(), "contact/pairs",
+                "contact" + why +
+                  "the bodies' own velocity fields are not averaged); allowed: empty, or "
+                  "volumetric stabilisation = none");
+        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/volumetric stabilisation",
+                "f-bar is available in the 1-phase step only (coupled 2-phase materials and body tractions run "
+                "the 2-phase step); allowed: none, or 1-phase materials");
+      }
     if (p.numerics.apic())
       {
         // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step, affine_offset);

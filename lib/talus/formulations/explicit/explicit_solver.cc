@@ -14,7 +14,9 @@
 #include <talus/io/vtu.h>
 #include <talus/io/png_snapshots.h>
 #include <talus/loads/kinematics.h>
+#include <talus/transfer/fbar.h>
 #include <talus/transfer/point_ops.h>
+#include <talus/transfer/stencil_ops.h>
 #include <talus/materials/strain_increments.h>
 
 #include <deal.II/base/function_parser.h>
@@ -113,6 +115,12 @@ namespace talus::explicit_mpm
     // (saved with the checkpoints like every property)
     if (prm.numerics.apic())
       affine_offset = points.layout.add_extra("affine_velocity", dim * dim);
+    // F-bar: the point's dJbar of the step, written before the update pass reads it
+    if (prm.numerics.fbar)
+      {
+        fbar_offset = points.layout.add_extra("smoothed_volume_increment", 1);
+        grid.reinit_vector(nodal_dj);
+      }
     points.initialize();
     if (prm.numerics.fem())
       fem =
@@ -246,6 +254,8 @@ namespace talus::explicit_mpm
     grid.reinit_vector(nodal_mass);
     grid.reinit_vector(nodal_a);
     grid.reinit_vector(nodal_p);
+    if (fbar_offset)
+      grid.reinit_vector(nodal_dj);
     dof_marker.clear();
     if (free_surface)
       free_surface->grid_changed();
@@ -402,6 +412,8 @@ namespace talus::explicit_mpm
       const StrainSmoothing<dim>                                    *smoothing;
       const bool                                                     need_strain_energy;
       PointProbes<dim>                                              &probes;
+      /// F-bar: offset of the point's dJbar (0: off; Solver::volume_averages_with)
+      const unsigned int fbar = 0;
 
       diagnostics::PointSums<dim> sums = {};
       bool                        bad  = false;
@@ -428,13 +440,45 @@ namespace talus::explicit_mpm
         transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
       }
 
+      /// The strain and spin increments the model sees: those of grad du, or
+      /// with F-bar those of dF-bar - I, dF-bar = (dJbar / dJ)^(1/dim) dF (seed
+      /// 002 Eq. 79, in plane in 2D: d_eps_zz stays 0)
+      inline void
+      increments_of(const double (&gu)[dim][dim], const double *P, materials::Strain &d_eps, materials::Spin &d_omega)
+      {
+        if (!fbar)
+          {
+            materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
+            return;
+          }
+        dealii::Tensor<2, 3> dF;
+        for (unsigned int i = 0; i < 3; ++i)
+          dF[i][i] = 1;
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            dF[i][j] += gu[i][j];
+        const double dJ = dealii::determinant(dF);
+        if (!(dJ > 0) || !(P[fbar] > 0)) // flagged by the stability check (the volume turns non-positive)
+          {
+            materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
+            bad = true;
+            return;
+          }
+        const dealii::Tensor<2, 3> f = transfer::stabilised_increment<dim>(dF, P[fbar]);
+        double                     g[dim][dim];
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            g[i][j] = f[i][j] - (i == j ? 1.0 : 0.0);
+        materials::strain_and_spin_increments<dim>(g, d_eps, d_omega);
+      }
+
       inline void
       update(const unsigned int c, const typename K::Cell &cell, double *P, const double (&gu)[dim][dim],
              PointState &state)
       {
         materials::Strain d_eps;
         materials::Spin   d_omega;
-        materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
+        increments_of(gu, P, d_eps, d_omega);
         if (smoothing) // §6.7.1: smoothed volumetric part
           smoothing->apply(c, d_eps);
         const materials::Material &m     = *materials[static_cast<unsigned int>(P[L::material])];
@@ -476,7 +520,7 @@ namespace talus::explicit_mpm
                 r.d_eps   = materials::Strain();
                 r.d_omega = materials::Spin();
               }
-            materials::strain_and_spin_increments<dim>(points[k].gu, r.d_eps, r.d_omega);
+            increments_of(points[k].gu, points[k].P, r.d_eps, r.d_omega);
             if (smoothing) // §6.7.1: smoothed volumetric part
               smoothing->apply(c, r.d_eps);
             r.sigma   = L::get_stress(points[k].P);
@@ -555,8 +599,8 @@ namespace talus::explicit_mpm
   Solver<dim>::g2p_update_with(K, const double h)
   {
     probes.clear_values();
-    ExplicitPointUpdate<dim, K> physics{prm.materials,   points.layout.history, h,     gravity, contact.get(),
-                                        smoothing.get(), need_strain_energy,    probes};
+    ExplicitPointUpdate<dim, K> physics{prm.materials,   points.layout.history, h,      gravity,    contact.get(),
+                                        smoothing.get(), need_strain_energy,    probes, fbar_offset};
     // the mass and force of the next step are accumulated here, at the updated
     // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
     // the next cycle fused into this pass) and for every particle that entered
@@ -589,7 +633,8 @@ namespace talus::explicit_mpm
   {
     probes.clear_values();
     ApicPointUpdate<dim, K> physics{
-      {prm.materials, points.layout.history, h, gravity, nullptr, nullptr, need_strain_energy, probes}, affine_offset};
+      {prm.materials, points.layout.history, h, gravity, nullptr, nullptr, need_strain_energy, probes, fbar_offset},
+      affine_offset};
     // as g2p_update_with: the update pass with the next step's mass and force fused
     zero_on_active(nodal_mass);
     zero_on_active(nodal_a);
@@ -599,6 +644,37 @@ namespace talus::explicit_mpm
     transfer::for_each_active_cell(points, fused);
     local_sums = physics.sums;
     local_bad  = physics.bad;
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::volume_averages_with(K, const double h)
+  {
+    // the map: sum N m dJ at the nodes (the scalar slot: component 0), dJ of the
+    // increment the update pass will use (h x the nodal velocity, at x^t)
+    using Stencil = transfer::PointStencil<dim, K>;
+    using It      = transfer::PointIterator<dim>;
+    using L       = PropertyLayout<dim>;
+    zero_on_active(nodal_dj);
+    const double *V  = nodal_p.begin();
+    double       *mj = nodal_dj.begin();
+    transfer::for_each_point_stencil<dim, K>(grid, points, [&](unsigned int, It &it, const Stencil &s) {
+      const double *P = it->get_properties().data();
+      double        gv[dim][dim];
+      s.vector_gradient(V, gv);
+      s.scatter(mj, P[L::mass] * dealii::determinant(transfer::increment_tensor<dim>(gv, h)));
+    });
+    nodal_dj.compress(dealii::VectorOperation::add);
+    // dJ_I = sum N m dJ / sum N m (the lumped mass of this step; every node a
+    // point's N reaches carries mass, so a uniform dJ comes back exactly)
+    const double *M = nodal_mass.begin();
+    for (const unsigned int i : active_dofs)
+      mj[i] = M[i] > 0 ? mj[i] / M[i] : 0.0;
+    nodal_dj.update_ghost_values();
+    // the remap: dJbar = sum N dJ_I at the point
+    transfer::for_each_point_stencil<dim, K>(
+      grid, points, [&](unsigned int, It &it, const Stencil &s) { it->get_properties()[fbar_offset] = s.value(mj); });
   }
 
   template <int dim>
@@ -648,6 +724,8 @@ namespace talus::explicit_mpm
       {
         // APIC (contact, FEM, 2-phase, smoothing are refused with it)
         apic_nodal_velocity(h);
+        if (fbar_offset)
+          with_kernel([&](auto kernel) { volume_averages_with(kernel, h); });
         timings.grid += seconds_since(t0);
         t0 = Clock::now();
         with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
@@ -670,6 +748,8 @@ namespace talus::explicit_mpm
       contact->correct_velocities(*this, h);
     if (smoothing)
       smoothing->compute(*this, h);
+    if (fbar_offset)
+      with_kernel([&](auto kernel) { volume_averages_with(kernel, h); });
     timings.grid += seconds_since(t0);
     t0 = Clock::now();
     if (fem)

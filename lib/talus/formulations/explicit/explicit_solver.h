@@ -247,6 +247,14 @@ namespace talus::explicit_mpm
     void apic_nodal_velocity(const double dt);
     template <class Kernel>
     void g2p_update_apic_with(Kernel, const double dt);
+    /// numerics/volumetric stabilisation = f-bar, after the nodal velocity: each
+    /// point's dJ = det(I + h grad v) mapped to the nodes weighted by mass and
+    /// back (seed 002 Eqs. 79-80; transfer/fbar.h) into its property fbar_offset.
+    template <class Kernel>
+    void volume_averages_with(Kernel, const double dt);
+    /// F-bar: offset of the point's smoothed dJbar (0: off) and the nodal sum m dJ
+    unsigned int fbar_offset = 0;
+    Vector       nodal_dj;
     /// Relocation; moved points add their mass and force to the next step's sums.
     void relocate();
     void write_final_particles() const;

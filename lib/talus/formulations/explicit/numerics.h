@@ -63,6 +63,10 @@ namespace talus::explicit_mpm
     double      fill_factor  = 0.9;  ///< F_fill of Eq. 6.33
     bool        mixed_linear = true; ///< MPM-MIXED cell stress linear (else constant, Eq. 6.32 alone)
     Smoothing   smoothing    = Smoothing::none;
+    /// 'numerics/volumetric stabilisation' (transfer/fbar.h, docs/explicit.md "F-bar"):
+    /// f-bar = the increment's volume change replaced by the mass-weighted node
+    /// map and remap of the points' dJ (seed 002 Eqs. 79-80), any shape kernel
+    bool fbar = false;
 
     struct ContactPair
     {

@@ -109,14 +109,6 @@ namespace talus::implicit_mpm
                         "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
                         "pressure projection (seed 001 ch. 5; static analysis, neo hookean with 'volumetric energy "
                         "= split' or j2 plasticity, direct linear solver).");
-      prm.declare_entry("volumetric stabilisation", "none", Selection("none|f-bar"),
-                        "irreducible formulation: none, or f-bar: each point's constitutive update sees "
-                        "dFbar = (jbar / j)^(1/dim) dF (in-plane in 2D), jbar the volume-weighted mean of "
-                        "det dF over the points of its grid cell, and its volume follows jbar (de Souza Neto "
-                        "et al. 1996, with the cell as the patch; the exact tangent couples the points of a "
-                        "cell). Removes the volumetric locking of Q1 cells with several points (near "
-                        "incompressible elasticity, isochoric plastic flow). Not with 'mixed up' or "
-                        "'axisymmetric'.");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
@@ -242,7 +234,6 @@ namespace talus::implicit_mpm
     p.ramp_loads              = prm.get_bool("ramp loads");
     p.mixed_up                = prm.get("formulation") == "mixed up";
     p.stabilisation           = prm.get_double("stabilisation factor");
-    p.fbar                    = prm.get("volumetric stabilisation") == "f-bar";
     p.axisymmetric            = prm.get("geometry") == "axisymmetric";
     p.moving_velocity_regions = prm.get_bool("velocity regions follow");
     p.negligible_mass         = prm.get_double("negligible nodal mass");
@@ -252,10 +243,17 @@ namespace talus::implicit_mpm
     prm.leave_subsection();
     require(p.beta > 0, "implicit/newmark beta", "must be > 0 (beta = 0 is the explicit central difference)");
     Newmark(p.gamma, p.beta); // validates the pair
-    require(!p.fbar || !p.mixed_up, "implicit/volumetric stabilisation",
+    // 'numerics/volumetric stabilisation' is the shared scene's (scene_parameters.cc): here f-bar
+    // is the cell mean of det dF with its exact tangent (docs/implicit.md, "F-bar")
+    require(p.volumetric_stabilisation != transfer::VolumetricStabilisation::modified_f_bar,
+            "numerics/volumetric stabilisation",
+            "modified f-bar (the b_e scaling over patches of seed 002) is not implemented in talus-implicit; "
+            "allowed: none, f-bar");
+    p.fbar = p.volumetric_stabilisation == transfer::VolumetricStabilisation::f_bar;
+    require(!p.fbar || !p.mixed_up, "numerics/volumetric stabilisation",
             "'f-bar' is for 'formulation = irreducible' (the mixed u-p form treats the volume through its pressure "
             "field); allowed with 'mixed up': none");
-    require(!p.fbar || !p.bspline(), "implicit/volumetric stabilisation",
+    require(!p.fbar || !p.bspline(), "numerics/volumetric stabilisation",
             "'f-bar' (a mean over the points of a cell) is for 'shape function = linear': a B-spline point "
             "reaches beyond its cell; allowed with 'quadratic bspline': none");
     require(p.ghost_penalty == 0 || !p.bspline(), "implicit/ghost penalty",
@@ -266,7 +264,7 @@ namespace talus::implicit_mpm
     require(!p.bspline() || !p.axisymmetric, "numerics/shape function",
             "'quadratic bspline' is not available with 'geometry = axisymmetric' (the axis is no wall of the "
             "B-spline basis); allowed there: linear");
-    require(!p.fbar || !p.axisymmetric, "implicit/volumetric stabilisation",
+    require(!p.fbar || !p.axisymmetric, "numerics/volumetric stabilisation",
             "'f-bar' is not available with 'geometry = axisymmetric' (the hoop stretch is not in the cell mean); "
             "allowed there: none");
     prm.enter_subsection("rigid footing");

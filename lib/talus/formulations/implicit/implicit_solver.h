@@ -64,7 +64,7 @@ namespace talus::implicit_mpm
     /// V_p and m_p of a point are those of its ring (2 pi r x the seeded area),
     /// dF_zz = r_{n+1} / r_n is the hoop stretch (docs/implicit.md)
     bool axisymmetric = false;
-    /// 'implicit/volumetric stabilisation = f-bar' (irreducible form): each point's model sees
+    /// 'numerics/volumetric stabilisation = f-bar' (irreducible form): each point's model sees
     /// dFbar = (jbar / j)^(1/dim) dF, jbar the volume-weighted mean det dF of its grid cell,
     /// with the exact tangent (docs/implicit.md, "F-bar")
     bool fbar = false;

@@ -37,13 +37,9 @@ namespace talus::semi_implicit
     double conductivity = 0;   ///< hydraulic conductivity k_0 [m/s] (PoreLiquid::hydraulic_conductivity())
   };
 
-  /// Volumetric-locking stabilisation of the soil (seed 002 §4.4.2).
-  enum class VolumetricStabilisation
-  {
-    none,          ///< the increment dF as it is
-    f_bar,         ///< dF scaled by (node-smoothed dJ / dJ)^(1/dim) (Eqs. 79-80)
-    modified_f_bar ///< and b_e^t by (patch mean J^e / J^e)^(2/3) (Eqs. 81-83)
-  };
+  /// Volumetric-locking stabilisation of the soil (seed 002 §4.4.2):
+  /// 'numerics/volumetric stabilisation', the shared scene's (transfer/fbar.h).
+  using VolumetricStabilisation = transfer::VolumetricStabilisation;
 
   template <int dim>
   struct Parameters : SceneParameters<dim>, RunParameters<dim>
@@ -70,13 +66,12 @@ namespace talus::semi_implicit
     /// the ML hierarchy of the Poisson solve is rebuilt at every step that is a
     /// multiple of this (and when the pressure DoF set changes, at checkpoints);
     /// 1: every step
-    unsigned int            pressure_rebuild_interval = 100;
-    bool                    kozeny_carman             = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
-    bool                    pressure_smoothing        = true;  ///< Eq. 77 map-remap of the pore pressure every step
-    bool                    linear_smoothing          = true;  ///< the map carries each point's value by its gradient
-    double                  flip_fraction             = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
-    VolumetricStabilisation stabilisation             = VolumetricStabilisation::none;
-    double                  patch_size                = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
+    unsigned int pressure_rebuild_interval = 100;
+    bool         kozeny_carman             = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
+    bool         pressure_smoothing        = true;  ///< Eq. 77 map-remap of the pore pressure every step
+    bool         linear_smoothing          = true;  ///< the map carries each point's value by its gradient
+    double       flip_fraction             = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
+    double       patch_size                = 1.5;   ///< side of the modified F-bar patches in cells (Eq. 83)
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;

@@ -81,13 +81,6 @@ namespace talus::semi_implicit
       prm.declare_entry("flip fraction", "1", Double(0, 1),
                         "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
                         "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
-      prm.declare_entry("volumetric stabilisation", "none", Selection("none|f-bar|modified f-bar"),
-                        "Soil volumetric-locking stabilisation (seed 002 §4.4.2). none: the increment dF as "
-                        "computed. f-bar: dF scaled by (dJbar / dJ)^(1/dim), dJbar the mass-weighted node map "
-                        "and remap of the points' dJ (Eqs. 79-80). modified f-bar: in addition the elastic b_e "
-                        "of the last step scaled by (Jebar / J^e)^(2/3), Jebar the mass-weighted mean of "
-                        "J^e = sqrt(det b_e) over the soil points of a fixed square patch (Eqs. 81-83); needs a "
-                        "model that keeps b_e (hencky mohr coulomb, nor sand, neo hookean).");
       prm.declare_entry("point sets", "double", Selection("double|single"),
                         "double: soil and water are two sets of material points, each moving with its own "
                         "velocity (the paper's double-point method). single: the water is carried on the soil "
@@ -241,10 +234,6 @@ namespace talus::semi_implicit
           }
       }
       {
-        const std::string st       = prm.get("volumetric stabilisation");
-        p.stabilisation            = st == "f-bar"            ? VolumetricStabilisation::f_bar
-                                     : st == "modified f-bar" ? VolumetricStabilisation::modified_f_bar
-                                                              : VolumetricStabilisation::none;
         p.patch_size               = prm.get_double("patch size");
         p.single_point             = prm.get("point sets") == "single";
         p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
@@ -384,14 +373,14 @@ namespace talus::semi_implicit
       require(any_soil, phases,
               "the scene has no soil points (free water needs a skeleton for the drag and the mixture): give a "
               "body phase = saturated or soil");
-      if (p.stabilisation == VolumetricStabilisation::modified_f_bar)
+      if (p.volumetric_stabilisation == VolumetricStabilisation::modified_f_bar)
         for (unsigned int b = 0; b < p.bodies.size(); ++b)
           if (p.phase_of_body[b] != Phase::water)
             for (const unsigned int mid : p.materials_of_body[b])
               {
                 const auto &m = *p.materials[mid];
                 require(
-                  m.keeps_elastic_b(), "semi implicit/volumetric stabilisation",
+                  m.keeps_elastic_b(), "numerics/volumetric stabilisation",
                   "modified f-bar needs a model that keeps the elastic left Cauchy-Green tensor b_e, but material " +
                     std::to_string(mid) + " (of body " + std::to_string(b) + ") is '" + m.model_name() +
                     "'; allowed: hencky mohr coulomb, nor sand, neo hookean (or volumetric stabilisation = none | "

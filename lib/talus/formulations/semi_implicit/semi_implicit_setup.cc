@@ -130,9 +130,9 @@ namespace talus::semi_implicit
     bloads.extend_layout(soil.layout, fs.surface_offset); // the point tractions' slots
     fs.poisson_coefficient = soil.layout.add_extra("poisson_coefficient", 1);
     fs.poisson_flux        = soil.layout.add_extra("poisson_flux", dim, true);
-    if (prm.stabilisation != VolumetricStabilisation::none)
+    if (prm.volumetric_stabilisation != VolumetricStabilisation::none)
       fs.smoothed_volume_increment = soil.layout.add_extra("smoothed_volume_increment", 1);
-    if (prm.stabilisation == VolumetricStabilisation::modified_f_bar)
+    if (prm.volumetric_stabilisation == VolumetricStabilisation::modified_f_bar)
       fs.patch_elastic_jacobian = soil.layout.add_extra("patch_elastic_jacobian", 1);
     for (const auto &m : prm.materials)
       smooth_jacobian = smooth_jacobian || (prm.smoothed_specific_volume && m->has_specific_volume());

@@ -17,7 +17,7 @@
 #include <talus/formulations/common/probes.h>
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/semi_implicit/boundary_loads.h>
-#include <talus/formulations/semi_implicit/fbar.h>
+#include <talus/transfer/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
@@ -293,8 +293,8 @@ namespace talus::semi_implicit
     Vector                     Mdj; // F-bar: sum N m dJ of the soil points
     Vector                     Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
     // modified F-bar patches: a fixed square tiling from the grid's lower corner
-    PatchTiling<dim>    patches;
-    std::vector<double> patch_mass, patch_mass_Je;
+    transfer::PatchTiling<dim> patches;
+    std::vector<double>        patch_mass, patch_mass_Je;
 
 
     // rigid plates (issue 37; docs/semi-implicit.md 'Rigid plate'): per local

@@ -6,7 +6,7 @@
 // and stress (with the F-bar averages) and the move of both sets.
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
-#include <talus/formulations/semi_implicit/fbar.h>
+#include <talus/transfer/fbar.h>
 #include <talus/formulations/semi_implicit/semi_implicit_solver.h>
 #include <talus/loads/rigid_plate.h>
 #include <talus/materials/material.h>
@@ -177,7 +177,7 @@ namespace talus::semi_implicit
       plate_node_spread(this_step);
     add_lap(phase.n2p);
 
-    if (prm.stabilisation != VolumetricStabilisation::none || smooth_jacobian)
+    if (prm.volumetric_stabilisation != VolumetricStabilisation::none || smooth_jacobian)
       volume_averages<K>(h, this_step.ms_cut);
     update_and_move_points<K>(this_step);
     if (this_step.initial_stage && !initialising(time + h))
@@ -1352,16 +1352,17 @@ namespace talus::semi_implicit
       // the increment the model sees: ΔF, or ΔF-bar (79); the modified F-bar
       // also replaces the model's b_e by b_e-bar (82) before the push (81)
       dealii::Tensor<2, 3> dF_model = dF;
-      if (s.prm.stabilisation != VolumetricStabilisation::none)
+      if (s.prm.volumetric_stabilisation != VolumetricStabilisation::none)
         {
           const double dJ_bar = P[s.fs.smoothed_volume_increment];
           if (!(dJ_bar > 0))
             throw InstabilityError("a soil point's smoothed volume increment (F-bar) " + std::to_string(dJ_bar) +
                                    " is not positive");
-          if (s.prm.stabilisation == VolumetricStabilisation::modified_f_bar)
-            scale_elastic_b(history, P[s.fs.patch_elastic_jacobian] /
-                                       m.elastic_jacobian(dealii::ArrayView<const double>(history, m.n_history())));
-          dF_model = stabilised_increment<dim>(dF, dJ_bar);
+          if (s.prm.volumetric_stabilisation == VolumetricStabilisation::modified_f_bar)
+            transfer::scale_elastic_b(history,
+                                      P[s.fs.patch_elastic_jacobian] /
+                                        m.elastic_jacobian(dealii::ArrayView<const double>(history, m.n_history())));
+          dF_model = transfer::stabilised_increment<dim>(dF, dJ_bar);
         }
       P[L::volume] *= dJ;             // (8d)
       if (s.bloads.carries_offsets()) // the loaded face moves with the material: d <- dF d (0 stays 0)
@@ -1456,10 +1457,10 @@ namespace talus::semi_implicit
   void
   Solver<dim>::volume_averages(const double h, const double ms_cut)
   {
-    const bool fbar     = prm.stabilisation != VolumetricStabilisation::none;
+    const bool fbar     = prm.volumetric_stabilisation != VolumetricStabilisation::none;
     using Stencil       = transfer::PointStencil<dim, K>;
     using It            = transfer::PointIterator<dim>;
-    const bool modified = prm.stabilisation == VolumetricStabilisation::modified_f_bar;
+    const bool modified = prm.volumetric_stabilisation == VolumetricStabilisation::modified_f_bar;
     if (modified)
       {
         patch_mass.assign(patches.size(), 0.0);
@@ -1476,13 +1477,7 @@ namespace talus::semi_implicit
           double *P = it->get_properties().data();
           double  gv[dim][dim];
           s.vector_gradient(v, gv);
-          dealii::Tensor<2, 3> dF; // I + h grad v (plane strain: dF_33 = 1)
-          for (unsigned int i = 0; i < 3; ++i)
-            dF[i][i] = 1;
-          for (unsigned int i = 0; i < dim; ++i)
-            for (unsigned int j = 0; j < dim; ++j)
-              dF[i][j] += h * gv[i][j];
-          const double dJ = dealii::determinant(dF);
+          const double dJ = dealii::determinant(transfer::increment_tensor<dim>(gv, h)); // I + h grad v
           if (fbar)
             s.scatter(mj, P[L::mass] * dJ);
           if (smooth_jacobian) // J^{t+1} = (V / V0) dJ

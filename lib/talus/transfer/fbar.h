@@ -1,7 +1,11 @@
-// talus — the F-bar pieces of the semi-implicit family (seed 002 §4.4.2,
-// Eqs. 79-83) that need no grid: the stabilised increment a soil point's model
-// sees, and the fixed patch tiling of the modified F-bar. The averages (the node
-// map-remap of dJ, the patch means of J^e) are walks in semi_implicit_step.cc.
+// talus — the F-bar of seed 002 §4.4.2 (Eqs. 79-83), shared by the explicit
+// and semi-implicit families (numerics/volumetric stabilisation): a point's volume increment dJ from
+// the nodal velocity on its stencil, the stabilised increment its model sees,
+// the modified F-bar's b_e scaling and its fixed patch tiling. Kernel-agnostic:
+// the stencil is transfer::PointStencil<dim, K> of any shape policy. The node
+// map-remap of dJ is a walk of each family (its nodal vectors and fused sums:
+// Solver::volume_averages in both), made of volume_increment and
+// PointStencil::scatter / value.
 #pragma once
 
 #include <deal.II/base/point.h>
@@ -12,8 +16,33 @@
 #include <cmath>
 #include <vector>
 
-namespace talus::semi_implicit
+namespace talus::transfer
 {
+  /// 'numerics/volumetric stabilisation' of every family (declared with the
+  /// shared scene, formulations/common/scene_parameters.cc); each family refuses
+  /// what it does not implement, naming the entry.
+  enum class VolumetricStabilisation
+  {
+    none,          ///< the increment dF as it is
+    f_bar,         ///< dF scaled by (smoothed dJ / dJ)^(1/dim) (seed 002 Eqs. 79-80; implicit: cell mean)
+    modified_f_bar ///< and b_e^t by (patch mean J^e / J^e)^(2/3) (Eqs. 81-83; semi-implicit only)
+  };
+
+  /// The increment dF = I + h grad v of a point (grad v of the nodal velocity
+  /// on its stencil, gv[i][j] = d v_i / d x_j; plane strain in 2D: dF_33 = 1).
+  template <int dim>
+  inline dealii::Tensor<2, 3>
+  increment_tensor(const double (&gv)[dim][dim], const double h)
+  {
+    dealii::Tensor<2, 3> dF;
+    for (unsigned int i = 0; i < 3; ++i)
+      dF[i][i] = 1;
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int j = 0; j < dim; ++j)
+        dF[i][j] += h * gv[i][j];
+    return dF;
+  }
+
   /// dF-bar = (dJbar / dJ)^(1/dim) dF (Eq. 79; in 2D the in-plane block, the
   /// paper's dof = 2): the increment a soil point's model sees with either F-bar.
   template <int dim>
@@ -85,4 +114,4 @@ namespace talus::semi_implicit
       return k;
     }
   };
-} // namespace talus::semi_implicit
+} // namespace talus::transfer
