@@ -42,6 +42,15 @@ namespace talus
         arrays.push_back(std::move(a));
         k += size;
       }
+    // property k of point i goes to first[k][i * stride[k]]
+    std::vector<float *>      first(slot.size());
+    std::vector<unsigned int> stride(slot.size());
+    for (unsigned int k = 0; k < slot.size(); ++k)
+      {
+        auto &a   = arrays[slot[k].first];
+        first[k]  = a.f32.data() + slot[k].second;
+        stride[k] = a.n_components;
+      }
     std::vector<float> points(3 * n, 0.0f);
     std::size_t        i = 0;
     for (const auto &pt : set.handler)
@@ -51,11 +60,8 @@ namespace talus
         for (unsigned int d = 0; d < dim; ++d)
           points[3 * i + d] = static_cast<float>(x[d]);
         const auto P = pt.get_properties();
-        for (unsigned int k = 0; k < slot.size(); ++k)
-          {
-            auto &a                                    = arrays[slot[k].first];
-            a.f32[i * a.n_components + slot[k].second] = static_cast<float>(P[k]);
-          }
+        for (unsigned int k = 0; k < first.size(); ++k)
+          first[k][i * stride[k]] = static_cast<float>(P[k]);
         ++i;
       }
     const std::string file = io::write_points_vtu(points, arrays, time, directory, name, counter, comm);
