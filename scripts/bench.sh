@@ -2,8 +2,8 @@
 # make bench: the explicit MPM benchmark (3D soft block spreading under gravity,
 # 8 material points per cell, 1.31M points, fixed number of steps, one rank), with
 # linear shape functions and then with quadratic B-splines.
-# Prints ns per particle-step with a breakdown and the fraction of material points
-# that changed cell per step. Then the parallel figures (issue 15) of the 3D block
+# Prints ns per particle-step with a breakdown, the fraction of material points
+# that changed cell per step and the cost of a VTU snapshot in steps. Then the parallel figures (issue 15) of the 3D block
 # and of a 2D column collapse in the corner of a wide box: 1 rank, two concurrent
 # 1-rank runs (the memory-bandwidth ceiling of 2 ranks), 2 ranks (and 2 ranks with
 # load balancing for the corner scene): speed-up, efficiency against the ceiling,
@@ -36,7 +36,7 @@ python3 - "$LOG" <<'PY'
 import re, sys
 text = open(sys.argv[1]).read()
 b = re.search(r"breakdown \[s\]: P2G ([\d.e+-]+), grid ([\d.e+-]+), G2P\+stress ([\d.e+-]+), relocation ([\d.e+-]+) \(moves [\d.e+-]+, sorts [\d.e+-]+\), "
-              r"output ([\d.e+-]+); particles moved cell (\d+)", text)
+              r"output ([\d.e+-]+) \((\d+) VTU snapshots ([\d.e+-]+)\); particles moved cell (\d+)", text)
 d = re.search(r"done: (\d+) steps, (\d+) particles, wall ([\d.e+-]+) s", text)
 steps, n, wall = int(d.group(1)), int(d.group(2)), float(d.group(3))
 ps = steps * n
@@ -45,7 +45,13 @@ print("\nbench summary: %d material points, %d steps, wall %.1f s" % (n, steps, 
 for name, v in zip(names, b.groups()[:5]):
     print("  %-30s %7.1f ns/particle-step" % (name, 1e9 * float(v) / ps))
 print("  %-30s %7.1f ns/particle-step" % ("total", 1e9 * wall / ps))
-print("  material points changing cell per step: %.1f %%" % (100.0 * int(b.group(6)) / ps))
+print("  material points changing cell per step: %.1f %%" % (100.0 * int(b.group(8)) / ps))
+# a VTU snapshot against a step: the loop's wall time without its output, per step (the first
+# snapshot is written before the loop, the last one inside it)
+n_snap, t_snap = int(b.group(6)), float(b.group(7))
+step = (wall - float(b.group(5))) / steps
+print("  VTU snapshot: %.3f s each (%d written), a step %.3f s: snapshot = %.2f steps (goal <= 1)"
+      % (t_snap / n_snap, n_snap, step, t_snap / n_snap / step))
 PY
 done
 

@@ -3,7 +3,7 @@
 # Does nothing (and needs no network) when everything is already present.
 set -euo pipefail
 PKGS=(cmake ninja-build g++ make libdeal.ii-dev libeigen3-dev gmsh libgmsh-dev libhdf5-dev
-      libgtest-dev openmpi-bin ccache gnuplot-nox python3 clang-format-14)
+      libgtest-dev openmpi-bin ccache gnuplot-nox python3 python3-vtk9 clang-format-14)
 missing=()
 for p in "${PKGS[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -168,3 +168,13 @@ set_tests_properties(verification.explicit_load_balance PROPERTIES PROCESSORS 2)
 # ranks rebalancing at every check, bitwise restart across rebalances; FEM refused)
 talus_verification(explicit_load_balance_features check_load_balance_features.py verification/load_balance_collapse.prm)
 set_tests_properties(verification.explicit_load_balance_features PROPERTIES PROCESSORS 2)
+
+# the point-set VTU files (raw appended binary) read by VTK's own readers and by talus-plot,
+# against particles_final.csv, on 1 and 2 ranks (one rank without points). VTK's python module
+# is the Debian package python3-vtk9 (scripts/install-deps.sh), so this runs the Debian python3,
+# not the first python3 on PATH (which may be a pyenv one without Debian's packages).
+find_program(TALUS_DEBIAN_PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH REQUIRED)
+add_test(NAME verification.explicit_vtu_vtk_reader
+         COMMAND ${TALUS_DEBIAN_PYTHON3} ${_v}/check_vtu.py ${TALUS_TOOLS_DIR} ${_w}/explicit_vtu_vtk_reader)
+set_tests_properties(verification.explicit_vtu_vtk_reader PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     PROCESSORS 2 TIMEOUT 600)

@@ -57,6 +57,9 @@ namespace talus
   {
     double output = 0; ///< series rows, VTU, checkpoints
     double total  = 0; ///< the whole loop
+    /// the VTU snapshots (write_vtu) of the run, the one before the loop included
+    double       snapshots   = 0;
+    unsigned int n_snapshots = 0;
   };
 
   enum class StepOutcome

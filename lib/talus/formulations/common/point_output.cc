@@ -3,7 +3,6 @@
 #include <talus/io/vtu.h>
 
 #include <deal.II/base/mpi.h>
-#include <deal.II/particles/data_out.h>
 
 #include <algorithm>
 #include <iomanip>
@@ -16,13 +15,56 @@ namespace talus
                   const unsigned int counter, const double time, std::vector<std::pair<double, std::string>> &records,
                   MPI_Comm comm)
   {
-    dealii::Particles::DataOut<dim> out;
-    out.build_patches(set.handler, set.layout.names(), set.layout.interpretations());
-    dealii::DataOutBase::VtkFlags flags;
-    flags.time              = time;
-    flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
-    out.set_flags(flags);
-    const std::string file = io::write_vtu_atomic(out, directory, name, counter, comm);
+    using namespace dealii::DataComponentInterpretation;
+    // the arrays: "id", then the properties in layout order, a run of vector
+    // components of one name as one 3-component array (zero z in 2D)
+    const auto                     names  = set.layout.names();
+    const auto                     interp = set.layout.interpretations();
+    const auto                     n      = set.handler.n_locally_owned_particles();
+    std::vector<io::VtuPointArray> arrays(1);
+    arrays[0].name    = "id";
+    arrays[0].integer = true;
+    arrays[0].u64.reserve(n);
+    std::vector<std::pair<unsigned int, unsigned int>> slot(names.size()); // property -> (array, component)
+    for (unsigned int k = 0; k < names.size();)
+      {
+        unsigned int size = 1;
+        if (interp[k] == component_is_part_of_vector)
+          while (k + size < names.size() && interp[k + size] == component_is_part_of_vector &&
+                 names[k + size] == names[k] && size < dim)
+            ++size;
+        io::VtuPointArray a;
+        a.name         = names[k];
+        a.n_components = interp[k] == component_is_part_of_vector ? 3 : 1;
+        a.f32.assign(n * a.n_components, 0.0f);
+        for (unsigned int c = 0; c < size; ++c)
+          slot[k + c] = {static_cast<unsigned int>(arrays.size()), c};
+        arrays.push_back(std::move(a));
+        k += size;
+      }
+    // property k of point i goes to first[k][i * stride[k]]
+    std::vector<float *>      first(slot.size());
+    std::vector<unsigned int> stride(slot.size());
+    for (unsigned int k = 0; k < slot.size(); ++k)
+      {
+        auto &a   = arrays[slot[k].first];
+        first[k]  = a.f32.data() + slot[k].second;
+        stride[k] = a.n_components;
+      }
+    std::vector<float> points(3 * n, 0.0f);
+    std::size_t        i = 0;
+    for (const auto &pt : set.handler)
+      {
+        arrays[0].u64.push_back(pt.get_id());
+        const auto x = pt.get_location();
+        for (unsigned int d = 0; d < dim; ++d)
+          points[3 * i + d] = static_cast<float>(x[d]);
+        const auto P = pt.get_properties();
+        for (unsigned int k = 0; k < first.size(); ++k)
+          first[k][i * stride[k]] = static_cast<float>(P[k]);
+        ++i;
+      }
+    const std::string file = io::write_points_vtu(points, arrays, time, directory, name, counter, comm);
     records.emplace_back(time, file);
     if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       io::write_pvd(directory + "/" + name + ".pvd", records);

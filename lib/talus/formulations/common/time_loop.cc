@@ -147,11 +147,18 @@ namespace talus
     };
 
     f.prepare_output();
-    auto &counters = f.counters;
+    auto       &counters = f.counters;
+    LoopTimings timings;
+    const auto  snapshot = [&]() {
+      const auto t0 = Clock::now();
+      f.write_vtu(counters.vtu_counter++);
+      timings.snapshots += seconds_since(t0);
+      ++timings.n_snapshots;
+    };
     if (!restored)
       {
         write_series_row(false);
-        f.write_vtu(counters.vtu_counter++);
+        snapshot();
         counters.next_series     = settings.series_interval;
         counters.next_vtu        = settings.vtu_interval;
         counters.next_checkpoint = settings.checkpoint_interval;
@@ -174,7 +181,6 @@ namespace talus
       return due;
     };
 
-    LoopTimings timings;
     const auto  t_start  = Clock::now();
     auto        t_report = t_start;
     bool        failed   = false; // unstable or stopped: the run ends after series.csv is closed
@@ -237,7 +243,7 @@ namespace talus
               }
             if ((settings.vtu_interval > 0 && f.time >= counters.next_vtu - eps_t) || last_step)
               {
-                f.write_vtu(counters.vtu_counter++);
+                snapshot();
                 while (settings.vtu_interval > 0 && counters.next_vtu <= f.time + eps_t)
                   counters.next_vtu += settings.vtu_interval;
               }

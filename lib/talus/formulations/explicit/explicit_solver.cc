@@ -1133,9 +1133,10 @@ namespace talus::explicit_mpm
                              sent  = dealii::Utilities::MPI::sum(rs.sent_to_ranks, comm);
     log() << std::setprecision(4) << "  breakdown [s]: P2G " << timings.p2g << ", grid " << timings.grid
           << ", G2P+stress " << timings.g2p << ", relocation " << timings.relocation << " (moves " << rs.seconds_moves
-          << ", sorts " << rs.seconds_sorts << "), output " << timings.output << "; particles moved cell " << moved
-          << " (to other ranks " << sent << "), full sorts " << rs.global_sorts << ", memory-order sorts "
-          << rs.storage_sorts << ", lost " << rs.lost;
+          << ", sorts " << rs.seconds_sorts << "), output " << timings.output << " (" << loop_timings.n_snapshots
+          << " VTU snapshots " << loop_timings.snapshots << ")"
+          << "; particles moved cell " << moved << " (to other ranks " << sent << "), full sorts " << rs.global_sorts
+          << ", memory-order sorts " << rs.storage_sorts << ", lost " << rs.lost;
     log() << balance.summary();
     log() << "\n";
     log() << "talus-explicit: done: " << step_number << " steps, " << n_particles() << " particles, wall "
