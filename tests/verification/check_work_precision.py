@@ -1,0 +1,72 @@
+"""The fast subset of the work-precision campaign (issue 42): every family of every scene of
+tests/verification/work_precision.py (talus-explicit, talus-fem, talus-implicit,
+talus-semi-implicit on the shared scene fragments parameter_files/work_precision/scenes/*.inc)
+run by talus-convergence at the scene's two smallest resolutions (Scene.fast_values). Checks:
+  * every run completes and the family's criterion holds on the two runs: the pairwise order
+    within the stated range (bar: explicit [1.8, 2.6], implicit Newmark [1.8, 3.6]; cantilever
+    [1.5, 2.3] for MPM damped to rest, UL-FEM and implicit static; Terzaghi explicit [0.8, 1.2])
+    and/or every error below the stated bound (Terzaghi semi-implicit: 3e-3);
+  * the work measures of each tool: talus-implicit reports Newton and linear iterations (> 0,
+    linear >= Newton), talus-semi-implicit pressure CG iterations (> 0) and no Newton
+    iterations, talus-explicit / talus-fem neither; every run reports its points and steps and
+    a time-loop wall time no longer than the whole process;
+  * the same scene gives the same problem to every tool: on the coarser resolution the families
+    of a scene that share the cell size also share the number of points of the solid.
+Usage: check_work_precision.py TOOLS_DIR WORKDIR
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import talus_verify as tv
+import work_precision as wp
+
+tools, work = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+tool = os.path.join(tools, "talus-convergence")
+
+for sc in wp.SCENES:
+    points = {}
+    for f in sc.families:
+        text = open(os.path.join(wp.PRM_DIR, f.name + ".prm")).read()
+        text = re.sub(r"(?m)^(\s*set base parameter file\s*=\s*)(\S+)\s*$",
+                      lambda m: m.group(1) + os.path.join(wp.PRM_DIR, m.group(2)), text)
+        text = tv.prm_set(text, "family/values", ", ".join(str(v) for v in sc.fast_values))
+        text = tv.prm_set(text, "output/directory", f.name)
+        text = tv.prm_set(text, "output/plots", "false")
+        prm = os.path.join(work, f.name + ".prm")
+        with open(prm, "w") as fh:
+            fh.write(text)
+        p = subprocess.run([tool, prm], cwd=work, capture_output=True, text=True, env=tv.child_env())
+        print(p.stdout[-1500:])
+        if p.returncode != 0:
+            print(p.stderr[-1500:])
+            tv.check(False, f"{sc.name}: {f.name}: talus-convergence exit {p.returncode}")
+            continue
+        r = tv.read_csv(os.path.join(work, f.name, f.name + ".csv"))
+        order = tv.read_csv(os.path.join(work, f.name, f.name + "_summary.csv"))["observed_order"][0]
+        errs = r["error"]
+        tv.check(len(errs) == 2 and f.holds(order, errs),
+                 f"{sc.name}: {f.name} at N = {sc.fast_values}: errors {', '.join(f'{e:.3e}' for e in errs)}, "
+                 f"order {order:.3f}; criterion: {f.criterion()}")
+        newton, linear = r["newton_iterations"], r["linear_iterations"]
+        if f.tool == "talus-implicit":
+            ok = all(n > 0 and l >= n for n, l in zip(newton, linear))
+        elif f.tool == "talus-semi-implicit":
+            ok = all(n == 0 and l > 0 for n, l in zip(newton, linear))
+        else:
+            ok = all(n == 0 and l == 0 for n, l in zip(newton, linear))
+        tv.check(ok, f"{sc.name}: {f.name} ({f.tool}): Newton iterations {newton}, linear iterations {linear}")
+        ok = all(n > 0 and s > 0 and 0 < w <= t for n, s, w, t in
+                 zip(r["n_particles"], r["n_steps"], r["solver_wall_s"], r["run_time_s"]))
+        tv.check(ok, f"{sc.name}: {f.name}: points {r['n_particles']}, steps {r['n_steps']}, loop "
+                 f"{r['solver_wall_s']} s within the run time {r['run_time_s']} s")
+        # the solid's points of the coarser run (the semi-implicit count holds soil + water)
+        n = r["n_particles"][0] / (2 if f.tool == "talus-semi-implicit" else 1)
+        points[f.name] = n
+    tv.check(len(set(points.values())) == 1,
+             f"{sc.name}: every family seeds the same solid from the shared fragment ({points})")
+tv.finish()
