@@ -15,7 +15,9 @@ campaign only). Checks:
   * the same scene gives the same problem to every tool: on the coarser resolution the families
     of a scene that share the cell size also share the number of points of the solid;
   * the `value` reference of talus-convergence refuses V = 0, a missing V and a missing quantity
-    (exit 2, naming the entry, nothing written).
+    (exit 2, naming the entry, nothing written);
+  * the `particles:<column>:front` quantity (the column collapse's run-out) on points of known
+    spacing: the front of the contiguous body to 1e-12, a stray point left out.
 Usage: check_work_precision.py TOOLS_DIR WORKDIR
 """
 import os
@@ -75,6 +77,23 @@ for sc in wp.SCENES:
         points[f.name] = n
     tv.check(len(set(points.values())) == 1,
              f"{sc.name}: every family seeds the same solid from the shared fragment ({points})")
+# particles:<column>:front (the column collapse's run-out): the front of the contiguous body,
+# strays left out, on points of known spacing: 10 x 3 points at x = 0.05 .. 0.95 (volume 0.01,
+# width 0.1) and one stray at x = 2: the front is 0.95 + 0.05 = 1 (to rounding), whatever the stray
+import importlib.machinery  # noqa: E402
+import importlib.util  # noqa: E402
+
+loader = importlib.machinery.SourceFileLoader("talus_convergence", tool)
+spec = importlib.util.spec_from_loader("talus_convergence", loader)
+tc = importlib.util.module_from_spec(spec)
+loader.exec_module(tc)
+pts = {"pos_x": [0.05 + 0.1 * i for i in range(10) for _ in range(3)] + [2.0], "volume": [0.01] * 31}
+f = tc._front(pts["pos_x"], pts)
+tv.check(abs(f - 1.0) < 1e-12, f"particles:pos_x:front of a block 0..1 and a stray at 2: {f:.15g} = 1")
+pts["pos_x"][-1] = 1.04  # a point in the next bin joins the body
+f = tc._front(pts["pos_x"], pts)
+tv.check(abs(f - 1.09) < 1e-12, f"particles:pos_x:front with a point at 1.04 joining the body: {f:.15g} = 1.09")
+
 # the 'value' reference (the footing's common reference): bad input is refused before any run
 # or output, naming the entry (exit 2)
 base = open(os.path.join(wp.PRM_DIR, "footing_implicit.prm")).read()

@@ -97,8 +97,8 @@ SCENES = [
           [8, 16]),
     Scene("column_collapse", "dynamic, large deformation",
           "the seed 001 granular column collapse, a = 1.2 (scenes/column_collapse.inc)",
-          "run-out (the largest x of a point at t = 0.8 s) against the family's finest run (`richardson`, "
-          "`particles:pos_x:max`), in m; h = d_i/N, talus-explicit N = 12, 18, 24, 36, talus-implicit N = 12, "
+          "run-out (the front of the contiguous deposit at t = 0.8 s, points ahead of its first gap left out) "
+          "against the family's finest run (`richardson`, `particles:pos_x:front`), in m; h = d_i/N, talus-explicit N = 12, 18, 24, 36, talus-implicit N = 12, "
           "18, 24 (the finest run of each family is its reference and has no error)",
           [Family("column_collapse_explicit", "talus-explicit", "Courant 0.5",
                   why="no order expected of the front of a plastic flow: self-convergence", shrinks=True),
