@@ -2,7 +2,9 @@
 """The verification campaign of `make verify` (issue 6).
 
 1. convergence families (talus-convergence on parameter_files/convergence/*.prm);
-2. stability stress tests, each pass/fail by a stated criterion (and the cell-crossing
+2. the work-precision campaign across the families (issue 42: shared scenes, one
+   talus-convergence family per tool and option set, tests/verification/work_precision.py);
+3. stability stress tests, each pass/fail by a stated criterion (and the cell-crossing
    growth rate measured against the Floquet analysis):
    * Courant sweeps (talus-critical-dt --probe: bisection on forced runs) of the explicit
      formulations: 1-phase solid (bar), 1-phase liquid (water column), 2-phase (Terzaghi);
@@ -10,7 +12,7 @@
      total energy balance;
    * near-incompressible elasticity (nu = 0.49, 0.499) with and without strain smoothing
      (tests/verification/check_smoothing.py);
-3. regenerates docs/verification/README.md (+ csv/, png/) from the CSVs of this run.
+4. regenerates docs/verification/README.md (+ csv/, png/) from the CSVs of this run.
 
 Usage: verify_campaign.py BUILD_DIR [--only=a,b] [--readme-only]
 Exit 0 if every criterion holds, 1 otherwise (the README is written in both cases).
@@ -115,6 +117,91 @@ def run_families(build, work, only):
             shutil.copy(os.path.join(out, f), os.path.join(DOCS, "csv", f))
         for f in (name + "_error.png", name + "_work.png"):
             shutil.copy(os.path.join(out, f), os.path.join(DOCS, "png", f))
+
+
+def _wp():
+    sys.path.insert(0, os.path.join(ROOT, "tests", "verification"))
+    import work_precision
+    return work_precision
+
+
+WP_CSV = os.path.join(DOCS, "csv", "work_precision")
+
+
+def wp_rows(name):
+    p = os.path.join(WP_CSV, name + ".csv")
+    return read_csv(p) if os.path.isfile(p) else None
+
+
+def wp_summary(name):
+    p = os.path.join(WP_CSV, name + "_summary.csv")
+    return read_csv(p)[0] if os.path.isfile(p) else None
+
+
+def plot_work_precision(wp, scene, work):
+    """One figure per scene: error against the wall time of the time loop, log-log, one line
+    per family and option set (from the CSVs in csv/work_precision/)."""
+    d = os.path.join(work, "work_precision")
+    os.makedirs(d, exist_ok=True)
+    plots = []
+    for i, f in enumerate(scene.families):
+        rows = wp_rows(f.name)
+        if not rows:
+            continue
+        data = os.path.join(d, f"{scene.name}_{f.name}.dat")
+        write_atomic(data, "".join(f"{r['solver_wall_s']:.10g} {r['error']:.10g}\n" for r in rows
+                                   if r["error"] > 0 and r["solver_wall_s"] > 0))
+        plots.append(f"'{data}' using 1:2 with linespoints lw 2 pt {5 + i} title '{f.tool}: {f.options}'")
+    if not plots:
+        return
+    out = os.path.join(DOCS, "png", wp.figure_name(scene))
+    script = ("set terminal pngcairo size 720,520 noenhanced\nset logscale xy\nset grid\nset key top right\n"
+              "set format y '%.0e'\n"
+              f"set output '{out}.part'\nset title 'work-precision: {scene.name} ({scene.kind})'\n"
+              "set xlabel 'wall time of the time loop [s]'\nset ylabel 'error'\n"
+              "plot " + ", ".join(plots) + "\n")
+    p = subprocess.run(["gnuplot"], input=script, text=True, capture_output=True)
+    if p.returncode != 0:
+        print("FAIL: gnuplot: " + p.stderr[-500:])
+        return
+    os.replace(out + ".part", out)
+
+
+def run_work_precision(build, work, only):
+    """The work-precision campaign across the families (issue 42): every family of every
+    scene (tests/verification/work_precision.py) by talus-convergence; CSVs to
+    csv/work_precision/, one figure per scene to png/."""
+    wp = _wp()
+    tool = os.path.join(build, "tools", "talus-convergence")
+    os.makedirs(WP_CSV, exist_ok=True)
+    for scene in wp.SCENES:
+        if only and "work_precision" not in only and scene.name not in only:
+            continue
+        for f in scene.families:
+            print(f"== work-precision: {scene.name}: {f.name}", flush=True)
+            p = subprocess.run([tool, os.path.join(wp.PRM_DIR, f.name + ".prm")], cwd=work, capture_output=True,
+                               text=True, env=env())
+            print(p.stdout[-2000:], p.stderr[-2000:])
+            if p.returncode != 0:
+                print(f"FAIL: talus-convergence {f.name}: exit {p.returncode}")
+                continue
+            out = os.path.join(work, "work_precision", f.name)
+            for x in (f.name + ".csv", f.name + "_summary.csv"):
+                shutil.copy(os.path.join(out, x), os.path.join(WP_CSV, x))
+        plot_work_precision(wp, scene, work)
+    if only and "work_precision" not in only and "terzaghi_k1e-7" not in only:
+        return
+    for name, _, _ in wp.LOW_K:  # the cost probes of Terzaghi at k = 1e-7
+        print(f"== work-precision: terzaghi_k1e-7 cost probe: {name}", flush=True)
+        p = subprocess.run([tool, os.path.join(wp.PRM_DIR, name + ".prm")], cwd=work, capture_output=True,
+                           text=True, env=env())
+        print(p.stdout[-1500:], p.stderr[-1500:])
+        if p.returncode != 0:
+            print(f"FAIL: talus-convergence {name}: exit {p.returncode}")
+            continue
+        out = os.path.join(work, "work_precision", name)
+        for x in (name + ".csv", name + "_summary.csv"):
+            shutil.copy(os.path.join(out, x), os.path.join(WP_CSV, x))
 
 
 def run_sweeps(build, work, only):
@@ -300,6 +387,9 @@ def readme():
                      f"{x['run_time_s']:.2f} | {x['solver_wall_s']:.4f} | {int(x['n_particles'])} | {int(x['n_steps'])} | "
                      f"{x['ns_per_particle_step']:.0f} |")
         L += ["", f"![error]({'png/' + name + '_error.png'}) ![work-precision]({'png/' + name + '_work.png'})", ""]
+    wp_lines, wp_ok = _wp().section(wp_rows, wp_summary)
+    L += wp_lines
+    ok_all = ok_all and wp_ok
     L += ["## Stability stress tests", "", "### Courant sweeps (talus-critical-dt --probe)", "",
           "Bisection on the factor f of forced runs at f x the formula step (400 steps each, blow-up detected by "
           "energy growth or a non-finite state). Criterion: the measured limit is at least the formula (the "
@@ -395,6 +485,7 @@ def main(argv):
     os.makedirs(work, exist_ok=True)
     if "--readme-only" not in argv:
         run_families(build, work, only)
+        run_work_precision(build, work, only)
         run_sweeps(build, work, only)
         run_large_deformation(build, work, only)
         run_crossing_growth(build, work, only)

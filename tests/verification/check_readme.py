@@ -3,7 +3,10 @@
 Every table row of the README is compared with the CSV row it came from, number by
 number, to the printed precision: the convergence tables (value, abscissa, error,
 pairwise order, run times, points, steps, ns per point-step), the observed orders, the
-Courant sweeps, the large-deformation row and the smoothing criteria. Also: every plot
+Courant sweeps, the large-deformation row and the smoothing criteria; the work-precision
+section (issue 42): its tables number by number against csv/work_precision/, one figure per
+scene, and its other lines (orders, PASS/FAIL, crossovers, recommendations) equal to those
+regenerated from the CSVs by tests/verification/work_precision.py. Also: every plot
 the README shows exists and is a PNG (the large-deformation case shows one snapshot of its final
 state, issue 17), every convergence CSV has a table, and a PASS/FAIL
 printed matches the criterion flag in the CSV. A number edited in the README or a
@@ -163,5 +166,95 @@ if os.path.isfile(sm):
     tv.check(ok, f"smoothing: {len(rows)} criteria and results match the CSV")
 else:
     tv.check(False, "smoothing CSV exists")
+# issue 42: the work-precision section against csv/work_precision/ (the tables number by
+# number; the orders, PASS/FAIL, crossovers and recommendations as regenerated from the CSVs)
+import work_precision as wp  # noqa: E402
+
+wpd = os.path.join(docs, "csv", "work_precision")
+
+
+def wp_rows(name):
+    p = os.path.join(wpd, name + ".csv")
+    if not os.path.isfile(p):
+        return None
+    return [{k: float(v) for k, v in r.items()} for r in rows_of(p)]
+
+
+def wp_summary(name):
+    p = os.path.join(wpd, name + "_summary.csv")
+    if not os.path.isfile(p):
+        return None
+    r = rows_of(p)[0]
+    r["observed_order"] = float(r["observed_order"])
+    return r
+
+
+expected, _ = wp.section(wp_rows, wp_summary)
+tv.check("## Work-precision across the families (issue 42)\n" in text, "work-precision: section in the README")
+for sc in wp.SCENES:
+    heading = f"### work-precision: {sc.name} ({sc.kind})\n"
+    if heading not in text:
+        tv.check(False, f"work-precision {sc.name}: section in the README")
+        continue
+    sec = text[text.index(heading):].split("\n### ")[0]
+    table = [[c.strip() for c in line.strip().strip("|").split("|")] for line in sec.splitlines()
+             if line.startswith("| ") and not line.startswith("| family")]
+    bad, n_rows = [], 0
+    for f in sc.families:
+        rows = wp_rows(f.name)
+        tv.check(rows is not None and wp_summary(f.name) is not None, f"work-precision {f.name}: CSVs exist")
+        if rows is None:
+            continue
+        mine = [c for c in table if c[0] == f.name]
+        n_rows += len(rows)
+        if len(mine) != len(rows):
+            bad.append(f"{f.name}: {len(mine)} table rows vs {len(rows)} CSV rows")
+            continue
+        for cells, r in zip(mine, rows):
+            for c, col in zip(cells[1:], wp.TABLE_COLS):
+                n_numbers += 1
+                if not same(c, r[col]):
+                    bad.append(f"{f.name} {col} {c} vs {r[col]}")
+    tv.check(not bad and len(table) == n_rows, f"work-precision {sc.name}: {len(table)} table rows, every number "
+             "matches the CSVs" + (f" ({'; '.join(bad[:3])})" if bad else ""))
+    pics = re.findall(r"\]\((png/[^)]+)\)", sec)
+    tv.check(pics == [f"png/{wp.figure_name(sc)}"], f"work-precision {sc.name}: one figure ({', '.join(pics)})")
+# Terzaghi at k = 1e-7: the cost probes' table against their CSVs
+if "### work-precision: terzaghi_k1e-7" in text:
+    sec = text[text.index("### work-precision: terzaghi_k1e-7"):].split("\n### ")[0]
+    table = [[c.strip() for c in line.strip().strip("|").split("|")] for line in sec.splitlines()
+             if line.startswith("| ") and not line.startswith("| probe")]
+    bad, n_rows = [], 0
+    for name, _, t_probe in wp.LOW_K:
+        rows = wp_rows(name)
+        if rows is None:
+            bad.append(f"{name}: no CSV")
+            continue
+        mine = [c for c in table if c[0] == name]
+        xs = wp.low_k_rows(name, rows, t_probe)
+        n_rows += len(xs)
+        if len(mine) != len(xs):
+            bad.append(f"{name}: {len(mine)} rows vs {len(xs)}")
+            continue
+        for cells, x in zip(mine, xs):
+            for c, v in zip(cells[1:], [x[0], x[1], x[2], x[3] * 1e3, x[4], x[5], x[5] / 3600]):
+                n_numbers += 1
+                if not same(c, v) and not (abs(float(c) - v) <= 0.5e-2 * abs(v)):  # [h]: 3 significant digits
+                    bad.append(f"{name} {c} vs {v}")
+    tv.check(not bad and len(table) == n_rows, f"work-precision terzaghi_k1e-7: {len(table)} probe rows match the "
+             "CSVs" + (f" ({'; '.join(bad[:3])})" if bad else ""))
+else:
+    tv.check(False, "work-precision: the terzaghi_k1e-7 cost estimate in the README")
+# every other line of the section (orders, criteria, crossovers, recommendations) as regenerated
+i = text.find("## Work-precision across the families (issue 42)")
+j = text.find("\n## ", i + 1)
+printed = text[i:j].strip().splitlines() if i >= 0 else []
+expected = "\n".join(expected).strip().splitlines()
+differ = [(a, b) for a, b in zip(printed, expected) if a.strip() != b.strip() and not a.startswith("| ")]
+tv.check(len(printed) == len(expected) and not differ,
+         "work-precision: orders, criteria, crossovers and recommendations as regenerated from the CSVs"
+         + (f" (first difference: '{differ[0][0][:120]}' vs '{differ[0][1][:120]}')" if differ else
+            f" ({len(printed)} lines vs {len(expected)})"))
+
 print(f"{n_numbers} numbers compared")
 tv.finish()

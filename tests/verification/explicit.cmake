@@ -89,6 +89,13 @@ add_test(NAME verification.convergence_bar
                  ${TALUS_PRM_DIR} ${_w}/convergence_bar)
 set_tests_properties(verification.convergence_bar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 
+# issue 42: the fast subset of the work-precision campaign across the families (every family
+# of every shared scene at its two smallest resolutions: orders within the stated ranges,
+# the work measures of each tool; tests/verification/work_precision.py)
+add_test(NAME verification.work_precision_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_work_precision.py ${TALUS_TOOLS_DIR} ${_w}/work_precision_fast)
+set_tests_properties(verification.work_precision_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
 # issue 6: the committed docs/verification/README.md matches the committed CSVs
 add_test(NAME verification.readme_matches_csv
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_readme.py ${CMAKE_SOURCE_DIR}/docs/verification)

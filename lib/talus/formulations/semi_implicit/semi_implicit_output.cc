@@ -233,13 +233,13 @@ namespace talus::semi_implicit
   Solver<dim>::summary(const LoopTimings &timings)
   {
     log() << "talus-semi-implicit: done: " << step_number << " steps, dt " << dt << " s, wall " << timings.total
-          << " s (pressure solves " << seconds_solve << " s, mean "
-          << (n_solves ? double(solver_iterations) / n_solves : 0.0) << " CG iterations; AMG set-ups "
-          << pressure_solver.n_setups() << " (interval " << prm.pressure_rebuild_interval << ", fallbacks "
-          << pressure_solver.n_fallbacks() << ", after slow solves " << pressure_solver.n_slow_solves()
-          << "), pressure DoF set rebuilds " << n_pattern_changes << " (" << n_pattern_window_changes
-          << " for a stencil outside the kept pattern)), lost points " << lost_points() << balance.summary()
-          << ", output in " << prm.output_directory << "/" << std::endl;
+          << " s (pressure solves " << seconds_solve << " s, " << n_solves << " solves, " << solver_iterations
+          << " CG iterations, mean " << (n_solves ? double(solver_iterations) / n_solves : 0.0)
+          << " CG iterations; AMG set-ups " << pressure_solver.n_setups() << " (interval "
+          << prm.pressure_rebuild_interval << ", fallbacks " << pressure_solver.n_fallbacks() << ", after slow solves "
+          << pressure_solver.n_slow_solves() << "), pressure DoF set rebuilds " << n_pattern_changes << " ("
+          << n_pattern_window_changes << " for a stencil outside the kept pattern)), lost points " << lost_points()
+          << balance.summary() << ", output in " << prm.output_directory << "/" << std::endl;
     // per-phase wall clock (rank 0's; the step's point passes: 7 walks of each
     // set per step, 8-9 of the soil with F-bar)
     // the timing walk only when asked (make bench passes --time-shape-walk): it is work of its own
