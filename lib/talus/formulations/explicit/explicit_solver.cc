@@ -451,13 +451,8 @@ namespace talus::explicit_mpm
             materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
             return;
           }
-        dealii::Tensor<2, 3> dF;
-        for (unsigned int i = 0; i < 3; ++i)
-          dF[i][i] = 1;
-        for (unsigned int i = 0; i < dim; ++i)
-          for (unsigned int j = 0; j < dim; ++j)
-            dF[i][j] += gu[i][j];
-        const double dJ = dealii::determinant(dF);
+        const dealii::Tensor<2, 3> dF = transfer::increment_tensor<dim>(gu, 1.0);
+        const double               dJ = dealii::determinant(dF);
         if (!(dJ > 0) || !(P[fbar] > 0)) // flagged by the stability check (the volume turns non-positive)
           {
             materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);

@@ -1337,13 +1337,8 @@ namespace talus::semi_implicit
     update(const unsigned int, const typename K::Cell &, double *P, const double (&gu)[dim][dim], PointState &)
     {
       // ΔF = I + grad Δu (Alg. 8(b), the usual index order)
-      dealii::Tensor<2, 3> dF;
-      for (unsigned int i = 0; i < 3; ++i)
-        dF[i][i] = 1;
-      for (unsigned int i = 0; i < dim; ++i)
-        for (unsigned int j = 0; j < dim; ++j)
-          dF[i][j] += gu[i][j];
-      const double dJ = dealii::determinant(dF);
+      const dealii::Tensor<2, 3> dF = transfer::increment_tensor<dim>(gu, 1.0);
+      const double               dJ = dealii::determinant(dF);
       if (!(dJ > 0))
         throw InstabilityError("a soil point's volume increment det(ΔF) = " + std::to_string(dJ) + " is not positive");
       const unsigned int         mid     = static_cast<unsigned int>(P[L::material]);
