@@ -106,6 +106,12 @@ cases = {
                                            ["negligible nodal mass", "2"]),
     "negligible mass load limit out of range": (tv.prm_set(base, "implicit/negligible mass load limit", "1.5"),
                                                 ["negligible mass load limit", "1.5"]),
+    "negative ghost penalty": (tv.prm_set(base, "implicit/ghost penalty", "-1"), ["ghost penalty", "-1"]),
+    "ghost penalty with B-splines": (tv.prm_set(tv.prm_set(base, "implicit/ghost penalty", "0.01"),
+                                                "numerics/shape function", "quadratic bspline"),
+                                     ["implicit/ghost penalty", "linear", "allowed with 'quadratic bspline': 0"]),
+    "carry start imbalance not a bool": (tv.prm_set(base, "implicit/carry start imbalance", "maybe"),
+                                         ["carry start imbalance", "maybe"]),
     "unknown direct package": (tv.prm_set(base, "linear solver/direct package", "superlu"),
                                ["direct package", "superlu"]),
     "moving velocity regions with restart": (
