@@ -196,6 +196,22 @@ def by_initial_position(t):
     return {c: [v[i] for i in key] for c, v in t.items()}
 
 
+def cantilever_tip(p, h, l=8.0):
+    """Tip deflection of the seed 001 cantilever from its particles_final.csv table p (docs/implicit.md):
+    the points do not sit on the free end, so u_y is extrapolated linearly to X = l from the mean u_y of
+    the two outermost point columns (X = l - h/4, l - 3h/4): 1.5 u1 - 0.5 u2. Returns (delta, the
+    number of points in each of the two columns)."""
+    cols = ([], [])
+    for x, ux, uy in zip(p["pos_x"], p["u_x"], p["u_y"]):
+        for j, c in enumerate((l - h / 4, l - 3 * h / 4)):
+            if abs(x - ux - c) < 1e-9:
+                cols[j].append(uy)
+    if not cols[0] or not cols[1]:
+        return float("nan"), (len(cols[0]), len(cols[1]))
+    u1, u2 = (sum(c) / len(c) for c in cols)
+    return 1.5 * u1 - 0.5 * u2, (len(cols[0]), len(cols[1]))
+
+
 def zigzag_index(X, Y, p, h):
     """Checkerboard measure of a point field p (e.g. the mean stress) on the initial lattice of
     2 x 2 points per cell of size h (X, Y the initial positions): per point and direction with
