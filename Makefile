@@ -17,7 +17,7 @@ OMPI_MCA_pml ?= ob1
 OMPI_MCA_btl ?= self,vader
 export OMPI_MCA_pml OMPI_MCA_btl
 
-.PHONY: all deps format configure build demo test verify verify-paper campaign sanitize bench clean
+.PHONY: all deps format configure build demo test verify verify-paper campaign composability sanitize bench clean
 
 all: build
 
@@ -63,6 +63,12 @@ campaign: build
 	python3 scripts/verify_campaign.py $(BUILD_DIR)
 	cd $(BUILD_DIR) && ctest --output-on-failure -R "verification.readme_matches_csv"
 	$(MAKE) -C parameter_files/campaigns BUILD=$(abspath $(BUILD_DIR))
+
+# docs/composability.md: every explicit feature under every option set, run or refused
+# (tests/verification/composability.py; ctest verification.composability_matrix checks it)
+composability: build
+	python3 tests/verification/composability.py $(BUILD_DIR)/tools/talus-explicit $(BUILD_DIR)/composability \
+	  --write docs/composability.md
 
 # Unit tests and short runs of every tool (plus the fast .prm fuzz subset) built
 # with -DTALUS_SANITIZE=ON in $(SAN_BUILD_DIR); any ASan/UBSan report fails.

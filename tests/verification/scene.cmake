@@ -51,3 +51,13 @@ add_test(NAME verification.point_load_bad_input
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_point_load_input.py ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
                  ${_w}/point_load_bad_input)
 set_tests_properties(verification.point_load_bad_input PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+
+# the composability matrix of talus-explicit (issue 38 item 4): every feature alone under every
+# option set (kernel, velocity transfer, stabilisation) for 6 steps; each pair runs and conserves
+# mass (and momentum where nothing external acts) or is refused with exit 2 naming the entry;
+# docs/composability.md must equal the generated table (`make composability` rewrites it)
+add_test(NAME verification.composability_matrix
+         COMMAND ${Python3_EXECUTABLE} ${_v}/composability.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${_w}/composability_matrix --check ${CMAKE_SOURCE_DIR}/docs/composability.md)
+set_tests_properties(verification.composability_matrix PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" PROCESSORS 2
+                     TIMEOUT 900)

@@ -6,6 +6,7 @@
 #include <talus/transfer/cell_walk.h>
 #include <talus/shape/q1.h>
 
+#include <algorithm>
 #include <cmath>
 
 
@@ -222,13 +223,20 @@ namespace talus::explicit_mpm
           }
         nn        = std::sqrt(nn);
         double dn = 0; // (v_g - v) . n > 0: approaching
+        // the decision from the relative velocity (v_g - v_partner) . n, whose value is the
+        // same, negated twice, for both bodies: dn of the two can differ in sign by round-off
+        // when they barely approach, and then the adhesion term (not proportional to dn)
+        // moved one body alone (momentum not conserved; docs/composability.md)
+        double rel = 0;
         for (unsigned int d = 0; d < dim; ++d)
           {
             n[d] /= nn;
             dn += (vb[g][d] - v[d]) * n[d];
+            rel += (vb[g][d] - vb[partner][d]) * n[d];
           }
-        if (dn <= 0)
-          continue; // separating: free
+        if (rel <= 0)
+          continue;                    // separating: free
+        dn        = std::max(dn, 0.0); // approaching: dn >= 0 up to round-off
         corrected = true;
         std::array<double, dim> vt;
         double                  vt_norm = 0;

@@ -1024,6 +1024,7 @@ namespace talus::explicit_mpm
       c.push_back(std::string("momentum_") + ax[d]);
     c.push_back("n_particles");
     c.push_back("lost_particles");
+    c.push_back("mass"); // both phases: the composability matrix checks it is conserved
     balance.add_series_column(c);
     if (control && control->has_convergence())
       {
@@ -1055,18 +1056,21 @@ namespace talus::explicit_mpm
     // lost) are they summed by separate passes.
     Energies               e;
     dealii::Tensor<1, dim> p;
+    double                 mass = 0;
     if (after_step && !points.relocator().sorted_last)
       {
         auto s = local_sums;
         s.sum_over_ranks(comm);
-        e = {s.kinetic, s.strain, s.gravity_potential, external_work};
-        p = s.total_momentum();
+        e    = {s.kinetic, s.strain, s.gravity_potential, external_work};
+        p    = s.total_momentum();
+        mass = s.mass + s.second_mass;
       }
     else
       {
         const auto s = point_sums(true);
         e            = {s.kinetic, s.strain, s.gravity_potential, external_work};
         p            = s.total_momentum();
+        mass         = s.mass + s.second_mass;
       }
     if (free_surface)
       free_surface->update();
@@ -1075,6 +1079,7 @@ namespace talus::explicit_mpm
       r.push_back(p[d]);
     r.push_back(static_cast<double>(n_particles()));
     r.push_back(static_cast<double>(points.relocation_stats.lost));
+    r.push_back(mass);
     balance.add_series_value(r);
     if (control && control->has_convergence())
       {
