@@ -165,10 +165,23 @@ namespace talus::implicit_mpm
     // negligible-mass reactions). The step's constraints and residual are
     // unchanged on return, also when the assembly throws.
     Vector kept(residual);
-    std::swap(constraints, other);
+    std::swap(constraints, other); // `other` holds the step's constraints until swapped back
     try
       {
         assemble(false, g);
+        // 'carry start imbalance' belongs to the DoFs the step solves for: at a DoF the
+        // step holds the reaction is the whole force, so give the carried part back
+        // (subtracted, the plate and contact reactions read as their increment only)
+        if (carrying_imbalance)
+          {
+            const auto &owned = space.locally_owned_dofs();
+            for (unsigned int k = 0; k < residual.locally_owned_size(); ++k)
+              {
+                const auto i = owned.nth_index_in_set(k);
+                if (other.is_constrained(i) && !constraints.is_constrained(i))
+                  residual.local_element(k) += start_imbalance.local_element(k);
+              }
+          }
       }
     catch (...)
       {
