@@ -382,6 +382,19 @@ namespace talus::explicit_mpm
 
   template <int dim>
   void
+  Solver<dim>::apic_body_velocities()
+  {
+    with_kernel([&](auto kernel) {
+      transfer::ApicVelocity<dim, decltype(kernel)> op(grid, nodal_p.begin(), affine_offset);
+      transfer::for_each_active_cell(points, op);
+    });
+    control->particle_velocities(*this, affine_offset);
+    scatter_point_momentum(nodal_p);
+    nodal_velocity();
+  }
+
+  template <int dim>
+  void
   Solver<dim>::nodal_velocity()
   {
     const double *M = nodal_mass.begin();
@@ -719,11 +732,17 @@ namespace talus::explicit_mpm
       {
         // APIC (contact, FEM, 2-phase, smoothing are refused with it)
         apic_nodal_velocity(h);
+        const bool body = control && control->has_particle_conditions();
+        if (body) // v_p, C_p from v^L, the prescribed ones set, then v = p / m
+          apic_body_velocities();
         if (fbar_offset)
           with_kernel([&](auto kernel) { volume_averages_with(kernel, h); });
         timings.grid += seconds_since(t0);
         t0 = Clock::now();
-        with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
+        if (body) // the update pass of the FLIP step: v_p, C_p are set already
+          g2p_update(h);
+        else
+          with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
         timings.g2p += seconds_since(t0);
         t0 = Clock::now();
         relocate();

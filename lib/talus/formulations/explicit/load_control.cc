@@ -690,7 +690,7 @@ namespace talus::loads
 
   template <int dim>
   void
-  LoadControl<dim>::particle_velocities(Solver &s)
+  LoadControl<dim>::particle_velocities(Solver &s, const unsigned int affine)
   {
     if (particle_conditions.empty())
       return;
@@ -720,6 +720,10 @@ namespace talus::loads
               P[L::velocity + d] += change;
               dv[0][d] += change;
               work += P[L::mass] * change * P[L::velocity + d];
+              // APIC: the prescribed field is uniform over the body, its gradient 0
+              if (affine && pv.component[d])
+                for (unsigned int k = 0; k < dim; ++k)
+                  P[affine + d * dim + k] = 0.0;
             }
           // 2-phase point: its pore liquid moves with the body as well
           const double mL = cp ? s.two_phase->liquid_mass(P) : 0.0;
@@ -738,6 +742,15 @@ namespace talus::loads
         }
       return hit;
     };
+    if (affine) // APIC: the caller projects the points' (v_p, C_p) anew
+      {
+        double w[2], dv[2][dim];
+        transfer::for_each_point(s.points, [&](const unsigned int, transfer::PointIterator<dim> &it) {
+          source(it->get_properties().data(), w, dv);
+        });
+        s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+        return;
+      }
     s.with_kernel([&](auto kernel) {
       transfer::ScatterPointVectors<dim, decltype(kernel), decltype(source), 2> op(
         s.grid, source, {{s.nodal_p.begin(), cp ? s.two_phase->p_liquid.begin() : nullptr}});
