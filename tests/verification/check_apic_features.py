@@ -22,12 +22,18 @@ per run of this script (4th argument):
                given v_y = 1 mm/s (apply to = body, components y) with its base
                free: a rigid translation; every point moved by v t (1e-9 m),
                C_p = 0 (1e-12 1/s), |stress| < 1e-6 E v t / h; 1 vs 2 ranks to
-               1e-10 (positions, velocities);
+               1e-10 (positions, velocities); and two bodies side by side
+               without gravity, the left one driven, the right one free: the
+               driven points' v_y and the y rows of C_p exactly the prescribed
+               field (v, 0) while the free body is dragged (C_yx != 0 there);
   momentum     two elastic blocks, no gravity, no wall within reach, thrown at
-               each other (v = +-1 m/s, plus a spin on one) so that they
+               each other (v = +-1 m/s, one spinning at 2 rad/s) so that they
                collide and rebound on the shared grid: no external force acts,
                the total momentum (series momentum_x, momentum_y) stays at its
-               initial value to 1e-12 relative to sum m |v| at every output.
+               initial value to 1e-12 relative to sum m |v| at every output, and
+               the angular momentum with APIC's affine part, sum m (x x v_p +
+               eps : (C_p D_p)^T) from particles_final.csv, after one step and
+               at the end, to 1e-12 sum m |v| r (r the box's largest |x|).
 Usage: check_apic_features.py TOOL PRM_DIR WORKDIR CASE
 """
 import filecmp
@@ -161,6 +167,37 @@ elif case == "body_velocity":
     tv.check(cmax < 1e-12, f"C_p = 0 for the rigid translation (largest |C_p| {cmax:.1e} 1/s)")
     tv.check(sig < 1e-6 * E * v * t / h,
              f"rigid translation, largest |stress| {sig:.2e} Pa < 1e-6 E v t / h = {1e-6 * E * v * t / h:.1e} Pa")
+    # two bodies side by side, no gravity: the left one driven up (components y), the right one
+    # free and dragged along through the shared nodes (no contact pair): the driven points' v_y
+    # is the prescribed value and their C_p rows of y are 0 although the grid's velocity field
+    # varies across the interface (its x row is the APIC one)
+    two = tv.prm_set(text, "gravity/acceleration", "0, 0")
+    two = tv.prm_set(two, "body 0/upper corner", "0.09375, 1")
+    two = tv.prm_set(two, "number of bodies", "2") + """
+subsection body 1
+  set name                    = free
+  set material                = 0
+  set shape                   = box
+  set lower corner            = 0.09375, 0
+  set upper corner            = 0.1875, 1
+  set particles per direction = 2
+end
+"""
+    two = tv.prm_set(two, "output/directory", "two")
+    tv.run_tool(tool, two, work, "two")
+    b = tv.read_csv(f"{work}/two/particles_final.csv")
+    left = [i for i in range(len(b["id"])) if b["pos_x"][i] - b["u_x"][i] < 0.09375]
+    right = [i for i in range(len(b["id"])) if i not in set(left)]
+    dv = max(abs(b["v_y"][i] - v) for i in left)
+    cy = max(max(abs(b["affine_velocity_yx"][i]), abs(b["affine_velocity_yy"][i])) for i in left)
+    cyr = max(abs(b["affine_velocity_yx"][i]) for i in right)
+    vr = sum(b["v_y"][i] for i in right) / len(right)
+    tv.check(len(left) == len(right) > 0, f"two bodies: {len(left)} driven and {len(right)} free points")
+    tv.check(dv == 0.0, f"two bodies: the driven points' v_y is the prescribed value (largest deviation {dv:.1e})")
+    tv.check(cy == 0.0, f"two bodies: the driven points' C_p rows of y are 0 (largest {cy:.1e} 1/s)")
+    tv.check(cyr > 1e-6 and 0 < vr < v,
+             f"two bodies: the free body is dragged (mean v_y {vr:.3e} m/s in (0, {v:g}), largest |C_yx| {cyr:.2e} "
+             f"1/s > 1e-6: the grid field varies across the interface)")
 
 elif case == "momentum":
     text = apic(open(os.path.join(prm_dir, "verification", "block_friction.prm")).read())
@@ -168,7 +205,7 @@ elif case == "momentum":
                        "boundary conditions/friction": "", "gravity/acceleration": "0, 0",
                        "time/end time": "0.2", "output/directory": "out",
                        "body 0/lower corner": "0.2, 0.15", "body 0/upper corner": "0.4, 0.3",
-                       "body 0/initial velocity function": "1; 2 * (0.225 - y)"}.items():
+                       "body 0/initial velocity function": "1 - 2 * (y - 0.225); 2 * (x - 0.3)"}.items():
         text = tv.prm_set(text, key, value)
     text = tv.prm_set(text, "number of bodies", "2") + """
 subsection body 1
@@ -189,6 +226,27 @@ end
         d = max(abs(p - s[c][0]) for p in s[c])
         tv.check(d < 1e-12 * scale, f"{c}: largest change {d:.2e} kg m/s < 1e-12 sum m |v| "
                                     f"({1e-12 * scale:.1e}) over {len(s[c])} outputs")
+    # angular momentum about the origin (2D: z), APIC's: sum m (x v_y - y v_x + (h^2 / 4)(C_yx - C_xy));
+    # every point has m = rho (h / 2)^2 (2 x 2 points in full cells) and stays in the splines' interior
+    # (D_p = h^2 / 4 I); after one step and at the end (the start has C_p = 0 by seeding)
+    h = 0.025
+    m = rho * (h / 2) ** 2
+
+    def angular(t):
+        return sum(m * (x * vy - y * vx + h * h / 4 * (cyx - cxy)) for x, y, vx, vy, cyx, cxy in
+                   zip(t["pos_x"], t["pos_y"], t["v_x"], t["v_y"], t["affine_velocity_yx"],
+                       t["affine_velocity_xy"]))
+
+    one = tv.prm_set(text, "time/end time", "1e-9")
+    one = tv.prm_set(tv.prm_set(one, "output/directory", "one"), "output/final particles csv", "true")
+    tv.run_tool(tool, one, work, "one")
+    tv.run_tool(tool, tv.prm_set(text, "output/final particles csv", "true"), work, "blocks_csv")
+    L1 = angular(tv.read_csv(f"{work}/one/particles_final.csv"))
+    L2 = angular(tv.read_csv(f"{work}/out/particles_final.csv"))
+    r = 0.5 * math.hypot(1.0, 0.5)  # the largest |x| in the box
+    tv.check(abs(L2 - L1) < 1e-12 * scale * r,
+             f"angular momentum after one step {L1:.12e}, at {s['time'][-1]:g} s {L2:.12e} kg m^2/s: change "
+             f"{abs(L2 - L1):.2e} < 1e-12 sum m |v| r ({1e-12 * scale * r:.1e})")
     ke = s["kinetic_energy"]
     tv.check(min(ke) < 0.9 * ke[0], f"the blocks collided (kinetic energy {ke[0]:.4g} J -> min {min(ke):.4g} J)")
 else:
