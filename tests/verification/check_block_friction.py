@@ -13,7 +13,9 @@ mu, seed 000 §6.2 specialised to a rigid fixed boundary).
 With a 4th argument `bspline` (issue 12): the same with quadratic B-spline
 shape functions (the friction nodes act on the wall nodes' sums, whichever
 kernel made them).
-Usage: check_block_friction.py TOOL PRM WORKDIR [bspline]
+With `bspline_apic` (issue 38): the same with the affine particle-in-cell
+transfer (the friction nodes set a and v^L before the APIC G2P).
+Usage: check_block_friction.py TOOL PRM WORKDIR [bspline | bspline_apic]
 """
 import math
 import sys
@@ -22,8 +24,10 @@ import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1:4]
 base = open(prm_path).read()
-if len(sys.argv) > 4 and sys.argv[4] == "bspline":
+if len(sys.argv) > 4 and sys.argv[4] in ("bspline", "bspline_apic"):
     base = tv.prm_set(base, "numerics/shape function", "quadratic bspline")
+    if sys.argv[4] == "bspline_apic":
+        base = tv.prm_set(base, "numerics/velocity transfer", "apic")
 g = 9.81
 for theta, mu in ((30.0, 0.3), (15.0, 0.4)):
     th = math.radians(theta)

@@ -11,7 +11,11 @@ stage ends by the force/energy ratio criterion (§6.4). Checks:
 With a 4th argument `bspline` (issue 12): the same with quadratic B-spline
 shape functions on a column 3 cells wide (B-splines need 3 cells per direction);
 the traction point forces then reach the nodes of each point's 3 x 3 window.
-Usage: check_oedometer.py TOOL PRM WORKDIR [bspline]
+With `bspline_apic` (issue 38): the same B-spline column with the affine
+particle-in-cell transfer (numerics/velocity transfer = apic): the traction
+point forces enter the nodal force, hence v^L, from which the points' v_p and
+C_p are read back.
+Usage: check_oedometer.py TOOL PRM WORKDIR [bspline | bspline_apic]
 """
 import sys
 
@@ -19,11 +23,13 @@ import talus_verify as tv
 
 tool, prm_path, work = sys.argv[1:4]
 base = open(prm_path).read()
-if len(sys.argv) > 4 and sys.argv[4] == "bspline":
+if len(sys.argv) > 4 and sys.argv[4] in ("bspline", "bspline_apic"):
     for key, value in {"numerics/shape function": "quadratic bspline", "grid/cells": "3, 50",
                        "grid/upper corner": "0.075, 1.25", "body 0/upper corner": "0.075, 1",
                        "output/probes": "0.0375, 1.0; 0.0375, 0.5"}.items():
         base = tv.prm_set(base, key, value)
+    if sys.argv[4] == "bspline_apic":
+        base = tv.prm_set(base, "numerics/velocity transfer", "apic")
 E, nu, q = 1e6, 0.3, 1e3
 E_oed = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 points = [("probe0_uy", 0.99375), ("probe1_uy", 0.49375)]

@@ -47,6 +47,27 @@ function(talus_verification_bspline name script prm)
 endfunction()
 talus_verification_bspline(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
 talus_verification_bspline(explicit_block_friction check_block_friction.py verification/block_friction.prm)
+# issue 38 item 3: the loads with quadratic B-splines and APIC (numerics/velocity transfer = apic)
+function(talus_verification_bspline_apic name script prm)
+  add_test(NAME verification.${name}_bspline_apic
+           COMMAND ${Python3_EXECUTABLE} ${_v}/${script} ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/${prm} ${_w}/${name}_bspline_apic bspline_apic)
+  set_tests_properties(verification.${name}_bspline_apic PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+endfunction()
+talus_verification_bspline_apic(explicit_oedometer_traction check_oedometer.py verification/oedometer_traction.prm)
+talus_verification_bspline_apic(explicit_block_friction check_block_friction.py verification/block_friction.prm)
+# APIC with load balancing (1 vs 2 ranks 1e-10, bitwise restart), a point load (base reaction 1 %),
+# a friction wall (deceleration mu g within 1 %), a prescribed body velocity (rigid translation,
+# C_p = 0) and momentum conservation without external force (1e-12): check_apic_features.py
+foreach(_case balance point_load friction body_velocity momentum)
+  add_test(NAME verification.explicit_apic_${_case}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_apic_features.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR} ${_w}/explicit_apic_${_case} ${_case})
+  set_tests_properties(verification.explicit_apic_${_case} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 900)
+endforeach()
+set_tests_properties(verification.explicit_apic_balance verification.explicit_apic_body_velocity PROPERTIES
+                     PROCESSORS 2)
 # rigid plate (issue 37, docs/explicit.md "Rigid plate"): the shared layer with Q1, quadratic
 # B-splines and FEM integration (settlement within 1 %), displacement control (reaction within
 # 1 %), the plate nodes moving as one (frictionless), rough vs frictionless, permeable and impermeable

@@ -137,6 +137,50 @@ namespace talus::transfer
       }
   }
 
+  /// APIC G2P of v_p and C_p alone (no point update) from the nodal velocity
+  /// V: the first half of the step with body velocity conditions (Solver::step),
+  /// whose points are then set to the prescribed field and projected anew.
+  template <int dim, class K>
+  struct ApicVelocity
+  {
+    ApicVelocity(const BackgroundGrid<dim> &grid, const double *V, const unsigned int affine)
+        : grid(grid)
+        , V(V)
+        , affine(affine)
+    {
+    }
+    const BackgroundGrid<dim> &grid;
+    const double *const        V;
+    const unsigned int         affine;
+
+    static constexpr bool prefetch_location = false;
+    typename K::Cell      cell;
+    typename K::Field     v;
+
+    inline void
+    begin_cell(const unsigned int c)
+    {
+      cell = K::cell(grid, c);
+      K::gather(cell, V, 1.0, v, true);
+    }
+    inline bool
+    point(const unsigned int, PointIterator<dim> &it)
+    {
+      using L            = PropertyLayout<dim>;
+      double          *P = it->get_properties().data();
+      typename K::Eval e;
+      K::evaluate(cell, it->get_reference_location(), e);
+      double gv[dim][dim], vp[dim];
+      default_increments<dim, K>(cell, e, v, gv, vp);
+      apic_point_velocity<dim, K>(cell, e, v, 1.0, gv, vp, P + L::velocity, P + affine);
+      return true;
+    }
+    inline void
+    end_cell(const unsigned int)
+    {
+    }
+  };
+
   /// APIC P2G of one point's momentum with the affine term into the kernel's
   /// per-cell momentum sums: lp[slot] += N m (v + C r).
   template <int dim, class K>

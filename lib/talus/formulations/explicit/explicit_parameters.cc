@@ -162,10 +162,13 @@ namespace talus::explicit_mpm
       }
     if (p.numerics.apic())
       {
-        // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step, affine_offset);
-        // the passes below keep their own (FLIP) velocity transfer or were not checked with it
-        const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
-                                "FLIP velocity update, or were not checked with the affine transfer); allowed: ";
+        // APIC replaces the 1-phase step's G2P/P2G of the velocity (Solver::step,
+        // affine_offset). The loads act on the nodal force or velocity that the
+        // APIC G2P reads (tractions, point loads, friction walls, prescribed
+        // nodes, rigid plates); body velocities set v_p and C_p (rows 0, the
+        // gradient of a uniform field) before an affine P2G; C_p is a point
+        // property, carried by load balancing and checkpoints. What stays refused
+        // and why: docs/shape-functions.md, "APIC".
         // linear shape functions: the transfers are implemented and unit-tested
         // (C_p = grad v), but the collapse a = 3 blows up at Courant 0.5 and 0.2
         // (a = f / m at nodes a point barely touches goes straight into v^L)
@@ -173,30 +176,22 @@ namespace talus::explicit_mpm
                 "apic needs numerics/shape function = quadratic bspline: with linear shape functions the APIC "
                 "step was measured unstable (granular column collapse, Courant 0.5 and 0.2; "
                 "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
+        // the cell-integrated passes: they integrate on the cells with linear
+        // shape functions by definition, and APIC needs quadratic B-splines
+        const std::string cells = " is not available with numerics/velocity transfer = apic: APIC needs quadratic "
+                                  "B-splines, and this pass integrates on the cells with linear shape functions "
+                                  "(docs/shape-functions.md, \"APIC\"); allowed: ";
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration_name()) + why + "mpm, or velocity transfer = flip");
+                std::string(p.numerics.integration_name()) + cells + "mpm, or velocity transfer = flip");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
-                "strain smoothing" + why + "none, or velocity transfer = flip");
+                "strain smoothing" + cells + "none, or velocity transfer = flip");
+        // contact and the coupled 2-phase step keep their own (FLIP) velocity transfer
+        const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
+                                "FLIP velocity update: per-body velocity fields, the liquid's momentum); allowed: ";
         require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
                 "coupled 2-phase materials and body tractions" + why +
                   "1-phase materials, or velocity transfer = flip");
-        require(!p.balance.enabled(), "load balancing/interval",
-                "load balancing" + why + "interval = 0, or velocity transfer = flip");
-        for (const auto &st : p.loads.stages)
-          {
-            for (const auto &t : st.tractions)
-              require(t.target != loads::Traction<dim>::Target::point, t.where,
-                      "point loads" + why + "no point loads, or velocity transfer = flip");
-            require(st.tractions.empty(), "loads/traction",
-                    "tractions" + why + "no traction conditions, or velocity transfer = flip");
-            require(st.friction_ids.empty(), "boundary conditions/friction",
-                    "boundary friction" + why + "no friction walls, or velocity transfer = flip");
-            for (const auto &v : st.velocities)
-              require(v.target != loads::PrescribedVelocity<dim>::Target::body, "loads/velocity",
-                      "prescribed velocities of bodies (apply to = body)" + why +
-                        "apply to = boundary | region, or velocity transfer = flip");
-          }
       }
     if (p.bspline())
       {

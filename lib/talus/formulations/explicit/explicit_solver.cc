@@ -368,8 +368,20 @@ namespace talus::explicit_mpm
   {
     // p^t with the affine term, then the Lagrangian nodal velocity
     // v^L = p^t / m + h a (a after the loads: a prescribed node gets
-    // a = (vbar - v^t) / h, so v^L = vbar there), as nodal_velocity() leaves it
-    scatter_point_momentum(nodal_p);
+    // a = (vbar - v^t) / h, so v^L = vbar there), as nodal_velocity() leaves it.
+    // The loads' p^t of this step, when they scattered one, is the same P2G of
+    // the same points (bitwise): copied instead of a second pass
+    const Vector *pt = control ? control->point_momentum_at_t() : nullptr;
+    if (pt)
+      {
+        nodal_p.zero_out_ghost_values();
+        const double *src = pt->begin();
+        double       *dst = nodal_p.begin();
+        for (const unsigned int i : active_dofs)
+          dst[i] = src[i];
+      }
+    else
+      scatter_point_momentum(nodal_p);
     const double *M = nodal_mass.begin();
     const double *A = nodal_a.begin();
     double       *V = nodal_p.begin();
@@ -378,6 +390,19 @@ namespace talus::explicit_mpm
     if (control)
       control->nodal_velocities(*this);
     nodal_p.update_ghost_values();
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::apic_body_velocities()
+  {
+    with_kernel([&](auto kernel) {
+      transfer::ApicVelocity<dim, decltype(kernel)> op(grid, nodal_p.begin(), affine_offset);
+      transfer::for_each_active_cell(points, op);
+    });
+    control->particle_velocities(*this, affine_offset);
+    scatter_point_momentum(nodal_p);
+    nodal_velocity();
   }
 
   template <int dim>
@@ -719,11 +744,17 @@ namespace talus::explicit_mpm
       {
         // APIC (contact, FEM, 2-phase, smoothing are refused with it)
         apic_nodal_velocity(h);
+        const bool body = control && control->has_particle_conditions();
+        if (body) // v_p, C_p from v^L, the prescribed ones set, then v = p / m
+          apic_body_velocities();
         if (fbar_offset)
           with_kernel([&](auto kernel) { volume_averages_with(kernel, h); });
         timings.grid += seconds_since(t0);
         t0 = Clock::now();
-        with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
+        if (body) // the update pass of the FLIP step: v_p, C_p are set already
+          g2p_update(h);
+        else
+          with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
         timings.g2p += seconds_since(t0);
         t0 = Clock::now();
         relocate();

@@ -247,6 +247,12 @@ namespace talus::explicit_mpm
     void apic_nodal_velocity(const double dt);
     template <class Kernel>
     void g2p_update_apic_with(Kernel, const double dt);
+    /// APIC with body velocity conditions (after apic_nodal_velocity): the
+    /// APIC G2P of v_p and C_p from v^L, the conditioned points set to their
+    /// prescribed velocity (C_p rows 0), the affine P2G of all points and
+    /// v = p / m; the update pass then moves the points with that v (MUSL, as
+    /// the FLIP step does) and keeps their v_p, C_p.
+    void apic_body_velocities();
     /// numerics/volumetric stabilisation = f-bar, after the nodal velocity: each
     /// point's dJ = det(I + h grad v) mapped to the nodes weighted by mass and
     /// back (seed 002 Eqs. 79-80; transfer/fbar.h) into its property fbar_offset.

@@ -312,6 +312,7 @@ namespace talus::loads
     using L           = PropertyLayout<dim>;
     h                 = step;
     const bool vt_now = need_vt || check_step(s);
+    vt_scattered      = false;
     if (vt_now && momentum_t) // the caller's nodal momentum at t (owned entries)
       {
         const double *src = momentum_t->begin();
@@ -320,7 +321,10 @@ namespace talus::loads
           dst[i] = src[i];
       }
     else if (vt_now) // nodal momentum p^t of the points (the shape functions of the run)
-      s.scatter_point_momentum(vt);
+      {
+        s.scatter_point_momentum(vt);
+        vt_scattered = true;
+      }
     // with momentum_t (the 2-phase step) the caller has scattered the tractions
     // in its own P2G pass (begin/end_traction_scatter)
     const bool scatter = forces.any() && !momentum_t;
@@ -690,7 +694,7 @@ namespace talus::loads
 
   template <int dim>
   void
-  LoadControl<dim>::particle_velocities(Solver &s)
+  LoadControl<dim>::particle_velocities(Solver &s, const unsigned int affine)
   {
     if (particle_conditions.empty())
       return;
@@ -720,6 +724,10 @@ namespace talus::loads
               P[L::velocity + d] += change;
               dv[0][d] += change;
               work += P[L::mass] * change * P[L::velocity + d];
+              // APIC: the prescribed field is uniform over the body, its gradient 0
+              if (affine && pv.component[d])
+                for (unsigned int k = 0; k < dim; ++k)
+                  P[affine + d * dim + k] = 0.0;
             }
           // 2-phase point: its pore liquid moves with the body as well
           const double mL = cp ? s.two_phase->liquid_mass(P) : 0.0;
@@ -738,6 +746,15 @@ namespace talus::loads
         }
       return hit;
     };
+    if (affine) // APIC: the caller projects the points' (v_p, C_p) anew
+      {
+        double w[2], dv[2][dim];
+        transfer::for_each_point(s.points, [&](const unsigned int, transfer::PointIterator<dim> &it) {
+          source(it->get_properties().data(), w, dv);
+        });
+        s.external_work += dealii::Utilities::MPI::sum(work, s.comm);
+        return;
+      }
     s.with_kernel([&](auto kernel) {
       transfer::ScatterPointVectors<dim, decltype(kernel), decltype(source), 2> op(
         s.grid, source, {{s.nodal_p.begin(), cp ? s.two_phase->p_liquid.begin() : nullptr}});

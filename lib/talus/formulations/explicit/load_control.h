@@ -18,6 +18,8 @@
 //   G2P velocity, P2G momentum (solver)
 //   particle_velocities  prescribed material point velocities (momentum corrected)
 //   v = p / m (solver)
+//   (APIC: v^L = p^t / m + dt a, then with body conditions the APIC G2P of v_p
+//   and C_p, particle_velocities, the affine P2G and v = p / m: Solver::step)
 //   nodal_velocities     prescribed values, no penetration / stick at friction nodes
 //
 // Rigid plates (loads/rigid_plate.h, issue 37; the scene's
@@ -151,7 +153,19 @@ namespace talus::loads
       return current->viscous_damping;
     }
     void nodal_accelerations(Solver &s);
-    void particle_velocities(Solver &s);
+    /// Body conditions (apply to = body): v_p of the conditioned components
+    /// becomes the prescribed value at t + h. FLIP (affine = 0): the momentum
+    /// change m_p dv_p is added to the nodal momentum. APIC (affine: the offset
+    /// of C_p): the rows of C_p of those components become 0 (the gradient of
+    /// the body's uniform prescribed velocity) and nothing is scattered: the
+    /// caller projects (v_p, C_p) of all points anew (Solver::step).
+    void particle_velocities(Solver &s, unsigned int affine = 0);
+    /// whether a body condition acts in this stage (the same on every rank)
+    bool
+    has_particle_conditions() const
+    {
+      return !particle_conditions.empty();
+    }
     void nodal_velocities(Solver &s);
 
     /// Rigid plates, at setup (fresh or restored run, before any output): the
@@ -185,6 +199,14 @@ namespace talus::loads
       if (current) // else the stage about to begin builds them
         build_node_lists(s);
     }
+    /// The nodal momentum p^t of the points that before_nodal_solve scattered
+    /// in this step (the run's P2G, affine with APIC), or nullptr if it did not
+    /// scatter one: the APIC step takes it instead of a second identical pass.
+    const Vector *
+    point_momentum_at_t() const
+    {
+      return vt_scattered ? &vt : nullptr;
+    }
     /// Last evaluated ratios (NaN before the first evaluation of the stage).
     double force_ratio  = std::numeric_limits<double>::quiet_NaN();
     double energy_ratio = std::numeric_limits<double>::quiet_NaN();
@@ -201,7 +223,8 @@ namespace talus::loads
     bool                 converged   = false;
     double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
 
-    bool                       need_vt = false;
+    bool                       need_vt      = false;
+    bool                       vt_scattered = false; ///< vt is this step's P2G of the points
     Vector                     trac, vt;
     std::vector<int>           component; ///< of each local DoF (-1: none)
     std::vector<unsigned char> excluded;  ///< DoFs left out of the force ratio

@@ -22,8 +22,8 @@ namespace talus::explicit_mpm
     prm.enter_subsection("numerics");
     // 'shape function' is declared with the shared scene (scene_parameters.cc);
     // quadratic B-splines need integration = mpm, without strain smoothing,
-    // contact, 2-phase materials, tractions, friction or prescribed velocities
-    // of bodies (refused by parse_parameters in explicit_solver.cc)
+    // contact or coupled 2-phase materials (refused by parse_parameters in
+    // explicit_parameters.cc, as are the passes APIC is not available with)
     prm.declare_entry(
       "velocity transfer", "flip", Selection("flip|apic"),
       "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
@@ -31,8 +31,9 @@ namespace talus::explicit_mpm
       "nodal momentum sum N m_p (v_p + C_p (x_i - x_p)), v_p and the affine matrix C_p from the "
       "updated nodal velocity; conserves linear and angular momentum in the transfers, "
       "docs/shape-functions.md). 'apic' needs shape function = quadratic bspline (measured unstable with linear "
-      "shape functions), integration = mpm and 1-phase materials, without "
-      "strain smoothing, contact, tractions, prescribed body velocities or load balancing.");
+      "shape functions), integration = mpm, no strain smoothing, no contact and 1-phase materials; it works "
+      "with tractions, point loads, friction walls, prescribed velocities of boundaries, regions and bodies "
+      "(v_p set, C_p = 0 for the prescribed components), rigid plates, damping, stages and load balancing.");
     prm.declare_entry("integration", default_integration, Selection("mpm|mpm-mixed|fem|ul-fem"),
                       "Integration of the internal force (seed 000 §6.6; Anura3D MPM-MP / MPM-MIXED / FEM / "
                       "UL-FEM): 'mpm' at the material points; "
