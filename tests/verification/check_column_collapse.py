@@ -100,23 +100,7 @@ t_inf = next((t[i] for i in range(ip, len(t)) if ke[i] < 0.05 * peak), float("na
 
 p = tv.read_csv(f"{work}/out/particles_final.csv")
 xs, ys = p["pos_x"], p["pos_y"]
-
-
-def contiguous_front(origin):
-    """Largest x of the points in the run of occupied bins (width hx, bin edges at
-    origin + k hx) that starts at the wall."""
-    occupied = {}
-    for x in xs:
-        k = int((x - origin) // hx)
-        occupied[k] = occupied.get(k, 0) + 1
-    k = int((min(xs) - origin) // hx)
-    while k in occupied:
-        k += 1
-    edge = origin + k * hx
-    return max(x for x in xs if x < edge), sum(1 for x in xs if x >= edge)
-
-
-fronts = [contiguous_front(g_lo[0] - q * hx / 4) for q in range(4)]
+fronts = [tv.deposit_front(xs, hx, g_lo[0] - q * hx / 4) for q in range(4)]
 d_inf = sum(f for f, _ in fronts) / 4 + 0.5 * spacing - lower[0]
 n_beyond = max(n for _, n in fronts)
 h_inf = max(ys) + 0.5 * spacing - lower[1]

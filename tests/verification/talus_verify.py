@@ -212,6 +212,21 @@ def cantilever_tip(p, h, l=8.0):
     return 1.5 * u1 - 0.5 * u2, (len(cols[0]), len(cols[1]))
 
 
+def deposit_front(xs, hx, origin):
+    """Front of a granular deposit from its points' x: the points are binned by x in bins of width
+    hx (edges at origin + k hx); the deposit is the run of occupied bins that starts at the wall
+    (the smallest x). Returns (largest x inside that run, number of points beyond it)."""
+    occupied = {}
+    for x in xs:
+        k = int((x - origin) // hx)
+        occupied[k] = occupied.get(k, 0) + 1
+    k = int((min(xs) - origin) // hx)
+    while k in occupied:
+        k += 1
+    edge = origin + k * hx
+    return max(x for x in xs if x < edge), sum(1 for x in xs if x >= edge)
+
+
 def zigzag_index(X, Y, p, h):
     """Checkerboard measure of a point field p (e.g. the mean stress) on the initial lattice of
     2 x 2 points per cell of size h (X, Y the initial positions): per point and direction with
