@@ -127,6 +127,12 @@ add_test(NAME verification.implicit_up_block_3d
                  ${TALUS_PRM_DIR}/implicit/up_block_3d.prm ${_w}/implicit_up_block_3d)
 set_tests_properties(verification.implicit_up_block_3d PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900
                      PROCESSORS 2)
+# the same in 2D on Cook's membrane at nu = 0.499999 (n = 16, 647 points; the 2D rotation mode of the AMG)
+add_test(NAME verification.implicit_up_block_cooks
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_up_block.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_up_block_cooks)
+set_tests_properties(verification.implicit_up_block_cooks PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
 
 # bad input, Newton failure, singular system: messages, exit codes, no NaN
 add_test(NAME verification.implicit_bad_input
