@@ -108,7 +108,7 @@ namespace talus::implicit_mpm
                         "irreducible: the nodal displacement only; mixed up: displacement and the nodal pressure "
                         "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
                         "pressure projection (seed 001 ch. 5; static analysis, neo hookean with 'volumetric energy "
-                        "= split' or j2 plasticity, direct linear solver).");
+                        "= split' or j2 plasticity, linear solver 'direct' or 'gmres block amg').");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
