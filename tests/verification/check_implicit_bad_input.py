@@ -22,6 +22,8 @@ the right exit code, no NaN written.
     contact walls, a penalty <= 0 or not a number, a penalty with the node
     method, a negative or malformed Coulomb coefficient, the node method's
     'contact gap'/'contact passes' with points, Coulomb friction with cg amg;
+  * the linear solver: mixed u-p with 'cg amg' or 'gmres amg' (allowed: direct, gmres
+    block amg), 'gmres block amg' with the displacement formulation;
   * Newton that cannot converge (max iterations 1 with a tolerance no single
     iteration meets): every step is cut back max_cut_backs times, then the run
     stops with exit 3 and says so; series.csv holds only finite values;
@@ -118,7 +120,12 @@ cases = {
         tv.prm_set(tv.prm_set(base, "implicit/velocity regions follow", "true"), "checkpoint/restart", "if available"),
         ["implicit/velocity regions follow", "restart"]),
     "mixed up with cg amg": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"), "linear solver/method",
-                                        "cg amg"), ["linear solver/method", "direct"]),
+                                        "cg amg"), ["linear solver/method", "direct", "gmres block amg"]),
+    "mixed up with gmres amg": (tv.prm_set(tv.prm_set(base, "implicit/formulation", "mixed up"),
+                                           "linear solver/method", "gmres amg"),
+                                ["linear solver/method", "direct", "gmres block amg"]),
+    "gmres block amg without mixed up": (tv.prm_set(base, "linear solver/method", "gmres block amg"),
+                                         ["linear solver/method", "mixed up", "direct | cg amg | gmres amg"]),
     "traction and total force": (tv.prm_set(tv.prm_set(tv.prm_set(base, "loads/number of tractions", "1"),
                                                        "loads/traction 0/traction", "0, -1"),
                                             "loads/traction 0/total force", "0, -1"),

@@ -114,9 +114,12 @@ namespace talus
 
   LinearSolveInfo
   solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
-               const LinearSolverOptions &options, const std::vector<std::vector<bool>> &constant_modes)
+               const LinearSolverOptions &options, const std::vector<std::vector<bool>> &constant_modes,
+               const std::vector<double> &dof_coordinates)
   {
     LinearSolveInfo info;
+    if (options.method == LinearSolverOptions::Method::gmres_block_amg)
+      return solve_block_up(A, x, b, options, constant_modes, dof_coordinates);
     if (options.method == LinearSolverOptions::Method::direct)
       {
         std::vector<Vector> xs;

@@ -23,9 +23,10 @@ namespace talus
   {
     enum class Method
     {
-      direct,   ///< TrilinosWrappers::SolverDirect (Amesos_Klu)
-      cg_amg,   ///< TrilinosWrappers::SolverCG + PreconditionAMG (ML): symmetric matrices
-      gmres_amg ///< TrilinosWrappers::SolverGMRES (restart 100) + PreconditionAMG (ML): non-symmetric ones
+      direct,         ///< TrilinosWrappers::SolverDirect (Amesos_Klu)
+      cg_amg,         ///< TrilinosWrappers::SolverCG + PreconditionAMG (ML): symmetric matrices
+      gmres_amg,      ///< TrilinosWrappers::SolverGMRES (restart 100) + PreconditionAMG (ML): non-symmetric ones
+      gmres_block_amg ///< mixed u-p: GMRES with a block-triangular preconditioner (solve_block_up)
     };
     Method method = Method::direct;
     /// direct: the Amesos package ("Amesos_Klu" or "Amesos_Mumps"). KLU's
@@ -52,10 +53,25 @@ namespace talus
 
   /// Solve A x = b (x: initial guess for CG, overwritten). `constant_modes`
   /// (NodalSpace::constant_modes(): one per component) help AMG on vector
-  /// problems; empty: a single mode. Collective. Throws on non-convergence.
+  /// problems; empty: a single mode. `dof_coordinates` (gmres_block_amg only,
+  /// optional): dim coordinates per locally owned DoF, for the rigid rotations
+  /// of the displacement AMG. Collective. Throws on non-convergence.
   LinearSolveInfo solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
                                const LinearSolverOptions            &options,
-                               const std::vector<std::vector<bool>> &constant_modes = {});
+                               const std::vector<std::vector<bool>> &constant_modes  = {},
+                               const std::vector<double>            &dof_coordinates = {});
+
+  /// Mixed u-p: right-preconditioned GMRES (deal.II's, restart 300) to |b - A x|
+  /// <= tol |b| with the block upper-triangular preconditioner [A_hat K_up; 0
+  /// S_hat]: one ML V-cycle on K_uu (near null space: the translations and,
+  /// with `dof_coordinates`, the rotations); S_hat the diagonal of K_pp -
+  /// K_pu diag(K_uu)^-1 K_up. The blocks are taken out of A by the component
+  /// masks `constant_modes` (dim + 1 of them, the last the pressure; the DoFs
+  /// may be interleaved). solvers/block_up_solver.cc. Collective.
+  LinearSolveInfo solve_block_up(const dealii::TrilinosWrappers::SparseMatrix &A, Vector &x, const Vector &b,
+                                 const LinearSolverOptions            &options,
+                                 const std::vector<std::vector<bool>> &constant_modes,
+                                 const std::vector<double>            &dof_coordinates = {});
 
   /// The direct solve of solve_linear (one factorisation of A, with its
   /// iterative refinement) for several right-hand sides: xs[k] from bs[k]

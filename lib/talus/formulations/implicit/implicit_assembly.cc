@@ -384,7 +384,16 @@ namespace talus::implicit_mpm
     LinearSolveInfo info;
     try
       {
-        info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes());
+        std::vector<double> coordinates; // the rigid rotations of the u-p block preconditioner's AMG
+        if (prm.linear.method == LinearSolverOptions::Method::gmres_block_amg)
+          {
+            const unsigned int n_owned = space.locally_owned_dofs().n_elements();
+            coordinates.resize(std::size_t(n_owned) * dim);
+            for (unsigned int l = 0; l < n_owned; ++l)
+              for (unsigned int d = 0; d < dim; ++d)
+                coordinates[std::size_t(l) * dim + d] = space.position(l)[d];
+          }
+        info = solve_linear(tangent, delta, rhs, prm.linear, space.constant_modes(), coordinates);
       }
     catch (const std::exception &e)
       {

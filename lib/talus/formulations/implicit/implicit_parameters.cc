@@ -108,7 +108,7 @@ namespace talus::implicit_mpm
                         "irreducible: the nodal displacement only; mixed up: displacement and the nodal pressure "
                         "p (mean Cauchy stress, tension positive) on the same Q1 nodes, stabilised by polynomial "
                         "pressure projection (seed 001 ch. 5; static analysis, neo hookean with 'volumetric energy "
-                        "= split' or j2 plasticity, direct linear solver).");
+                        "= split' or j2 plasticity, linear solver 'direct' or 'gmres block amg').");
       prm.declare_entry("stabilisation factor", "1", Double(0),
                         "mixed up: alpha of the PPP term int (alpha/G)(q - q~)(p - p~) dv (Eq. 5.15), q~, p~ the "
                         "means over the points of a grid cell; 0 = no stabilisation (the pressure oscillates).");
@@ -201,11 +201,13 @@ namespace talus::implicit_mpm
     prm.leave_subsection();
     prm.enter_subsection("linear solver");
     {
-      prm.declare_entry("method", "direct", Selection("direct|cg amg|gmres amg"),
+      prm.declare_entry("method", "direct", Selection("direct|cg amg|gmres amg|gmres block amg"),
                         "direct: Amesos KLU; gmres amg: GMRES (restart 100) with ML algebraic multigrid (any tangent "
                         "of the irreducible form: plastic models, F-bar, Coulomb friction); cg amg: conjugate "
                         "gradients with ML algebraic multigrid "
-                        "(symmetric tangents only: elastic models).");
+                        "(symmetric tangents only: elastic models); gmres block amg: mixed u-p only, GMRES with a "
+                        "block-triangular preconditioner (ML AMG on the displacement block and on a Schur "
+                        "complement approximation of the pressure block).");
       prm.declare_entry("direct package", "klu", Selection("klu|mumps"),
                         "direct: the Amesos package, KLU or MUMPS (MUMPS is much faster on the indefinite mixed "
                         "u-p tangent, whose pivoting fills KLU's factors).");
@@ -446,9 +448,10 @@ namespace talus::implicit_mpm
                   "the grid's solution; allowed: boundary | region (prescribed grid nodes)");
       }
     prm.enter_subsection("linear solver");
-    p.linear.method             = prm.get("method") == "direct"   ? LinearSolverOptions::Method::direct
-                                  : prm.get("method") == "cg amg" ? LinearSolverOptions::Method::cg_amg
-                                                                  : LinearSolverOptions::Method::gmres_amg;
+    p.linear.method             = prm.get("method") == "direct"      ? LinearSolverOptions::Method::direct
+                                  : prm.get("method") == "cg amg"    ? LinearSolverOptions::Method::cg_amg
+                                  : prm.get("method") == "gmres amg" ? LinearSolverOptions::Method::gmres_amg
+                                                                     : LinearSolverOptions::Method::gmres_block_amg;
     p.linear.direct_package     = prm.get("direct package") == "mumps" ? "Amesos_Mumps" : "Amesos_Klu";
     p.linear.relative_tolerance = prm.get_double("relative tolerance");
     p.linear.max_iterations     = prm.get_integer("max iterations");
@@ -471,10 +474,16 @@ namespace talus::implicit_mpm
                   "hencky mohr coulomb, nor sand");
         require(m.n_history() <= 64, "material " + std::to_string(k), "more than 64 history variables");
       }
+    require(p.mixed_up || p.linear.method != LinearSolverOptions::Method::gmres_block_amg, "linear solver/method",
+            "'gmres block amg' is the solver of the mixed u-p system ('implicit/formulation = mixed up'); allowed "
+            "with the displacement formulation: direct | cg amg | gmres amg");
     if (p.mixed_up)
       {
-        require(p.linear.method == LinearSolverOptions::Method::direct, "linear solver/method",
-                "'mixed up' needs 'direct' (the u-p system is indefinite; no block preconditioner yet)");
+        require(p.linear.method == LinearSolverOptions::Method::direct ||
+                  p.linear.method == LinearSolverOptions::Method::gmres_block_amg,
+                "linear solver/method",
+                "'mixed up' needs 'direct' or 'gmres block amg' (the u-p system is indefinite: CG does not apply, "
+                "and AMG on the whole system does not see the pressure block's structure)");
         for (unsigned int k = 0; k < p.materials.size(); ++k)
           {
             // the split (materials/material.h): the nodal pressure replaces p(J); a

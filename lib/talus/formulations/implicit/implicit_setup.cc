@@ -468,9 +468,10 @@ namespace talus::implicit_mpm
     out << "  Newton: " << to_string(prm.newton.criterion) << " test, residual relative "
         << prm.newton.residual_relative << ", absolute " << prm.newton.residual_absolute << ", at most "
         << prm.newton.max_iterations << " iterations; linear solver "
-        << (prm.linear.method == LinearSolverOptions::Method::direct   ? "direct (" + prm.linear.direct_package + ")"
-            : prm.linear.method == LinearSolverOptions::Method::cg_amg ? std::string("CG + ML AMG")
-                                                                       : std::string("GMRES + ML AMG"))
+        << (prm.linear.method == LinearSolverOptions::Method::direct      ? "direct (" + prm.linear.direct_package + ")"
+            : prm.linear.method == LinearSolverOptions::Method::cg_amg    ? std::string("CG + ML AMG")
+            : prm.linear.method == LinearSolverOptions::Method::gmres_amg ? std::string("GMRES + ML AMG")
+                                                                          : std::string("GMRES + block AMG (u-p)"))
         << std::endl;
   }
 
