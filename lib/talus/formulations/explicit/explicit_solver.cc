@@ -368,8 +368,20 @@ namespace talus::explicit_mpm
   {
     // p^t with the affine term, then the Lagrangian nodal velocity
     // v^L = p^t / m + h a (a after the loads: a prescribed node gets
-    // a = (vbar - v^t) / h, so v^L = vbar there), as nodal_velocity() leaves it
-    scatter_point_momentum(nodal_p);
+    // a = (vbar - v^t) / h, so v^L = vbar there), as nodal_velocity() leaves it.
+    // The loads' p^t of this step, when they scattered one, is the same P2G of
+    // the same points (bitwise): copied instead of a second pass
+    const Vector *pt = control ? control->point_momentum_at_t() : nullptr;
+    if (pt)
+      {
+        nodal_p.zero_out_ghost_values();
+        const double *src = pt->begin();
+        double       *dst = nodal_p.begin();
+        for (const unsigned int i : active_dofs)
+          dst[i] = src[i];
+      }
+    else
+      scatter_point_momentum(nodal_p);
     const double *M = nodal_mass.begin();
     const double *A = nodal_a.begin();
     double       *V = nodal_p.begin();

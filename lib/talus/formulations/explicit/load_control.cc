@@ -312,6 +312,7 @@ namespace talus::loads
     using L           = PropertyLayout<dim>;
     h                 = step;
     const bool vt_now = need_vt || check_step(s);
+    vt_scattered      = false;
     if (vt_now && momentum_t) // the caller's nodal momentum at t (owned entries)
       {
         const double *src = momentum_t->begin();
@@ -320,7 +321,10 @@ namespace talus::loads
           dst[i] = src[i];
       }
     else if (vt_now) // nodal momentum p^t of the points (the shape functions of the run)
-      s.scatter_point_momentum(vt);
+      {
+        s.scatter_point_momentum(vt);
+        vt_scattered = true;
+      }
     // with momentum_t (the 2-phase step) the caller has scattered the tractions
     // in its own P2G pass (begin/end_traction_scatter)
     const bool scatter = forces.any() && !momentum_t;

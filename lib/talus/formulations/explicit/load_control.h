@@ -199,6 +199,14 @@ namespace talus::loads
       if (current) // else the stage about to begin builds them
         build_node_lists(s);
     }
+    /// The nodal momentum p^t of the points that before_nodal_solve scattered
+    /// in this step (the run's P2G, affine with APIC), or nullptr if it did not
+    /// scatter one: the APIC step takes it instead of a second identical pass.
+    const Vector *
+    point_momentum_at_t() const
+    {
+      return vt_scattered ? &vt : nullptr;
+    }
     /// Last evaluated ratios (NaN before the first evaluation of the stage).
     double force_ratio  = std::numeric_limits<double>::quiet_NaN();
     double energy_ratio = std::numeric_limits<double>::quiet_NaN();
@@ -215,7 +223,8 @@ namespace talus::loads
     bool                 converged   = false;
     double               potential0 = 0, work_loads = 0; ///< baselines of W_ext
 
-    bool                       need_vt = false;
+    bool                       need_vt      = false;
+    bool                       vt_scattered = false; ///< vt is this step's P2G of the points
     Vector                     trac, vt;
     std::vector<int>           component; ///< of each local DoF (-1: none)
     std::vector<unsigned char> excluded;  ///< DoFs left out of the force ratio
