@@ -1,6 +1,6 @@
 """Checkpoint/restart of talus-explicit (issue 7).
 
-Scene: the Mohr-Coulomb column collapse of the demo on a coarse grid (history
+Scene: the Mohr-Coulomb column collapse of restart_collapse.prm (the former demo) on a coarse grid (history
 variables, plastic flow, points changing cells every step), checkpoints every
 0.02 s of simulated time, two kept.
 

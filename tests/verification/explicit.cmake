@@ -92,7 +92,7 @@ set_tests_properties(verification.explicit_contact PROPERTIES LABELS "fast" ENVI
 
 # checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
 # 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
-talus_verification(explicit_checkpoint_restart check_restart.py demo/column_collapse_2d.prm)
+talus_verification(explicit_checkpoint_restart check_restart.py verification/restart_collapse.prm)
 set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESSORS 2)
 
 # chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
