@@ -289,6 +289,12 @@ add_test(NAME verification.implicit_lame_plane_strain
                  0.0015 0.008 0.015 0.012 0.05 0.7 20 40 80)
 set_tests_properties(verification.implicit_lame_plane_strain PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600)
+# the pressure on a circle gathers the loaded points' angles over the ranks: 1 vs 2 ranks (n = 40) to 1e-8
+add_test(NAME verification.implicit_ranks_lame
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/lame_cylinder_plane_strain.prm ${_w}/implicit_ranks_lame "grid/cells=40, 40")
+set_tests_properties(verification.implicit_ranks_lame PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
 
 # axisymmetry (seed 001 App. C): thick-walled cylinder under internal pressure vs the
 # linear Lame solution (u_r, hoop stress), 3 grids (fast) / 4 grids (verify)
