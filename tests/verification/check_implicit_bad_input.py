@@ -12,6 +12,10 @@ the right exit code, no NaN written.
     'geometry = axisymmetric' (on thick_cylinder_axisymmetric.prm beside PRM) in
     3D, with mixed u-p, on a grid reaching x < 0, with a radial gravity, with a
     'total force' traction, restarted with tractions;
+  * the pressure on a circle (loads/traction 0/pressure centre, on
+    lame_cylinder_plane_strain.prm beside PRM; --check and a run): on a body face,
+    with a traction, radius 0, a circle missing the region or crossing it twice,
+    a pressure without its centre, with 'geometry = axisymmetric';
   * rigid plates: a force and a displacement, a boundary id the grid lacks, a
     region holding no grid node, the axis held by a wall at every node, two
     plates sharing a node;
@@ -238,6 +242,21 @@ cases.update({
     "axisymmetric restart with tractions": (tv.prm_set(axi, "checkpoint/restart", "if available"),
                                             ["checkpoint/restart", "axisymmetric"]),
 })
+# the pressure on a circle (loads/traction k/pressure centre; lame_cylinder_plane_strain.prm beside
+# PRM), refused with --check and with a run alike
+lame = open(os.path.join(os.path.dirname(prm_path), "lame_cylinder_plane_strain.prm")).read()
+tr = "loads/traction 0/"
+for label, settings, needles in (
+        ("pressure on a body face", [tr + "apply to=body face"], [tr + "apply to", "region"]),
+        ("pressure and traction", [tr + "traction=1, 0"], [tr + "pressure centre", "not both"]),
+        ("pressure radius 0", [tr + "pressure radius=0"], [tr + "pressure radius", "> 0"]),
+        ("circle missing the region", [tr + "pressure radius=5"], [tr + "pressure radius", "does not pass"]),
+        ("circle in two arcs", [tr + "region lower corner=-0.5, -1.5", tr + "region upper corner=0.5, 1.5"],
+         [tr + "region lower corner", "2 separate arcs"]),
+        ("pressure without centre", [tr + "pressure centre="], [tr + "pressure", "without 'pressure centre'"]),
+        ("pressure with axisymmetric", ["implicit/geometry=axisymmetric"],
+         [tr + "pressure centre", "axisymmetric"])):
+    tv.check_refused(tool, tv.prm_set_args(lame, settings), label, needles, os.path.join(work, label.replace(" ", "_")))
 for name, (text, needles) in cases.items():
     rc, out, err = tv.run_tool(tool, text, work, name.replace(" ", "_"), expect_rc=None)
     msg = err.strip()

@@ -45,25 +45,11 @@ if bspline:
     base = tv.prm_set(base, "numerics/shape function", "quadratic bspline")
 refs = {"0.33": 0.323, "0.499999": 0.275}
 # thesis Table 5.1 (triangles, one point per element): U, UP no stab, UP stab
-thesis = {
-    "0.33": {2: (0.089, 0.1013, 0.1172), 4: (0.1415, 0.1718, 0.1953), 8: (0.2183, 0.2511, 0.2669),
-             16: (0.2771, 0.2952, 0.3025), 32: (0.30386, 0.3119, 0.315), 64: (0.3133, 0.3176, 0.319)},
-    "0.499999": {2: (0.0723, 0.0788, 0.1277), 4: (0.0736, 0.1157, 0.1932), 8: (0.0742, 0.1821, 0.2424),
-                 16: (0.075, 0.2356, 0.2648), 32: (0.0775, 0.2606, 0.2725), 64: (0.0862, 0.2702, 0.275)},
-}
+thesis = tv.COOKS_TABLE_5_1
 
 
 def corner_displacement(path):
-    t = tv.read_csv(path)
-    pts = [(t["pos_x"][i] - t["u_x"][i], t["pos_y"][i] - t["u_y"][i], t["u_y"][i]) for i in range(len(t["id"]))]
-    pts.sort(key=lambda p: (p[0] - 48) ** 2 + (p[1] - 60) ** 2)
-    near = pts[:6]
-    # normal equations of the plane fit (3 x 3), solved by Cramer's rule
-    rows = [(1.0, x - 48, y - 60) for x, y, _ in near]
-    A = [[sum(r[i] * r[j] for r in rows) for j in range(3)] for i in range(3)]
-    b = [sum(r[i] * p[2] for r, p in zip(rows, near)) for i in range(3)]
-    Ab = [[b[i] if j == 0 else A[i][j] for j in range(3)] for i in range(3)]
-    return tv.det3(Ab) / tv.det3(A), len(pts)
+    return tv.cooks_corner_uy(tv.read_csv(path))
 
 
 FORMS = ("irreducible", "mixed up") if bspline else ("irreducible", "mixed up", "f-bar")

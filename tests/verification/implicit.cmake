@@ -261,6 +261,56 @@ add_test(NAME verification.implicit_ranks_cooks_fbar
 set_tests_properties(verification.implicit_ranks_cooks_fbar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
 
+# Table 5.1's "UP No Stab" column (issue 39 item 4; docs/implicit.md "Cook's membrane"): u-p with
+# 'stabilisation factor = 0' beside alpha = 1, n = 8, 16, 32 (fast) / 2 ... 64 (verify): no stab below stab
+# at every n, the pressure zigzag >= 3 x the stabilised one (n >= 8, nu = 0.499999), no locking, and
+# u_y(A) at the finest n within 3 % (fast, n = 32; measured 0.25 % / 1.95 %) / 1 % (verify, n = 64;
+# measured 0.21 % / 0.23 %) of the thesis's UP No Stab
+add_test(NAME verification.implicit_cooks_membrane_nostab
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cooks_nostab.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_cooks_membrane_nostab 0.03 3 8 16 32)
+set_tests_properties(verification.implicit_cooks_membrane_nostab PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900)
+add_test(NAME verification.implicit_cooks_membrane_nostab_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_cooks_nostab.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cooks_membrane.prm ${_w}/implicit_cooks_membrane_nostab_full 0.01 3
+                 2 4 8 16 32 64)
+set_tests_properties(verification.implicit_cooks_membrane_nostab_full PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1800)
+
+# the J2 plane-strain tension test (thesis §5.4.2; docs/implicit.md "J2 plane-strain tension test"): u and
+# u-p at nu = 0.3 and 0.499999 vs the limit load 2 sigma_Y / sqrt(3) (u-p within 3 %, the two nu within
+# 3 %, elastic slope within [0, 20 %) above E / (1 - nu^2), u at nu = 0.499999 locked above 1.1 x);
+# fast: 10 load steps, verify: 20
+add_test(NAME verification.implicit_j2_tension
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_j2_tension.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/j2_tension_plane_strain.prm ${_w}/implicit_j2_tension 0.03 0.2 0.1
+                 "time/time step=0.1")
+set_tests_properties(verification.implicit_j2_tension PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+add_test(NAME verification.implicit_j2_tension_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_j2_tension.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/j2_tension_plane_strain.prm ${_w}/implicit_j2_tension_full 0.03 0.2 0.1)
+set_tests_properties(verification.implicit_j2_tension_full PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
+                     TIMEOUT 900)
+
+# the plane-strain Lame cylinder (issue 39 item 4; docs/implicit.md "Lamé cylinder in plane strain"): a quarter
+# annulus seeded on the box grid, internal pressure as a pressure on a circle, u_r and the hoop stress vs Lame
+# on grids of h = 0.125, 0.0625, 0.03125 m (~4 s); at the finest (measured): u_r RMS 7.7e-4 < 1.5e-3, largest
+# 4.6e-3 < 8e-3, u_t 1.06e-2 < 1.5e-2 of u_r(a); hoop stress beyond 2h of the surfaces RMS 6.4e-3 < 1.2e-2,
+# largest 3.2e-2 < 5e-2 of sigma_tt(a); orders 0.96 / 0.91 >= 0.7
+add_test(NAME verification.implicit_lame_plane_strain
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_lame_plane_strain.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/lame_cylinder_plane_strain.prm ${_w}/implicit_lame_plane_strain
+                 0.0015 0.008 0.015 0.012 0.05 0.7 20 40 80)
+set_tests_properties(verification.implicit_lame_plane_strain PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+# the pressure on a circle gathers the loaded points' angles over the ranks: 1 vs 2 ranks (n = 40) to 1e-8
+add_test(NAME verification.implicit_ranks_lame
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_ranks.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/lame_cylinder_plane_strain.prm ${_w}/implicit_ranks_lame "grid/cells=40, 40")
+set_tests_properties(verification.implicit_ranks_lame PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600
+                     PROCESSORS 2)
+
 # axisymmetry (seed 001 App. C): thick-walled cylinder under internal pressure vs the
 # linear Lame solution (u_r, hoop stress), 3 grids (fast) / 4 grids (verify)
 add_test(NAME verification.implicit_axisymmetric_cylinder

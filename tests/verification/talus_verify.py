@@ -227,6 +227,32 @@ def deposit_front(xs, hx, origin):
     return max(x for x in xs if x < edge), sum(1 for x in xs if x >= edge)
 
 
+# seed 001 Table 5.1, Cook's membrane, u_y(A) per elements per side n (structured triangles, one
+# point per element): (U, UP no stab, UP stab) for nu = 0.33 and 0.499999 (as printed)
+COOKS_TABLE_5_1 = {
+    "0.33": {2: (0.089, 0.1013, 0.1172), 4: (0.1415, 0.1718, 0.1953), 8: (0.2183, 0.2511, 0.2669),
+             16: (0.2771, 0.2952, 0.3025), 32: (0.30386, 0.3119, 0.315), 64: (0.3133, 0.3176, 0.319)},
+    "0.499999": {2: (0.0723, 0.0788, 0.1277), 4: (0.0736, 0.1157, 0.1932), 8: (0.0742, 0.1821, 0.2424),
+                 16: (0.075, 0.2356, 0.2648), 32: (0.0775, 0.2606, 0.2725), 64: (0.0862, 0.2702, 0.275)},
+}
+
+
+def cooks_corner_uy(t, corner=(48.0, 60.0)):
+    """Vertical displacement of Cook's membrane's corner A from a particles_final.csv table t
+    (docs/implicit.md, "Cook's membrane"): no point sits on A; the value at A of the least-squares
+    plane u_y = a + b (X - 48) + c (Y - 60) through the 6 points nearest to A by initial position
+    X = x - u. Returns (u_y(A), number of points)."""
+    pts = [(t["pos_x"][i] - t["u_x"][i], t["pos_y"][i] - t["u_y"][i], t["u_y"][i]) for i in range(len(t["id"]))]
+    pts.sort(key=lambda q: (q[0] - corner[0]) ** 2 + (q[1] - corner[1]) ** 2)
+    near = pts[:6]
+    # normal equations of the plane fit (3 x 3), solved by Cramer's rule
+    rows = [(1.0, x - corner[0], y - corner[1]) for x, y, _ in near]
+    A = [[sum(r[i] * r[j] for r in rows) for j in range(3)] for i in range(3)]
+    b = [sum(r[i] * q[2] for r, q in zip(rows, near)) for i in range(3)]
+    Ab = [[b[i] if j == 0 else A[i][j] for j in range(3)] for i in range(3)]
+    return det3(Ab) / det3(A), len(pts)
+
+
 def zigzag_index(X, Y, p, h):
     """Checkerboard measure of a point field p (e.g. the mean stress) on the initial lattice of
     2 x 2 points per cell of size h (X, Y the initial positions): per point and direction with

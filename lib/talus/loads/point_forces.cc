@@ -5,11 +5,28 @@
 #include <deal.II/base/mpi.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <sstream>
 
 namespace talus::loads
 {
+  namespace
+  {
+    /// angle of x about the centre of a pressure traction, from the start of its arc, in [0, 2 pi)
+    template <int dim>
+    double
+    arc_angle(const Traction<dim> &t, const dealii::Point<dim> &x)
+    {
+      double phi = std::atan2(x[1] - t.centre[1], x[0] - t.centre[0]) - t.arc_start;
+      while (phi < 0)
+        phi += 2.0 * M_PI;
+      while (phi >= 2.0 * M_PI)
+        phi -= 2.0 * M_PI;
+      return phi;
+    }
+  } // namespace
+
   template <int dim>
   void
   PointForces<dim>::extend_layout(PropertyLayout<dim> &layout, const unsigned int n_slots)
@@ -68,6 +85,13 @@ namespace talus::loads
         const auto spacing = [&](const auto &pt) {
           const auto        &cc = grid.cells[pt.get_surrounding_cell()->active_cell_index()];
           const unsigned int b  = static_cast<unsigned int>(pt.get_properties()[L::body]);
+          if (t.radial) // a pressure on a circle: the smallest point spacing
+            {
+              double h = cc.h[0];
+              for (unsigned int d = 1; d < dim; ++d)
+                h = std::min(h, cc.h[d]);
+              return h / bodies[b].particles_per_direction;
+            }
           return cc.h[t.axis] / bodies[b].particles_per_direction;
         };
         double extreme = -std::numeric_limits<double>::max();
@@ -86,6 +110,8 @@ namespace talus::loads
           for (unsigned int d = 0; d < dim; ++d)
             if (X[d] < t.lower[d] || X[d] > t.upper[d])
               return false;
+          if (t.radial) // the points within one spacing of the circle: one layer along a surface
+            return std::abs(X.distance(t.centre) - t.radius) < spacing(pt);
           return true;
         };
         double       area_sum = 0;
@@ -99,8 +125,46 @@ namespace talus::loads
         area_sum         = dealii::Utilities::MPI::sum(area_sum, comm);
         const auto n_all = dealii::Utilities::MPI::sum(n_sel, comm);
         require(n_all > 0, t.where, "selects no material point (check the body/face or the region)");
-        double scale = 1.0;
-        if (t.total) // the resultant spread by area share: traction = force / loaded area
+        // a pressure on a circle: each loaded point's share of the arc is the
+        // angular interval between the mid-angles to its neighbours (sorted by
+        // angle over all ranks; the arc's ends close the first and last
+        // interval, the whole circle wraps), so the shares follow the points'
+        // spacing along the arc and add up to the arc inside the region box
+        std::vector<double> sorted_angles, shares;
+        if (t.radial)
+          {
+            std::vector<double> mine;
+            for (const auto &pt : points.handler)
+              if (selected(pt))
+                mine.push_back(arc_angle(t, initial(pt)));
+            for (const auto &v : dealii::Utilities::MPI::all_gather(comm, mine))
+              sorted_angles.insert(sorted_angles.end(), v.begin(), v.end());
+            std::sort(sorted_angles.begin(), sorted_angles.end());
+            const std::size_t m    = sorted_angles.size();
+            const bool        full = t.arc_span >= 2.0 * M_PI * (1 - 1e-12);
+            shares.resize(m);
+            for (std::size_t k = 0; k < m; ++k)
+              {
+                const double lo = k > 0  ? 0.5 * (sorted_angles[k - 1] + sorted_angles[k])
+                                  : full ? 0.5 * (sorted_angles[m - 1] - 2.0 * M_PI + sorted_angles[0])
+                                         : std::min(0.0, sorted_angles[0]);
+                const double hi = k + 1 < m ? 0.5 * (sorted_angles[k] + sorted_angles[k + 1])
+                                  : full    ? 0.5 * (sorted_angles[m - 1] + 2.0 * M_PI + sorted_angles[0])
+                                            : std::max(t.arc_span, sorted_angles[m - 1]);
+                shares[k]       = t.radius * (hi - lo);
+              }
+          }
+        // the share of a point at angle phi: the mean over the points at exactly that angle
+        const auto arc_share = [&](const double phi) {
+          const auto lo  = std::lower_bound(sorted_angles.begin(), sorted_angles.end(), phi);
+          const auto hi  = std::upper_bound(sorted_angles.begin(), sorted_angles.end(), phi);
+          double     sum = 0;
+          for (auto it = lo; it != hi; ++it)
+            sum += shares[it - sorted_angles.begin()];
+          return sum / std::max<std::ptrdiff_t>(1, hi - lo);
+        };
+        double scale = 1.0; // (a pressure on a circle: the arc shares above)
+        if (t.total)        // the resultant spread by area share: traction = force / loaded area
           scale = 1.0 / area_sum;
         else if (t.target == Traction<dim>::Target::body_face)
           {
@@ -116,12 +180,25 @@ namespace talus::loads
             {
               auto         P  = pt.get_properties();
               const double Ap = scale * P[L::volume] / spacing(pt);
-              for (unsigned int d = 0; d < dim; ++d)
-                P[off + j * dim + d] = t.traction[d] * Ap;
+              if (t.radial)
+                {
+                  const dealii::Tensor<1, dim> r     = initial(pt) - t.centre;
+                  const double                 share = arc_share(arc_angle(t, initial(pt)));
+                  for (unsigned int d = 0; d < dim; ++d)
+                    P[off + j * dim + d] = t.pressure * share * r[d] / r.norm();
+                }
+              else
+                for (unsigned int d = 0; d < dim; ++d)
+                  P[off + j * dim + d] = t.traction[d] * Ap;
             }
-        log() << "  " << t.where << ": " << n_all << " boundary material points, loaded area "
-              << (t.total ? area_sum : area_sum * scale) << (dim == 2 ? " m (per unit thickness)" : " m^2")
-              << (t.total ? " (total force given)" : "") << ", f(t) = " << t.function.text() << std::endl;
+        if (t.radial)
+          log() << "  " << t.where << ": pressure " << t.pressure << " Pa on the circle about " << t.centre
+                << ", radius " << t.radius << ": " << n_all << " material points, arc length " << t.radius * t.arc_span
+                << " m inside the region, f(t) = " << t.function.text() << std::endl;
+        else
+          log() << "  " << t.where << ": " << n_all << " boundary material points, loaded area "
+                << (t.total ? area_sum : area_sum * scale) << (dim == 2 ? " m (per unit thickness)" : " m^2")
+                << (t.total ? " (total force given)" : "") << ", f(t) = " << t.function.text() << std::endl;
       }
   }
 

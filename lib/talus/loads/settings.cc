@@ -7,6 +7,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <cmath>
+#include <vector>
 
 namespace talus::loads
 {
@@ -94,6 +95,18 @@ namespace talus::loads
                             "Instead of 'traction': the resultant force [N; per unit thickness in 2D] spread over "
                             "the selected points in proportion to their area shares (traction = total force / loaded "
                             "area: exact totals where the seeded points do not fill the face exactly); empty = off.");
+          prm.declare_entry("pressure centre", "", Anything(),
+                            "Instead of 'traction' (2D, apply to = region): the centre of a circle that carries a "
+                            "pressure, e.g. the bore of a thick cylinder; empty = off. The points within one point "
+                            "spacing of the circle (and in the region box) carry 'pressure' times their share of the "
+                            "arc inside the region box, along the unit vector from the centre to their initial "
+                            "position; the direction does not follow the deformation.");
+          prm.declare_entry("pressure radius", "0", Double(0),
+                            "With 'pressure centre': the circle's radius [m] (> 0).");
+          prm.declare_entry("pressure", "0", Double(),
+                            "With 'pressure centre': the pressure [Pa]; positive pushes the material away from the "
+                            "centre (an internal pressure on a bore; an external pressure on an outer surface is "
+                            "negative).");
           declare_time_function(prm, "the traction", "the stage's time for a stage load, else the absolute time");
           prm.leave_subsection();
         }
@@ -216,6 +229,46 @@ namespace talus::loads
               t.traction = parse_point<dim>(tot, where + "/total force");
               t.total    = true;
             }
+          const std::string centre = prm.get("pressure centre");
+          if (!centre.empty())
+            {
+              require(dim == 2, where + "/pressure centre", "a pressure on a circle is available in 2D only");
+              require(t.target == Traction<dim>::Target::region, where + "/apply to",
+                      "'pressure centre' needs apply to = region (the region box bounds the loaded arc)");
+              require(t.traction.norm() == 0 && !t.total, where + "/pressure centre",
+                      "give either 'pressure centre' with 'pressure' or 'traction'/'total force', not both");
+              t.radial = true;
+              t.centre = parse_point<dim>(centre, where + "/pressure centre");
+              t.radius = prm.get_double("pressure radius");
+              require(t.radius > 0, where + "/pressure radius", "must be > 0 with 'pressure centre'");
+              t.pressure = prm.get_double("pressure");
+              // the arc inside the region box: midpoint samples of 2^16 angles; one
+              // connected arc (or the whole circle) is required
+              const unsigned int n = 1u << 16;
+              std::vector<bool>  in(n);
+              unsigned int       n_in = 0, n_starts = 0, start = 0;
+              for (unsigned int k = 0; k < n; ++k)
+                {
+                  const double phi = -M_PI + 2.0 * M_PI * (k + 0.5) / n;
+                  const double x = t.centre[0] + t.radius * std::cos(phi), y = t.centre[1] + t.radius * std::sin(phi);
+                  in[k] = x >= t.lower[0] && x <= t.upper[0] && y >= t.lower[1] && y <= t.upper[1];
+                  n_in += in[k] ? 1 : 0;
+                }
+              for (unsigned int k = 0; k < n; ++k)
+                if (in[k] && !in[(k + n - 1) % n])
+                  ++n_starts, start = k;
+              require(n_in > 0, where + "/pressure radius",
+                      "the circle does not pass through the region box (region lower/upper corner)");
+              require(n_starts <= 1, where + "/region lower corner",
+                      "the circle crosses the region box in " + std::to_string(n_starts) +
+                        " separate arcs; allowed: one arc (or the whole circle) per traction");
+              t.arc_span  = 2.0 * M_PI * n_in / n;
+              t.arc_start = n_in == n ? -M_PI : -M_PI + 2.0 * M_PI * start / n;
+            }
+          else
+            require(prm.get_double("pressure radius") == 0 && prm.get_double("pressure") == 0,
+                    where + (prm.get_double("pressure") != 0 ? "/pressure" : "/pressure radius"),
+                    "is given without 'pressure centre' (set the centre, or remove the entry)");
           t.function = parse_time_function(prm, where);
           prm.leave_subsection();
           tractions.push_back(t);

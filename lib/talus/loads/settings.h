@@ -42,8 +42,19 @@ namespace talus::loads
     dealii::Point<dim>            position;           ///< point: where the user put it
     dealii::Tensor<1, dim> traction; ///< [Pa] (force per area); with `total` (always for a point): the resultant [N]
     bool                   total = false; ///< `traction` is the resultant over the selected points
-    TimeFunction           function;
-    std::string            where;
+    /// 'pressure centre' given (2D, region): a pressure `pressure` [Pa] on the
+    /// arc of the circle (centre, radius) inside the region box, carried by the
+    /// points within one point spacing of the circle, along the radial unit
+    /// vector from the centre (docs/boundary-conditions.md, "Pressure on a circle")
+    bool               radial = false;
+    dealii::Point<dim> centre;
+    double             radius   = 0;
+    double             pressure = 0;
+    /// the arc of the circle inside the region box: start angle [rad] (from the
+    /// centre, atan2 convention) and angular length (2 pi: the whole circle)
+    double       arc_start = 0, arc_span = 0;
+    TimeFunction function;
+    std::string  where;
   };
 
   /// Prescribed velocity on grid nodes (boundary id or region) or on the

@@ -531,6 +531,10 @@ namespace talus::implicit_mpm
                   "a point load is not available with 'axisymmetric' (a material point off the axis stands for a "
                   "ring, so its force would be a ring load); allowed: plane strain, or a traction in Pa");
         for (const auto &t : p.tractions)
+          require(!t.radial, t.where + "/pressure centre",
+                  "a pressure on a circle is not available with 'axisymmetric' (the circle would be a torus); "
+                  "allowed: plane strain, or a traction on a body face");
+        for (const auto &t : p.tractions)
           require(!t.total, t.where,
                   "'total force' is not available with 'axisymmetric' (give the traction in Pa; it is applied per "
                   "unit ring area)");

@@ -74,6 +74,9 @@ namespace talus::semi_implicit
     const std::string rigid = "'semi implicit/rigid skeleton = true' holds every soil node at rest";
     for (const auto &t : p.tractions)
       {
+        require(!t.radial, t.where + "/pressure centre",
+                "a pressure on a circle is not available in talus-semi-implicit (allowed: talus-explicit, "
+                "talus-implicit in plane strain; here 'traction' on a face)");
         require(!p.rigid_skeleton, t.where,
                 "talus-semi-implicit cannot honour a traction here: " + rigid +
                   ", so no load can move the soil (allowed: rigid skeleton = false, or no traction)");
