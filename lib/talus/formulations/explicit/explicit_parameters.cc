@@ -207,8 +207,9 @@ namespace talus::explicit_mpm
                 std::string(p.numerics.integration_name()) + why + "mpm");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + why + "none");
-        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
-        // the loads are kernel templates: the nodal momentum p^t (ScatterMomentum),
+        // contact (contact/pairs) is a kernel template (contact.cc; normals from
+        // the B-spline mass gradient, docs/explicit.md "Contact between bodies").
+        // The loads are kernel templates: the nodal momentum p^t (ScatterMomentum),
         // the traction point forces and the momentum of prescribed point
         // velocities (ScatterPointVectors); wall friction acts on the wall nodes'
         // sums, whichever kernel made them. The 2-phase step is a kernel template

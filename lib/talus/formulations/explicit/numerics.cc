@@ -177,6 +177,11 @@ namespace talus::explicit_mpm
     const bool             linear_stress = s.prm.numerics.mixed_linear;
     Contact<dim>          *contact       = s.contact.get();
     const auto             g             = s.gravity; // of the running stage
+    if (!mixed)
+      {
+        contact->p2g(s); // contact alone: on the run's kernel (contact.cc)
+        return;
+      }
 
     double *const M  = s.nodal_mass.begin();
     double *const Fv = s.nodal_a.begin();
@@ -190,6 +195,7 @@ namespace talus::explicit_mpm
       for (auto &f : contact->fields)
         {
           zero_on(f.mass, s.active_dofs);
+          zero_on(f.volume, s.active_dofs);
           zero_on(f.force, s.active_dofs);
           zero_on(f.momentum, s.active_dofs);
         }
@@ -275,19 +281,18 @@ namespace talus::explicit_mpm
             F::expand_moments(a.T, cc.inv_h, fb);
             auto         &fl = contact->fields[b];
             double *const bm = fl.mass.begin();
+            double *const bv = fl.volume.begin();
             double *const bf = fl.force.begin();
             double *const bp = fl.momentum.begin();
             for (unsigned int v = 0; v < nv; ++v)
-              {
-                bm[cc.dofs[v * dim + 0]] += a.lm[v];
-                bm[cc.dofs[v * dim + 1]] += a.lvol[v];
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    const unsigned int i = cc.dofs[v * dim + d];
-                    bf[i] += fb[v][d];
-                    bp[i] += a.lp[v][d];
-                  }
-              }
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  const unsigned int i = cc.dofs[v * dim + d];
+                  bm[i] += a.lm[v];
+                  bv[i] += a.lvol[v];
+                  bf[i] += fb[v][d];
+                  bp[i] += a.lp[v][d];
+                }
           }
     };
     transfer::for_each_active_cell(s.points, begin_cell, at_point, end_cell);
