@@ -25,11 +25,14 @@ Usage: check_contact_bspline.py TOOL SLIDING_PRM DISKS_PRM WORKDIR slide|disks|r
 """
 import math
 import os
+import shutil
 import sys
 
 import talus_verify as tv
 
 tool, sliding_prm, disks_prm, work, part = sys.argv[1:6]
+shutil.rmtree(work, ignore_errors=True)  # no checkpoint of an earlier run may be restarted from
+os.makedirs(work)
 g = 9.81
 BSPLINE = "quadratic bspline"
 
@@ -145,7 +148,7 @@ elif part == "restart":
         tv.run_tool(tool, tv.prm_set(text, "checkpoint/restart", "true"), work, cut + "_restart", np=n)
         same = open(f"{work}/{cut}/particles_final.csv").read() == open(f"{work}/{ref}/particles_final.csv").read()
         series = open(f"{work}/{cut}/series.csv").read() == open(f"{work}/{ref}/series.csv").read()
-        tv.check(same and series, f"{n} rank(s): stopped at 1.2 s, restarted from the 1.0 s checkpoint: "
+        tv.check(same and series, f"{n} rank(s): stopped at 1.2 s, restarted from its newest checkpoint: "
                                   f"particles_final.csv and series.csv bitwise identical ({same}, {series})")
 else:
     tv.fail(f"unknown part '{part}'")
