@@ -154,8 +154,8 @@ namespace talus::explicit_mpm
                   "stabilisation = none");
         require(!p.numerics.contact(), "contact/pairs",
                 "contact" + why +
-                  "the bodies' own velocity fields are not averaged); allowed: empty, or "
-                  "volumetric stabilisation = none");
+                  "the map and remap of dJ use the combined velocity field, while a body in contact "
+                  "deforms with its own; docs/explicit.md); allowed: empty, or volumetric stabilisation = none");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/volumetric stabilisation",
                 "f-bar is available in the 1-phase step only (coupled 2-phase materials and body tractions run "
                 "the 2-phase step); allowed: none, or 1-phase materials");
@@ -200,7 +200,8 @@ namespace talus::explicit_mpm
       }
     if (p.bspline())
       {
-        // the passes that are not yet kernel templates (transfer/) walk with Q1
+        // the passes that are not kernel templates (MPM-MIXED, FEM/UL-FEM, strain
+        // smoothing) walk with Q1
         const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
                                 "(its particle passes use linear shape functions); allowed: ";
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",

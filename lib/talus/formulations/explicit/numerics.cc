@@ -21,9 +21,10 @@ namespace talus::explicit_mpm
     using namespace dealii::Patterns;
     prm.enter_subsection("numerics");
     // 'shape function' is declared with the shared scene (scene_parameters.cc);
-    // quadratic B-splines need integration = mpm, without strain smoothing,
-    // contact, 2-phase materials, tractions, friction or prescribed velocities
-    // of bodies (refused by parse_parameters in explicit_solver.cc)
+    // quadratic B-splines need integration = mpm, no strain smoothing, no coupled
+    // 2-phase materials (or their body tractions) and a box grid of >= 3 cells per
+    // direction (refused by parse_parameters in explicit_parameters.cc); contact,
+    // loads, friction and prescribed velocities work on both kernels
     prm.declare_entry(
       "velocity transfer", "flip", Selection("flip|apic"),
       "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
@@ -64,7 +65,9 @@ namespace talus::explicit_mpm
                       "Body pairs in frictional contact (seed 000 §6.2): 'a, b, mu, adhesion; ...' with body ids "
                       "a != b, Coulomb friction coefficient mu >= 0 and adhesion >= 0 [Pa] (tangential force cap "
                       "adhesion x contact area of the node). Empty: contact off (all bodies share one velocity "
-                      "field). With contact on, bodies whose pair is not listed stick to each other.");
+                      "field). With contact on, bodies whose pair is not listed stick to each other. Works with "
+                      "both shape functions (docs/explicit.md); not with velocity transfer = apic, "
+                      "volumetric stabilisation = f-bar, integration = fem | ul-fem or coupled 2-phase materials.");
     prm.leave_subsection();
   }
 
