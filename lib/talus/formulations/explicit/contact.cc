@@ -3,8 +3,8 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/numerics.h>
+#include <talus/shape/with_kernel.h>
 #include <talus/transfer/cell_walk.h>
-#include <talus/shape/q1.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,18 +13,14 @@
 namespace talus::explicit_mpm
 {
   template <int dim>
-  Contact<dim>::Contact(const BackgroundGrid<dim> &g, const NumericsOptions &o, const unsigned int nb)
+  Contact<dim>::Contact(const BackgroundGrid<dim> &g, const NumericsOptions &o, const unsigned int nb,
+                        const bool bspline)
       : grid(g)
       , n_bodies(nb)
+      , bspline(bspline)
   {
     fields.resize(n_bodies);
-    for (auto &f : fields)
-      {
-        grid.reinit_vector(f.mass);
-        grid.reinit_vector(f.force);
-        grid.reinit_vector(f.momentum);
-        grid.reinit_vector(f.gradient);
-      }
+    grid_changed();
     pair_index.assign(n_bodies * n_bodies, -1);
     pairs = o.contact_pairs;
     for (unsigned int k = 0; k < pairs.size(); ++k)
@@ -53,40 +49,200 @@ namespace talus::explicit_mpm
     for (auto &f : fields)
       {
         grid.reinit_vector(f.mass);
+        grid.reinit_vector(f.volume);
         grid.reinit_vector(f.force);
         grid.reinit_vector(f.momentum);
         grid.reinit_vector(f.gradient);
       }
     node_marker.clear();
     nodes.clear();
+    capacity_ready = false;
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Contact<dim>::compute_capacity(K)
+  {
+    // integral of N_i over the owned cells, scattered and summed over the
+    // ranks: per direction 2-point Gauss on each half cell (the quadratic
+    // B-spline and its wall-modified form are polynomials of degree <= 2 on
+    // each half cell: exact)
+    grid.reinit_vector(capacity);
+    constexpr unsigned int nq    = 4;
+    const double           a     = 0.25 / std::sqrt(3.0);
+    const double           q[nq] = {0.25 - a, 0.25 + a, 0.75 - a, 0.75 + a};
+    double                 ones[dim];
+    std::fill(ones, ones + dim, 1.0);
+    unsigned int n_points = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      n_points *= nq;
+    for (unsigned int c = 0; c < grid.cells.size(); ++c)
+      if (grid.cells[c].locally_owned)
+        {
+          const typename K::Cell cell = K::cell(grid, c);
+          typename K::Momentum   sums;
+          sums.clear();
+          double volume = 1.0;
+          for (unsigned int d = 0; d < dim; ++d)
+            volume *= grid.cells[c].h[d];
+          const double w = volume / n_points;
+          for (unsigned int k = 0; k < n_points; ++k)
+            {
+              dealii::Point<dim> xi;
+              for (unsigned int d = 0, r = k; d < dim; ++d, r /= nq)
+                xi[d] = q[r % nq];
+              typename K::Eval e;
+              K::evaluate(cell, xi, e);
+              sums.add(e, w, ones);
+            }
+          sums.scatter(cell, capacity.begin());
+        }
+    capacity.compress(dealii::VectorOperation::add);
+    capacity_ready = true;
+  }
+
+  template <int dim>
+  void
+  Contact<dim>::p2g(Solver<dim> &s)
+  {
+    shape::with_kernel<dim>(bspline, [&](auto kernel) { p2g_with(kernel, s); });
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Contact<dim>::p2g_with(K, Solver<dim> &s)
+  {
+    // The solver's P2G (ScatterMassForce: the combined lumped mass and
+    // internal + gravity force) and, in the same pass, every body's: per cell,
+    // the kernel's sums for each body with points in it, scattered once per
+    // cell. Quadratic B-splines: the outward normal of the body at a node is
+    // sum_p m_p grad N_i(x_p) (minus the gradient of the body's mass density;
+    // the C1 kernel makes it continuous in the point positions).
+    using L         = PropertyLayout<dim>;
+    const auto zero = [&](Vector &x) {
+      x.zero_out_ghost_values();
+      double *p = x.begin();
+      for (const unsigned int i : s.active_dofs)
+        p[i] = 0.0;
+    };
+    zero(s.nodal_mass);
+    zero(s.nodal_a);
+    for (auto &f : fields)
+      {
+        zero(f.mass);
+        zero(f.volume);
+        zero(f.force);
+        zero(f.momentum);
+        if (bspline)
+          zero(f.gradient);
+      }
+    struct BodySums
+    {
+      typename K::MassForce mass_force;
+      typename K::Momentum  momentum;
+      typename K::Momentum  volume; // sum V N (all components)
+    };
+    std::vector<BodySums>      acc(n_bodies);
+    std::vector<unsigned char> in_cell(n_bodies, 0);
+    std::vector<unsigned int>  touched;
+    typename K::Cell           cell;
+    typename K::MassForce      all;
+    double                     ones[dim];
+    std::fill(ones, ones + dim, 1.0);
+    const dealii::Tensor<1, dim> g        = s.gravity; // of the running stage
+    const auto                   begin_ce = [&](const unsigned int c) {
+      cell = K::cell(grid, c);
+      all.clear();
+      touched.clear();
+    };
+    const auto at_point = [&](const unsigned int, auto &pt) {
+      const double            *P  = pt->get_properties().data();
+      const dealii::Point<dim> xi = pt->get_reference_location();
+      typename K::Eval         e;
+      K::evaluate(cell, xi, e);
+      const double m = P[L::mass], V = P[L::volume];
+      double       t[dim][dim];
+      minus_V_sigma<dim>(P, V, t);
+      all.add(e, m, t);
+      const unsigned int b = static_cast<unsigned int>(P[L::body]);
+      auto              &a = acc[b];
+      if (!in_cell[b])
+        {
+          in_cell[b] = 1;
+          touched.push_back(b);
+          a.mass_force.clear();
+          a.momentum.clear();
+          a.volume.clear();
+        }
+      a.mass_force.add(e, m, t);
+      a.momentum.add(e, m, P + L::velocity);
+      a.volume.add(e, V, ones);
+      if (bspline)
+        {
+          unsigned int slot[K::n_point_nodes];
+          double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
+          K::point_stencil(cell, xi, slot, N, G);
+          double *X = fields[b].gradient.begin();
+          for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+            for (unsigned int d = 0; d < dim; ++d)
+              X[cell.dofs[slot[w] * dim + d]] += m * G[w][d];
+        }
+    };
+    const auto end_ce = [&](const unsigned int) {
+      all.scatter(cell, g, s.nodal_mass.begin(), s.nodal_a.begin());
+      for (const unsigned int b : touched)
+        {
+          in_cell[b] = 0;
+          auto &a    = acc[b];
+          auto &f    = fields[b];
+          a.mass_force.scatter(cell, g, f.mass.begin(), f.force.begin());
+          a.momentum.scatter(cell, f.momentum.begin());
+          a.volume.scatter(cell, f.volume.begin());
+        }
+    };
+    transfer::for_each_active_cell(s.points, begin_ce, at_point, end_ce);
   }
 
   template <int dim>
   void
   Contact<dim>::collect_nodes(const Solver<dim> &s)
   {
-    // owned nodes among the active DoFs (their component-0 DoF identifies them)
+    shape::with_kernel<dim>(bspline, [&](auto kernel) { collect_nodes_with(kernel, s); });
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Contact<dim>::collect_nodes_with(K, const Solver<dim> &s)
+  {
+    // owned nodes among the active DoFs (their component-0 DoF identifies them):
+    // the nodes of the kernel's stencils of the active cells (Q1: the cell's
+    // vertices; B-splines: its patch, slots outside the grid skipped)
     const unsigned int n_owned = s.nodal_mass.locally_owned_size();
     if (node_marker.size() != n_owned)
       node_marker.assign(n_owned, 0);
     nodes.clear();
-    const auto add = [&](const CellCache<dim> &cc) {
-      for (unsigned int v = 0; v < (1u << dim); ++v)
+    const auto add_node = [&](const unsigned int *node_dofs) {
+      const unsigned int i0 = node_dofs[0];
+      if (i0 < n_owned && !node_marker[i0]) // invalid (outside the grid) > n_owned
         {
-          const unsigned int i0 = cc.dofs[v * dim];
-          if (i0 < n_owned && !node_marker[i0])
-            {
-              node_marker[i0] = 1;
-              std::array<unsigned int, dim> d;
-              for (unsigned int c = 0; c < dim; ++c)
-                d[c] = cc.dofs[v * dim + c];
-              nodes.push_back(d);
-            }
+          node_marker[i0] = 1;
+          std::array<unsigned int, dim> d;
+          for (unsigned int c = 0; c < dim; ++c)
+            d[c] = node_dofs[c];
+          nodes.push_back(d);
         }
     };
     for (const auto &ac : s.points.active_cells())
-      add(grid.cells[ac.cell]);
-    // owned nodes that only other ranks' particles touch: any cell around them
+      {
+        const typename K::Cell cell = K::cell(grid, ac.cell);
+        for (unsigned int n = 0; n < K::n_nodes; ++n)
+          add_node(cell.dofs + n * dim);
+      }
+    // owned nodes that only other ranks' particles touch (every owned node is a
+    // vertex of an owned cell): the vertices of the cells around them
     if (dealii::Utilities::MPI::n_mpi_processes(s.comm) > 1)
       {
         std::vector<unsigned char> wanted(n_owned, 0);
@@ -97,7 +253,8 @@ namespace talus::explicit_mpm
           if (cc.h[0] > 0)
             for (unsigned int v = 0; v < (1u << dim); ++v)
               if (cc.dofs[v * dim] < n_owned && wanted[cc.dofs[v * dim]] && !node_marker[cc.dofs[v * dim]])
-                add(cc);
+                for (unsigned int u = 0; u < (1u << dim); ++u)
+                  add_node(cc.dofs + u * dim);
       }
     for (const auto &d : nodes)
       node_marker[d[0]] = 0;
@@ -107,7 +264,13 @@ namespace talus::explicit_mpm
   void
   Contact<dim>::compute_normals(const Solver<dim> &s)
   {
-    // Outward normal of body b at node i: minus the gradient of the body's
+    if (bspline) // scattered by p2g_with from the points
+      {
+        for (auto &f : fields)
+          f.gradient.compress(dealii::VectorOperation::add);
+        return;
+      }
+    // Linear shape functions: outward normal of body b at node i: minus the gradient of the body's
     // nodal mass field, summed over the active cells around the node (cell
     // centre value x cell volume). Unlike sum_p m_p grad N_i(x_p), which jumps
     // whenever a point crosses a cell boundary (a sliding block's bottom normal
@@ -173,6 +336,20 @@ namespace talus::explicit_mpm
           vb[b][d] = 0;
     if (n_present < 2)
       return false;
+    if (bspline)
+      {
+        // B-splines: a node is a contact node only where at least two bodies
+        // each fill a share of it; a body that reaches the node only with the
+        // tail of its shape function (the support extends 1.5 cells, its mass
+        // up to 1.25 cells beyond its surface) does not meet another body there
+        const double cap     = capacity.begin()[dofs[0]];
+        unsigned int n_share = 0;
+        for (unsigned int b = 0; b < n_bodies; ++b)
+          if (mb[b] > 0 && fields[b].volume.begin()[dofs[0]] >= bspline_share * cap)
+            ++n_share;
+        if (n_share < 2)
+          return false;
+      }
     ++contact_nodes;
     // combined velocity (Eq. 6.3)
     std::array<double, dim> v{};
@@ -255,8 +432,8 @@ namespace talus::explicit_mpm
             double hn = 0;
             for (unsigned int d = 0; d < dim; ++d)
               hn += std::abs(n[d]) * h[d];
-            const double Vg   = fields[g].mass.begin()[dofs[1]];
-            const double Vp   = fields[partner].mass.begin()[dofs[1]];
+            const double Vg   = fields[g].volume.begin()[dofs[0]];
+            const double Vp   = fields[partner].volume.begin()[dofs[0]];
             const double area = 2.0 * std::min(Vg, Vp) / hn;
             cap += pairs[k].adhesion * area * dt / mb[g];
           }
@@ -281,11 +458,14 @@ namespace talus::explicit_mpm
     for (auto &f : fields)
       {
         f.mass.compress(dealii::VectorOperation::add);
+        f.volume.compress(dealii::VectorOperation::add);
         f.force.compress(dealii::VectorOperation::add);
         f.momentum.compress(dealii::VectorOperation::add);
       }
     compute_normals(s);
     collect_nodes(s);
+    if (bspline && !capacity_ready)
+      compute_capacity(shape::BSpline2Box<dim>());
     contact_nodes = corrected_nodes = 0;
     std::vector<double>                  mb(n_bodies);
     std::vector<std::array<double, dim>> vb(n_bodies), v0(n_bodies);
@@ -328,10 +508,19 @@ namespace talus::explicit_mpm
   void
   Contact<dim>::g2p_velocity_p2g_momentum(Solver<dim> &s, const double h)
   {
-    using L                     = PropertyLayout<dim>;
-    constexpr unsigned int nv   = 1u << dim;
-    double *const          Pn   = s.nodal_p.begin();
-    const auto             zero = [&](Vector &x) {
+    shape::with_kernel<dim>(bspline, [&](auto kernel) { g2p_with(kernel, s, h); });
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Contact<dim>::g2p_with(K, Solver<dim> &s, const double h)
+  {
+    // UpdateVelocityScatterMomentum with the point's own body's corrected
+    // acceleration (gathered once per cell and body) and the momentum scattered
+    // into the combined and the body's vectors
+    using L         = PropertyLayout<dim>;
+    const auto zero = [&](Vector &x) {
       x.zero_out_ghost_values();
       double *p = x.begin();
       for (const unsigned int i : s.active_dofs)
@@ -340,34 +529,46 @@ namespace talus::explicit_mpm
     zero(s.nodal_p);
     for (auto &f : fields)
       zero(f.momentum);
-    const CellCache<dim> *cell     = nullptr;
-    const auto            at_point = [&](const unsigned int, auto &pt) {
-      const auto        &cc = *cell;
-      double            *P  = pt->get_properties().data();
-      const unsigned int b  = static_cast<unsigned int>(P[L::body]);
-      const double      *A  = fields[b].force.begin();
-      double            *Pb = fields[b].momentum.begin();
-      double             N[nv];
-      shape::Q1<dim>::values(pt->get_reference_location(), N);
+    std::vector<typename K::Field>    a(n_bodies);
+    std::vector<typename K::Momentum> pb(n_bodies);
+    std::vector<unsigned char>        in_cell(n_bodies, 0);
+    std::vector<unsigned int>         touched;
+    typename K::Cell                  cell;
+    typename K::Momentum              all;
+    const auto                        begin_ce = [&](const unsigned int c) {
+      cell = K::cell(grid, c);
+      all.clear();
+      touched.clear();
+    };
+    const auto at_point = [&](const unsigned int, auto &pt) {
+      double            *P = pt->get_properties().data();
+      const unsigned int b = static_cast<unsigned int>(P[L::body]);
+      if (!in_cell[b])
+        {
+          in_cell[b] = 1;
+          touched.push_back(b);
+          K::gather(cell, fields[b].force.begin(), 1.0, a[b], false);
+          pb[b].clear();
+        }
+      typename K::Values N;
+      K::values(cell, pt->get_reference_location(), N);
+      double ap[dim];
+      K::interpolate(a[b], N, ap);
       double *vel = P + L::velocity;
       for (unsigned int d = 0; d < dim; ++d)
-        {
-          double sum = 0;
-          for (unsigned int v = 0; v < nv; ++v)
-            sum += N[v] * A[cc.dofs[v * dim + d]];
-          vel[d] += h * sum; // Eq. 4.46 with the corrected acceleration
-        }
-      const double m = P[L::mass];
-      for (unsigned int v = 0; v < nv; ++v)
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const double q = m * N[v] * vel[d];
-            Pn[cc.dofs[v * dim + d]] += q;
-            Pb[cc.dofs[v * dim + d]] += q;
-          }
+        vel[d] += h * ap[d]; // Eq. 4.46 with the corrected acceleration
+      all.add(N, P[L::mass], vel);
+      pb[b].add(N, P[L::mass], vel);
     };
-    transfer::for_each_active_cell(
-      s.points, [&](const unsigned int c) { cell = &s.grid.cells[c]; }, at_point, [](const unsigned int) {});
+    const auto end_ce = [&](const unsigned int) {
+      all.scatter(cell, s.nodal_p.begin());
+      for (const unsigned int b : touched)
+        {
+          in_cell[b] = 0;
+          pb[b].scatter(cell, fields[b].momentum.begin());
+        }
+    };
+    transfer::for_each_active_cell(s.points, begin_ce, at_point, end_ce);
     s.nodal_p.compress(dealii::VectorOperation::add);
     for (auto &f : fields)
       f.momentum.compress(dealii::VectorOperation::add);

@@ -154,8 +154,8 @@ namespace talus::explicit_mpm
                   "stabilisation = none");
         require(!p.numerics.contact(), "contact/pairs",
                 "contact" + why +
-                  "the bodies' own velocity fields are not averaged); allowed: empty, or "
-                  "volumetric stabilisation = none");
+                  "the map and remap of dJ use the combined velocity field, while a body in contact "
+                  "deforms with its own; docs/explicit.md); allowed: empty, or volumetric stabilisation = none");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/volumetric stabilisation",
                 "f-bar is available in the 1-phase step only (coupled 2-phase materials and body tractions run "
                 "the 2-phase step); allowed: none, or 1-phase materials");
@@ -195,15 +195,17 @@ namespace talus::explicit_mpm
       }
     if (p.bspline())
       {
-        // the passes that are not yet kernel templates (transfer/) walk with Q1
+        // the passes that are not kernel templates (MPM-MIXED, FEM/UL-FEM, strain
+        // smoothing) walk with Q1
         const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
                                 "(its particle passes use linear shape functions); allowed: ";
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
                 std::string(p.numerics.integration_name()) + why + "mpm");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + why + "none");
-        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty");
-        // the loads are kernel templates: the nodal momentum p^t (ScatterMomentum),
+        // contact (contact/pairs) is a kernel template (contact.cc; normals from
+        // the B-spline mass gradient, docs/explicit.md "Contact between bodies").
+        // The loads are kernel templates: the nodal momentum p^t (ScatterMomentum),
         // the traction point forces and the momentum of prescribed point
         // velocities (ScatterPointVectors); wall friction acts on the wall nodes'
         // sums, whichever kernel made them. The 2-phase step is a kernel template

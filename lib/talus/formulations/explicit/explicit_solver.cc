@@ -130,7 +130,7 @@ namespace talus::explicit_mpm
             "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
             "2-phase materials or tractions); use integration = mpm, strain smoothing = none, no contact pairs");
     if (prm.numerics.contact())
-      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size());
+      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline());
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
       smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
@@ -442,6 +442,10 @@ namespace talus::explicit_mpm
 
       diagnostics::PointSums<dim> sums = {};
       bool                        bad  = false;
+      /// contact: each body's displacement increments on the stencil of the
+      /// cell (its dofs) they were last gathered for
+      std::vector<typename K::Field>    body_du   = {};
+      std::vector<const unsigned int *> body_cell = {};
       /// from update() to moved() of one point
       struct PointState
       {
@@ -453,15 +457,22 @@ namespace talus::explicit_mpm
       increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, const double *P,
                  double (&gu)[dim][dim], double (&dx)[dim])
       {
-        if constexpr (std::is_same_v<K, shape::Q1Box<dim>>)
-          if (contact) // the body's own nodal velocities (§6.2)
-            {
-              typename K::Field dub;
-              contact->body_increments(*cell.cc, static_cast<unsigned int>(P[L::body]), h, dub.u);
-              shape::Q1Factorised<dim>::differences(dub.u, dub.D);
-              transfer::default_increments<dim, K>(cell, ev, dub, gu, dx);
-              return;
-            }
+        if (contact) // the body's own nodal velocities (§6.2), gathered once per cell and body
+          {
+            const unsigned int b = static_cast<unsigned int>(P[L::body]);
+            if (body_du.empty())
+              {
+                body_du.resize(contact->fields.size());
+                body_cell.assign(contact->fields.size(), nullptr);
+              }
+            if (body_cell[b] != cell.dofs)
+              {
+                contact->template body_increments<K>(cell, b, h, body_du[b]);
+                body_cell[b] = cell.dofs;
+              }
+            transfer::default_increments<dim, K>(cell, ev, body_du[b], gu, dx);
+            return;
+          }
         transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
       }
 

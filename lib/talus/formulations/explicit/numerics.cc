@@ -21,9 +21,11 @@ namespace talus::explicit_mpm
     using namespace dealii::Patterns;
     prm.enter_subsection("numerics");
     // 'shape function' is declared with the shared scene (scene_parameters.cc);
-    // quadratic B-splines need integration = mpm, without strain smoothing,
-    // contact or coupled 2-phase materials (refused by parse_parameters in
-    // explicit_parameters.cc, as are the passes APIC is not available with)
+    // quadratic B-splines need integration = mpm, no strain smoothing, no coupled
+    // 2-phase materials (or their body tractions) and a box grid of >= 3 cells per
+    // direction (refused by parse_parameters in explicit_parameters.cc, as are the
+    // passes APIC is not available with); contact, loads, friction and prescribed
+    // velocities work on both kernels
     prm.declare_entry(
       "velocity transfer", "flip", Selection("flip|apic"),
       "Velocity transfer of the 1-phase step: 'flip' (seed 000: v_p += h a(x_p), then the nodal "
@@ -65,7 +67,9 @@ namespace talus::explicit_mpm
                       "Body pairs in frictional contact (seed 000 §6.2): 'a, b, mu, adhesion; ...' with body ids "
                       "a != b, Coulomb friction coefficient mu >= 0 and adhesion >= 0 [Pa] (tangential force cap "
                       "adhesion x contact area of the node). Empty: contact off (all bodies share one velocity "
-                      "field). With contact on, bodies whose pair is not listed stick to each other.");
+                      "field). With contact on, bodies whose pair is not listed stick to each other. Works with "
+                      "both shape functions (docs/explicit.md); not with velocity transfer = apic, "
+                      "volumetric stabilisation = f-bar, integration = fem | ul-fem or coupled 2-phase materials.");
     prm.leave_subsection();
   }
 
@@ -178,6 +182,11 @@ namespace talus::explicit_mpm
     const bool             linear_stress = s.prm.numerics.mixed_linear;
     Contact<dim>          *contact       = s.contact.get();
     const auto             g             = s.gravity; // of the running stage
+    if (!mixed)
+      {
+        contact->p2g(s); // contact alone: on the run's kernel (contact.cc)
+        return;
+      }
 
     double *const M  = s.nodal_mass.begin();
     double *const Fv = s.nodal_a.begin();
@@ -191,6 +200,7 @@ namespace talus::explicit_mpm
       for (auto &f : contact->fields)
         {
           zero_on(f.mass, s.active_dofs);
+          zero_on(f.volume, s.active_dofs);
           zero_on(f.force, s.active_dofs);
           zero_on(f.momentum, s.active_dofs);
         }
@@ -276,19 +286,18 @@ namespace talus::explicit_mpm
             F::expand_moments(a.T, cc.inv_h, fb);
             auto         &fl = contact->fields[b];
             double *const bm = fl.mass.begin();
+            double *const bv = fl.volume.begin();
             double *const bf = fl.force.begin();
             double *const bp = fl.momentum.begin();
             for (unsigned int v = 0; v < nv; ++v)
-              {
-                bm[cc.dofs[v * dim + 0]] += a.lm[v];
-                bm[cc.dofs[v * dim + 1]] += a.lvol[v];
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    const unsigned int i = cc.dofs[v * dim + d];
-                    bf[i] += fb[v][d];
-                    bp[i] += a.lp[v][d];
-                  }
-              }
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  const unsigned int i = cc.dofs[v * dim + d];
+                  bm[i] += a.lm[v];
+                  bv[i] += a.lvol[v];
+                  bf[i] += fb[v][d];
+                  bp[i] += a.lp[v][d];
+                }
           }
     };
     transfer::for_each_active_cell(s.points, begin_cell, at_point, end_cell);

@@ -138,22 +138,29 @@ namespace talus::explicit_mpm
     Vector                     nodal;      ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
   };
 
-  /// Contact between bodies (§6.2). Every body gets its own nodal mass, force,
-  /// momentum and mass gradient (distributed vectors, allocated only when
-  /// contact is on). At nodes where a body meets another one, the
+  /// Contact between bodies (§6.2). Every body gets its own nodal mass, volume,
+  /// force, momentum and outward normal (distributed vectors, allocated only
+  /// when contact is on). At nodes where a body meets another one, the
   /// predictor-corrector of Bardenhagen et al. corrects the body's velocity:
   /// free separation, no interpenetration, Coulomb friction with adhesion for
-  /// the pairs listed in the .prm, sticking for pairs not listed.
+  /// the pairs listed in the .prm, sticking for pairs not listed. The point
+  /// walks are templates on the shape kernel (linear Q1 or quadratic B-spline,
+  /// docs/explicit.md "Contact between bodies").
   template <int dim>
   class Contact
   {
   public:
-    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies);
+    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies, bool bspline);
 
     /// After a repartition: the per-body nodal fields re-sized for the new DoF
     /// numbering (every step fills them from the points: P2G, contact law), the
     /// node marker cleared; the contact node list is collected every step.
     void grid_changed();
+    /// Full P2G of the combined mass and force (into the solver's nodal_mass,
+    /// nodal_a) and of every body's mass, volume, force and momentum (and, with
+    /// B-splines, its outward normal), with integration = mpm, on the run's
+    /// kernel. (MPM-MIXED with contact: p2g_extended, linear only.)
+    void p2g(Solver<dim> &s);
     /// Lagrangian phase: after nodal_acceleration(), the corrected per-body
     /// accelerations a~_b = (v~_b - v_b^t) / dt (Eq. 6.21).
     void correct_accelerations(Solver<dim> &s, double dt);
@@ -163,15 +170,13 @@ namespace talus::explicit_mpm
     /// Convective phase: per-body nodal velocities from momentum, corrected
     /// by the same contact law (after the solver's nodal_velocity()).
     void correct_velocities(Solver<dim> &s, double dt);
-    /// Displacement increments dt * v_b of body b at the vertices of a cell.
+    /// Displacement increments dt * v~_b of body b on the stencil of a cell of
+    /// kernel K (with what K needs for gradients), after correct_velocities().
+    template <class K>
     inline void
-    body_increments(const CellCache<dim> &cc, const unsigned int body, const double dt,
-                    double (&du)[1u << dim][dim]) const
+    body_increments(const typename K::Cell &cell, const unsigned int body, const double dt, typename K::Field &du) const
     {
-      const double *V = fields[body].momentum.begin();
-      for (unsigned int v = 0; v < (1u << dim); ++v)
-        for (unsigned int d = 0; d < dim; ++d)
-          du[v][d] = dt * V[cc.dofs[v * dim + d]];
+      K::gather(cell, fields[body].momentum.begin(), dt, du, true);
     }
 
     /// Statistics of the last step (for the log): nodes with > 1 body, nodes corrected.
@@ -179,10 +184,11 @@ namespace talus::explicit_mpm
 
     struct BodyFields
     {
-      Vector mass;     ///< component 0: mass, component 1: volume (for the adhesion area)
+      Vector mass;     ///< lumped mass (every component of a node holds it)
+      Vector volume;   ///< lumped volume sum V_p N_i (for the adhesion area; every component)
       Vector force;    ///< internal + gravity force; after correct_accelerations: a~_b
       Vector momentum; ///< momentum; after correct_velocities: v~_b
-      Vector gradient; ///< minus the gradient of the nodal mass field: outward normal of the body
+      Vector gradient; ///< outward normal of the body (minus the gradient of its mass field)
     };
     std::vector<BodyFields> fields;
 
@@ -190,6 +196,18 @@ namespace talus::explicit_mpm
     friend void                p2g_extended<dim>(Solver<dim> &s);
     const BackgroundGrid<dim> &grid;
     unsigned int               n_bodies;
+    /// quadratic B-splines: normals from the points (p2g), nodes from the cells' patches
+    bool bspline;
+    /// quadratic B-splines: a node is a contact node only where at least two
+    /// bodies' nodal volumes each fill this fraction of its capacity (docs/explicit.md)
+    static constexpr double bspline_share = 0.1;
+    /// quadratic B-splines: capacity of every node, the integral of its shape
+    /// function over the grid (the nodal volume sum V_p N_i of a grid full of
+    /// points); computed when first needed after a (re)partition
+    Vector capacity;
+    bool   capacity_ready = false;
+    template <class K>
+    void compute_capacity(K);
     /// pair_index[a * n + b]: index into pairs or -1 (stick)
     std::vector<int>                          pair_index;
     std::vector<NumericsOptions::ContactPair> pairs;
@@ -198,8 +216,14 @@ namespace talus::explicit_mpm
     /// owned active nodes: local DoF indices of their dim components
     std::vector<std::array<unsigned int, dim>> nodes;
     std::vector<unsigned char>                 node_marker;
-    void                                       collect_nodes(const Solver<dim> &s);
-    void                                       compute_normals(const Solver<dim> &s);
+    template <class K>
+    void p2g_with(K, Solver<dim> &s);
+    template <class K>
+    void g2p_with(K, Solver<dim> &s, double dt);
+    template <class K>
+    void collect_nodes_with(K, const Solver<dim> &s);
+    void collect_nodes(const Solver<dim> &s);
+    void compute_normals(const Solver<dim> &s);
     /// the contact law at one node: predicted per-body velocities vb (in),
     /// corrected (out); returns true if a correction was applied
     bool correct_node(const std::array<unsigned int, dim> &dofs, const std::vector<unsigned char> &constrained,
