@@ -29,12 +29,22 @@ grep -q "CMAKE_BUILD_TYPE:STRING=Release" "$BUILD/CMakeCache.txt" || {
 python3 scripts/bench_startup.py "$BUILD"
 echo
 
+# ---- the memory bandwidth of one core (issue 41 item 1): the roofline of the explicit step
+STREAM_BIN=$(mktemp)
+c++ -O2 -o "$STREAM_BIN" scripts/stream_bandwidth.cc
+echo "bench: memory bandwidth of one core (scripts/stream_bandwidth.cc)"
+"$STREAM_BIN" | tee "$LOG"
+rm -f "$STREAM_BIN"
+TRIAD=$(awk '/^stream: triad/ {print $3}' "$LOG")
+echo
+
 for PRM in parameter_files/bench/block_spreading_3d.prm parameter_files/bench/block_spreading_3d_bspline.prm; do
 echo "bench: $PRM (single rank)"
 "$BUILD/tools/talus-explicit" "$PRM" | tee "$LOG"
-python3 - "$LOG" <<'PY'
+python3 - "$LOG" "$TRIAD" <<'PY'
 import re, sys
 text = open(sys.argv[1]).read()
+triad = float(sys.argv[2])
 b = re.search(r"breakdown \[s\]: P2G ([\d.e+-]+), grid ([\d.e+-]+), G2P\+stress ([\d.e+-]+), relocation ([\d.e+-]+) \(moves [\d.e+-]+, sorts [\d.e+-]+\), "
               r"output ([\d.e+-]+) \((\d+) VTU snapshots ([\d.e+-]+)\); particles moved cell (\d+)", text)
 d = re.search(r"done: (\d+) steps, (\d+) particles, wall ([\d.e+-]+) s", text)
@@ -45,6 +55,21 @@ print("\nbench summary: %d material points, %d steps, wall %.1f s" % (n, steps, 
 for name, v in zip(names, b.groups()[:5]):
     print("  %-30s %7.1f ns/particle-step" % (name, 1e9 * float(v) / ps))
 print("  %-30s %7.1f ns/particle-step" % ("total", 1e9 * wall / ps))
+# roofline (docs/scaling.md, "Roofline of the explicit step"): the bytes each pass must move per
+# point-step for the 3D linear elastic point (location and reference location 3 doubles each, 16
+# property doubles), at the bus bandwidth of one core = STREAM triad x 4/3 (triad does not count
+# the write-allocate read of its target)
+bus = triad * 4.0 / 3.0
+model = [("momentum pass (P2G column)", 152, 0), ("grid update", 24, 1), ("update pass (G2P column)", 352, 2)]
+print("  roofline at %.2f GB/s (triad %.2f x 4/3): measured / bound per pass" % (bus, triad))
+bound_total = 0
+for name, nbytes, k in model:
+    bound = nbytes / bus
+    bound_total += bound
+    measured = 1e9 * float(b.groups()[k]) / ps
+    print("    %-28s %4d B  bound %6.1f ns  measured %7.1f ns  ratio %5.2f" % (name, nbytes, bound, measured, measured / bound))
+print("    %-28s %4d B  bound %6.1f ns  measured %7.1f ns  ratio %5.2f (relocation and output not bounded)"
+      % ("step", sum(m[1] for m in model), bound_total, 1e9 * wall / ps, 1e9 * wall / ps / bound_total))
 print("  material points changing cell per step: %.1f %%" % (100.0 * int(b.group(8)) / ps))
 # a VTU snapshot against a step: the loop's wall time without its output, per step (the first
 # snapshot is written before the loop, the last one inside it)

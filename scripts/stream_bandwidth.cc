@@ -19,8 +19,8 @@
 int
 main(int argc, char **argv)
 {
-  const std::size_t n       = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : (std::size_t(1) << 24);
-  const int         repeats = argc > 2 ? std::atoi(argv[2]) : 10;
+  const std::size_t   n       = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : (std::size_t(1) << 24);
+  const int           repeats = argc > 2 ? std::atoi(argv[2]) : 10;
   std::vector<double> a(n, 1.0), b(n, 2.0), c(n, 0.0);
   const double        s = 3.0;
   double              best[4];
@@ -40,7 +40,7 @@ main(int argc, char **argv)
       auto t3 = Clock::now();
       for (std::size_t i = 0; i < n; ++i)
         a[i] = b[i] + s * c[i];
-      auto                         t4 = Clock::now();
+      auto                                t4   = Clock::now();
       const std::chrono::duration<double> d[4] = {t1 - t0, t2 - t1, t3 - t2, t4 - t3};
       for (int k = 0; k < 4; ++k)
         best[k] = std::min(best[k], d[k].count());

@@ -39,48 +39,8 @@ plot = os.path.join(tools, "talus-plot")
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 
-BLOCK = """set dimension = 2
-subsection time
-  set end time       = 0.1
-  set courant number = 0.5
-end
-subsection grid
-  set lower corner = 0, 0
-  set upper corner = 2, 1
-  set cells        = 20, 10
-end
-subsection boundary conditions
-  set fixed  = 2
-  set roller = 0, 1
-end
-subsection gravity
-  set acceleration = 0, -9.81
-end
-subsection output
-  set directory    = run
-  set vtu interval = 0.02
-  set probes       = 0.9, 0.4
-  set progress     = false
-end
-set number of materials = 1
-subsection material 0
-  set model   = linear elastic
-  set density = 1000
-  subsection linear elastic
-    set young modulus = 1e5
-    set poisson ratio = 0.3
-  end
-end
-set number of bodies = 1
-subsection body 0
-  set name                    = block
-  set material                = 0
-  set shape                   = box
-  set lower corner            = 0.5, 0
-  set upper corner            = 1.3, 0.4
-  set particles per direction = 2
-end
-"""
+BLOCK = tv.elastic_block_scene((2, 1), (20, 10), (0.5, 0), (1.3, 0.4), 0.1,
+                             {"directory": "run", "vtu interval": "0.02", "probes": "0.9, 0.4", "progress": "false"})
 
 
 def read_png(path):

@@ -42,48 +42,9 @@ spec = importlib.util.spec_from_loader("talus_plot", loader)
 plot = importlib.util.module_from_spec(spec)
 loader.exec_module(plot)
 
-BLOCK = """set dimension = 2
-subsection time
-  set end time       = 0.06
-  set courant number = 0.5
-end
-subsection grid
-  set lower corner = 0, 0
-  set upper corner = 4, 1
-  set cells        = 40, 10
-end
-subsection boundary conditions
-  set fixed  = 2
-  set roller = 0, 1
-end
-subsection gravity
-  set acceleration = 0, -9.81
-end
-subsection output
-  set directory    = out
-  set vtu interval = 0.02
-  set progress     = false
-  set final particles csv = true
-end
-set number of materials = 1
-subsection material 0
-  set model   = linear elastic
-  set density = 1000
-  subsection linear elastic
-    set young modulus = 1e5
-    set poisson ratio = 0.3
-  end
-end
-set number of bodies = 1
-subsection body 0
-  set name                    = block
-  set material                = 0
-  set shape                   = box
-  set lower corner            = 0.2, 0
-  set upper corner            = 1.0, 0.4
-  set particles per direction = 2
-end
-"""
+BLOCK = tv.elastic_block_scene((4, 1), (40, 10), (0.2, 0), (1.0, 0.4), 0.06,
+                             {"directory": "out", "vtu interval": "0.02", "progress": "false",
+                              "final particles csv": "true"})
 
 VTK_TYPES = {"Float32": vtk.VTK_FLOAT, "UInt64": vtk.VTK_UNSIGNED_LONG_LONG}
 

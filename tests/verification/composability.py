@@ -28,45 +28,10 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import talus_verify as tv  # noqa: E402
 
-BASE = """set dimension = 2
-subsection time
-  set end time       = 1
-  set courant number = 0.4
-  set maximum steps  = 6
-end
-subsection grid
-  set lower corner = 0, 0
-  set upper corner = 1, 1
-  set cells        = 8, 8
-end
-subsection gravity
-  set acceleration = 0, 0
-end
-subsection output
-  set directory       = out
-  set series interval = 1e-9
-  set vtu interval    = 0
-  set progress        = false
-end
-set number of materials = 1
-subsection material 0
-  set model   = linear elastic
-  set density = 1000
-  subsection linear elastic
-    set young modulus = 1e5
-    set poisson ratio = 0.3
-  end
-end
-set number of bodies = 1
-subsection body 0
-  set name                    = block
-  set shape                   = box
-  set lower corner            = 0.25, 0.25
-  set upper corner            = 0.625, 0.625
-  set particles per direction = 2
-  set initial velocity        = 0.2, 0.1
-end
-"""
+BASE = tv.prm_set(tv.elastic_block_scene((1, 1), (8, 8), (0.25, 0.25), (0.625, 0.625), 1,
+                                         {"directory": "out", "series interval": "1e-9", "vtu interval": "0",
+                                          "progress": "false"}, walls=False, gravity="0, 0",
+                                         initial_velocity=(0.2, 0.1), courant=0.4), "time/maximum steps", "6")
 
 # The columns: one option set each (APIC needs B-splines: measured unstable with linear ones).
 COLUMNS = [

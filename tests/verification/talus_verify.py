@@ -212,6 +212,53 @@ def cantilever_tip(p, h, l=8.0):
     return 1.5 * u1 - 0.5 * u2, (len(cols[0]), len(cols[1]))
 
 
+def elastic_block_scene(upper, cells, block_lower, block_upper, end_time, output, walls=True,
+                        gravity="0, -9.81", initial_velocity=None, courant=0.5):
+    """A small 2D talus-explicit scene: an elastic block (E 1e5 Pa, nu 0.3, rho 1000, 2 x 2 points per
+    cell) in a box grid from the origin to `upper` with `cells`; with `walls` a fixed base and roller
+    sides; `output` a dict of output/ entries. The scene of check_plot.py, check_vtu.py and the
+    composability matrix."""
+    def pair(v):
+        return ", ".join(str(x) for x in v)
+    text = f"""set dimension = 2
+subsection time
+  set end time       = {end_time}
+  set courant number = {courant}
+end
+subsection grid
+  set lower corner = 0, 0
+  set upper corner = {pair(upper)}
+  set cells        = {pair(cells)}
+end
+"""
+    if walls:
+        text += "subsection boundary conditions\n  set fixed  = 2\n  set roller = 0, 1\nend\n"
+    text += f"subsection gravity\n  set acceleration = {gravity}\nend\nsubsection output\n"
+    text += "".join(f"  set {k} = {v}\n" for k, v in output.items())
+    text += f"""end
+set number of materials = 1
+subsection material 0
+  set model   = linear elastic
+  set density = 1000
+  subsection linear elastic
+    set young modulus = 1e5
+    set poisson ratio = 0.3
+  end
+end
+set number of bodies = 1
+subsection body 0
+  set name                    = block
+  set material                = 0
+  set shape                   = box
+  set lower corner            = {pair(block_lower)}
+  set upper corner            = {pair(block_upper)}
+  set particles per direction = 2
+"""
+    if initial_velocity:
+        text += f"  set initial velocity        = {pair(initial_velocity)}\n"
+    return text + "end\n"
+
+
 def deposit_front(xs, hx, origin):
     """Front of a granular deposit from its points' x: the points are binned by x in bins of width
     hx (edges at origin + k hx); the deposit is the run of occupied bins that starts at the wall
