@@ -9,7 +9,8 @@ and H = 1 m the initial height of the column:
            sigma'_yy = -(rho_sat - rho_L) g (H - Y), rho_sat = (1-n) rho_S + n rho_L
 Every point must be within 2 % of the value at the base (max |error| / (rho g H)),
 and the column must be at rest (final kinetic energy < 1e-3 of its peak).
-Usage: check_hydrostatic.py TOOL PRM WORKDIR liquid|two-phase [model]
+Usage: check_hydrostatic.py TOOL PRM WORKDIR liquid|two-phase [model] [entry=value ...]
+  entry=value: .prm settings applied first (e.g. numerics/shape function=quadratic bspline);
   model (liquid only): newtonian (default) | bingham | frictional fluid; the
   frictional fluid carries a deviatoric stress at rest, so for it the vertical
   stress -sigma_yy = rho g (H - Y) is checked instead of the pressure.
@@ -19,8 +20,10 @@ import sys
 import talus_verify as tv
 
 tool, prm_path, work, mode = sys.argv[1:5]
-model = sys.argv[5] if len(sys.argv) > 5 else "newtonian"
-text = tv.prm_set(open(prm_path).read(), "output/directory", "out")
+rest = [a for a in sys.argv[5:] if "=" not in a]
+model = rest[0] if rest else "newtonian"
+text = tv.prm_set_args(open(prm_path).read(), [a for a in sys.argv[5:] if "=" in a])
+text = tv.prm_set(text, "output/directory", "out")
 g, H = 9.81, 1.0
 if mode == "liquid" and model != "newtonian":
     text = tv.prm_set(text, "material 0/model", model)

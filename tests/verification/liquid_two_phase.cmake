@@ -15,6 +15,12 @@ endfunction()
 talus_liquid_case(liquid_hydrostatic_newtonian fast check_hydrostatic.py
                   verification/hydrostatic_water_1phase.prm liquid newtonian)
 talus_liquid_case(liquid_dam_break fast check_dam_break.py verification/dam_break.prm)
+# the same on quadratic B-splines (issue 38; the free-surface density with the B-spline kernel)
+talus_liquid_case(liquid_dam_break_bspline fast check_dam_break.py verification/dam_break.prm
+                  "numerics/shape function=quadratic bspline")
+talus_liquid_case(liquid_hydrostatic_bspline fast check_hydrostatic.py verification/hydrostatic_water_1phase.prm
+                  liquid newtonian "numerics/shape function=quadratic bspline" "grid/upper corner=0.09375, 1.25"
+                  "grid/cells=3, 40" "body 0/upper corner=0.09375, 1")
 talus_liquid_case(two_phase_hydrostatic fast check_hydrostatic.py verification/hydrostatic_2phase.prm two-phase)
 talus_liquid_case(two_phase_terzaghi_fast fast check_terzaghi.py verification/terzaghi_consolidation.prm fast)
 talus_liquid_case(two_phase_terzaghi verify check_terzaghi.py verification/terzaghi_consolidation.prm)

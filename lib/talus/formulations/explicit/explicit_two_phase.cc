@@ -5,6 +5,7 @@
 #include <talus/formulations/explicit/with_kernel.h>
 #include <talus/materials/strain_increments.h>
 #include <talus/shape/q1.h>
+#include <talus/shape/q1_box.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/move_point.h>
 
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 namespace talus::explicit_mpm
 {
@@ -825,14 +827,46 @@ namespace talus::explicit_mpm
   void
   FreeSurface<dim>::update()
   {
+    s.with_kernel([&](auto kernel) { update_with<decltype(kernel)>(); });
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  FreeSurface<dim>::update_with()
+  {
     using L                   = PropertyLayout<dim>;
     using Q                   = shape::Q1<dim>;
-    constexpr unsigned int nv = Q::n_vertices;
-    // nodal density (Eq. 6.38) on the x-component DoFs: mass share over the
-    // volume share of the non-empty cells around the node
+    constexpr bool         q1 = std::is_same_v<K, shape::Q1Box<dim>>;
+    constexpr unsigned int nv = q1 ? Q::n_vertices : K::n_point_nodes;
+    // nodal density (Eq. 6.38) on the scalar slot of each node: mass share over
+    // the volume share of the non-empty cells around the node. Q1: the share of
+    // a vertex is Omega_el / n_vertices; other kernels: int_cell N_i, by a
+    // 2-point Gauss rule on each half of the cell per direction (exact for the
+    // quadratic B-spline, whose pieces break at the cell centre)
     mass             = 0.0;
     volume           = 0.0;
     double *const Mn = mass.begin(), *const Vn = volume.begin();
+    // the point's nodes and values: slot i of the scalar slots `at`, N[i]
+    const auto stencil = [&](const unsigned int c, const dealii::Point<dim> &xi, unsigned int(&at)[nv],
+                             double(&N)[nv]) {
+      if constexpr (q1)
+        {
+          const auto &cc = s.grid.cells[c];
+          Q::values(xi, N);
+          for (unsigned int v = 0; v < nv; ++v)
+            at[v] = cc.dofs[v * dim];
+        }
+      else
+        {
+          const auto   kc = K::cell(s.grid, c);
+          unsigned int slot[nv];
+          double       G[nv][dim];
+          K::point_stencil(kc, xi, slot, N, G);
+          for (unsigned int v = 0; v < nv; ++v)
+            at[v] = kc.dofs[slot[v] * dim];
+        }
+    };
     transfer::for_each_active_cell(
       s.points,
       [&](const unsigned int c) {
@@ -840,16 +874,37 @@ namespace talus::explicit_mpm
         double      vol = 1.0;
         for (unsigned int d = 0; d < dim; ++d)
           vol *= cc.h[d];
-        for (unsigned int v = 0; v < nv; ++v)
-          Vn[cc.dofs[v * dim]] += vol / nv;
+        if constexpr (q1)
+          for (unsigned int v = 0; v < nv; ++v)
+            Vn[cc.dofs[v * dim]] += vol / nv;
+        else
+          {
+            const double g    = 0.25 / std::sqrt(3.0);
+            const double r[4] = {0.25 - g, 0.25 + g, 0.75 - g, 0.75 + g};
+            unsigned int n_q  = 1;
+            for (unsigned int d = 0; d < dim; ++d)
+              n_q *= 4;
+            const double w = vol / n_q;
+            for (unsigned int k = 0; k < n_q; ++k)
+              {
+                dealii::Point<dim> xi;
+                for (unsigned int d = 0, kk = k; d < dim; ++d, kk /= 4)
+                  xi[d] = r[kk % 4];
+                unsigned int at[nv];
+                double       N[nv];
+                stencil(c, xi, at, N);
+                for (unsigned int v = 0; v < nv; ++v)
+                  Vn[at[v]] += w * N[v];
+              }
+          }
       },
       [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
-        const auto &cc = s.grid.cells[c];
-        double      N[nv];
-        Q::values(pt->get_reference_location(), N);
+        unsigned int at[nv];
+        double       N[nv];
+        stencil(c, pt->get_reference_location(), at, N);
         const double m = pt->get_properties()[L::mass];
         for (unsigned int v = 0; v < nv; ++v)
-          Mn[cc.dofs[v * dim]] += m * N[v];
+          Mn[at[v]] += m * N[v];
       },
       [](const unsigned int) {});
     mass.compress(dealii::VectorOperation::add);
@@ -861,12 +916,12 @@ namespace talus::explicit_mpm
     unsigned long long  n_flagged = 0;
     std::vector<double> lo(dim, std::numeric_limits<double>::max()), hi(dim, -std::numeric_limits<double>::max());
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
-      const auto &cc = s.grid.cells[c];
-      double      N[nv];
-      Q::values(pt->get_reference_location(), N);
+      unsigned int at[nv];
+      double       N[nv];
+      stencil(c, pt->get_reference_location(), at, N);
       double rho = 0;
       for (unsigned int v = 0; v < nv; ++v)
-        rho += N[v] * Mn[cc.dofs[v * dim]]; // Eq. 6.39
+        rho += N[v] * Mn[at[v]]; // Eq. 6.39
       double            *P   = pt->get_properties().data();
       const unsigned int mat = static_cast<unsigned int>(P[L::material]);
       // reference density: that of the material, or of the solid mass per

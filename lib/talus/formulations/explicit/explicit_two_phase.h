@@ -155,6 +155,11 @@ namespace talus::explicit_mpm
     unsigned int        flag = 0;
 
   private:
+    /// the nodal density (Eq. 6.38) and its value at the points (6.39) with the
+    /// shape kernel K of the run
+    template <class K>
+    void update_with();
+
     Solver<dim> &s;
     double       factor;
     Vector       mass, volume;
