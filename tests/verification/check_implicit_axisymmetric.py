@@ -37,19 +37,7 @@ tools, prm_path, work = sys.argv[1], sys.argv[2], sys.argv[3]
 tol_u, tol_s, min_order = float(sys.argv[4]), float(sys.argv[5]), float(sys.argv[6])
 hs = [float(h) for h in sys.argv[7:]]
 a, b, p, E, nu = 1.0, 2.0, 1000.0, 1e7, 0.3
-A = a * a * p / (b * b - a * a)
-
-
-def u_exact(r):
-    return (1 + nu) / E * A * ((1 - 2 * nu) * r + b * b / r)
-
-
-def hoop_exact(r):
-    return A * (1 + b * b / (r * r))
-
-
-def radial_exact(r):
-    return A * (1 - b * b / (r * r))
+u_exact, hoop_exact, radial_exact = tv.lame_cylinder(a, b, p, E, nu)
 
 
 base = tv.prm_set(open(prm_path).read(), "output/directory", "out")

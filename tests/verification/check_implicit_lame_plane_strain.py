@@ -38,19 +38,7 @@ tools, prm_path, work = sys.argv[1], sys.argv[2], sys.argv[3]
 u_rms, u_max, ut_max, s_rms, s_max, min_order = (float(x) for x in sys.argv[4:10])
 ns = [int(n) for n in sys.argv[10:]]
 a, b, p, E, nu = 1.0, 2.0, 1000.0, 1e7, 0.3
-A = a * a * p / (b * b - a * a)
-
-
-def u_exact(r):
-    return (1 + nu) / E * A * ((1 - 2 * nu) * r + b * b / r)
-
-
-def hoop_exact(r):
-    return A * (1 + b * b / (r * r))
-
-
-def radial_exact(r):
-    return A * (1 - b * b / (r * r))
+u_exact, hoop_exact, radial_exact = tv.lame_cylinder(a, b, p, E, nu)
 
 
 def rms(v):

@@ -259,6 +259,15 @@ subsection body 0
     return text + "end\n"
 
 
+def lame_cylinder(a, b, p, E, nu):
+    """Lamé's thick-walled cylinder (inner radius a, outer b, internal pressure p, plane strain or
+    the axisymmetric long cylinder): functions r -> radial displacement, hoop stress, radial stress."""
+    A = a * a * p / (b * b - a * a)
+    return (lambda r: (1 + nu) / E * A * ((1 - 2 * nu) * r + b * b / r),
+            lambda r: A * (1 + b * b / (r * r)),
+            lambda r: A * (1 - b * b / (r * r)))
+
+
 def deposit_front(xs, hx, origin):
     """Front of a granular deposit from its points' x: the points are binned by x in bins of width
     hx (edges at origin + k hx); the deposit is the run of occupied bins that starts at the wall

@@ -121,12 +121,7 @@ namespace talus::explicit_mpm
     // sum_p m_p grad N_i(x_p) (minus the gradient of the body's mass density;
     // the C1 kernel makes it continuous in the point positions).
     using L         = PropertyLayout<dim>;
-    const auto zero = [&](Vector &x) {
-      x.zero_out_ghost_values();
-      double *p = x.begin();
-      for (const unsigned int i : s.active_dofs)
-        p[i] = 0.0;
-    };
+    const auto zero = [&](Vector &x) { s.zero_on_active(x); };
     zero(s.nodal_mass);
     zero(s.nodal_a);
     for (auto &f : fields)
@@ -520,12 +515,7 @@ namespace talus::explicit_mpm
     // acceleration (gathered once per cell and body) and the momentum scattered
     // into the combined and the body's vectors
     using L         = PropertyLayout<dim>;
-    const auto zero = [&](Vector &x) {
-      x.zero_out_ghost_values();
-      double *p = x.begin();
-      for (const unsigned int i : s.active_dofs)
-        p[i] = 0.0;
-    };
+    const auto zero = [&](Vector &x) { s.zero_on_active(x); };
     zero(s.nodal_p);
     for (auto &f : fields)
       zero(f.momentum);

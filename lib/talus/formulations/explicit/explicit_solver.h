@@ -210,6 +210,9 @@ namespace talus::explicit_mpm
     /// Write the results file (output/results file, HDF5): series, probes,
     /// final particle fields and fields mapped to the grid nodes. Collective.
     void write_results(const std::string &series_csv) const;
+    /// Zero a nodal vector where it can be non-zero: the active DoFs and the ghosts
+    /// (empty regions of the grid cost nothing).
+    void zero_on_active(Vector &v) const;
 
   private:
     friend class loads::LoadControl<dim>;
@@ -224,7 +227,6 @@ namespace talus::explicit_mpm
     void collect_active_cells();
     void collect_active_dofs();
 
-    void zero_on_active(Vector &v) const;
     /// After the partition changed: boundary flags, nodal vectors, cell lists,
     /// active DoFs and the features' grid data.
     void                       grid_changed() override;
