@@ -218,6 +218,7 @@ namespace talus::implicit_mpm
   Solver<dim>::grid_changed()
   {
     space.setup();
+    held_last_step.clear(); // numbered on the old partition
     if (current_stage < prm.stages.size())
       stage_nodes(current_stage);
     for (Vector *v : {&du, &delta, &residual, &mass, &v_n, &a_n, &a_new, &inertia_field, &contact_state, &contact_gap,

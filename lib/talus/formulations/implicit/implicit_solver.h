@@ -574,6 +574,13 @@ namespace talus::implicit_mpm
     double start_imbalance_norm = 0, start_imbalance_share = 0;
     /// whether assemble() subtracts start_imbalance (prm.carry_imbalance, once measured)
     bool carrying_imbalance = false;
+    /// Owned DoFs the last converged step held by a condition of the step
+    /// (prescribed, plate, contact, negligible mass; not the walls, not the
+    /// inactive pins): their start imbalance is that hold's reaction, not the
+    /// grid change, and is not carried. Empty after a grid change or a restart.
+    std::vector<dealii::types::global_dof_index> held_last_step;
+    /// held_last_step from the step's final constraints. Collective.
+    void record_held_dofs();
     void compute_cell_jbar();
     /// consistent mass: a^{n+1} + alpha_R v^{n+1} at the free DoFs (0 at constrained
     /// ones), ghosts updated, the field the inertia integrand reads

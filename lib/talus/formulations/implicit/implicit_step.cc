@@ -71,11 +71,18 @@ namespace talus::implicit_mpm
   Solver<dim>::begin_step(const double h)
   {
     newmark.set_time_step(h);
-    if (point_contact) // a footing's base to where it is at the step's start and end
-      point_contact->set_time(time, time + h);
     prepare_step();
     if (!dynamic())
-      measure_start_imbalance();
+      {
+        // the converged state under its own loads: a footing's base where it
+        // stood at the end of the last step (at t + h its advance would enter
+        // r_0, and the carry would cancel the step's load)
+        if (point_contact)
+          point_contact->set_time(time, time);
+        measure_start_imbalance();
+      }
+    if (point_contact) // a footing's base to where it is at the step's start and end
+      point_contact->set_time(time, time + h);
     const double                 level = step_load_level(h);
     const dealii::Tensor<1, dim> g     = apply_loads_at(time + h, level);
     if (dynamic() && prm.rayleigh_beta > 0)
@@ -147,6 +154,12 @@ namespace talus::implicit_mpm
       for (unsigned int k = 0; k < start_imbalance.locally_owned_size(); ++k)
         if (space.component(k) == dim)
           start_imbalance.local_element(k) = 0;
+    // a DoF the last step held and this one frees (a footing's row the moving
+    // region has left, a negligible node that gained mass, a released contact):
+    // its out-of-balance force is the reaction of that hold, a load the step
+    // must answer, not the grid change
+    for (const auto i : held_last_step)
+      start_imbalance[i] = 0;
     // relative to the step's load scale |f_ext| (begin_step divides)
     start_imbalance_norm = start_imbalance.l2_norm();
     du                   = 0;
@@ -366,9 +379,24 @@ namespace talus::implicit_mpm
 
   template <int dim>
   void
+  Solver<dim>::record_held_dofs()
+  {
+    held_last_step.clear();
+    const auto base  = step_constraints(nullptr, false, false, false, false);
+    const auto owned = space.locally_owned_dofs();
+    for (const auto i : owned)
+      if (constraints.is_constrained(i) && !base.is_constrained(i))
+        held_last_step.push_back(i);
+  }
+
+  template <int dim>
+  void
   Solver<dim>::convective_phase(const StepState &s)
   {
     const double h = s.h;
+
+    if (!dynamic() && prm.carry_imbalance)
+      record_held_dofs(); // the final pass's constraints, before the points move
 
     if (point_contact)
       {
