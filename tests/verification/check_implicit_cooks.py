@@ -31,7 +31,6 @@ u and u-p run); checks: the runs end with Newton <= 8 iterations and the u-p dis
 finest n within TOL of the references; u is reported (the B-spline basis locks less than Q1).
 Usage: check_implicit_cooks.py TOOLS_DIR PRM WORKDIR TOL N1 [N2 ...] [--bspline]
 """
-import math
 import sys
 
 import talus_verify as tv
@@ -57,13 +56,7 @@ results = {}
 for nu in ("0.33", "0.499999"):
     for form in FORMS:
         for n in ns:
-            h = 48.0 / n
-            rows = math.ceil(62.0 / h - 1e-9)
-            text = tv.prm_set(base, "grid/cells", f"{n}, {rows}")
-            text = tv.prm_set(text, "grid/upper corner", f"48, {rows * h}")
-            text = tv.prm_set(text, "loads/traction 0/region lower corner", f"{48 - h / 2}, 40")
-            text = tv.prm_set(text, "loads/traction 0/region upper corner", f"48, {rows * h}")
-            text = tv.prm_set(text, "material 0/neo hookean/poisson ratio", nu)
+            text = tv.cooks_membrane_prm(base, n, nu)
             text = tv.prm_set(text, "implicit/formulation", "irreducible" if form == "f-bar" else form)
             if form == "f-bar":
                 text = tv.prm_set(text, "numerics/volumetric stabilisation", "f-bar")

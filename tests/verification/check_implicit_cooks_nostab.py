@@ -35,12 +35,7 @@ for nu in ("0.33", "0.499999"):
     for alpha in ("0", "1"):
         for n in ns:
             h = 48.0 / n
-            rows = math.ceil(62.0 / h - 1e-9)
-            text = tv.prm_set(base, "grid/cells", f"{n}, {rows}")
-            text = tv.prm_set(text, "grid/upper corner", f"48, {rows * h}")
-            text = tv.prm_set(text, "loads/traction 0/region lower corner", f"{48 - h / 2}, 40")
-            text = tv.prm_set(text, "loads/traction 0/region upper corner", f"48, {rows * h}")
-            text = tv.prm_set(text, "material 0/neo hookean/poisson ratio", nu)
+            text = tv.cooks_membrane_prm(base, n, nu)
             text = tv.prm_set(text, "implicit/formulation", "mixed up")
             text = tv.prm_set(text, "implicit/stabilisation factor", alpha)
             name = f"nu{nu}_alpha{alpha}_n{n}"

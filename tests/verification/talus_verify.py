@@ -4,6 +4,7 @@ Only the Python standard library is used so that the checks run anywhere.
 """
 import contextlib
 import csv
+import math
 import os
 import re
 import shutil
@@ -291,6 +292,19 @@ COOKS_TABLE_5_1 = {
     "0.499999": {2: (0.0723, 0.0788, 0.1277), 4: (0.0736, 0.1157, 0.1932), 8: (0.0742, 0.1821, 0.2424),
                  16: (0.075, 0.2356, 0.2648), 32: (0.0775, 0.2606, 0.2725), 64: (0.0862, 0.2702, 0.275)},
 }
+
+
+def cooks_membrane_prm(base, n, nu):
+    """The Cook's membrane .prm `base` (docs/implicit.md) on n cells along the 48 mm side: the grid
+    rows that cover the 62 mm height, the shear traction on the right edge's column of points
+    and the Poisson ratio nu (a string)."""
+    h = 48.0 / n
+    rows = math.ceil(62.0 / h - 1e-9)
+    text = prm_set(base, "grid/cells", f"{n}, {rows}")
+    text = prm_set(text, "grid/upper corner", f"48, {rows * h}")
+    text = prm_set(text, "loads/traction 0/region lower corner", f"{48 - h / 2}, 40")
+    text = prm_set(text, "loads/traction 0/region upper corner", f"48, {rows * h}")
+    return prm_set(text, "material 0/neo hookean/poisson ratio", nu)
 
 
 def cooks_corner_uy(t, corner=(48.0, 60.0)):
