@@ -173,16 +173,7 @@ elif case == "body_velocity":
     # varies across the interface (its x row is the APIC one)
     two = tv.prm_set(text, "gravity/acceleration", "0, 0")
     two = tv.prm_set(two, "body 0/upper corner", "0.09375, 1")
-    two = tv.prm_set(two, "number of bodies", "2") + """
-subsection body 1
-  set name                    = free
-  set material                = 0
-  set shape                   = box
-  set lower corner            = 0.09375, 0
-  set upper corner            = 0.1875, 1
-  set particles per direction = 2
-end
-"""
+    two = tv.prm_set(two, "number of bodies", "2") + tv.box_body(1, "free", "0.09375, 0", "0.1875, 1")
     two = tv.prm_set(two, "output/directory", "two")
     tv.run_tool(tool, two, work, "two")
     b = tv.read_csv(f"{work}/two/particles_final.csv")
@@ -207,17 +198,7 @@ elif case == "momentum":
                        "body 0/lower corner": "0.2, 0.15", "body 0/upper corner": "0.4, 0.3",
                        "body 0/initial velocity function": "1 - 2 * (y - 0.225); 2 * (x - 0.3)"}.items():
         text = tv.prm_set(text, key, value)
-    text = tv.prm_set(text, "number of bodies", "2") + """
-subsection body 1
-  set name                    = other
-  set material                = 0
-  set shape                   = box
-  set lower corner            = 0.6, 0.2
-  set upper corner            = 0.8, 0.35
-  set particles per direction = 2
-  set initial velocity        = -1, 0
-end
-"""
+    text = tv.prm_set(text, "number of bodies", "2") + tv.box_body(1, "other", "0.6, 0.2", "0.8, 0.35", "-1, 0")
     tv.run_tool(tool, text, work, "blocks")
     s = tv.read_csv(f"{work}/out/series.csv")
     rho = 2000.0

@@ -29,16 +29,7 @@ base = tv.prm_set(base, "load balancing/imbalance threshold", "1.0")
 
 contact = tv.prm_set(base, "number of bodies", "2")
 contact = tv.prm_set(contact, "body 0/upper corner", "0.0905, 0.0543")
-contact = contact + """
-subsection body 1
-  set name                    = top
-  set material                = 0
-  set shape                   = box
-  set lower corner            = 0, 0.0543
-  set upper corner            = 0.0905, 0.1086
-  set particles per direction = 2
-end
-"""
+contact = contact + tv.box_body(1, "top", "0, 0.0543", "0.0905, 0.1086")
 contact = tv.prm_set(contact, "contact/pairs", "0, 1, 0.3, 0")
 
 cases = {

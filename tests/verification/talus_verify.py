@@ -213,6 +213,20 @@ def cantilever_tip(p, h, l=8.0):
     return 1.5 * u1 - 0.5 * u2, (len(cols[0]), len(cols[1]))
 
 
+def box_body(k, name, lower, upper, initial_velocity=None, ppd=2, material=0):
+    """The .prm text of `body k`: a box of material `material` from `lower` to `upper` (strings
+    "x, y" or sequences), seeded with ppd points per direction; appended to a scene that has set
+    `number of bodies` (deal.II reads a subsection given after the others)."""
+    def pair(v):
+        return v if isinstance(v, str) else ", ".join(str(x) for x in v)
+    text = (f"subsection body {k}\n  set name                    = {name}\n  set material                = {material}\n"
+            f"  set shape                   = box\n  set lower corner            = {pair(lower)}\n"
+            f"  set upper corner            = {pair(upper)}\n  set particles per direction = {ppd}\n")
+    if initial_velocity is not None:
+        text += f"  set initial velocity        = {pair(initial_velocity)}\n"
+    return text + "end\n"
+
+
 def elastic_block_scene(upper, cells, block_lower, block_upper, end_time, output, walls=True,
                         gravity="0, -9.81", initial_velocity=None, courant=0.5):
     """A small 2D talus-explicit scene: an elastic block (E 1e5 Pa, nu 0.3, rho 1000, 2 x 2 points per
