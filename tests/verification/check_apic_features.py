@@ -36,11 +36,9 @@ per run of this script (4th argument):
                at the end, to 1e-12 sum m |v| r (r the box's largest |x|).
 Usage: check_apic_features.py TOOL PRM_DIR WORKDIR CASE
 """
-import filecmp
 import math
 import os
 import re
-import shutil
 import sys
 
 import talus_verify as tv
@@ -86,18 +84,7 @@ if case == "balance":
     a = ranks_agree("balance", f"{work}/np1", f"{work}/np2")
     cmax = max(max(abs(x) for x in a[c]) for c in a if c.startswith("affine_velocity"))
     tv.check(cmax > 0, f"the collapse has a non-zero C_p (largest |C_p| {cmax:.3e} 1/s)")
-    restart = tv.prm_set(base, "output/directory", "restart")
-    restart = tv.prm_set(restart, "checkpoint/interval", "0.02")
-    tv.run_tool(tool, restart, work, "restart_full", np=2)
-    shutil.copy(f"{work}/restart/particles_final.csv", f"{work}/uninterrupted.csv")
-    _, log3, _ = tv.run_tool(tool, tv.prm_set(restart, "checkpoint/restart", "true"), work, "restart_cont", np=2)
-    m = re.search(r"restarting from \S+ \(step (\d+)", log3)
-    tv.check(m is not None and int(m.group(1)) > 100,
-             f"restarted from the checkpoint at step {m.group(1) if m else '?'}")
-    n_after = int(re.search(r"rebalances (\d+)", log3).group(1))
-    tv.check(n_after >= 2, f"the continuation rebalances again ({n_after} times)")
-    tv.check(filecmp.cmp(f"{work}/uninterrupted.csv", f"{work}/restart/particles_final.csv", shallow=False),
-             "the continuation is bitwise identical to the uninterrupted run (particles_final.csv)")
+    tv.check_restart_across_rebalances(tool, base, work, "balance", interval=0.02, min_step=100, min_rebalances=2)
 
 elif case == "point_load":
     scene = os.path.join(prm_dir, "verification", "point_load")

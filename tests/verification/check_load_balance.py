@@ -25,9 +25,7 @@ wide grid: partitioned by cells, one rank holds nearly all points. Checks:
      velocities included, agree to 1e-10 relative, with >= 20 rebalances.
 Usage: check_load_balance.py TOOL PRM WORKDIR
 """
-import filecmp
 import re
-import shutil
 import sys
 
 import talus_verify as tv
@@ -68,17 +66,7 @@ worst = worst_difference(particles("out_np1"), particles("out_np2"))
 tv.check(worst <= 1e-10, f"1 rank vs 2 ranks rebalancing every 20 steps agree to 1e-10 relative (worst {worst:.2e})")
 
 # 3. restart across rebalances: bitwise on 2 ranks
-restart = tv.prm_set(eager, "output/directory", "out_restart")
-restart = tv.prm_set(restart, "checkpoint/interval", "0.1")
-tv.run_tool(tool, restart, work, "restart_full", np=2)
-shutil.copy(f"{work}/out_restart/particles_final.csv", f"{work}/uninterrupted.csv")
-_, log3, _ = tv.run_tool(tool, tv.prm_set(restart, "checkpoint/restart", "true"), work, "restart_cont", np=2)
-m = re.search(r"restarting from \S+ \(step (\d+)", log3)
-tv.check(m is not None and int(m.group(1)) > 500, f"restarted from the checkpoint at step {m.group(1) if m else '?'}")
-n_after = int(re.search(r"rebalances (\d+)", log3).group(1))
-tv.check(n_after >= 5, f"the continuation rebalances again ({n_after} times)")
-tv.check(filecmp.cmp(f"{work}/uninterrupted.csv", f"{work}/out_restart/particles_final.csv", shallow=False),
-         "the continuation is bitwise identical to the uninterrupted run (particles_final.csv)")
+tv.check_restart_across_rebalances(tool, eager, work, "eager", interval=0.1, min_step=500, min_rebalances=5)
 
 # 4. refused combination
 rc, out, err = tv.run_tool(tool, tv.prm_set(base, "numerics/integration", "ul-fem"), work, "refused", expect_rc=2)

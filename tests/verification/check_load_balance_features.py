@@ -15,9 +15,7 @@ checkpoint between rebalances continues bitwise identically on 2 ranks
 UL-FEM stays refused with load balancing (exit 2 naming the entry).
 Usage: check_load_balance_features.py TOOL PRM WORKDIR
 """
-import filecmp
 import re
-import shutil
 import sys
 
 import talus_verify as tv
@@ -58,20 +56,7 @@ for name, text in cases.items():
     tv.check(worst <= 1e-10, f"{name}: 1 rank vs 2 ranks rebalancing at every check agree to 1e-10 relative "
                              f"(worst {worst:.2e})")
 
-    restart = tv.prm_set(text, "output/directory", f"out_{name}_restart")
-    restart = tv.prm_set(restart, "checkpoint/interval", "0.03")
-    tv.run_tool(tool, restart, work, f"{name}_restart_full", np=2)
-    shutil.copy(f"{work}/out_{name}_restart/particles_final.csv", f"{work}/{name}_uninterrupted.csv")
-    _, log3, _ = tv.run_tool(tool, tv.prm_set(restart, "checkpoint/restart", "true"), work,
-                             f"{name}_restart_cont", np=2)
-    m = re.search(r"restarting from \S+ \(step (\d+)", log3)
-    tv.check(m is not None and int(m.group(1)) > 100, f"{name}: restarted from the checkpoint at step "
-                                                       f"{m.group(1) if m else '?'}")
-    n_after = int(re.search(r"rebalances (\d+)", log3).group(1))
-    tv.check(n_after >= 2, f"{name}: the continuation rebalances again ({n_after} times)")
-    tv.check(filecmp.cmp(f"{work}/{name}_uninterrupted.csv", f"{work}/out_{name}_restart/particles_final.csv",
-                         shallow=False),
-             f"{name}: the continuation is bitwise identical to the uninterrupted run (particles_final.csv)")
+    tv.check_restart_across_rebalances(tool, text, work, name, interval=0.03, min_step=100, min_rebalances=2)
 
 for mode in ("ul-fem",):
     rc, out, err = tv.run_tool(tool, tv.prm_set(base, "numerics/integration", mode), work, f"refused_{mode}",

@@ -174,6 +174,28 @@ def check_refused(tool, text, label, expected, workdir):
                         f"{'no output' if not os.path.exists(out) else 'OUTPUT WRITTEN'} ({last[:150]})")
 
 
+def check_restart_across_rebalances(tool, text, workdir, name, interval, min_step, min_rebalances, np=2):
+    """A checkpoint taken between rebalances continues bitwise: `text` (a .prm that rebalances and
+    writes particles_final.csv) runs uninterrupted on `np` ranks writing checkpoints every `interval`
+    [s], then again from its last checkpoint; the restart must come from a step > `min_step`, rebalance
+    at least `min_rebalances` times more, and end with the same particles_final.csv byte for byte."""
+    import filecmp
+    restart = prm_set(text, "output/directory", f"out_{name}_restart")
+    restart = prm_set(restart, "checkpoint/interval", str(interval))
+    run_tool(tool, restart, workdir, f"{name}_restart_full", np=np)
+    out = os.path.join(workdir, f"out_{name}_restart", "particles_final.csv")
+    uninterrupted = os.path.join(workdir, f"{name}_uninterrupted.csv")
+    shutil.copy(out, uninterrupted)
+    _, log, _ = run_tool(tool, prm_set(restart, "checkpoint/restart", "true"), workdir, f"{name}_restart_cont", np=np)
+    m = re.search(r"restarting from \S+ \(step (\d+)", log)
+    check(m is not None and int(m.group(1)) > min_step,
+          f"{name}: restarted from the checkpoint at step {m.group(1) if m else '?'} (> {min_step})")
+    n_after = int(re.search(r"rebalances (\d+)", log).group(1))
+    check(n_after >= min_rebalances, f"{name}: the continuation rebalances again ({n_after} >= {min_rebalances} times)")
+    check(filecmp.cmp(uninterrupted, out, shallow=False),
+          f"{name}: the continuation is bitwise identical to the uninterrupted run (particles_final.csv)")
+
+
 def read_csv(path):
     """Columns of a CSV file as a dict name -> list of floats."""
     with open(path) as f:
