@@ -17,7 +17,9 @@ campaign only). Checks:
   * the `value` reference of talus-convergence refuses V = 0, a missing V and a missing quantity
     (exit 2, naming the entry, nothing written);
   * the `particles:<column>:front` quantity (the column collapse's run-out) on points of known
-    spacing: the front of the contiguous body to 1e-12, a stray point left out.
+    spacing: the front of the contiguous body to 1e-12, a stray point left out;
+  * the column collapse's fragment is one problem for both tools: at N = 12 the run-outs of
+    talus-explicit and talus-implicit agree within 5 %.
 Usage: check_work_precision.py TOOLS_DIR WORKDIR
 """
 import os
@@ -93,6 +95,27 @@ tv.check(abs(f - 1.0) < 1e-12, f"particles:pos_x:front of a block 0..1 and a str
 pts["pos_x"][-1] = 1.04  # a point in the next bin joins the body
 f = tc._front(pts["pos_x"], pts)
 tv.check(abs(f - 1.09) < 1e-12, f"particles:pos_x:front with a point at 1.04 joining the body: {f:.15g} = 1.09")
+
+# the column collapse's shared fragment gives both tools the same problem: at N = 12 cells per
+# column width their run-outs (particles:pos_x:front) agree within 5 %. Measured +2.6 %
+# (explicit over implicit); with the rough base as 'fixed' instead of a prescribed zero velocity
+# +8.8 % (talus-explicit's FLIP points slid on the base; docs/boundary-conditions.md).
+fronts = {}
+for name, dt in (("explicit", None), ("implicit", "0.0015")):
+    text = open(os.path.join(wp.PRM_DIR, "scenes", f"column_collapse_{name}.prm")).read()
+    text = text.replace("include column_collapse.inc",
+                        "include " + os.path.join(wp.PRM_DIR, "scenes", "column_collapse.inc"))
+    text = tv.prm_set(text, "grid/cells", "60, 20")
+    text = tv.prm_set(text, "output/directory", f"collapse_{name}")
+    text = tv.prm_set(text, "output/series interval", "0")
+    if dt:
+        text = tv.prm_set(text, "time/time step", dt)
+    tv.run_tool(os.path.join(tools, f"talus-{name}"), text, work, f"collapse_{name}")
+    d = tc._particles(os.path.join(work, f"collapse_{name}"))
+    fronts[name] = tc._front(d["pos_x"], d)
+ratio = fronts["explicit"] / fronts["implicit"] - 1
+tv.check(abs(ratio) <= 0.05, f"column collapse at N = 12: run-out talus-explicit {fronts['explicit']:.4f} m, "
+         f"talus-implicit {fronts['implicit']:.4f} m, {100 * ratio:+.1f} % (within 5 %)")
 
 # the 'value' reference (the footing's common reference): bad input is refused before any run
 # or output, naming the entry (exit 2)
