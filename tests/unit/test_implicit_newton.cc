@@ -512,6 +512,7 @@ namespace
         return std::abs(dx);
       };
       p.apply = [this](const double alpha) { x += alpha * dx; };
+      p.slope = [this] { return dx * r; }; // d/dalpha of E = x atan x - ln(1 + x^2) / 2
       return p;
     }
   };
@@ -529,7 +530,7 @@ namespace
     EXPECT_EQ(rp.iterations, 4u); // stopped by divergence detection, not by the limit
 
     NewtonSettings s;
-    s.line_search       = true;
+    s.line_search       = LineSearch::residual;
     s.residual_relative = 1e-10;
     Arctan     ls;
     const auto rl = NewtonSolver(s).solve(ls.problem());
@@ -548,6 +549,30 @@ namespace
     for (unsigned int k = 1; k <= rl.iterations; ++k)
       EXPECT_NEAR(std::abs(ls.x_at_solve[k] - ls.x_at_solve[k - 1]), rl.history[k].increment,
                   1e-14 * (1 + rl.history[k].increment));
+  }
+
+  TEST(ImplicitNewton, EnergyLineSearchRescuesOvershoot)
+  {
+    // the energy E(x) = x atan x - ln(1 + x^2) / 2 is convex with its minimum at
+    // the root: the full step from x = 2 overshoots its minimum along dx
+    NewtonSettings s;
+    s.line_search       = LineSearch::energy;
+    s.residual_relative = 1e-10;
+    Arctan     ls;
+    const auto rl = NewtonSolver(s).solve(ls.problem());
+    print("arctan, energy line search", rl);
+    ASSERT_TRUE(rl.converged);
+    EXPECT_LT(std::abs(ls.x), 1e-9);
+    EXPECT_GT(rl.history[1].halvings, 0u);
+    EXPECT_LT(rl.history[1].alpha, 1.0);
+    EXPECT_GT(rl.history[1].alpha, 0.0);
+    EXPECT_EQ(rl.history.back().alpha, 1.0); // full steps near the root
+    EXPECT_GE(rl.observed_order, 1.8);
+    EXPECT_EQ(ls.stale_tangents, 0u);
+    // without the slope the energy search is refused
+    NewtonProblem p = ls.problem();
+    p.slope         = nullptr;
+    EXPECT_THROW(NewtonSolver(s).solve(p), std::exception);
   }
 
   TEST(ImplicitNewton, FailuresMapToCutBack)
@@ -622,7 +647,7 @@ namespace
       return base(t);
     };
     s             = NewtonSettings();
-    s.line_search = true;
+    s.line_search = LineSearch::residual;
     const auto ri = NewtonSolver(s).solve(p);
     print("rejected full step, line search", ri);
     EXPECT_TRUE(ri.converged) << ri.message;

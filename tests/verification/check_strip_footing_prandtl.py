@@ -131,7 +131,7 @@ def scene(settlement):
     if yield_stress:
         text = tv.prm_set(text, "material 0/j2 plasticity/yield stress", yield_stress)
     if "--line-search" in sys.argv:  # h = 0.05 m needs it (docs/implicit.md)
-        text = tv.prm_set(text, "newton/line search", "true")
+        text = tv.prm_set(text, "newton/line search", "residual")
     if fixed_nodes:
         text = tv.prm_set(text, "implicit/velocity regions follow", "false")
     return tv.prm_set_args(text, [a[len("--set="):] for a in sys.argv if a.startswith("--set=")])

@@ -21,6 +21,15 @@ add_test(NAME verification.implicit_load_steps
                  1,5,10,20,50,100 "linear,quadratic bspline" 0.005 100 --without-carry=50
                  "--set=implicit/carry start imbalance=true")
 set_tests_properties(verification.implicit_load_steps PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+# the energy line search ('newton/line search = energy', docs/implicit.md "Newton driver"): the seed
+# cantilever in 1 and 10 load steps, linear and B-spline, completes without a cut-back within 0.5 % of
+# -0.67433 m (the residual-norm search cuts the 1-step linear run back 23 times)
+add_test(NAME verification.implicit_line_search_energy
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_implicit_load_steps.py ${TALUS_TOOLS_DIR}
+                 ${TALUS_PRM_DIR}/implicit/cantilever_self_weight.prm ${_w}/implicit_line_search_energy 0.0625
+                 1,10 "linear,quadratic bspline" 0.005 100
+                 "--set=implicit/carry start imbalance=true" "--set=newton/line search=energy")
+set_tests_properties(verification.implicit_line_search_energy PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
 # the ghost penalty ('implicit/ghost penalty', docs/implicit.md "Ghost penalty"): the 10-step cantilever at
 # h = 0.0625 stops without it and completes with gamma = 0.01; one step moves < 1e-4; 1 vs 2 ranks 1e-10
 add_test(NAME verification.implicit_ghost_penalty

@@ -196,7 +196,10 @@ namespace talus::implicit_mpm
       prm.declare_entry("criterion", "residual",
                         Selection("residual|increment|residual and increment|residual or increment"),
                         "Which tests must pass.");
-      prm.declare_entry("line search", "false", Bool(), "Backtracking line search on the residual norm.");
+      prm.declare_entry("line search", "none", Selection("none|residual|energy"),
+                        "none; residual: backtracking on the residual norm (Armijo); energy: regula falsi on the "
+                        "energy's derivative du . r along the increment, only when the full step overshoots "
+                        "(docs/implicit.md, 'Newton driver').");
     }
     prm.leave_subsection();
     prm.enter_subsection("linear solver");
@@ -304,7 +307,12 @@ namespace talus::implicit_mpm
     p.newton.increment_relative = prm.get_double("increment relative");
     p.newton.increment_absolute = prm.get_double("increment absolute");
     p.newton.criterion          = parse_newton_criterion(prm.get("criterion"));
-    p.newton.line_search        = prm.get_bool("line search");
+    {
+      const std::string ls = prm.get("line search");
+      p.newton.line_search = ls == "residual" ? LineSearch::residual
+                             : ls == "energy" ? LineSearch::energy
+                                              : LineSearch::none;
+    }
     prm.leave_subsection();
     p.newton.validate();
     prm.enter_subsection("boundary conditions");

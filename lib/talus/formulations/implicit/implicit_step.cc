@@ -226,6 +226,7 @@ namespace talus::implicit_mpm
         plate_step[k] += alpha * plate_c[k];
     };
     problem.step_increment_norm = [&]() { return du.l2_norm(); };
+    problem.slope               = [&]() { return delta * residual; };
     problem.residual_reference  = [&]() { return std::max(f_ext, lifted_residual); };
     // Newton, then (contact walls) the active set from the converged state's
     // reactions and penetrations; a change re-solves from there

@@ -77,6 +77,14 @@ namespace talus::implicit_mpm
                      "': allowed are residual | increment | residual and increment | residual or increment");
   }
 
+  /// The line search of the driver ('newton/line search').
+  enum class LineSearch
+  {
+    none,
+    residual, ///< backtracking on the residual norm (Armijo)
+    energy    ///< regula falsi on the directional derivative du . r(alpha)
+  };
+
   /// Settings of the driver. Defaults: the Kratos MPM inputs quoted in the
   /// seed001 notes §1.9 (the thesis gives none).
   struct NewtonSettings
@@ -97,13 +105,23 @@ namespace talus::implicit_mpm
     double          increment_absolute = 1e-9;
     NewtonCriterion criterion          = NewtonCriterion::residual;
 
-    /// Backtracking line search on the residual norm: accept the step length
-    /// alpha (1, 1/2, 1/4, ...) once r(alpha) <= (1 - armijo * alpha) r_prev,
-    /// at most line_search_max_halvings halvings; when none passes, the
-    /// smallest step is kept (the divergence tests then judge).
-    bool         line_search              = false;
+    /// Line search along the Newton increment du (docs/implicit.md, "Newton
+    /// driver"):
+    ///  - residual: backtracking on the residual norm: accept the step length
+    ///    alpha (1, 1/2, 1/4, ...) once r(alpha) <= (1 - armijo * alpha) r_prev,
+    ///    at most line_search_max_halvings halvings; when none passes, the
+    ///    smallest step is kept (the divergence tests then judge);
+    ///  - energy: the directional derivative of the energy s(alpha) = du .
+    ///    r(u + alpha du) (NewtonProblem::slope); the full step is kept unless it
+    ///    overshoots the energy's minimum along du (s(1) > 0 and |s(1)| >
+    ///    energy_tolerance |s(0)|); then regula falsi on s in (0, 1), at most
+    ///    line_search_max_halvings trials, alpha >= 1/10 of the bracket. The
+    ///    residual norm may grow on the way to a solution of a geometrically
+    ///    non-linear problem; the energy does not.
+    LineSearch   line_search              = LineSearch::none;
     unsigned int line_search_max_halvings = 6;
     double       armijo                   = 1e-4;
+    double       energy_tolerance         = 0.5;
 
     /// Divergence: r_k > divergence_factor * r_{k-w} or |du_k| >
     /// divergence_factor * |du_{k-w}| with w = divergence_window. 0 disables.
@@ -124,6 +142,7 @@ namespace talus::implicit_mpm
       require(increment_relative > 0 || increment_absolute > 0 || criterion == NewtonCriterion::residual, w,
               "the increment test has no positive tolerance");
       require(armijo >= 0 && armijo < 1, w, "the Armijo constant must lie in [0, 1)");
+      require(energy_tolerance > 0 && energy_tolerance < 1, w, "the energy tolerance must lie in (0, 1)");
       require(divergence_factor == 0 || divergence_factor > 1, w, "the divergence factor must be 0 (off) or > 1");
       require(divergence_window >= 1, w, "the divergence window must be at least 1");
     }
@@ -147,6 +166,10 @@ namespace talus::implicit_mpm
     std::function<void(double alpha)> apply;
     /// Optional: |Du|, the accumulated increment of the step at the iterate.
     std::function<double()> step_increment_norm;
+    /// du . r at the current iterate, du the last solve's increment and r the
+    /// residual of the last assembly (a global sum): the derivative of the
+    /// energy along du. Required by LineSearch::energy.
+    std::function<double()> slope;
     /// Optional: a force scale of the step (e.g. |f_ext| + |f_inertia|) so that
     /// a step starting in equilibrium to round-off is not judged relative to
     /// its round-off residual. Called once, after the first assembly.
@@ -253,6 +276,8 @@ namespace talus::implicit_mpm
     solve(const NewtonProblem &p) const
     {
       require(bool(p.assemble) && bool(p.solve) && bool(p.apply), "Newton", "assemble, solve and apply are required");
+      require(settings_.line_search != LineSearch::energy || bool(p.slope), "Newton",
+              "the energy line search needs the slope du . r");
       NewtonResult res;
       try
         {
@@ -322,7 +347,7 @@ namespace talus::implicit_mpm
           // with line search, a trial the callables reject (e.g. an inverted
           // point at the full step) counts as an infinite residual: halve
           const auto trial = [&](const bool with_tangent) {
-            if (!s.line_search)
+            if (s.line_search == LineSearch::none)
               return p.assemble(with_tangent);
             try
               {
@@ -333,9 +358,10 @@ namespace talus::implicit_mpm
                 return std::numeric_limits<double>::infinity();
               }
           };
+          const double s0 = s.line_search == LineSearch::energy ? p.slope() : 0.0;
           p.apply(1.0);
           double r = trial(true);
-          if (s.line_search)
+          if (s.line_search == LineSearch::residual)
             while (!(r <= (1 - s.armijo * alpha) * r_prev) && halvings < s.line_search_max_halvings)
               {
                 p.apply(-0.5 * alpha);
@@ -344,6 +370,33 @@ namespace talus::implicit_mpm
                 r            = trial(false);
                 have_tangent = false;
               }
+          if (s.line_search == LineSearch::energy && s0 < 0)
+            {
+              // a rejected trial (infinite residual) counts as an overshoot
+              const auto slope = [&]() {
+                return std::isfinite(r) ? p.slope() : std::numeric_limits<double>::infinity();
+              };
+              double s_hi = slope(), a_lo = 0, s_lo = s0, a_hi = 1;
+              while (s_hi > 0 && std::abs(s_hi) > s.energy_tolerance * std::abs(s0) &&
+                     halvings < s.line_search_max_halvings)
+                {
+                  double a = std::isfinite(s_hi) ? a_lo - s_lo * (a_hi - a_lo) / (s_hi - s_lo) : 0.5 * (a_lo + a_hi);
+                  const double margin = 0.1 * (a_hi - a_lo);
+                  a                   = std::min(std::max(a, a_lo + margin), a_hi - margin);
+                  p.apply(a - alpha);
+                  alpha = a;
+                  ++halvings;
+                  r                  = trial(false);
+                  have_tangent       = false;
+                  const double s_now = slope();
+                  if (std::abs(s_now) <= s.energy_tolerance * std::abs(s0))
+                    break;
+                  if (s_now > 0)
+                    a_hi = a, s_hi = s_now;
+                  else
+                    a_lo = a, s_lo = s_now;
+                }
+            }
 
           const double inc  = alpha * du;
           const double step = p.step_increment_norm ? p.step_increment_norm() : nan;
