@@ -23,6 +23,20 @@ Modes:
            |centre| < 0.025, profile < 0.03, y spread < 0.01 (measured 0.013,
            0.020, 0.002 at worst); the grid-face variant: |centre| < 0.015, profile < 0.015,
            y spread < 0.01 (measured 0.0075, 0.0072, 0.003).
+  convergence  (verify; issue 40) the convergence study: the centre error (above) at
+           t = 0.6, 1.2, 2.4 s vs the step at fixed h (h = a / 10 and a / 20 at courant
+           0.8, 0.4, 0.2) and vs h at the default step (h = a / 10, a / 20, a / 40 at
+           courant 0.8); prints the tables, the observed orders in dt (from the
+           differences of the centre pressure of successive halvings, and from the
+           errors against the series) and in h; checks: at the default step
+           (courant 0.8) every |centre error| < 3 % of the series' peak centre pressure
+           (1.1535 p0, the transient's scale), at the smaller steps < 5 % (the growth as
+           the step shrinks, docs/semi-implicit.md 'Convergence study'); at the default
+           step and h <= a / 20 the profile's normalised L2 error < 3 % (at h = a / 10 it
+           is 3.5-4.4 %: the bound on the whole profile needs h <= a / 20).
+  convergence_fast  the coarse version: h = a / 10 at courant 0.8, 0.4, 0.2 (t = 1.2 s)
+           and at courant 0.8 also t = 0.6, 2.4 s; h = a / 20 at courant 0.8 (t = 1.2 s);
+           the same checks and printed orders.
   measure  prints the measures for h = a / 10 at courant 0.8, 0.4, 0.2 and
            h = a / 20 at courant 0.8 and t = 0.3, 0.6, 1.2, 2.4 s, both variants (no check).
 Usage: check_semi_mandel.py MODE TOOL PRM WORKDIR
@@ -136,6 +150,69 @@ elif mode == "verify":
         tv.check(abs(centre) < 0.015, "grid face: centre error %.4f p0 < 0.015" % centre)
         tv.check(prof < 0.015, "grid face: profile L2 error %.4f < 0.015" % prof)
         tv.check(spread < 0.01, "grid face: y spread %.4f p0 < 0.01" % spread)
+elif mode in ("convergence", "convergence_fast"):
+    # the series' peak of the centre pressure (the ramped load): the scale of the transient
+    peak = max(ref.pressure(0.0, 0.01 * i) for i in range(1, 300))
+    print("series peak of the centre pressure: %.4f p0" % (peak / p0))
+    fast = mode == "convergence_fast"
+    grids = {10: "14, 5", 20: "28, 10", 40: "56, 20"}
+    courants = (0.8, 0.4, 0.2)
+    dt_study = {10: (0.6, 1.2, 2.4) if not fast else (1.2,)}
+    if not fast:
+        dt_study[20] = (0.6, 1.2, 2.4)
+    err, val, prof = {}, {}, {}  # (n, courant, t) -> centre error / peak, centre pressure / p0, profile L2
+
+    def measure_run(n, courant, t):
+        h = a / n
+        w = run("conv_h%d_c%g_t%g" % (n, courant, t), t, courant, grids[n])
+        m = measures(w, t, h)
+        err[n, courant, t] = m[0] * p0 / peak
+        val[n, courant, t] = m[1]
+        prof[n, courant, t] = m[2]
+        print("h = a/%-2d courant %.1f t = %.1f s (T = %.3f): centre p %.4f p0, error %+.4f p0 = %+.2f %% of the "
+              "peak, profile L2 %.4f" % (n, courant, t, c * t / a**2, m[1], m[0], 100 * err[n, courant, t], m[2]))
+
+    for n, times_n in dt_study.items():
+        for t in times_n:
+            for courant in courants:
+                measure_run(n, courant, t)
+    default_times = (0.6, 1.2, 2.4)
+    h_study = (10, 20, 40) if not fast else (10, 20)
+    for n in h_study:
+        for t in (default_times if (not fast or n == 10) else (1.2,)):
+            if (n, 0.8, t) not in err:
+                measure_run(n, 0.8, t)
+    print("\nerror vs the step (centre error, % of the peak; order p from e(dt) / e(dt / 2) = 2^p, "
+          "q from the self-differences of the centre pressure)")
+    for n, times_n in dt_study.items():
+        for t in times_n:
+            e = [err[n, cr, t] for cr in courants]
+            v = [val[n, cr, t] for cr in courants]
+            p = [math.log2(abs(e[i]) / abs(e[i + 1])) if e[i + 1] != 0 and e[i] != 0 else float("nan")
+                 for i in range(2)]
+            d1, d2 = v[0] - v[1], v[1] - v[2]
+            qo = math.log2(abs(d1) / abs(d2)) if d2 != 0 and d1 != 0 else float("nan")
+            print("  h = a/%-2d t = %.1f s: courant 0.8 / 0.4 / 0.2: %+.2f / %+.2f / %+.2f %%; observed order in dt "
+                  "p = %.2f, %.2f; q = %.2f" % (n, t, 100 * e[0], 100 * e[1], 100 * e[2], p[0], p[1], qo))
+    print("error vs h at the default step (courant 0.8; order r from e(h) / e(h / 2) = 2^r)")
+    for t in default_times:
+        hs = [n for n in h_study if (n, 0.8, t) in err]
+        e = [err[n, 0.8, t] for n in hs]
+        r = [math.log2(abs(e[i]) / abs(e[i + 1])) if e[i + 1] != 0 and e[i] != 0 else float("nan")
+             for i in range(len(e) - 1)]
+        print("  t = %.1f s: %s; observed order in h %s" % (
+            t, " / ".join("a/%d %+.2f %%" % (n, 100 * x) for n, x in zip(hs, e)),
+            ", ".join("%.2f" % x for x in r) if r else "-"))
+    for (n, courant, t), e in sorted(err.items()):
+        if courant == 0.8:
+            tv.check(abs(e) < 0.03, "h = a/%d, t = %g s, the default step: |centre error| %.4f < 3 %% of the peak"
+                     % (n, t, abs(e)))
+        else:
+            tv.check(abs(e) < 0.05, "h = a/%d, t = %g s, courant %g: |centre error| %.4f < 5 %% of the peak"
+                     % (n, t, courant, abs(e)))
+        if courant == 0.8 and n >= 20:
+            tv.check(prof[n, courant, t] < 0.03, "h = a/%d, t = %g s, the default step: profile L2 error %.4f < 3 %%"
+                     % (n, t, prof[n, courant, t]))
 elif mode == "measure":
     times = [0.3, 0.6, 1.2, 2.4]
     for variant in ("", "face_"):

@@ -62,6 +62,21 @@ add_test(NAME verification.semi_implicit_terzaghi
                  ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi
                  0.05,0.1,0.2,0.5,1.0)
 set_tests_properties(verification.semi_implicit_terzaghi PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+# the same case at the family's automatic step (issue 40): courant 0.8 of the soil
+# skeleton's critical step (2.72e-4 s, 2.7 x the paper's 1e-4 s), normalised L2 error
+# < 2 % at T_v = 0.05, 0.1, 0.2 (fast) and 0.05 ... 1.0 (verify)
+add_test(NAME verification.semi_implicit_terzaghi_default_step_fast
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_default_step_fast
+                 0.05,0.1,0.2 --courant=0.8 --tol=0.02)
+set_tests_properties(verification.semi_implicit_terzaghi_default_step_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+add_test(NAME verification.semi_implicit_terzaghi_default_step
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_default_step
+                 0.05,0.1,0.2,0.5,1.0 --courant=0.8 --tol=0.02)
+set_tests_properties(verification.semi_implicit_terzaghi_default_step PROPERTIES LABELS "verify" ENVIRONMENT "${_env}"
+                     TIMEOUT 1800)
 # the single-point variant (water carried on the soil points), same tolerance:
 # T_v = 0.1 (fast), 0.05 ... 1.0 (verify)
 add_test(NAME verification.semi_implicit_terzaghi_single_fast
@@ -297,6 +312,24 @@ foreach(_mode fast verify)
            COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_mandel.py ${_mode} ${TALUS_TOOLS_DIR}/talus-semi-implicit
                    ${TALUS_PRM_DIR}/verification/mandel/mandel_semi_implicit.prm ${_w}/${_name})
   set_tests_properties(${_name} PROPERTIES LABELS "${_mode}" ENVIRONMENT "${_env}" TIMEOUT 600)
+endforeach()
+# Mandel's convergence study (issue 40; docs/semi-implicit.md 'Convergence study'): the
+# centre's pore pressure error vs the step at fixed h and vs h at the default step
+# (courant 0.8), the observed orders printed; the default step's error < 3 % of the
+# series' peak centre pressure at every h and time, the smaller steps' < 5 %; fast: the
+# coarse version (h = a / 10 at three steps, h = a / 20 at the default step)
+foreach(_mode convergence_fast convergence)
+  if(_mode STREQUAL "convergence_fast")
+    set(_name verification.semi_implicit_mandel_convergence_fast)
+    set(_label fast)
+  else()
+    set(_name verification.semi_implicit_mandel_convergence)
+    set(_label verify)
+  endif()
+  add_test(NAME ${_name}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_mandel.py ${_mode} ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                   ${TALUS_PRM_DIR}/verification/mandel/mandel_semi_implicit.prm ${_w}/${_name})
+  set_tests_properties(${_name} PROPERTIES LABELS "${_label}" ENVIRONMENT "${_env}" TIMEOUT 1800)
 endforeach()
 set_tests_properties(verification.semi_implicit_mandel_fast PROPERTIES PROCESSORS 2)
 
