@@ -104,17 +104,18 @@ namespace talus::semi_implicit
     // and sum_w V_w N grad p^t from the nodal p^t
     const double *pn  = at_local(p_node);
     double       *gpw = at_local(Gpw), *gps = at_local(Gps);
-    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-      double    *P   = it->get_properties().data();
-      const bool wet = P[fs.water_mass] > 0;
-      if (wet && prm.pressure_smoothing)
-        P[fs.pressure] = s.value(pn);
-      double gp[dim];
-      s.gradient(pn, gp);
-      s.scatter_vector(gps, P[L::volume], gp);
-      if (wet)
-        s.scatter_vector(gpw, water_volume(P), gp);
-    });
+    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                             [&](unsigned int, It &it, const Stencil &s) {
+                                               double    *P   = it->get_properties().data();
+                                               const bool wet = P[fs.water_mass] > 0;
+                                               if (wet && prm.pressure_smoothing)
+                                                 P[fs.pressure] = s.value(pn);
+                                               double gp[dim];
+                                               s.gradient(pn, gp);
+                                               s.scatter_vector(gps, P[L::volume], gp);
+                                               if (wet)
+                                                 s.scatter_vector(gpw, water_volume(P), gp);
+                                             });
   }
 
   template <int dim>
@@ -124,14 +125,15 @@ namespace talus::semi_implicit
   {
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
-    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-      const double *P = it->get_properties().data();
-      double        gp[dim];
-      s.gradient(phi, gp);
-      s.scatter_vector(fs_out, P[L::volume], gp);
-      if (P[fs.water_mass] > 0)
-        s.scatter_vector(fw_out, water_volume(P), gp);
-    });
+    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                             [&](unsigned int, It &it, const Stencil &s) {
+                                               const double *P = it->get_properties().data();
+                                               double        gp[dim];
+                                               s.gradient(phi, gp);
+                                               s.scatter_vector(fs_out, P[L::volume], gp);
+                                               if (P[fs.water_mass] > 0)
+                                                 s.scatter_vector(fw_out, water_volume(P), gp);
+                                             });
   }
 
   template <int dim>
@@ -146,32 +148,33 @@ namespace talus::semi_implicit
     // terms (on V_w) enter as V_w / V times theirs
     const double  h = this_step.h, rw = prm.water_density;
     const double *vss = at_local(vs_star), *vws = at_local(vw_star);
-    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-      double      *P   = it->get_properties().data();
-      const double n   = P[fs.porosity];
-      const double rs  = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
-      const double r   = P[fs.water_mass] > 0 ? water_volume(P) / P[L::volume] : 0.0; // V_w / V
-      double       c   = prm.rigid_skeleton ? 0.0 : h * (1 - n) / rs;
-      double       q[dim] = {};
-      if (!prm.rigid_skeleton)
-        {
-          double v[dim];
-          s.vector_value(vss, v);
-          for (unsigned int d = 0; d < dim; ++d)
-            q[d] = (1 - n) * v[d];
-        }
-      if (r > 0)
-        {
-          double v[dim];
-          s.vector_value(vws, v);
-          c += r * h * n / rw;
-          for (unsigned int d = 0; d < dim; ++d)
-            q[d] += r * n * v[d];
-        }
-      P[fs.poisson_coefficient] = c;
-      for (unsigned int d = 0; d < dim; ++d)
-        P[fs.poisson_flux + d] = q[d];
-    });
+    transfer::for_each_point_stencil<dim, K>(
+      grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+        double      *P      = it->get_properties().data();
+        const double n      = P[fs.porosity];
+        const double rs     = prm.materials[static_cast<unsigned int>(P[L::material])]->density();
+        const double r      = P[fs.water_mass] > 0 ? water_volume(P) / P[L::volume] : 0.0; // V_w / V
+        double       c      = prm.rigid_skeleton ? 0.0 : h * (1 - n) / rs;
+        double       q[dim] = {};
+        if (!prm.rigid_skeleton)
+          {
+            double v[dim];
+            s.vector_value(vss, v);
+            for (unsigned int d = 0; d < dim; ++d)
+              q[d] = (1 - n) * v[d];
+          }
+        if (r > 0)
+          {
+            double v[dim];
+            s.vector_value(vws, v);
+            c += r * h * n / rw;
+            for (unsigned int d = 0; d < dim; ++d)
+              q[d] += r * n * v[d];
+          }
+        P[fs.poisson_coefficient] = c;
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fs.poisson_flux + d] = q[d];
+      });
   }
 
   template <int dim>
@@ -183,16 +186,17 @@ namespace talus::semi_implicit
     using It      = transfer::PointIterator<dim>;
     // a force plate's unit response: the water's flux n e_w added on the soil's
     // (1 - n) e_s, weighed by V_w / V as in one_set_poisson_terms
-    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-      double *P = it->get_properties().data();
-      if (!(P[fs.water_mass] > 0))
-        return;
-      const double r = water_volume(P) / P[L::volume];
-      double       v[dim];
-      s.vector_value(ew, v);
-      for (unsigned int d = 0; d < dim; ++d)
-        P[fs.plate_flux + d] += r * P[fs.porosity] * v[d];
-    });
+    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                             [&](unsigned int, It &it, const Stencil &s) {
+                                               double *P = it->get_properties().data();
+                                               if (!(P[fs.water_mass] > 0))
+                                                 return;
+                                               const double r = water_volume(P) / P[L::volume];
+                                               double       v[dim];
+                                               s.vector_value(ew, v);
+                                               for (unsigned int d = 0; d < dim; ++d)
+                                                 P[fs.plate_flux + d] += r * P[fs.porosity] * v[d];
+                                             });
   }
 
   template <int dim>
@@ -205,40 +209,41 @@ namespace talus::semi_implicit
     // nodes_to_particles for both phases: FLIP of the soil and the water
     // velocity, the pore pressure increment and gradient, the MUSL scatter of
     // the soil's momentum
-    Ps = 0;
+    Ps                = 0;
     const double *vsn = at_local(vs_new), *vst = at_local(vs_t), *vwn = at_local(vw_new), *vwt = at_local(vw_t),
                  *dpn = at_local(dp_node), *pn = at_local(p_node);
     const double flip = prm.flip_fraction;
     double      *ps   = at_local(Ps);
-    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-      double *P = it->get_properties().data();
-      double  a[dim], b[dim];
-      s.vector_value(vsn, a);
-      s.vector_value(vst, b);
-      for (unsigned int d = 0; d < dim; ++d)
-        P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-      s.scatter_vector(ps, P[L::mass], P + L::velocity);
-      if (!(P[fs.water_mass] > 0))
-        return;
-      s.vector_value(vwn, a);
-      s.vector_value(vwt, b);
-      for (unsigned int d = 0; d < dim; ++d)
-        P[fs.water_velocity + d] = flip * (P[fs.water_velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-      P[fs.pressure] += s.value(dpn);
-      double gp[dim], gdp[dim];
-      s.gradient(pn, gp);
-      s.gradient(dpn, gdp);
-      for (unsigned int d = 0; d < dim; ++d)
-        P[fs.pressure_gradient + d] = gp[d] + gdp[d];
-    });
+    transfer::for_each_point_stencil<dim, K>(
+      grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
+        double *P = it->get_properties().data();
+        double  a[dim], b[dim];
+        s.vector_value(vsn, a);
+        s.vector_value(vst, b);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+        s.scatter_vector(ps, P[L::mass], P + L::velocity);
+        if (!(P[fs.water_mass] > 0))
+          return;
+        s.vector_value(vwn, a);
+        s.vector_value(vwt, b);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fs.water_velocity + d] = flip * (P[fs.water_velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
+        P[fs.pressure] += s.value(dpn);
+        double gp[dim], gdp[dim];
+        s.gradient(pn, gp);
+        s.gradient(dpn, gdp);
+        for (unsigned int d = 0; d < dim; ++d)
+          P[fs.pressure_gradient + d] = gp[d] + gdp[d];
+      });
   }
 
-#define TALUS_ONE_SET_INSTANTIATE(dim, K)                                                           \
-  template void Solver<dim>::one_set_to_nodes<K>(const StepState &);                                \
-  template void Solver<dim>::one_set_pressure_forces<K>();                                          \
-  template void Solver<dim>::one_set_weak_gradients<K>(const double *, double *, double *);         \
-  template void Solver<dim>::one_set_poisson_terms<K>(const StepState &);                           \
-  template void Solver<dim>::one_set_plate_flux<K>(const double *);                                 \
+#define TALUS_ONE_SET_INSTANTIATE(dim, K)                                                   \
+  template void Solver<dim>::one_set_to_nodes<K>(const StepState &);                        \
+  template void Solver<dim>::one_set_pressure_forces<K>();                                  \
+  template void Solver<dim>::one_set_weak_gradients<K>(const double *, double *, double *); \
+  template void Solver<dim>::one_set_poisson_terms<K>(const StepState &);                   \
+  template void Solver<dim>::one_set_plate_flux<K>(const double *);                         \
   template void Solver<dim>::one_set_to_particles<K>();
   TALUS_ONE_SET_INSTANTIATE(2, shape::BSpline2Box<2>)
   TALUS_ONE_SET_INSTANTIATE(2, shape::Q1Box<2>)

@@ -567,8 +567,22 @@ namespace talus::semi_implicit
     // point's B-spline window moved (a half-cell line) onto a pair the kept
     // pattern lacks (couplings_covered). The decision is global:
     // ActiveSet::reinit and the AMG set-up are collective.
-    const bool cells_changed =
-      soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 || partition_changed || A.m() == 0;
+    // The pattern is the union of both sets' stencils: a set's cells changing
+    // inside the cells the pattern was built on (a double-point water point
+    // entering or leaving a cell that soil points hold) leaves it to the
+    // couplings check, as a window move does (docs/semi-implicit.md 'The
+    // pressure solve: reuse between steps')
+    const auto union_changed = [&] {
+      std::vector<unsigned int> held;
+      for (const MaterialPointSet<dim> *set : {&soil, &water})
+        for (const auto &ac : set->active_cells())
+          held.push_back(ac.cell);
+      std::sort(held.begin(), held.end());
+      held.erase(std::unique(held.begin(), held.end()), held.end());
+      return held != active.cells();
+    };
+    const bool cells_changed = step_number == 0 || partition_changed || A.m() == 0 ||
+                               ((soil.cell_set_changed() || water.cell_set_changed()) && union_changed());
     const bool         window_moved = !cells_changed && !active.template couplings_covered<K>({&soil, &water});
     const unsigned int why          = dealii::Utilities::MPI::max(cells_changed ? 2u : window_moved ? 1u : 0u, comm);
     const bool         new_pattern  = why != 0;
