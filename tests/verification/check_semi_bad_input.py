@@ -47,6 +47,10 @@ cases = [
     ("single point with a water body", [("semi implicit/point sets", "single"), ("number of bodies", "2"),
                                         ("body 1/phase", "water"), ("body 1/upper corner", "0.075, 1.05"),
                                         ("body 1/lower corner", "0, 1")], "semi implicit/point sets"),
+    ("one set with a water body", [("semi implicit/point sets", "one set"), ("number of bodies", "2"),
+                                   ("body 1/phase", "water"), ("body 1/upper corner", "0.075, 1.05"),
+                                   ("body 1/lower corner", "0, 1")], "one set needs every body"),
+    ("bad point sets", [("semi implicit/point sets", "one")], "point sets"),
     # the shared loads (issue 37, docs/boundary-conditions.md; the per-body
     # 'surface load' entries they replace are gone): a region upside down
     ("traction region upside down", [("loads/number of tractions", "1"), ("loads/traction 0/apply to", "region"),

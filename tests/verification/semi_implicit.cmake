@@ -89,6 +89,25 @@ add_test(NAME verification.semi_implicit_terzaghi_single
                  ${TALUS_PRM_DIR}/verification/semi_implicit_terzaghi.prm ${_w}/semi_implicit_terzaghi_single
                  0.05,0.1,0.2,0.5,1.0 "--set=semi implicit/point sets=single")
 set_tests_properties(verification.semi_implicit_terzaghi_single PROPERTIES LABELS "verify" ENVIRONMENT "${_env}" TIMEOUT 1800)
+# the one-set single-point variant (point sets = one set, issue 40 item 2):
+# Terzaghi at T_v = 0.1 against the series (3 %) and against double (row means
+# of the pore pressure within 1 % of q, top settlement within 1 %) and single
+# (every point within 1e-4); the hydrostatic column (1 %, and within 0.1 % of
+# rho_w g H of double); 1 vs 2 ranks to 1e-10; restart byte for byte on 1 and 2 ranks
+foreach(_mode terzaghi hydrostatic ranks restart)
+  set(_prm ${TALUS_PRM_DIR}/verification/semi_implicit_${_mode}.prm)
+  if(_mode STREQUAL "ranks" OR _mode STREQUAL "restart")
+    set(_prm ${TALUS_PRM_DIR}/verification/semi_implicit_consolidation.prm)
+  endif()
+  add_test(NAME verification.semi_implicit_one_set_${_mode}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_one_set.py ${_mode} ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                   ${_prm} ${_w}/semi_implicit_one_set_${_mode})
+  set_tests_properties(verification.semi_implicit_one_set_${_mode} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 600)
+endforeach()
+set_tests_properties(verification.semi_implicit_one_set_ranks verification.semi_implicit_one_set_restart
+                     PROPERTIES PROCESSORS 2)
+
 # the same with linear shape functions
 add_test(NAME verification.semi_implicit_consolidation_linear
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_consolidation.py ${TALUS_TOOLS_DIR}/talus-semi-implicit

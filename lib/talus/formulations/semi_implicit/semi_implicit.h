@@ -75,6 +75,9 @@ namespace talus::semi_implicit
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;
+    /// one set (with single_point): one point set, each point carrying the soil
+    /// and its pore water; every point pass walks it once for both phases
+    bool one_set = false;
     /// Nor-Sand specific volume v = v0 Jbar with Jbar the node-smoothed total J
     /// of the soil points (seed 002 Eqs. 96-97), else v = v0 J (Eq. 95)
     bool smoothed_specific_volume = true;

@@ -72,9 +72,22 @@ namespace talus::semi_implicit
   std::vector<double>
   Solver<dim>::series_values(const bool)
   {
-    auto ek = diagnostics::sum_points(soil), ew = diagnostics::sum_points(water); // kinetic energies
-    diagnostics::sum_over_ranks<dim>({&ek, &ew}, comm);
+    auto   ek = diagnostics::sum_points(soil), ew = diagnostics::sum_points(water); // kinetic energies
     double vmax[2] = {0, 0}, pmin = 0, soil_volume = 0, fu = 0, fsum = 0;
+    if (prm.one_set) // the water the soil points carry (the water set is empty)
+      for (const auto &pt : soil.handler)
+        {
+          const auto P = pt.get_properties();
+          if (!(P[fs.water_mass] > 0))
+            continue;
+          double v2 = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            v2 += P[fs.water_velocity + d] * P[fs.water_velocity + d];
+          ew.kinetic += 0.5 * P[fs.water_mass] * v2;
+          vmax[1] = std::max(vmax[1], std::sqrt(v2));
+          pmin    = std::min(pmin, P[fs.pressure]);
+        }
+    diagnostics::sum_over_ranks<dim>({&ek, &ew}, comm);
     for (const bool is_soil : {true, false})
       for (const auto &pt : (is_soil ? soil : water).handler)
         {
@@ -127,10 +140,10 @@ namespace talus::semi_implicit
     if (!water_probes.ids.empty())
       {
         std::vector<double> p(water_probes.ids.size(), 0.0), sum(p.size());
-        for (const auto &pt : water.handler)
+        for (const auto &pt : (prm.one_set ? soil : water).handler)
           for (unsigned int k = 0; k < p.size(); ++k)
             if (pt.get_id() == water_probes.ids[k])
-              p[k] = pt.get_properties()[fw.pressure];
+              p[k] = pt.get_properties()[prm.one_set ? fs.pressure : fw.pressure];
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(p), comm, dealii::ArrayView<double>(sum));
         v.insert(v.end(), sum.begin(), sum.end());
       }
@@ -166,6 +179,14 @@ namespace talus::semi_implicit
         info.time        = time;
         info.steps       = step_number;
         write_results_file(info, grid, soil, probes.ids, series_csv, comm, [&](io::H5File &out) {
+          if (prm.one_set) // the pore pressure of the points (one set: no water/ group)
+            {
+              std::vector<double> p;
+              for (const auto &pt : soil.handler)
+                p.push_back(pt.get_properties()[fs.pressure]);
+              out.write_rows("particles/pore_pressure", p, 1);
+              return;
+            }
           if (water.handler.n_global_particles() == 0)
             return;
           write_point_table(out, "water", water);

@@ -81,13 +81,15 @@ namespace talus::semi_implicit
       prm.declare_entry("flip fraction", "1", Double(0, 1),
                         "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
                         "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
-      prm.declare_entry("point sets", "double", Selection("double|single"),
+      prm.declare_entry("point sets", "double", Selection("double|single|one set"),
                         "double: soil and water are two sets of material points, each moving with its own "
-                        "velocity (the paper's double-point method). single: the water is carried on the soil "
-                        "points: the water points are seeded on the soil points and move with the soil's "
-                        "velocity, so they stay on them; the water keeps its own velocity, mass, pressure and "
-                        "the same equations and basis (the single-point comparison). single needs every body "
-                        "to be saturated or soil.");
+                        "velocity (the paper's double-point method). one set: the single-point variant, one "
+                        "set of points each carrying the soil and its pore water (water velocity, mass and "
+                        "pore pressure; the water's porosity is the point's), every point pass made once for "
+                        "both phases (the paper's single-point code of Table 4). single: the single-point "
+                        "variant as two sets, the water points seeded on the soil points and moved with the "
+                        "soil's velocity, so they stay on them (the same passes as double). single and one set "
+                        "need every body to be saturated or soil.");
       prm.declare_entry("nor sand specific volume", "node-smoothed", Selection("node-smoothed|point"),
                         "The specific volume v of nor sand soil points. node-smoothed: v = v0 Jbar, Jbar the "
                         "mass-weighted node map and remap of the points' total J (seed 002 Eqs. 96-97). point: "
@@ -235,7 +237,8 @@ namespace talus::semi_implicit
       }
       {
         p.patch_size               = prm.get_double("patch size");
-        p.single_point             = prm.get("point sets") == "single";
+        p.single_point             = prm.get("point sets") != "double";
+        p.one_set                  = prm.get("point sets") == "one set";
         p.smoothed_specific_volume = prm.get("nor sand specific volume") == "node-smoothed";
         require(p.patch_size >= 0.5 && p.patch_size <= 10, "semi implicit/patch size", "must lie in [0.5, 10] cells");
       }
@@ -358,8 +361,9 @@ namespace talus::semi_implicit
       if (p.single_point)
         for (unsigned int b = 0; b < p.bodies.size(); ++b)
           require(p.phase_of_body[b] != Phase::water, "semi implicit/point sets",
-                  "single needs every body to carry soil points (the water rides on them), but body " +
-                    std::to_string(b) + " has phase = water; allowed: point sets = double, or phase = saturated");
+                  std::string(p.one_set ? "one set" : "single") +
+                    " needs every body to carry soil points (the water rides on them), but body " + std::to_string(b) +
+                    " has phase = water; allowed: point sets = double, or phase = saturated");
       // a soil body has no pore water: its K0 state is the dry weight
       for (unsigned int b = 0; b < p.bodies.size(); ++b)
         require(p.phase_of_body[b] != Phase::soil || !p.initial_stress[b].enabled ||

@@ -143,6 +143,13 @@ namespace talus::semi_implicit
         fs.plate_flux = soil.layout.add_extra("plate_flux", dim, true);
         fw.plate_flux = water.layout.add_extra("plate_flux", dim, true);
       }
+    if (prm.one_set) // the pore water on the soil points (the water set stays empty)
+      {
+        fs.pressure          = soil.layout.add_extra("pore_pressure", 1);
+        fs.pressure_gradient = soil.layout.add_extra("pore_pressure_gradient", dim, true);
+        fs.water_velocity    = soil.layout.add_extra("water_velocity", dim, true);
+        fs.water_mass        = soil.layout.add_extra("water_mass", 1);
+      }
     fw.pressure            = water.layout.add_extra("pore_pressure", 1);
     fw.pressure_gradient   = water.layout.add_extra("pore_pressure_gradient", dim, true);
     fw.porosity            = water.layout.add_extra("porosity", 1);
@@ -178,8 +185,8 @@ namespace talus::semi_implicit
   Solver<dim>::select_probes()
   {
     probes.select(soil, prm.probes, comm);
-    if (water.handler.n_global_particles() > 0)
-      water_probes.select(water, prm.probes, comm);
+    if (has_water()) // one set: the pore pressure of the same soil points
+      water_probes.select(prm.one_set ? soil : water, prm.probes, comm);
   }
 
   template <int dim>
@@ -309,6 +316,8 @@ namespace talus::semi_implicit
     // the index of the .prm body
     for (const bool is_soil : {true, false})
       {
+        if (!is_soil && prm.one_set) // one set: the soil points carry the water
+          continue;
         MaterialPointSet<dim>            &set = is_soil ? soil : water;
         std::vector<BodyDescription<dim>> bodies;
         std::vector<unsigned int>         body_index;
@@ -342,6 +351,13 @@ namespace talus::semi_implicit
                 P[f.conductivity] = prm.soil_of_material[m].conductivity;
                 for (unsigned int d = 0; d < dim; ++d) // its share of a loaded face: BoundaryLoads::assign
                   P[f.surface_offset + d] = 0;
+                if (prm.one_set) // its pore water (Eq. 37), none in a soil body
+                  {
+                    P[f.water_mass] = prm.phase_of_body[b] == Phase::saturated ? n0 * prm.water_density * V0 : 0.0;
+                    P[f.pressure]   = 0;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      P[f.pressure_gradient + d] = P[f.water_velocity + d] = 0;
+                  }
               }
             else
               {
@@ -367,18 +383,20 @@ namespace talus::semi_implicit
     GeostaticState<dim> geo(prm.initial_stress, prm.gravity);
     geo.find_body_tops({&soil, &water}, grid, prm.bodies, comm);
     const double g = geo.gravity_norm();
-    for (auto &pt : water.handler)
+    // (one set: the pore water of the soil points that carry water)
+    const Fields &f = prm.one_set ? fs : fw;
+    for (auto &pt : (prm.one_set ? soil : water).handler)
       {
         auto               P = pt.get_properties();
         const unsigned int b = static_cast<unsigned int>(P[L::body]);
-        if (!geo.applies(b))
+        if (!geo.applies(b) || (prm.one_set && !(P[fs.water_mass] > 0)))
           continue;
         const double depth = geo.depths(b, pt.get_location()).water;
-        P[fw.pressure]     = -prm.water_density * g * depth;
+        P[f.pressure]      = -prm.water_density * g * depth;
         for (unsigned int d = 0; d < dim; ++d)
           {
-            const double up_d           = geo.up_direction()[d];
-            P[fw.pressure_gradient + d] = depth > 0 && up_d != 0 ? prm.water_density * g * up_d : 0.0;
+            const double up_d          = geo.up_direction()[d];
+            P[f.pressure_gradient + d] = depth > 0 && up_d != 0 ? prm.water_density * g * up_d : 0.0;
           }
       }
     for (auto &pt : soil.handler)
@@ -408,7 +426,9 @@ namespace talus::semi_implicit
     const auto ns = soil.handler.n_global_particles(), nw = water.handler.n_global_particles();
     out << "talus-semi-implicit: " << dim << "D, grid " << grid.tria.n_global_active_cells() << " cells (h_min "
         << grid.min_cell_size() << " m), " << (prm.bspline() ? "quadratic B-splines" : "linear shape functions") << ", "
-        << ns << " soil + " << nw << " water points\n"
+        << (prm.one_set ? std::to_string(ns) + " points (one set: soil and pore water on each)"
+                        : std::to_string(ns) + " soil + " + std::to_string(nw) + " water points")
+        << "\n"
         << "  time step " << dt << " s (soil skeleton critical step " << dt_soil_critical << " s"
         << (prm.time_step > 0 ? ", fixed" : ", courant " + std::to_string(prm.courant))
         << "), pressure: CG + ML AMG to " << prm.pressure_tolerance << " relative residual, AMG rebuilt every "

@@ -30,6 +30,7 @@
 
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 
+#include <algorithm>
 #include <initializer_list>
 #include <memory>
 #include <string>
@@ -54,6 +55,9 @@ namespace talus::semi_implicit
     unsigned int smoothed_volume_increment = 0, patch_elastic_jacobian = 0; // F-bar: dJbar, Jebar
     unsigned int smoothed_jacobian = 0;                                     // Nor-Sand (96)-(97): Jbar^{t+1}
     unsigned int plate_flux        = 0; // rigid plates with force control: dim values, phi v* of a unit plate velocity
+    /// point sets = one set: the pore water a soil point carries (soil layout;
+    /// pressure and pressure_gradient above are the soil's too then)
+    unsigned int water_velocity = 0, water_mass = 0; // water_velocity: dim values
   };
 
   template <int dim>
@@ -123,9 +127,11 @@ namespace talus::semi_implicit
     /// forces on both phases.
     template <class K>
     void particles_to_nodes(StepState &this_step);
-    /// soil mass, momentum, porosity, drag and force; nodal n and v_s^t; ms_cut
+    /// soil mass, momentum, porosity, drag and force
     template <class K>
     void soil_to_nodes(StepState &this_step);
+    /// their exchange; nodal n and v_s^t; ms_cut
+    void soil_nodal_fields(StepState &this_step);
     /// the water points' porosity and volume; water mass, velocity, mapped
     /// pore pressure, drag Q; cell water volumes; v_w^t; mw_cut
     template <class K>
@@ -204,15 +210,55 @@ namespace talus::semi_implicit
     /// Collective.
     void velocity_reactions(const StepState &this_step);
     /// (7)-(8a): FLIP velocities and pore pressure of the points, the MUSL
-    /// remap of the soil's velocity (vs_t).
+    /// scatter of the soil's momentum (Ps)
     template <class K>
-    void nodes_to_particles(const StepState &this_step);
+    void nodes_to_particles();
+    /// (8a): the remapped soil velocity vs_t from Ps
+    void remap_soil_velocity(const StepState &this_step);
     /// How far the plates' nodes moved apart and slipped (node_spread, node_slip).
     void plate_node_spread(const StepState &this_step);
     /// (7a), (8b-g): the soil's ΔF, volume, J, porosity, conductivity and
     /// stress, both sets moved and relocated.
     template <class K>
     void update_and_move_points(const StepState &this_step);
+    // point sets = one set (semi_implicit_one_set.cc): the point passes of
+    // both phases in one walk over the soil set, whose points carry the water;
+    // the phases above call them in place of their two walks (the water set
+    // is empty)
+    /// the scene has pore water (water points, or one-set points carrying water)
+    bool
+    has_water() const
+    {
+      if (prm.one_set)
+        return std::find(prm.phase_of_body.begin(), prm.phase_of_body.end(), Phase::saturated) !=
+               prm.phase_of_body.end();
+      return water.handler.n_global_particles() > 0;
+    }
+    /// the water volume a one-set point stands for, V_w = m_w / (rho_w n)
+    /// (Eq. 36 with the point's own porosity; 0 for a dry point)
+    double
+    water_volume(const double *P) const
+    {
+      return P[fs.water_mass] / (prm.water_density * P[fs.porosity]);
+    }
+    /// P2N of both phases (soil_to_nodes' sums and water_to_nodes')
+    template <class K>
+    void one_set_to_nodes(const StepState &this_step);
+    /// the smoothed pore pressure of the points; Gps and Gpw
+    template <class K>
+    void one_set_pressure_forces();
+    /// sum_s V N grad phi into fs, sum_w V_w N grad phi into fw
+    template <class K>
+    void one_set_weak_gradients(const double *phi, double *fs_out, double *fw_out);
+    /// the Poisson coefficient and flux of both phases, summed per point
+    template <class K>
+    void one_set_poisson_terms(const StepState &this_step);
+    /// a force plate's unit response: the water's flux (ew) added to the soil's
+    template <class K>
+    void one_set_plate_flux(const double *ew);
+    /// FLIP of both phases, the pore pressure, the MUSL scatter of the soil (into Ps)
+    template <class K>
+    void one_set_to_particles();
     /// The soil update of update_and_move_points (a transfer::UpdateAndMove op).
     template <class K>
     struct SoilUpdate;

@@ -172,7 +172,11 @@ namespace talus::semi_implicit
       plate_balance(this_step);
     velocity_reactions(this_step);
     add_lap(phase.grid);
-    nodes_to_particles<K>(this_step);
+    if (prm.one_set) // both phases in one walk
+      one_set_to_particles<K>();
+    else
+      nodes_to_particles<K>();
+    remap_soil_velocity(this_step);
     if (!prm.rigid_plates.empty()) // what the nodes moved the soil with: node_spread
       plate_node_spread(this_step);
     add_lap(phase.n2p);
@@ -217,7 +221,11 @@ namespace talus::semi_implicit
   void
   Solver<dim>::particles_to_nodes(StepState &this_step)
   {
-    soil_to_nodes<K>(this_step);
+    if (prm.one_set) // the sums of both phases in one walk (water_to_nodes then walks an empty set)
+      one_set_to_nodes<K>(this_step);
+    else
+      soil_to_nodes<K>(this_step);
+    soil_nodal_fields(this_step);
     water_to_nodes<K>(this_step);
     pore_pressure_forces<K>();
   }
@@ -230,10 +238,9 @@ namespace talus::semi_implicit
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
 
-    const bool         initial_stage = this_step.initial_stage;
-    const auto        &g             = this_step.g;
-    const double       rw            = prm.water_density;
-    const unsigned int nl            = n_local();
+    const bool   initial_stage = this_step.initial_stage;
+    const auto  &g             = this_step.g;
+    const double rw            = prm.water_density;
     // (1)-(2) P2N of the soil: mass (44), momentum (45), porosity (46), the
     // drag coefficient integrated over the soil points (in place of (47) and
     // (58), see below); effective-stress internal force and soil gravity (54)-(55)
@@ -260,6 +267,13 @@ namespace talus::semi_implicit
           bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, fsv);
         });
     }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::soil_nodal_fields(StepState &this_step)
+  {
+    const unsigned int nl = n_local();
     exchange({&Ms, &Ps, &Mn, &Mk, &Fs});
     double ms_max = 0;
     for (unsigned int i = 0; i < nl; ++i)
@@ -296,7 +310,8 @@ namespace talus::semi_implicit
     // (48, Alg. 8(h)) and their volume (36); water mass with the nodal porosity
     // (50), velocity with the weights rho_w V0 (51); the mass-weighted nodal
     // pore pressure (77 / A5); the water volume of each cell (free surface)
-    cell_water_volume.assign(grid.cells.size(), 0.0);
+    if (!prm.one_set) // (one set: summed by one_set_to_nodes)
+      cell_water_volume.assign(grid.cells.size(), 0.0);
     {
       const double *nn = at(n_node);
       double       *ww = at(Ww), *pw0 = at(Pw0), *ww0 = at(Ww0), *mwp = at(Mwp), *mw = at(Mw), *mwg = at(Mwg);
@@ -367,6 +382,11 @@ namespace talus::semi_implicit
     // nodal p^t (decision 'pressure force form' in docs/semi-implicit.md: the
     // printed mixture form -sum_w V p grad N split by n_I gives the soil of a
     // node at a free-water interface the buoyancy of the whole support)
+    if (prm.one_set) // both phases in one walk
+      {
+        one_set_pressure_forces<K>();
+        return exchange({&Gpw, &Gps});
+      }
     {
       const double *pn  = at(p_node);
       double       *gpw = at(Gpw), *gps = at(Gps);
@@ -474,7 +494,7 @@ namespace talus::semi_implicit
     point_poisson_terms<K>(this_step);
     add_lap(phase.poisson); // the points' Poisson coefficient and flux (also in a dry scene)
     // a dry scene (soil points only) is a single-phase solid: no pressure
-    if (water.handler.n_global_particles() == 0)
+    if (!has_water())
       {
         dp_node = 0;
         return;
@@ -509,6 +529,8 @@ namespace talus::semi_implicit
     // (5) pressure-increment Poisson equation (60)-(63): per point the
     // coefficient dt phi / rho and the source phi div v* (phi = 1 - n for the
     // soil, n for the water; point porosity, see docs/semi-implicit.md)
+    if (prm.one_set) // both phases' terms summed on each point
+      return one_set_poisson_terms<K>(this_step);
     {
       const double *vss = at(vs_star), *vws = at(vw_star);
       transfer::for_each_point_stencil<dim, K>(
@@ -545,8 +567,22 @@ namespace talus::semi_implicit
     // point's B-spline window moved (a half-cell line) onto a pair the kept
     // pattern lacks (couplings_covered). The decision is global:
     // ActiveSet::reinit and the AMG set-up are collective.
-    const bool cells_changed =
-      soil.cell_set_changed() || water.cell_set_changed() || step_number == 0 || partition_changed || A.m() == 0;
+    // The pattern is the union of both sets' stencils: a set's cells changing
+    // inside the cells the pattern was built on (a double-point water point
+    // entering or leaving a cell that soil points hold) leaves it to the
+    // couplings check, as a window move does (docs/semi-implicit.md 'The
+    // pressure solve: reuse between steps')
+    const auto union_changed = [&] {
+      std::vector<unsigned int> held;
+      for (const MaterialPointSet<dim> *set : {&soil, &water})
+        for (const auto &ac : set->active_cells())
+          held.push_back(ac.cell);
+      std::sort(held.begin(), held.end());
+      held.erase(std::unique(held.begin(), held.end()), held.end());
+      return held != active.cells();
+    };
+    const bool cells_changed = step_number == 0 || partition_changed || A.m() == 0 ||
+                               ((soil.cell_set_changed() || water.cell_set_changed()) && union_changed());
     const bool         window_moved = !cells_changed && !active.template couplings_covered<K>({&soil, &water});
     const unsigned int why          = dealii::Utilities::MPI::max(cells_changed ? 2u : window_moved ? 1u : 0u, comm);
     const bool         new_pattern  = why != 0;
@@ -675,7 +711,7 @@ namespace talus::semi_implicit
     // (the same answer on every rank: collective below)
     any_sealed = false;
     sealed_h   = this_step.h;
-    if (water.handler.n_global_particles() == 0 || !bloads.may_seal_surface() || prm.rigid_skeleton)
+    if (!has_water() || !bloads.may_seal_surface() || prm.rigid_skeleton)
       return;
     mark_free_surface();
     this_step.surface_marked = true;
@@ -833,7 +869,7 @@ namespace talus::semi_implicit
     any_plate_sealed = false;
     for (const auto &pl : prm.rigid_plates)
       any_plate_sealed = any_plate_sealed || !pl.permeable;
-    if (!any_plate_sealed || water.handler.n_global_particles() == 0)
+    if (!any_plate_sealed || !has_water())
       {
         any_plate_sealed = false;
         return;
@@ -933,6 +969,8 @@ namespace talus::semi_implicit
                                                    for (unsigned int d = 0; d < dim; ++d)
                                                      P[fs.plate_flux + d] = (1 - P[fs.porosity]) * v[d];
                                                  });
+        if (prm.one_set) // the water's share on the same points (the water set is empty)
+          one_set_plate_flux<K>(ew);
         transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water),
                                                  [&](unsigned int, It &it, const Stencil &s) {
                                                    double *P = it->get_properties().data();
@@ -984,13 +1022,19 @@ namespace talus::semi_implicit
     {
       const double *dpn = at(dp_node);
       double       *gsv = at(gs), *gwv = at(gw);
-      transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, gsv);
+      if (prm.one_set) // both phases in one walk
+        one_set_weak_gradients<K>(dpn, gsv, gwv);
+      else
+        transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, gsv);
       transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), dpn, L::volume, gwv);
     }
     for (auto &r : plate_response) // the unit responses' pressure forces
       {
         const double *dpn = at(r.dp);
-        transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, at(r.gs));
+        if (prm.one_set)
+          one_set_weak_gradients<K>(dpn, at(r.gs), at(r.gw));
+        else
+          transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), dpn, L::volume, at(r.gs));
         transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), dpn, L::volume, at(r.gw));
         exchange({&r.gs, &r.gw});
       }
@@ -1203,14 +1247,11 @@ namespace talus::semi_implicit
   template <int dim>
   template <class K>
   void
-  Solver<dim>::nodes_to_particles(const StepState &this_step)
+  Solver<dim>::nodes_to_particles()
   {
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
 
-    const unsigned int         nl      = n_local();
-    const double               ms_cut  = this_step.ms_cut;
-    const std::vector<double> &plate_v = this_step.plate_v;
     // (7) FLIP velocities of both sets, pore pressure to the water points;
     // (8a) MUSL: the soil's new momentum to the nodes (Ps reused)
     Ps = 0;
@@ -1245,6 +1286,15 @@ namespace talus::semi_implicit
             P[fw.pressure_gradient + d] = gp[d] + gdp[d];
         });
     }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::remap_soil_velocity(const StepState &this_step)
+  {
+    const unsigned int         nl      = n_local();
+    const double               ms_cut  = this_step.ms_cut;
+    const std::vector<double> &plate_v = this_step.plate_v;
     exchange({&Ps});
     for (unsigned int i = 0; i < nl; ++i)
       {
