@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <type_traits>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -424,8 +425,12 @@ namespace talus::explicit_mpm
     /// The explicit point physics of the update pass (seed 000 §4.3.7): strain
     /// and spin increments from the gradient of the displacement increment,
     /// the constitutive update, the volume update, and the sums of energies,
-    /// momentum, finiteness and probes at the new position.
-    template <int dim, class K>
+    /// momentum, finiteness and probes at the new position. `with_contact`:
+    /// the displacement increments come from each body's own nodal velocities
+    /// (a compile-time switch: a run-time branch on `contact` in the per-point
+    /// loop, whose taken side calls out of line, cost the contact-free update
+    /// pass ~40 instructions per point-step, docs/scaling.md)
+    template <int dim, class K, bool with_contact>
     struct ExplicitPointUpdate
     {
       using L = PropertyLayout<dim>;
@@ -457,7 +462,7 @@ namespace talus::explicit_mpm
       increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, const double *P,
                  double (&gu)[dim][dim], double (&dx)[dim])
       {
-        if (contact) // the body's own nodal velocities (§6.2), gathered once per cell and body
+        if constexpr (with_contact) // the body's own nodal velocities (§6.2), gathered once per cell and body
           {
             const unsigned int b = static_cast<unsigned int>(P[L::body]);
             if (body_du.empty())
@@ -603,7 +608,7 @@ namespace talus::explicit_mpm
     /// v_p and C_p from the nodal velocity of the update pass (v^L), instead of
     /// the FLIP increment of the separate G2P/P2G pass.
     template <int dim, class K>
-    struct ApicPointUpdate : ExplicitPointUpdate<dim, K>
+    struct ApicPointUpdate : ExplicitPointUpdate<dim, K, false>
     {
       using L             = PropertyLayout<dim>;
       unsigned int affine = 0;
@@ -630,31 +635,38 @@ namespace talus::explicit_mpm
   Solver<dim>::g2p_update_with(K, const double h)
   {
     probes.clear_values();
-    ExplicitPointUpdate<dim, K> physics{prm.materials,   points.layout.history, h,      gravity,    contact.get(),
-                                        smoothing.get(), need_strain_energy,    probes, fbar_offset};
-    // the mass and force of the next step are accumulated here, at the updated
-    // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
-    // the next cycle fused into this pass) and for every particle that entered
-    // an owned neighbour cell (into that cell); particles received from other
-    // ranks are added by the relocation, and any deal.II sort falls back to a
-    // full P2G pass.
-    // Every non-zero entry of the mass/force vectors belongs to a cell that
-    // holds particles now (writes go only to cells that hold particles after
-    // the relocation), so clearing the active DoFs clears everything, and the
-    // cells that receive moved particles below start from zero.
-    zero_on_active(nodal_mass);
-    zero_on_active(nodal_a);
-    transfer::UpdateAndMove<dim, K, ExplicitPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h, physics};
-    if (prm.numerics.extended_p2g()) // a full P2G pass follows
-      transfer::for_each_active_cell(points, update);
+    const auto run = [&](auto with_contact) {
+      using Physics = ExplicitPointUpdate<dim, K, decltype(with_contact)::value>;
+      Physics physics{prm.materials,   points.layout.history, h,      gravity,    contact.get(),
+                      smoothing.get(), need_strain_energy,    probes, fbar_offset};
+      // the mass and force of the next step are accumulated here, at the updated
+      // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
+      // the next cycle fused into this pass) and for every particle that entered
+      // an owned neighbour cell (into that cell); particles received from other
+      // ranks are added by the relocation, and any deal.II sort falls back to a
+      // full P2G pass.
+      // Every non-zero entry of the mass/force vectors belongs to a cell that
+      // holds particles now (writes go only to cells that hold particles after
+      // the relocation), so clearing the active DoFs clears everything, and the
+      // cells that receive moved particles below start from zero.
+      zero_on_active(nodal_mass);
+      zero_on_active(nodal_a);
+      transfer::UpdateAndMove<dim, K, Physics> update{grid, points, nodal_p.begin(), h, physics};
+      if (prm.numerics.extended_p2g()) // a full P2G pass follows
+        transfer::for_each_active_cell(points, update);
+      else
+        {
+          transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+          transfer::Fused                    fused{update, p2g};
+          transfer::for_each_active_cell(points, fused);
+        }
+      local_sums = physics.sums;
+      local_bad  = physics.bad;
+    };
+    if (contact)
+      run(std::true_type());
     else
-      {
-        transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-        transfer::Fused                    fused{update, p2g};
-        transfer::for_each_active_cell(points, fused);
-      }
-    local_sums = physics.sums;
-    local_bad  = physics.bad;
+      run(std::false_type());
   }
 
   template <int dim>
