@@ -79,9 +79,10 @@ namespace talus::semi_implicit
       add_upper(const double *P, const PN &p, transfer::LocalSystem &ls) const
       {
         static_assert(nc == 1, "PoissonWithFlux: a scalar space");
-        const double V = P[PropertyLayout<dim>::volume];
-        const double a = P[coefficient] * V;
-        for (unsigned int i = 0; i < p.n; ++i)
+        const double           V = P[PropertyLayout<dim>::volume];
+        const double           a = P[coefficient] * V;
+        constexpr unsigned int n = PN::capacity; // the patch path passes the whole window (p.n == capacity)
+        for (unsigned int i = 0; i < n; ++i)
           {
             double *row = ls.A + p.local[i] * ls.stride;
             {
@@ -90,7 +91,7 @@ namespace talus::semi_implicit
                 gg += p.G[i][d] * p.G[i][d];
               row[p.local[i]] += a * gg;
             }
-            for (unsigned int j = i + 1; j < p.n; ++j)
+            for (unsigned int j = i + 1; j < n; ++j)
               {
                 double gg = 0;
                 for (unsigned int d = 0; d < dim; ++d)
