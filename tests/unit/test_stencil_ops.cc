@@ -6,7 +6,9 @@
 //    point (linear reproduction, walls included);
 //  * PoissonWithSource over an ActiveSet: the matrix is symmetric and
 //    annihilates the constant on the active nodes; the source vector sums to
-//    sum_p V_p s_p (partition of unity).
+//    sum_p V_p s_p (partition of unity);
+//  * AssembleSystem's patch path (transfer/matrix_ops.h, window_path) gives the
+//    generic path's system bit for bit, points on half-cell lines included.
 #include <talus/grid/nodal_space.h>
 #include <talus/particles/material_point_set.h>
 #include <talus/shape/bspline2_box.h>
@@ -288,7 +290,130 @@ namespace
     walk("a removed point");
     EXPECT_EQ(walk("an unchanged set after the removal"), 0u);
   }
+
+  /// A symmetric scalar integrand (a V grad N_i . grad N_j, f V N_i), each
+  /// product formed once and added at (i, j) and (j, i): the generic path.
+  struct SymmetricPoisson
+  {
+    unsigned int          coefficient = 0, source = 0;
+    static constexpr bool matrix = true, vector = true;
+    template <int dim, unsigned int nc, class PN>
+    void
+    add(const double *P, const PN &p, transfer::LocalSystem &ls) const
+    {
+      const double V = P[PropertyLayout<dim>::volume], a = P[coefficient] * V, f = P[source] * V;
+      for (unsigned int i = 0; i < p.n; ++i)
+        {
+          for (unsigned int j = i; j < p.n; ++j)
+            {
+              double gg = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                gg += p.G[i][d] * p.G[j][d];
+              ls.a(p.local[i], p.local[j]) += a * gg;
+              if (j != i)
+                ls.a(p.local[j], p.local[i]) += a * gg;
+            }
+          ls.b[p.local[i]] += f * p.N[i];
+        }
+    }
+  };
+  /// The same terms, the matrix as its upper triangle: AssembleSystem's patch path.
+  struct SymmetricPoissonUpper : SymmetricPoisson
+  {
+    static constexpr bool upper_triangle = true;
+    template <int dim, unsigned int nc, class PN>
+    void
+    add_upper(const double *P, const PN &p, transfer::LocalSystem &ls) const
+    {
+      const double V = P[PropertyLayout<dim>::volume], a = P[coefficient] * V, f = P[source] * V;
+      for (unsigned int i = 0; i < p.n; ++i)
+        {
+          for (unsigned int j = i; j < p.n; ++j)
+            {
+              double gg = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                gg += p.G[i][d] * p.G[j][d];
+              ls.a(p.local[i], p.local[j]) += a * gg;
+            }
+          ls.b[p.local[i]] += f * p.N[i];
+        }
+    }
+  };
+
+  /// AssembleSystem's patch path (window_path: each point's whole B-spline
+  /// window summed on the cell's patch, untouched nodes included) gives the
+  /// generic path's matrix, vector and diagonal scale bit for bit, with points
+  /// on half-cell lines (xi = 0.5 exactly: window nodes with N = 0 and grad N
+  /// = 0, which the generic path leaves out) and on the lower walls.
+  template <int dim>
+  void
+  patch_assembly_is_bitwise()
+  {
+    using K = shape::BSpline2Box<dim>;
+    static_assert(transfer::AssembleSystem<dim, K, 1, SymmetricPoissonUpper>::window_path);
+    static_assert(!transfer::AssembleSystem<dim, K, 1, SymmetricPoisson>::window_path);
+    Scene<dim>             scene(true);
+    MaterialPointSet<dim> &set = *scene.set;
+    unsigned int           k   = 0;
+    for (auto &pt : set.handler)
+      {
+        auto       P           = pt.get_properties();
+        const auto x           = pt.get_location();
+        P[scene.coefficient]   = 1.0 + x[0] * x[dim - 1];
+        P[scene.source]        = std::cos(2 * x[0]) - x[dim - 1];
+        dealii::Point<dim> ref = pt.get_reference_location();
+        if (k % 3 == 0)
+          ref[0] = 0.5;
+        if (k % 5 == 1)
+          ref[dim - 1] = 0.5;
+        pt.set_reference_location(ref);
+        ++k;
+      }
+    NodalSpace<dim> space(scene.grid, 1);
+    space.setup();
+    ActiveSet<dim> active(space);
+    active.template reinit<K>({&set});
+    dealii::TrilinosWrappers::SparseMatrix A[2];
+    Vector                                 b[2];
+    double                                 diag[2][2];
+    const auto                             run = [&](auto terms, const unsigned int r) {
+      active.reinit_matrix(A[r]);
+      space.reinit_vector(b[r]);
+      transfer::AssembleSystem<dim, K, 1, decltype(terms)> op(active, active.constraints(), terms, &A[r], &b[r]);
+      transfer::for_each_active_cell(set, op);
+      transfer::finish_assembly(active, op.diag_sum, op.diag_count, &A[r], &b[r]);
+      diag[r][0] = op.diag_sum;
+      diag[r][1] = op.diag_count;
+    };
+    SymmetricPoissonUpper upper;
+    upper.coefficient = scene.coefficient;
+    upper.source      = scene.source;
+    run(static_cast<const SymmetricPoisson &>(upper), 0);
+    run(upper, 1);
+    const auto   same   = [](const double x, const double y) { return std::memcmp(&x, &y, sizeof(double)) == 0; };
+    unsigned int differ = 0, entries = 0;
+    for (const auto r : A[0].locally_owned_range_indices())
+      for (auto e = A[0].begin(r); e != A[0].end(r); ++e, ++entries)
+        differ += !same(e->value(), A[1].el(r, e->column()));
+    for (const auto r : b[0].locally_owned_elements())
+      differ += !same(b[0](r), b[1](r));
+    differ += !same(diag[0][0], diag[1][0]) + !same(diag[0][1], diag[1][1]);
+    const MPI_Comm comm = MPI_COMM_WORLD;
+    EXPECT_EQ(dealii::Utilities::MPI::sum(differ, comm), 0u);
+    EXPECT_GT(dealii::Utilities::MPI::sum(entries, comm), 0u);
+    EXPECT_EQ(A[0].n_nonzero_elements(), A[1].n_nonzero_elements());
+    EXPECT_GT(A[0].frobenius_norm(), 0.0);
+  }
 } // namespace
+
+TEST(AssembleSystem, PatchPathIsBitwiseIn2D)
+{
+  patch_assembly_is_bitwise<2>();
+}
+TEST(AssembleSystem, PatchPathIsBitwiseIn3D)
+{
+  patch_assembly_is_bitwise<3>();
+}
 
 TEST(StencilCache, FollowsThePointsQ1In2D)
 {

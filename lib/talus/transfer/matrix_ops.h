@@ -263,6 +263,20 @@ namespace talus::transfer
   {
   };
 
+  /// Whether an integrand can add a point's matrix as its upper triangle only
+  /// (add_upper<dim, nc>(P, nodes, local): the same terms as add, the matrix
+  /// entries (i, j) with local[i] <= local[j] alone; a symmetric integrand).
+  /// AssembleSystem then sums a window kernel's points on the cell's patch
+  /// (AssembleSystem::window_path).
+  template <class T, class = void>
+  struct has_add_upper : std::false_type
+  {
+  };
+  template <class T>
+  struct has_add_upper<T, std::void_t<decltype(T::upper_triangle)>> : std::bool_constant<T::upper_triangle>
+  {
+  };
+
   /// The sum of integrands.
   template <class... T>
   struct Sum
@@ -343,6 +357,19 @@ namespace talus::transfer
   struct AssembleSystem
   {
     static constexpr unsigned int max_rows = K::n_nodes * nc;
+    /// The patch path (docs/semi-implicit.md, "Performance"): a scalar system
+    /// of a 3-per-direction window kernel (quadratic B-splines) with a
+    /// symmetric integrand (has_add_upper) and no field. Each point adds its
+    /// whole window, untouched nodes included (their terms are products with a
+    /// zero factor, +-0, which leave every sum bitwise as it is), as the upper
+    /// triangle of a patch-indexed matrix (the window's slots increase with the
+    /// window index); no per-node look-up or filter in the point loop. The
+    /// cell's local system (the touched nodes in the order the points first
+    /// touch them, as the generic path numbers them) is read from it at
+    /// end_cell: the same local matrix and vector, bit for bit.
+    static constexpr bool window_path = nc == 1 && has_add_upper<Integrand>::value &&
+                                        std::is_same_v<typename K::Eval, typename shape::Window3<dim>::Eval> &&
+                                        K::n_nodes == shape::Window3<dim>::n_patch;
 
     AssembleSystem(const ActiveSet<dim> &active, const dealii::AffineConstraints<double> &constraints,
                    const Integrand &integrand, dealii::TrilinosWrappers::SparseMatrix *A, Vector *b,
@@ -357,9 +384,13 @@ namespace talus::transfer
         , Al(max_rows * max_rows)
         , bl(max_rows)
         , ul(field ? max_rows : 0)
+        , Aw(window_path ? K::n_nodes * K::n_nodes : 0, 0.0)
+        , bw(window_path ? K::n_nodes : 0, 0.0)
     {
       if (space.n_components() != nc)
         throw std::logic_error("transfer::AssembleSystem: nc differs from the space's number of components");
+      if (window_path && field != nullptr)
+        throw std::logic_error("transfer::AssembleSystem: the patch path takes no field");
       std::fill(std::begin(local_of_slot), std::end(local_of_slot), dealii::numbers::invalid_unsigned_int);
       if (Integrand::matrix && A != nullptr)
         {
@@ -390,6 +421,11 @@ namespace talus::transfer
     double diag_sum = 0, diag_count = 0;
     /// the fast distribution (constraints that only fix values), or null
     std::unique_ptr<FixedValueDistributor> fast;
+    /// window_path: the cell's sums on the patch (upper triangle, row-major
+    /// K::n_nodes columns; zero outside a cell), and the slots any point's
+    /// window covered in this cell (the entries to zero again at end_cell)
+    std::vector<double> Aw, bw;
+    unsigned long long  window_slots = 0;
 
     inline void
     begin_cell(const unsigned int c)
@@ -424,6 +460,30 @@ namespace talus::transfer
     inline bool
     point(const unsigned int, PointIterator<dim> &it)
     {
+      if constexpr (window_path)
+        {
+          using W = shape::Window3<dim>;
+          typename K::Eval e;
+          K::evaluate(cell, it->get_reference_location(), e);
+          PointNodes<dim, K::n_point_nodes> p;
+          p.n = K::n_point_nodes;
+          W::values_and_gradients(e, p.N, p.G); // the products of K::point_stencil
+          const unsigned int first = W::first_slot(e);
+          for (unsigned int w = 0; w < K::n_point_nodes; ++w)
+            {
+              const unsigned int s = first + W::window_offset(w);
+              p.local[w]           = s;
+              window_slots |= 1ull << s;
+              if (local_of_slot[s] == dealii::numbers::invalid_unsigned_int && touches<dim>(p.N[w], p.G[w]))
+                {
+                  local_of_slot[s]         = n_local;
+                  slot_of_local[n_local++] = s;
+                }
+            }
+          LocalSystem ls{Aw.data(), bw.data(), K::n_nodes, nullptr};
+          integrand.template add_upper<dim, nc>(it->get_properties().data(), p, ls);
+          return true;
+        }
       unsigned int slot[K::n_point_nodes];
       double       N[K::n_point_nodes], G[K::n_point_nodes][dim];
       K::point_stencil(cell, it->get_reference_location(), slot, N, G);
@@ -441,9 +501,37 @@ namespace talus::transfer
       integrand.template add<dim, nc>(it->get_properties().data(), p, ls);
       return true;
     }
+    /// window_path: the local system from the patch sums; the sums zeroed
+    inline void
+    window_to_local()
+    {
+      constexpr unsigned int n = K::n_nodes;
+      for (unsigned int i = 0; i < n_local; ++i)
+        {
+          const unsigned int si = slot_of_local[i];
+          if (Integrand::matrix)
+            for (unsigned int j = 0; j < n_local; ++j)
+              {
+                const unsigned int sj = slot_of_local[j];
+                Al[i * max_rows + j]  = si <= sj ? Aw[si * n + sj] : Aw[sj * n + si];
+              }
+          bl[i] = bw[si];
+        }
+      for (unsigned long long m = window_slots; m != 0; m &= m - 1)
+        {
+          const unsigned int s = __builtin_ctzll(m);
+          bw[s]                = 0.0;
+          if (Integrand::matrix)
+            for (unsigned long long k = window_slots >> s; k != 0; k &= k - 1) // the row's upper part
+              Aw[s * n + s + __builtin_ctzll(k)] = 0.0;
+        }
+      window_slots = 0;
+    }
     inline void
     end_cell(const unsigned int)
     {
+      if constexpr (window_path)
+        window_to_local();
       if (n_local == 0)
         return;
       if constexpr (has_cell_terms<Integrand>::value)

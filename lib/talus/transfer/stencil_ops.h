@@ -32,13 +32,28 @@ namespace talus::transfer
     double                        N[max_nodes];
     double                        G[max_nodes][dim];
 
+    /// f(w) for the nodes w = 0 ... n - 1 in order. A whole window (n ==
+    /// max_nodes: every point but those on a B-spline half-cell line) takes a
+    /// loop of fixed length, which the compiler unrolls and schedules across
+    /// the nodes; the same operations in the same order either way.
+    template <class F>
+    inline void
+    for_nodes(F &&f) const
+    {
+      if (n == max_nodes)
+        for (unsigned int w = 0; w < max_nodes; ++w)
+          f(w);
+      else
+        for (unsigned int w = 0; w < n; ++w)
+          f(w);
+    }
+
     /// A scalar nodal field at the point.
     inline double
     value(const double *f) const
     {
       double s = 0;
-      for (unsigned int w = 0; w < n; ++w)
-        s += N[w] * f[dof[w][0]];
+      for_nodes([&](const unsigned int w) { s += N[w] * f[dof[w][0]]; });
       return s;
     }
     /// A vector nodal field at the point.
@@ -47,9 +62,10 @@ namespace talus::transfer
     {
       for (unsigned int d = 0; d < dim; ++d)
         out[d] = 0;
-      for (unsigned int w = 0; w < n; ++w)
+      for_nodes([&](const unsigned int w) {
         for (unsigned int d = 0; d < dim; ++d)
           out[d] += N[w] * f[dof[w][d]];
+      });
     }
     /// Gradient of a scalar nodal field at the point.
     inline void
@@ -57,12 +73,11 @@ namespace talus::transfer
     {
       for (unsigned int d = 0; d < dim; ++d)
         out[d] = 0;
-      for (unsigned int w = 0; w < n; ++w)
-        {
-          const double fw = f[dof[w][0]];
-          for (unsigned int d = 0; d < dim; ++d)
-            out[d] += G[w][d] * fw;
-        }
+      for_nodes([&](const unsigned int w) {
+        const double fw = f[dof[w][0]];
+        for (unsigned int d = 0; d < dim; ++d)
+          out[d] += G[w][d] * fw;
+      });
     }
     /// Gradient of a vector nodal field at the point, out[i][j] = d f_i / d x_j.
     inline void
@@ -71,41 +86,43 @@ namespace talus::transfer
       for (unsigned int i = 0; i < dim; ++i)
         for (unsigned int j = 0; j < dim; ++j)
           out[i][j] = 0;
-      for (unsigned int w = 0; w < n; ++w)
+      for_nodes([&](const unsigned int w) {
         for (unsigned int i = 0; i < dim; ++i)
           for (unsigned int j = 0; j < dim; ++j)
             out[i][j] += f[dof[w][i]] * G[w][j];
+      });
     }
     /// Divergence of a vector nodal field at the point.
     inline double
     divergence(const double *f) const
     {
       double s = 0;
-      for (unsigned int w = 0; w < n; ++w)
+      for_nodes([&](const unsigned int w) {
         for (unsigned int d = 0; d < dim; ++d)
           s += G[w][d] * f[dof[w][d]];
+      });
       return s;
     }
     /// f[node] += a N (scalar field)
     inline void
     scatter(double *f, const double a) const
     {
-      for (unsigned int w = 0; w < n; ++w)
-        f[dof[w][0]] += a * N[w];
+      for_nodes([&](const unsigned int w) { f[dof[w][0]] += a * N[w]; });
     }
     /// f[node][d] += a N v[d] (vector field)
     inline void
     scatter_vector(double *f, const double a, const double *v) const
     {
-      for (unsigned int w = 0; w < n; ++w)
+      for_nodes([&](const unsigned int w) {
         for (unsigned int d = 0; d < dim; ++d)
           f[dof[w][d]] += a * N[w] * v[d];
+      });
     }
     /// f[node][i] += sum_j t[i][j] dN/dx_j (a stress-like tensor t)
     inline void
     scatter_divergence(double *f, const double (&t)[dim][dim]) const
     {
-      for (unsigned int w = 0; w < n; ++w)
+      for_nodes([&](const unsigned int w) {
         for (unsigned int i = 0; i < dim; ++i)
           {
             double q = 0;
@@ -113,6 +130,7 @@ namespace talus::transfer
               q += t[i][j] * G[w][j];
             f[dof[w][i]] += q;
           }
+      });
     }
   };
 

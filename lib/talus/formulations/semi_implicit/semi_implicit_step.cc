@@ -71,6 +71,39 @@ namespace talus::semi_implicit
             ls.b[p.local[i]] -= V * fg;
           }
       }
+      /// add's terms, the matrix as its upper triangle (local[i] < local[j]
+      /// for i < j: AssembleSystem's patch path, transfer::has_add_upper)
+      static constexpr bool upper_triangle = true;
+      template <int dim, unsigned int nc, class PN>
+      inline void
+      add_upper(const double *P, const PN &p, transfer::LocalSystem &ls) const
+      {
+        static_assert(nc == 1, "PoissonWithFlux: a scalar space");
+        const double           V = P[PropertyLayout<dim>::volume];
+        const double           a = P[coefficient] * V;
+        constexpr unsigned int n = PN::capacity; // the patch path passes the whole window (p.n == capacity)
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            double *row = ls.A + p.local[i] * ls.stride;
+            {
+              double gg = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                gg += p.G[i][d] * p.G[i][d];
+              row[p.local[i]] += a * gg;
+            }
+            for (unsigned int j = i + 1; j < n; ++j)
+              {
+                double gg = 0;
+                for (unsigned int d = 0; d < dim; ++d)
+                  gg += p.G[i][d] * p.G[j][d];
+                row[p.local[j]] += a * gg;
+              }
+            double fg = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              fg += P[flux + d] * p.G[i][d];
+            ls.b[p.local[i]] -= V * fg;
+          }
+      }
     };
 
     /// The source part of PoissonWithFlux alone (f -= V flux . grad N): the
@@ -92,6 +125,13 @@ namespace talus::semi_implicit
               fg += P[flux + d] * p.G[i][d];
             ls.b[p.local[i]] -= V * fg;
           }
+      }
+      static constexpr bool upper_triangle = true; // no matrix: add_upper is add
+      template <int dim, unsigned int nc, class PN>
+      inline void
+      add_upper(const double *P, const PN &p, transfer::LocalSystem &ls) const
+      {
+        add<dim, nc>(P, p, ls);
       }
     };
 
