@@ -208,7 +208,10 @@ endforeach()
 # double-point run, loose runs alike within 10 %), with the paper's modified F-bar. Verify, on
 # the 0.05 m grid: the dense pair (to 13 s including the 1 s App. B.4 stage; about 2 x 14 min
 # of CPU) and the loose pair (to 7 s; 2 x 7 min: 7.3 % apart). Without stabilisation the loose
-# pair was 21.6 % apart (docs/semi-implicit.md). Fast: the dense pair on the 0.1 m grid
+# pair was 21.6 % apart (docs/semi-implicit.md). Fast (issue 40 item 3): both pairs, the same
+# four runs and checks (the dense/loose gap check included) on the 0.1 m grid, about 200 s of
+# CPU; the dense pair must run to 13 s: at 7 s its gap (3.31 cm) is not yet above the loose one
+# (3.34 cm)
 add_test(NAME verification.semi_implicit_landslide_dense
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_landslide.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_landslide.prm ${_w}/semi_implicit_landslide_dense
@@ -235,9 +238,9 @@ set_tests_properties(verification.semi_implicit_landslide_paper PROPERTIES LABEL
 add_test(NAME verification.semi_implicit_landslide_coarse
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_landslide.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_landslide.prm ${_w}/semi_implicit_landslide_coarse
-                 "--set=grid/cells=40, 10" --only=dense)
+                 "--set=grid/cells=40, 10")
 set_tests_properties(verification.semi_implicit_landslide_coarse PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
-                     TIMEOUT 1800)
+                     TIMEOUT 3600)
 
 # a body read from a talus-mesh particle file equals the box body (1 and 2 ranks,
 # double and single point, materials from the file's rows), bad files refused
