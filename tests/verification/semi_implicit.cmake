@@ -128,7 +128,7 @@ add_test(NAME verification.strip_footing_up_fast
                  ${TALUS_PRM_DIR}/verification/semi_implicit_strip_footing.prm
                  ${TALUS_PRM_DIR}/implicit/strip_footing_up.prm ${_w}/strip_footing_up_fast --h=0.2 --tol=0.05
                  --long=2 --one-run --skip-none --skip-u)
-set_tests_properties(verification.strip_footing_up_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+set_tests_properties(verification.strip_footing_up_fast PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 1800)
 add_test(NAME verification.strip_footing_up
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_up.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/verification/semi_implicit_strip_footing.prm
