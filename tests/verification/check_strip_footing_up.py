@@ -77,6 +77,8 @@ stabilisations = ("modified f-bar",) if "--skip-none" in sys.argv else ("modifie
 one_run = "--one-run" in sys.argv
 skip_u = "--skip-u" in sys.argv
 t_check = 1.5  # the end of the scene's run: the time of the comparison
+if one_run and t_long <= t_check:
+    tv.fail(f"--one-run needs --long above {t_check} s (given {t_long})")
 n = round(10 / h)
 q, width = 2e4, 3.0
 
