@@ -47,7 +47,7 @@ namespace talus::semi_implicit
     const double rw            = prm.water_density;
     const bool   linear        = prm.linear_smoothing;
     cell_water_volume.assign(grid.cells.size(), 0.0);
-    double *ms = at_local(Ms), *ps = at_local(Ps), *mn = at_local(Mn), *mk = at_local(Mk), *fsv = at_local(Fs);
+    const SoilSums to{at_local(Ms), at_local(Ps), at_local(Mn), at_local(Mk), at_local(Fs)};
     double *ww = at_local(Ww), *pw0 = at_local(Pw0), *ww0 = at_local(Ww0), *mwp = at_local(Mwp), *mw = at_local(Mw),
            *mwg = at_local(Mwg);
     Stencil surface; // a loaded point's stencil at its share of the face
@@ -55,20 +55,8 @@ namespace talus::semi_implicit
       grid, soil, stencils<K>(soil), [&](unsigned int c, It &it, const Stencil &s) {
         const double *P = it->get_properties().data();
         // the soil: soil_to_nodes' sums
-        const double m = P[L::mass];
-        s.scatter(ms, m);
-        s.scatter_vector(ps, m, P + L::velocity);
-        s.scatter(mn, m * P[fs.porosity]);
-        const double k = initial_stage ? prm.initialisation_conductivity : P[fs.conductivity];
-        s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / k);
-        double gm[dim];
-        for (unsigned int d = 0; d < dim; ++d)
-          gm[d] = g[d];
-        s.scatter_vector(fsv, m, gm);
-        double t[dim][dim];
-        minus_V_sigma<dim>(P, P[L::volume], t);
-        s.scatter_divergence(fsv, t);
-        bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, fsv);
+        scatter_soil_point(P, s, to, initial_stage, g);
+        bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, to.fs);
         // its water: water_to_nodes' sums
         const double mwp_ = P[fs.water_mass];
         if (!(mwp_ > 0)) // a point of a soil body

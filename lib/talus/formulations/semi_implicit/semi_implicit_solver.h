@@ -241,6 +241,35 @@ namespace talus::semi_implicit
     {
       return P[fs.water_mass] / (prm.water_density * P[fs.porosity]);
     }
+    /// The nodal sums a soil point adds in P2N (steps (1)-(2)).
+    struct SoilSums
+    {
+      double *ms, *ps, *mn, *mk, *fs; ///< into Ms, Ps, Mn, Mk, Fs (local entries)
+    };
+    /// A soil point's P2N, shared by the two-set and the one-set walks: mass
+    /// (44), momentum (45), porosity (46), the drag coefficient integrated over
+    /// the soil points (in place of (47) and (58)), gravity and the
+    /// effective-stress force (54)-(55). A loaded point's traction is the caller's.
+    template <class Stencil>
+    void
+    scatter_soil_point(const double *P, const Stencil &s, const SoilSums &to, const bool initial_stage,
+                       const dealii::Tensor<1, dim> &g) const
+    {
+      const double m = P[L::mass];
+      s.scatter(to.ms, m);
+      s.scatter_vector(to.ps, m, P + L::velocity);
+      s.scatter(to.mn, m * P[fs.porosity]);
+      const double k = initial_stage ? prm.initialisation_conductivity : P[fs.conductivity];
+      s.scatter(to.mk,
+                P[fs.porosity] * P[fs.porosity] * prm.water_density * prm.unit_weight_gravity * P[L::volume] / k);
+      double gm[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        gm[d] = g[d];
+      s.scatter_vector(to.fs, m, gm);
+      double t[dim][dim];
+      minus_V_sigma<dim>(P, P[L::volume], t);
+      s.scatter_divergence(to.fs, t);
+    }
     /// P2N of both phases (soil_to_nodes' sums and water_to_nodes')
     template <class K>
     void one_set_to_nodes(const StepState &this_step);

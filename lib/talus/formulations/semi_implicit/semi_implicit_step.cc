@@ -278,35 +278,16 @@ namespace talus::semi_implicit
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
 
-    const bool   initial_stage = this_step.initial_stage;
-    const auto  &g             = this_step.g;
-    const double rw            = prm.water_density;
-    // (1)-(2) P2N of the soil: mass (44), momentum (45), porosity (46), the
-    // drag coefficient integrated over the soil points (in place of (47) and
-    // (58), see below); effective-stress internal force and soil gravity (54)-(55)
-    {
-      double *ms = at(Ms), *ps = at(Ps), *mn = at(Mn), *mk = at(Mk), *fsv = at(Fs);
-      Stencil surface; // a loaded point's stencil at its share of the face
-      transfer::for_each_point_stencil<dim, K>(
-        grid, soil, stencils<K>(soil), [&](unsigned int c, It &it, const Stencil &s) {
-          const double *P = it->get_properties().data();
-          const double  m = P[L::mass];
-          s.scatter(ms, m);
-          s.scatter_vector(ps, m, P + L::velocity);
-          s.scatter(mn, m * P[fs.porosity]);
-          const double k = initial_stage ? prm.initialisation_conductivity : P[fs.conductivity];
-          s.scatter(mk, P[fs.porosity] * P[fs.porosity] * rw * prm.unit_weight_gravity * P[L::volume] / k);
-          double gm[dim];
-          for (unsigned int d = 0; d < dim; ++d)
-            gm[d] = g[d];
-          s.scatter_vector(fsv, m, gm);
-          double t[dim][dim];
-          minus_V_sigma<dim>(P, P[L::volume], t);
-          s.scatter_divergence(fsv, t);
-          // a loaded point's traction force (at the body surface)
-          bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, fsv);
-        });
-    }
+    // (1)-(2) P2N of the soil (scatter_soil_point); a loaded point's traction
+    // force at the body surface
+    const SoilSums to{at(Ms), at(Ps), at(Mn), at(Mk), at(Fs)};
+    Stencil        surface; // a loaded point's stencil at its share of the face
+    transfer::for_each_point_stencil<dim, K>(
+      grid, soil, stencils<K>(soil), [&](unsigned int c, It &it, const Stencil &s) {
+        const double *P = it->get_properties().data();
+        scatter_soil_point(P, s, to, this_step.initial_stage, this_step.g);
+        bloads.template scatter_point_traction<K>(c, it->get_location(), P, s, surface, to.fs);
+      });
   }
 
   template <int dim>
