@@ -200,30 +200,17 @@ namespace talus::semi_implicit
     Ps                = 0;
     const double *vsn = at_local(vs_new), *vst = at_local(vs_t), *vwn = at_local(vw_new), *vwt = at_local(vw_t),
                  *dpn = at_local(dp_node), *pn = at_local(p_node);
-    const double flip = prm.flip_fraction;
-    double      *ps   = at_local(Ps);
-    transfer::for_each_point_stencil<dim, K>(
-      grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-        double *P = it->get_properties().data();
-        double  a[dim], b[dim];
-        s.vector_value(vsn, a);
-        s.vector_value(vst, b);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-        s.scatter_vector(ps, P[L::mass], P + L::velocity);
-        if (!(P[fs.water_mass] > 0))
-          return;
-        s.vector_value(vwn, a);
-        s.vector_value(vwt, b);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[fs.water_velocity + d] = flip * (P[fs.water_velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-        P[fs.pressure] += s.value(dpn);
-        double gp[dim], gdp[dim];
-        s.gradient(pn, gp);
-        s.gradient(dpn, gdp);
-        for (unsigned int d = 0; d < dim; ++d)
-          P[fs.pressure_gradient + d] = gp[d] + gdp[d];
-      });
+    double *ps = at_local(Ps);
+    transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                             [&](unsigned int, It &it, const Stencil &s) {
+                                               double *P = it->get_properties().data();
+                                               flip_update(s, vsn, vst, P + L::velocity);
+                                               s.scatter_vector(ps, P[L::mass], P + L::velocity);
+                                               if (!(P[fs.water_mass] > 0))
+                                                 return;
+                                               flip_update(s, vwn, vwt, P + fs.water_velocity);
+                                               pressure_update(s, pn, dpn, fs, P);
+                                             });
   }
 
 #define TALUS_ONE_SET_INSTANTIATE(dim, K)                                                   \

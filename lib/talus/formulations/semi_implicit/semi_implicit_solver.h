@@ -270,6 +270,33 @@ namespace talus::semi_implicit
       minus_V_sigma<dim>(P, P[L::volume], t);
       s.scatter_divergence(to.fs, t);
     }
+    /// (7a)-(7b) the FLIP update of a point velocity v (dim values) from the
+    /// nodal velocities at t + 1 and t, 1 - flip of PIC blended in.
+    template <class Stencil>
+    void
+    flip_update(const Stencil &s, const double *v_new, const double *v_old, double *v) const
+    {
+      const double flip = prm.flip_fraction;
+      double       a[dim], b[dim];
+      s.vector_value(v_new, a);
+      s.vector_value(v_old, b);
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = flip * (v[d] + a[d] - b[d]) + (1 - flip) * a[d];
+    }
+    /// (7c) a water point's pore pressure p += dp (as an increment: p_I^t + dp_I
+    /// interpolated differs by the remap) and its gradient grad p^t + grad dp;
+    /// `f`: the offsets of the point's layout.
+    template <class Stencil>
+    void
+    pressure_update(const Stencil &s, const double *p_t, const double *dp, const Fields &f, double *P) const
+    {
+      P[f.pressure] += s.value(dp);
+      double gp[dim], gdp[dim];
+      s.gradient(p_t, gp);
+      s.gradient(dp, gdp);
+      for (unsigned int d = 0; d < dim; ++d)
+        P[f.pressure_gradient + d] = gp[d] + gdp[d];
+    }
     /// P2N of both phases (soil_to_nodes' sums and water_to_nodes')
     template <class K>
     void one_set_to_nodes(const StepState &this_step);

@@ -1278,34 +1278,20 @@ namespace talus::semi_implicit
     Ps = 0;
     {
       const double *vsn = at(vs_new), *vst = at(vs_t), *vwn = at(vw_new), *vwt = at(vw_t), *dpn = at(dp_node),
-                   *pn  = at(p_node);
-      const double flip = prm.flip_fraction;
-      double      *ps   = at(Ps);
-      transfer::for_each_point_stencil<dim, K>(
-        grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
-          double *P = it->get_properties().data();
-          double  a[dim], b[dim];
-          s.vector_value(vsn, a);
-          s.vector_value(vst, b);
-          for (unsigned int d = 0; d < dim; ++d)
-            P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-          s.scatter_vector(ps, P[L::mass], P + L::velocity);
-        });
-      transfer::for_each_point_stencil<dim, K>(
-        grid, water, stencils<K>(water), [&](unsigned int, It &it, const Stencil &s) {
-          double *P = it->get_properties().data();
-          double  a[dim], b[dim];
-          s.vector_value(vwn, a);
-          s.vector_value(vwt, b);
-          for (unsigned int d = 0; d < dim; ++d)
-            P[L::velocity + d] = flip * (P[L::velocity + d] + a[d] - b[d]) + (1 - flip) * a[d];
-          P[fw.pressure] += s.value(dpn); // (7c) as an increment: p_I^t + dp_I interpolated differs by the remap
-          double gp[dim], gdp[dim];
-          s.gradient(pn, gp);
-          s.gradient(dpn, gdp);
-          for (unsigned int d = 0; d < dim; ++d)
-            P[fw.pressure_gradient + d] = gp[d] + gdp[d];
-        });
+                   *pn = at(p_node);
+      double *ps       = at(Ps);
+      transfer::for_each_point_stencil<dim, K>(grid, soil, stencils<K>(soil),
+                                               [&](unsigned int, It &it, const Stencil &s) {
+                                                 double *P = it->get_properties().data();
+                                                 flip_update(s, vsn, vst, P + L::velocity);
+                                                 s.scatter_vector(ps, P[L::mass], P + L::velocity);
+                                               });
+      transfer::for_each_point_stencil<dim, K>(grid, water, stencils<K>(water),
+                                               [&](unsigned int, It &it, const Stencil &s) {
+                                                 double *P = it->get_properties().data();
+                                                 flip_update(s, vwn, vwt, P + L::velocity);
+                                                 pressure_update(s, pn, dpn, fw, P);
+                                               });
     }
   }
 
