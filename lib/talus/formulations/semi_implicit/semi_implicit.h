@@ -70,8 +70,11 @@ namespace talus::semi_implicit
     bool         kozeny_carman             = false; ///< k = C1 n^3 / (1 - n)^2 (Alg. 8(g))
     bool         pressure_smoothing        = true;  ///< Eq. 77 map-remap of the pore pressure every step
     bool         linear_smoothing          = true;  ///< the map carries each point's value by its gradient
-    double       flip_fraction             = 1.0;   ///< 1: pure FLIP (the paper); the rest PIC
-    double       patch_size                = 1.5;   ///< side of the modified F-bar patches in cells (Eq. 83)
+    /// share of the smoothed value in a water point's pore pressure per step (1: Eq. 77,
+    /// the point's value replaced; below 1 the point keeps 1 - this of its own value)
+    double smoothing_fraction = 1.0;
+    double flip_fraction      = 1.0; ///< 1: pure FLIP (the paper); the rest PIC
+    double patch_size         = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;

@@ -78,6 +78,14 @@ namespace talus::semi_implicit
                         "p_I = sum N m (p + grad p . (x_I - x_p)) / sum N m, exact for linear fields "
                         "(docs/semi-implicit.md). none: the pressure changes only by the interpolated "
                         "increments (p += sum N dp).");
+      prm.declare_entry("pressure smoothing fraction", "1", Double(0, 1),
+                        "The share beta of the smoothed value in a water point's pore pressure at each step: "
+                        "p <- (1 - beta) p + beta sum N p_I, then p += sum N dp. 1 (the paper's Eq. 77): the "
+                        "point's value is replaced every step. The map-remap keeps linear fields and flattens "
+                        "curvature a little at every application, so its effect grows with the number of "
+                        "steps, not with time: where a consolidation needs millions of steps (low k) a "
+                        "smaller share keeps the profile (docs/semi-implicit.md, 'The smoothing at low k'). "
+                        "Ignored with pressure smoothing = none.");
       prm.declare_entry("flip fraction", "1", Double(0, 1),
                         "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
                         "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
@@ -208,6 +216,7 @@ namespace talus::semi_implicit
       p.kozeny_carman             = prm.get_bool("kozeny carman");
       p.pressure_smoothing        = prm.get("pressure smoothing") != "none";
       p.linear_smoothing          = prm.get("pressure smoothing") == "linear";
+      p.smoothing_fraction        = prm.get_double("pressure smoothing fraction");
       p.flip_fraction             = prm.get_double("flip fraction");
       p.rigid_skeleton            = prm.get_bool("rigid skeleton");
       // rigid plates (issue 37): a rigid skeleton holds every soil node, so no

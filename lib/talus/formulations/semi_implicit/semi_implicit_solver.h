@@ -283,6 +283,15 @@ namespace talus::semi_implicit
       for (unsigned int d = 0; d < dim; ++d)
         v[d] = flip * (v[d] + a[d] - b[d]) + (1 - flip) * a[d];
     }
+    /// (77) a water point's pore pressure from the nodal p^t: replaced (the paper),
+    /// or blended by `pressure smoothing fraction`
+    template <class Stencil>
+    void
+    smooth_pressure(const Stencil &s, const double *p_node, double &p) const
+    {
+      const double beta = prm.smoothing_fraction;
+      p                 = beta == 1.0 ? s.value(p_node) : (1 - beta) * p + beta * s.value(p_node);
+    }
     /// (7c) a water point's pore pressure p += dp (as an increment: p_I^t + dp_I
     /// interpolated differs by the remap) and its gradient grad p^t + grad dp;
     /// `f`: the offsets of the point's layout.

@@ -414,7 +414,7 @@ namespace talus::semi_implicit
       transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), pn, L::volume, gpw,
                                               [&](It &it, const Stencil &s) {
                                                 if (prm.pressure_smoothing)
-                                                  it->get_properties()[fw.pressure] = s.value(pn);
+                                                  smooth_pressure(s, pn, it->get_properties()[fw.pressure]);
                                               });
       transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), pn, L::volume, gps);
     }
