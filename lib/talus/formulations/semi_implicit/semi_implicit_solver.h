@@ -157,7 +157,17 @@ namespace talus::semi_implicit
     /// residual) and the flux of the moving impermeable surface beta . V in
     /// the continuity rows (docs/semi-implicit.md 'An impermeable plate')
     template <class K>
-    void plate_surface();
+    void plate_surface(const StepState &this_step);
+    /// The outflow terms of the plate's solved nodes at a draining face (the
+    /// plate-first rule keeps their rows; their support reaches the face the
+    /// water leaves by): the matrix entries of the surface force's increment
+    /// and the outflow beta_out_J . q*_J on the right-hand side
+    /// (docs/semi-implicit.md 'The plate's corner on a draining face')
+    template <class K>
+    void add_plate_outflow_terms(const dealii::AffineConstraints<double> &constraints);
+    /// the outflow beta_out_J . ((1 - n) vs_J + n vw_J) on the right-hand side
+    void add_plate_outflow_flux(const dealii::AffineConstraints<double> &constraints, const Vector &vs,
+                                const Vector &vw, Vector &f) const;
     /// the plate surface's flux beta_plate_J . v_J on the right-hand side of
     /// the Poisson rows (v: v_s* of the step or a plate's unit velocity)
     void add_plate_surface_flux(const dealii::AffineConstraints<double> &constraints, const Vector &v, Vector &f) const;
@@ -194,8 +204,10 @@ namespace talus::semi_implicit
     void correction(const StepState &this_step);
     /// v^{t+1} of local DoF i from v* and the pressure increment's weak
     /// gradients; a plate's axis DoF moves with Vp[k]
+    /// (dpv: the pressure increment of this response, for the surface terms)
     void correct_velocities(const StepState &this_step, const unsigned int i, const double vss, const double vws,
-                            const double gsi, const double gwi, const double *Vp, double &vs, double &vw) const;
+                            const double gsi, const double gwi, const double *dpv, const double *Vp, double &vs,
+                            double &vw) const;
     /// The rigid plates' momentum balance: the force plates' velocities (and
     /// the step's fields with them), every plate's force, reaction, position.
     void plate_balance(StepState &this_step);
@@ -399,10 +411,18 @@ namespace talus::semi_implicit
     bool                       any_sealed = false; // some rank has a sealed node this step
     Vector                     beta_plate; // per DoF: an impermeable plate's axis DoF: sum_s V grad N (0 elsewhere)
     bool                       any_plate_sealed = false; // the scene has an impermeable rigid plate
-    double                     sealed_h         = 0;     // the step's size (the Poisson terms of the seal)
-    std::vector<double>        cell_water_volume;
-    Vector                     Mdj; // F-bar: sum N m dJ of the soil points
-    Vector                     Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
+    /// per DoF: at a node an impermeable plate holds (its row solved), the
+    /// components the plate, walls and prescribed velocities leave free:
+    /// sum_s V grad N_J, the surface integral of N_J n over the faces other
+    /// than the plate's, i.e. the node's share of a draining face (0 inside)
+    Vector              beta_out;
+    bool                any_plate_outflow = false; // some DoF has beta_out != 0 this step
+    double              outflow_ms_cut    = 0;     // the step's soil mass cut-off (A3)
+    std::vector<double> outflow_bb;                // per node (component-0 DoF): |beta_out|^2
+    double              sealed_h = 0;              // the step's size (the Poisson terms of the seal)
+    std::vector<double> cell_water_volume;
+    Vector              Mdj; // F-bar: sum N m dJ of the soil points
+    Vector              Mjt; // Nor-Sand: sum N m J^{t+1} of the soil points
     // modified F-bar patches: a fixed square tiling from the grid's lower corner
     transfer::PatchTiling<dim> patches;
     std::vector<double>        patch_mass, patch_mass_Je;

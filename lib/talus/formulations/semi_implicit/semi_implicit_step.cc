@@ -202,7 +202,7 @@ namespace talus::semi_implicit
     StepState this_step = begin_step(h);
     particles_to_nodes<K>(this_step);
     sealed_surface<K>(this_step);
-    plate_surface<K>();
+    plate_surface<K>(this_step);
     add_lap(phase.p2n);
     water_and_mixture_predictors(this_step);
     add_lap(phase.grid);
@@ -455,9 +455,11 @@ namespace talus::semi_implicit
         const double       b = g[component[i]];
         // a sealed surface's node: the surface term -beta_J p_J^t of the pore pressure (sealed_surface)
         const double surface = any_sealed ? beta.local_element(i) * p_node.local_element(j) : 0.0;
+        // the plate's corner on a draining face: the surface term -beta_out p^t on both phases
+        const double out = any_plate_outflow ? beta_out.local_element(i) * p_node.local_element(j) : 0.0;
         const double rs =
-          Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * Gps.local_element(i) - surface);
-        const double rwv = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * Gpw.local_element(i));
+          Msi * vs_t.local_element(i) + h * (Fs.local_element(i) + (1 - n) * (Gps.local_element(i) - out) - surface);
+        const double rwv = Mwi * vw_t.local_element(i) + h * (Mwi * b + n * (Gpw.local_element(i) - out));
         double       vw = 0, vs = 0;
         const bool   has_soil = Msi > ms_cut, has_water = Mwi > 0;
         if (prm.rigid_skeleton) // v_s = 0: the water alone, its drag implicit
@@ -718,6 +720,11 @@ namespace talus::semi_implicit
         add_sealed_surface_terms<K>(constraints);
       if (any_plate_sealed)
         add_plate_surface_flux(constraints, vs_star, rhs);
+      if (any_plate_outflow)
+        {
+          add_plate_outflow_terms<K>(constraints);
+          add_plate_outflow_flux(constraints, vs_star, vw_star, rhs);
+        }
       transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, &A, &rhs);
     }
   }
@@ -877,7 +884,7 @@ namespace talus::semi_implicit
   template <int dim>
   template <class K>
   void
-  Solver<dim>::plate_surface()
+  Solver<dim>::plate_surface(const StepState &this_step)
   {
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
@@ -887,7 +894,18 @@ namespace talus::semi_implicit
     // continuity rows of its nodes see the surface move with the plate
     // (integral grad N_J . q = surface integral N_J V . n). beta_plate at the
     // plate's axis DoFs only (the plate holds them: no correction there).
-    any_plate_sealed = false;
+    // The plate's solved nodes whose support reaches a draining face (the
+    // corner where the plate meets a drained face or a free surface): the
+    // water leaves through that face, which their rows (the weak form
+    // without boundary term) would state as zero outflow. beta_out, the same
+    // sum over the components the plate leaves free, is that face's share;
+    // the pore pressure's surface term -beta_out p on both phases (the force
+    // in divergence form, p = 0 beyond the face) and its transpose, the
+    // outflow beta_out . q in the node's row, keep the system symmetric
+    // (docs/semi-implicit.md 'The plate's corner on a draining face').
+    any_plate_sealed  = false;
+    any_plate_outflow = false;
+    outflow_ms_cut    = this_step.ms_cut;
     for (const auto &pl : prm.rigid_plates)
       any_plate_sealed = any_plate_sealed || !pl.permeable;
     if (!any_plate_sealed || !has_water())
@@ -897,21 +915,39 @@ namespace talus::semi_implicit
       }
     const unsigned int nl = n_local();
     grid.reinit_vector(beta_plate);
+    grid.reinit_vector(beta_out);
     {
-      double *bt = at(beta_plate);
+      double *bt = at(beta_plate), *bo = at(beta_out);
       transfer::for_each_point_stencil<dim, K>(
         grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
           const double V = it->get_properties()[L::volume];
           for (unsigned int w = 0; w < s.n; ++w)
             for (unsigned int d = 0; d < dim; ++d)
-              if (const unsigned int k = plate_of[s.dof[w][d]]; k != no_plate && !prm.rigid_plates[k].permeable)
-                bt[s.dof[w][d]] += V * s.G[w][d];
+              {
+                if (const unsigned int k = plate_of[s.dof[w][d]]; k != no_plate && !prm.rigid_plates[k].permeable)
+                  bt[s.dof[w][d]] += V * s.G[w][d];
+                else if (plate_sealed[s.dof[w][0]])
+                  bo[s.dof[w][d]] += V * s.G[w][d];
+              }
         });
     }
-    exchange({&beta_plate});
+    exchange({&beta_plate, &beta_out});
+    unsigned int n_out = 0;
     for (unsigned int i = 0; i < nl; ++i)
-      if (const unsigned int k = plate_of[i]; k == no_plate || prm.rigid_plates[k].permeable)
-        beta_plate.local_element(i) = 0;
+      {
+        if (const unsigned int k = plate_of[i]; k == no_plate || prm.rigid_plates[k].permeable)
+          beta_plate.local_element(i) = 0;
+        // the plate's axis, walls (the soil's or the water's) and prescribed
+        // velocities hold their components: no flux, no force through them
+        if (!plate_sealed[node_of[i]] || plate_of[i] != no_plate || constrained[i] || water_constrained[i] ||
+            bloads.prescribed(i))
+          beta_out.local_element(i) = 0;
+        n_out += beta_out.local_element(i) != 0 ? 1 : 0;
+      }
+    outflow_bb.assign(nl, 0.0); // per node: |beta_out|^2
+    for (unsigned int i = 0; i < nl; ++i)
+      outflow_bb[node_of[i]] += beta_out.local_element(i) * beta_out.local_element(i);
+    any_plate_outflow = dealii::Utilities::MPI::sum(n_out, comm) > 0;
   }
 
   template <int dim>
@@ -930,6 +966,119 @@ namespace talus::semi_implicit
           const auto gJ = pspace.node_dof(J, 0);
           if (!constraints.is_constrained(gJ))
             f(gJ) += bv[J];
+        }
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  Solver<dim>::add_plate_outflow_terms(const dealii::AffineConstraints<double> &constraints)
+  {
+    using Stencil = transfer::PointStencil<dim, K>;
+    using It      = transfer::PointIterator<dim>;
+    // The plate's corner on a draining face (plate_surface; docs/semi-implicit.md
+    // 'The plate's corner on a draining face'). With c_s = (1 - n_J)^2 / M_sJ,
+    // c_w = n_J^2 / M_wJ, the correction at such a node J adds
+    // -h phi beta_out_J dp_J / M_J to each phase (phi = 1 - n_J, n_J), which row I of the continuity
+    // sees through the points' flux (sum V phi grad N_I N_J); row J loses the
+    // outflow beta_out_J . q_J^{t+1} of the correction's velocities. Both:
+    //   A_IJ += -h sum_phases c sum V N_J grad N_I . beta_out_J  (and A_JI),
+    //   A_JJ += h (c_s + c_w) |beta_out_J|^2,   f_J += beta_out_J . q*_J,
+    // the lumped h (B + S)^T M^-1 (B + S) of the divergence-form force: SPD.
+    // A Dirichlet row is skipped, a Dirichlet column moves its value to f.
+    const double h     = sealed_h;
+    const auto   entry = [&](const dealii::types::global_dof_index r, const dealii::types::global_dof_index c,
+                           const double v) {
+      if (constraints.is_constrained(r))
+        return;
+      if (constraints.is_constrained(c))
+        rhs(r) -= v * constraints.get_inhomogeneity(c);
+      else
+        A.add(r, c, v);
+    };
+    const double *bo      = at(beta_out);
+    const auto    has_out = [&](const unsigned int J) { return outflow_bb[J] > 0; };
+    // one phase's points: V their volume (the weak gradients' weight), c the coefficient at J
+    const auto add_points = [&](MaterialPointSet<dim> &set, const bool soil_phase, const bool water_on_soil) {
+      transfer::for_each_point_stencil<dim, K>(
+        grid, set, stencils<K>(set), [&](unsigned int, It &it, const Stencil &s) {
+          const double *P = it->get_properties().data();
+          double        V = P[L::volume];
+          if (water_on_soil)
+            {
+              if (!(P[fs.water_mass] > 0))
+                return;
+              V = water_volume(P);
+            }
+          for (unsigned int j = 0; j < s.n; ++j)
+            {
+              const unsigned int J = s.dof[j][0];
+              if (!plate_sealed[J] || !has_out(J))
+                continue;
+              const double n = n_node.local_element(J), Ms_J = Ms.local_element(J), Mw_J = Mw_node.local_element(J);
+              double       c = 0;
+              if (soil_phase && Ms_J > outflow_ms_cut)
+                c = (1 - n) * (1 - n) / Ms_J;
+              else if (!soil_phase && Mw_J > 0)
+                c = n * n / Mw_J;
+              if (c == 0)
+                continue;
+              c *= -h * V * s.N[j];
+              const auto gJ = pspace.node_dof(J, 0);
+              for (unsigned int i = 0; i < s.n; ++i)
+                {
+                  double gb = 0;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    gb += s.G[i][d] * bo[s.dof[j][d]];
+                  if (gb == 0)
+                    continue;
+                  const auto gI = pspace.node_dof(s.dof[i][0], 0);
+                  entry(gI, gJ, c * gb);
+                  entry(gJ, gI, c * gb);
+                }
+            }
+        });
+    };
+    add_points(soil, true, false);
+    if (prm.one_set) // the water on the soil points, on their water volume
+      add_points(soil, false, true);
+    else
+      add_points(water, false, false);
+    // the nodal terms once, by the node's owner
+    const unsigned int owned = grid.partitioner->locally_owned_size();
+    for (unsigned int J = 0; J < owned; ++J)
+      if (component[J] == 0 && plate_sealed[J] && has_out(J))
+        {
+          const auto gJ = pspace.node_dof(J, 0);
+          if (constraints.is_constrained(gJ))
+            continue;
+          const double n = n_node.local_element(J), Ms_J = Ms.local_element(J), Mw_J = Mw_node.local_element(J);
+          const double c = (Ms_J > outflow_ms_cut ? (1 - n) * (1 - n) / Ms_J : 0.0) + (Mw_J > 0 ? n * n / Mw_J : 0.0);
+          A.add(gJ, gJ, h * c * outflow_bb[J]);
+        }
+  }
+
+  template <int dim>
+  void
+  Solver<dim>::add_plate_outflow_flux(const dealii::AffineConstraints<double> &constraints, const Vector &vs,
+                                      const Vector &vw, Vector &f) const
+  {
+    const unsigned int  nl = n_local(), owned = grid.partitioner->locally_owned_size();
+    std::vector<double> bq(nl, 0.0);
+    for (unsigned int i = 0; i < nl; ++i)
+      if (const unsigned int J = node_of[i]; J < owned && beta_out.local_element(i) != 0)
+        {
+          const double n = n_node.local_element(J);
+          const double q = (Ms.local_element(J) > outflow_ms_cut ? (1 - n) * vs.local_element(i) : 0.0) +
+                           (Mw_node.local_element(J) > 0 ? n * vw.local_element(i) : 0.0);
+          bq[J] += beta_out.local_element(i) * q;
+        }
+    for (unsigned int J = 0; J < owned; ++J)
+      if (component[J] == 0 && bq[J] != 0)
+        {
+          const auto gJ = pspace.node_dof(J, 0);
+          if (!constraints.is_constrained(gJ))
+            f(gJ) += bq[J];
         }
   }
 
@@ -1010,6 +1159,8 @@ namespace talus::semi_implicit
                                              [&](const unsigned int k) { assembly.integrand = terms[k]; });
         if (any_plate_sealed)
           add_plate_surface_flux(constraints_h, r.es, rhs1);
+        if (any_plate_outflow)
+          add_plate_outflow_flux(constraints_h, r.es, r.ew, rhs1);
         transfer::finish_assembly(active, assembly.diag_sum, assembly.diag_count, nullptr, &rhs1);
         const auto          t0 = Clock::now();
         LinearSolverOptions options;
@@ -1063,7 +1214,8 @@ namespace talus::semi_implicit
     add_lap(phase.p2n);
     for (unsigned int i = 0; i < nl; ++i)
       correct_velocities(this_step, i, vs_star.local_element(i), vw_star.local_element(i), gs.local_element(i),
-                         gw.local_element(i), plate_v.data(), vs_new.local_element(i), vw_new.local_element(i));
+                         gw.local_element(i), at(dp_node), plate_v.data(), vs_new.local_element(i),
+                         vw_new.local_element(i));
   }
 
   // v^{t+1} from v* and the pressure increment's force; a plate's axis DoF
@@ -1071,16 +1223,19 @@ namespace talus::semi_implicit
   template <int dim>
   void
   Solver<dim>::correct_velocities(const StepState &this_step, const unsigned int i, const double vss, const double vws,
-                                  const double gsi, const double gwi, const double *Vp, double &vs, double &vw) const
+                                  const double gsi, const double gwi, const double *dpv, const double *Vp, double &vs,
+                                  double &vw) const
   {
     const double       h      = this_step.h;
     const double       ms_cut = this_step.ms_cut;
     const unsigned int j      = node_of[i];
     const double       Mwi = Mw_node.local_element(j), Msi = Ms.local_element(j), n = n_node.local_element(j);
     // a sealed surface's node: the surface term -beta_J dp_J (sealed_surface)
-    const double surface = any_sealed ? beta.local_element(i) * dp_node.local_element(j) : 0.0;
-    vw                   = Mwi > 0 ? vws + h * n * gwi / Mwi : 0.0;
-    vs                   = Msi > ms_cut && !prm.rigid_skeleton ? vss + h * ((1 - n) * gsi - surface) / Msi : 0.0;
+    const double surface = any_sealed ? beta.local_element(i) * dpv[j] : 0.0;
+    // the plate's corner on a draining face: -beta_out dp_J on both phases (plate_surface)
+    const double out = any_plate_outflow ? beta_out.local_element(i) * dpv[j] : 0.0;
+    vw               = Mwi > 0 ? vws + h * n * (gwi - out) / Mwi : 0.0;
+    vs               = Msi > ms_cut && !prm.rigid_skeleton ? vss + h * ((1 - n) * (gsi - out) - surface) / Msi : 0.0;
     if (constrained[i])
       vs = 0;
     if (water_constrained[i])
@@ -1207,7 +1362,8 @@ namespace talus::semi_implicit
         unit[force_plates[r]] = 1.0;
         for (unsigned int i = 0; i < nl; ++i)
           correct_velocities(this_step, i, u.es.local_element(i), u.ew.local_element(i), u.gs.local_element(i),
-                             u.gw.local_element(i), unit.data(), u.vs.local_element(i), u.vw.local_element(i));
+                             u.gw.local_element(i), at(u.dp), unit.data(), u.vs.local_element(i),
+                             u.vw.local_element(i));
         add_residual(1 + r, u.vs, u.vw, u.gs, u.gw, u.dp, false);
       }
     // the same sums, so the same V, on every rank
