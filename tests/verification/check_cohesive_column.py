@@ -20,10 +20,11 @@ Usage:
         stand:    every point moved less than 2 % of H (so did the front and the top surface), and at most
                   10 % of the points carry an accumulated plastic strain above 1 % (no plastic
                   flow through the column);
-        collapse: the front ran out more than 25 % of H beyond the initial face, the initial top
-                  surface settled more than 10 % of H (mean of its points), and a failure surface: at least 10 % of the points carry a
-                  plastic strain above 10 % while at least 10 % moved less than 2 % of H (a mass
-                  slid on a band past a part that stayed).
+        collapse: the front ran out more than 25 % of H beyond the initial face, the initial
+                  top surface settled more than 10 % of H (mean of its points), and a failure
+                  surface: at least 10 % of the points carry a plastic strain above 10 % while at
+                  least 10 % moved less than 2 % of H (a mass slid on a band past a part that
+                  stayed).
       --set entries are applied to the scene (e.g. the mutant material 0/hencky mohr
       coulomb/cohesion=2500).
   check_cohesive_column.py deposit TOOLS_DIR PRM_ROOT WORKDIR REFINE[,REFINE...] TOL_FAMILIES TOL_MESH
@@ -188,7 +189,8 @@ def measures(text, s, p):
 
 def describe(name, m):
     print(f"{name}: H = {m['H']:.4f} m, W = {m['W']:.4f} m, {m['n']} points, t = {m['t_end']:.3f} s, "
-          f"{m['steps']} steps ({m['cut_backs']} cut-backs); front {m['front']:.4f} m (run-out {m['runout']:+.4f} m = {m['runout'] / m['H']:+.3f} H), "
+          f"{m['steps']} steps ({m['cut_backs']} cut-backs); front {m['front']:.4f} m "
+          f"(run-out {m['runout']:+.4f} m = {m['runout'] / m['H']:+.3f} H), "
           f"crest {m['crest']:.4f} m, top surface settled {m['drop'] / m['H']:+.4f} H, largest |u| {m['umax']:.4g} m "
           f"({m['umax'] / m['H']:.4f} H); plastic strain max {m['eps_max']:.3g}, share > {STAND_PLASTIC:g}: "
           f"{m['plastic_share']:.3f}, > {BAND_STRAIN:g}: {m['band_share']:.3f}; moved < {STAND_MOVE:g} H: "
@@ -199,7 +201,8 @@ def check_stand(name, m):
     tv.check(m["umax"] < STAND_MOVE * m["H"], f"{name} stands: largest displacement {m['umax'] / m['H']:.4f} H "
              f"< {STAND_MOVE} H")
     tv.check(abs(m["runout"]) < STAND_MOVE * m["H"] and m["drop"] < STAND_MOVE * m["H"],
-             f"{name} stands: front moved {m['runout'] / m['H']:+.4f} H, top surface settled {m['drop'] / m['H']:+.4f} H")
+             f"{name} stands: front moved {m['runout'] / m['H']:+.4f} H, "
+             f"top surface settled {m['drop'] / m['H']:+.4f} H")
     tv.check(m["plastic_share"] <= STAND_PLASTIC_SHARE, f"{name}: no plastic flow through the column "
              f"({100 * m['plastic_share']:.1f} % of the points above {STAND_PLASTIC:g} plastic strain, "
              f"at most {100 * STAND_PLASTIC_SHARE:.0f} %)")
@@ -208,7 +211,8 @@ def check_stand(name, m):
 def check_collapse(name, m, failure_surface=True):
     tv.check(m["runout"] > COLLAPSE_RUNOUT * m["H"], f"{name} collapses: run-out {m['runout'] / m['H']:.3f} H "
              f"> {COLLAPSE_RUNOUT} H")
-    tv.check(m["drop"] > COLLAPSE_DROP * m["H"], f"{name} collapses: the top surface settled {m['drop'] / m['H']:.3f} H "
+    tv.check(m["drop"] > COLLAPSE_DROP * m["H"],
+             f"{name} collapses: the top surface settled {m['drop'] / m['H']:.3f} H "
              f"> {COLLAPSE_DROP} H")
     if failure_surface:
         tv.check(m["band_share"] >= BAND_SHARE and m["stayed_share"] >= STAYED_SHARE,
