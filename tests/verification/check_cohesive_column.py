@@ -7,7 +7,7 @@ talus-implicit (parameter_files/implicit/cohesive_column.prm: Newmark 1/2, 1/4) 
 talus-explicit (column_explicit.prm beside the fragment).
 
 Analytic yardstick: the critical height of a vertical unsupported cut,
-    H_c = 3.83 c / gamma tan(45 + phi / 2)   (Chen's log-spiral upper bound; 1.657 m here)
+    H_c = 3.83 c / gamma tan(45 + phi / 2)   (Chen's log-spiral upper bound; 1.656 m here)
 (the planar-wedge value 4 c / gamma tan(45 + phi / 2) = 1.730 m and the rigorous lower bound of the
 uniaxial stress field 2 c / gamma tan(45 + phi / 2) = 0.865 m are printed beside it).
 
@@ -17,9 +17,9 @@ Usage:
       For each RATIO a square column (W = H = RATIO x H_c: the cut's failure wedge, 0.64 H wide at
       the top, stays clear of the wall) on CELLS cells per H, talus-implicit to t = 2 s with
       dt = 0.01 s. EXPECT is 'stand' or 'collapse':
-        stand:    every point moved less than 2 % of H (so did the front and the top surface), and at most
-                  10 % of the points carry an accumulated plastic strain above 1 % (no plastic
-                  flow through the column);
+        stand:    every point moved less than 2 % of H (so did the front and the top surface),
+                  and at most 10 % of the points carry an accumulated plastic strain above 1 % (no
+                  plastic flow through the column);
         collapse: the front ran out more than 25 % of H beyond the initial face, the initial
                   top surface settled more than 10 % of H (mean of its points), and a failure
                   surface: at least 10 % of the points carry a plastic strain above 10 % while at
@@ -27,6 +27,15 @@ Usage:
                   stayed).
       --set entries are applied to the scene (e.g. the mutant material 0/hencky mohr
       coulomb/cohesion=2500).
+  check_cohesive_column.py gravity TOOLS_DIR PRM_ROOT WORKDIR RATIO CELLS[,CELLS...] LOW HIGH [--set=...]
+      The square column of RATIO x H_c on CELLS cells per H, static, the gravity ramped over 100
+      load steps until Newton fails (exit 3): the last converged gravity factor lambda_c gives the
+      numerical critical height lambda_c x RATIO x H_c (similar columns fail at one gamma H / c).
+      Checks per grid: the run stops before the full gravity, and at lambda_c the column is a
+      mechanism (the centre of mass's sideways shift at least 3 x its elastic extrapolation from
+      lambda_c / 2), not a Newton stall; on the finest grid the critical height lies within
+      [LOW, HIGH] x H_c; with several grids it falls as the grid is refined. Also printed: the
+      plastic band's inclination and where it meets the top (Culmann's plane: 45 + phi/2).
   check_cohesive_column.py deposit TOOLS_DIR PRM_ROOT WORKDIR REFINE[,REFINE...] TOL_FAMILIES TOL_MESH
                            [--set=entry=value ...]
       The scene as given (h = 0.05 m / REFINE; implicit dt = 5e-3 s / REFINE) by talus-implicit and
