@@ -665,3 +665,39 @@ add_test(NAME verification.implicit_block_coulomb_floor
                  ${TALUS_PRM_DIR}/implicit/block_coulomb_floor.prm ${_w}/implicit_block_coulomb_floor)
 set_tests_properties(verification.implicit_block_coulomb_floor PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600)
+# cohesive soil column (seed 001 §4.5.3; issue 39 item 4; docs/implicit.md "Cohesive soil column"):
+# the critical height of a vertical cut H_c = 3.83 c / gamma tan(45 + phi/2) = 1.656 m as the yardstick.
+# bracket: a square column released stress-free (Newmark, dt = 0.01 s, to 2 s) on N cells per H: 0.5 H_c
+# stands (every point < 2 % H, <= 10 % of the points above 1 % plastic strain), 2 H_c collapses (run-out
+# > 0.25 H, top surface down > 0.1 H, a failure surface). gravity: the 1.5 H_c column statically under a
+# gravity ramped over 100 load steps until Newton fails at a mechanism; the numerical critical height
+# lambda_c x 1.5 H_c within [0.8, 1.25] H_c (fast, N = 40: 1.11 H_c), falling with the grid and within
+# [0.85, 1.1] H_c at N = 60 (verify: 1.20, 1.11, 1.05 H_c; at N = 80 Newton stalls before a mechanism,
+# docs). deposit (verify): the scene of
+# cohesive_column.prm at h = 0.05 and 0.025 m by talus-implicit and talus-explicit, run-outs within
+# 10 % of each other per grid (-6.2 %, -3.0 %) and within 15 % between the grids per family (11.7 %, 8.7 %)
+add_test(NAME verification.implicit_cohesive_column_bracket
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_cohesive_column.py bracket ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/implicit_cohesive_column_bracket 10 0.5:stand,2:collapse)
+set_tests_properties(verification.implicit_cohesive_column_bracket PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+add_test(NAME verification.implicit_cohesive_column_gravity
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_cohesive_column.py gravity ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/implicit_cohesive_column_gravity 1.5 40 0.8 1.25)
+set_tests_properties(verification.implicit_cohesive_column_gravity PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)
+add_test(NAME verification.implicit_cohesive_column_bracket_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_cohesive_column.py bracket ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/implicit_cohesive_column_bracket_full 20 0.5:stand,2:collapse)
+set_tests_properties(verification.implicit_cohesive_column_bracket_full PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 1800)
+add_test(NAME verification.implicit_cohesive_column_gravity_full
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_cohesive_column.py gravity ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/implicit_cohesive_column_gravity_full 1.5 20,40,60 0.85 1.1)
+set_tests_properties(verification.implicit_cohesive_column_gravity_full PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 3600)
+add_test(NAME verification.implicit_cohesive_column_deposit
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_cohesive_column.py deposit ${TALUS_TOOLS_DIR} ${TALUS_PRM_DIR}
+                 ${_w}/implicit_cohesive_column_deposit 1,2 0.1 0.15)
+set_tests_properties(verification.implicit_cohesive_column_deposit PROPERTIES LABELS "verify"
+                     ENVIRONMENT "${_env}" TIMEOUT 7200)
