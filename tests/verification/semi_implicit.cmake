@@ -379,3 +379,13 @@ add_test(NAME verification.semi_implicit_drained_base
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_drained_base.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
                  ${TALUS_PRM_DIR}/verification/semi_implicit_boundary_loads.prm ${_w}/semi_implicit_drained_base)
 set_tests_properties(verification.semi_implicit_drained_base PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 600)
+# Terzaghi at a low permeability (issue 42): k = 1e-6 m/s, N = 5, dt = h/80 s to T_v = 0.2
+# (78,000 steps, about 20 s): with the pressure smoothing fraction 1e-4 within 2 % of the series
+# (measured 1.39 %, as at k = 1e-3); the paper's smoothing at every step gives 8.7 % here
+# (docs/semi-implicit.md, 'The smoothing at low k')
+add_test(NAME verification.semi_implicit_terzaghi_low_k
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi_low_k.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/work_precision/scenes/terzaghi_semi_implicit.prm ${_w}/semi_implicit_terzaghi_low_k
+                 1e-6 5 1e-4 0.02)
+set_tests_properties(verification.semi_implicit_terzaghi_low_k PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 600)

@@ -202,7 +202,7 @@ namespace talus
             // A remainder below 1e-3 dt after this step is taken with it: the sum of a
             // million steps drifts from the stage's end by up to ~1e-4 dt, and a sliver
             // step of its own is not harmless (talus-semi-implicit's pressure increment
-            // scales with 1/h: docs/semi-implicit.md, 'Terzaghi at k = 1e-7')
+            // scales with 1/h: docs/semi-implicit.md, 'The smoothing at low k')
             double h = std::min(f.dt, end_time - f.time);
             if (end_time - f.time - h < 1e-3 * f.dt)
               h = end_time - f.time;
