@@ -146,6 +146,19 @@ namespace talus::semi_implicit
     /// increment); docs/semi-implicit.md 'A sealed surface'
     template <class K>
     void sealed_surface(StepState &this_step);
+    /// A_rc += v in a Poisson row beyond the assembled cells: a Dirichlet row is
+    /// skipped, a Dirichlet column moves its value to the right-hand side
+    void
+    add_poisson_entry(const dealii::AffineConstraints<double> &constraints, const dealii::types::global_dof_index r,
+                      const dealii::types::global_dof_index c, const double v)
+    {
+      if (constraints.is_constrained(r))
+        return;
+      if (constraints.is_constrained(c))
+        rhs(r) -= v * constraints.get_inhomogeneity(c);
+      else
+        A.add(r, c, v);
+    }
     /// The sealed surface's terms of the Poisson system (before its
     /// compress): the matrix entries of the surface force's increment and the
     /// surface's flux beta_J . v_s*_J on the right-hand side

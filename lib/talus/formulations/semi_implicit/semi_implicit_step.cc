@@ -829,17 +829,10 @@ namespace talus::semi_implicit
     //   A_IJ += -h (1 - n_J) / M_sJ sum_s V N_J grad N_I . beta_J  (and A_JI),
     //   A_JJ += h |beta_J|^2 / M_sJ,   f_J += beta_J . v_s*_J.
     // A Dirichlet row is skipped, a Dirichlet column moves its value to f.
-    const double h     = sealed_h;
-    const auto   entry = [&](const dealii::types::global_dof_index r, const dealii::types::global_dof_index c,
-                           const double v) {
-      if (constraints.is_constrained(r))
-        return;
-      if (constraints.is_constrained(c))
-        rhs(r) -= v * constraints.get_inhomogeneity(c);
-      else
-        A.add(r, c, v);
-    };
-    const double *bt = at(beta);
+    const double  h     = sealed_h;
+    const auto    entry = [&](const dealii::types::global_dof_index r, const dealii::types::global_dof_index c,
+                           const double v) { add_poisson_entry(constraints, r, c, v); };
+    const double *bt    = at(beta);
     transfer::for_each_point_stencil<dim, K>(
       grid, soil, stencils<K>(soil), [&](unsigned int, It &it, const Stencil &s) {
         const double V = it->get_properties()[L::volume];
@@ -986,16 +979,9 @@ namespace talus::semi_implicit
     //   A_JJ += h (c_s + c_w) |beta_out_J|^2,   f_J += beta_out_J . q*_J,
     // the lumped h (B + S)^T M^-1 (B + S) of the divergence-form force: SPD.
     // A Dirichlet row is skipped, a Dirichlet column moves its value to f.
-    const double h     = sealed_h;
-    const auto   entry = [&](const dealii::types::global_dof_index r, const dealii::types::global_dof_index c,
-                           const double v) {
-      if (constraints.is_constrained(r))
-        return;
-      if (constraints.is_constrained(c))
-        rhs(r) -= v * constraints.get_inhomogeneity(c);
-      else
-        A.add(r, c, v);
-    };
+    const double  h       = sealed_h;
+    const auto    entry   = [&](const dealii::types::global_dof_index r, const dealii::types::global_dof_index c,
+                           const double v) { add_poisson_entry(constraints, r, c, v); };
     const double *bo      = at(beta_out);
     const auto    has_out = [&](const unsigned int J) { return outflow_bb[J] > 0; };
     // one phase's points: V their volume (the weak gradients' weight), c the coefficient at J
