@@ -328,6 +328,10 @@ namespace talus
                                      cell_iterators[c]->id().to_string() +
                                      (inside ? " missing from the ghost layer" : " outside the grid"));
           }
+        p.full = true;
+        for (unsigned int slot = 0; slot < BSplinePatch<dim>::n_slots; ++slot)
+          for (unsigned int d = 0; d < dim; ++d)
+            p.full = p.full && p.dofs[slot * dim] != invalid && p.dofs[slot * dim + d] == p.dofs[slot * dim] + d;
         patches.push_back(p);
       }
   }

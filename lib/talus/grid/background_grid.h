@@ -66,6 +66,10 @@ namespace talus
     /// (+ 16 p_2) is node i_cell[d] - 1 + p_d. numbers::invalid_unsigned_int for
     /// slots outside the grid.
     unsigned int dofs[n_slots * dim];
+    /// every slot inside the grid and the dim DoFs of each slot's node consecutive
+    /// (dofs[s * dim + d] = dofs[s * dim] + d): the B-spline kernel's gathers and
+    /// scatters then read one index per node and move its components as a block
+    bool full = false;
   };
 
   /// The grid as a uniform box (for the B-spline kernel): lower corner, cell size,

@@ -183,10 +183,10 @@ namespace talus::transfer
 
   /// APIC P2G of one point's momentum with the affine term into the kernel's
   /// per-cell momentum sums: lp[slot] += N m (v + C r).
-  template <int dim, class K>
+  template <int dim, class K, class Row>
   inline void
   add_affine_momentum(const typename K::Cell &cell, const typename K::Eval &e, const double mass, const double *vel,
-                      const double *C, double (*lp)[dim])
+                      const double *C, Row *lp)
   {
     double m[dim], D[dim];
     stencil_moments<dim, K>(cell, e, m, D);
