@@ -59,8 +59,17 @@ namespace talus::shape
           dN[z]     = 0.0;
           return;
         }
-      first          = upper ? 1 : 0;
-      const double s = upper ? xi - 1.0 : xi; // relative to the window's middle node, in [-1/2, 1/2]
+      evaluate_1d_inner(inv_h, xi, first, N, dN);
+    }
+
+    /// evaluate_1d() for a cell that is not next to a wall in this direction
+    /// (0 < j < n - 1): no wall test
+    static inline void
+    evaluate_1d_inner(const double inv_h, const double xi, unsigned char &first, double (&N)[3], double (&dN)[3])
+    {
+      const bool upper = xi >= 0.5;
+      first            = upper ? 1 : 0;
+      const double s   = upper ? xi - 1.0 : xi; // relative to the window's middle node, in [-1/2, 1/2]
       const double a = 0.5 - s, b = 0.5 + s;
       N[0]  = 0.5 * a * a;
       N[1]  = 0.75 - s * s;

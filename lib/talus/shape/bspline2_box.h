@@ -56,7 +56,13 @@ namespace talus::shape
     static inline void
     evaluate(const Cell &c, const dealii::Point<dim> &xi, Eval &e)
     {
-      B::evaluate(c.patch->i_cell, c.box->n_cells, c.box->inv_h, xi, e);
+      // a full patch (all 4^dim slots inside the grid) is a cell away from every
+      // wall: no point of it is in a wall half cell
+      if (c.patch->full)
+        for (unsigned int d = 0; d < dim; ++d)
+          B::evaluate_1d_inner(c.box->inv_h[d], xi[d], e.first[d], e.N[d], e.dN[d]);
+      else
+        B::evaluate(c.patch->i_cell, c.box->n_cells, c.box->inv_h, xi, e);
     }
     static inline void
     values(const Cell &c, const dealii::Point<dim> &xi, Values &e)
@@ -118,48 +124,44 @@ namespace talus::shape
             n[d][a]  = broadcast(e.N[d][a]);
             dn[d][a] = broadcast(e.dN[d][a]);
           }
-      // along direction 0 on the window lines l = b (+ 3 k): value and x-derivative
-      constexpr unsigned int n_lines = dim == 2 ? 3 : 9;
-      Pair                   v0[n_lines][P], d0[n_lines][P];
-      for (unsigned int l = 0; l < n_lines; ++l)
-        {
-          const double(*r)[field_width] = u + 4 * (l % 3) + 16 * (l / 3);
-          for (unsigned int v = 0; v < P; ++v)
-            {
-              const Pair r0 = load_aligned(r[0] + 2 * v), r1 = load_aligned(r[1] + 2 * v),
-                         r2 = load_aligned(r[2] + 2 * v);
-              v0[l][v]      = n[0][0] * r0 + n[0][1] * r1 + n[0][2] * r2;
-              if constexpr (with_gradient)
-                d0[l][v] = dn[0][0] * r0 + dn[0][1] * r1 + dn[0][2] * r2;
-            }
-        }
       auto sum3 = [](const Pair(&w)[3], const Pair(*x)[P], const unsigned int v) {
         return w[0] * x[0][v] + w[1] * x[1][v] + w[2] * x[2][v];
       };
-      if constexpr (dim == 2)
-        for (unsigned int v = 0; v < P; ++v)
+      // along direction 0 on the 3 window lines of plane k (the window itself in
+      // 2D): value and x-derivative, contracted along direction 1 at once (a
+      // plane's line sums only are live: fewer spills than all 9 lines first)
+      auto plane = [&](const unsigned int k, Pair(&pv)[P], Pair(&pdx)[P], Pair(&pdy)[P]) {
+        Pair v0[3][P], d0[3][P];
+        for (unsigned int b = 0; b < 3; ++b)
           {
-            val[v] = sum3(n[1], v0, v);
-            if constexpr (with_gradient)
-              {
-                grad[0][v] = sum3(n[1], d0, v);
-                grad[1][v] = sum3(dn[1], v0, v);
-              }
-          }
-      else
-        {
-          // direction 1 over the 3 planes, then direction 2
-          Pair v1[3][P], dx1[3][P], dy1[3][P];
-          for (unsigned int p = 0; p < 3; ++p)
+            const double(*r)[field_width] = u + 4 * b + 16 * k;
             for (unsigned int v = 0; v < P; ++v)
               {
-                v1[p][v] = sum3(n[1], v0 + 3 * p, v);
+                const Pair r0 = load_aligned(r[0] + 2 * v), r1 = load_aligned(r[1] + 2 * v),
+                           r2 = load_aligned(r[2] + 2 * v);
+                v0[b][v]      = n[0][0] * r0 + n[0][1] * r1 + n[0][2] * r2;
                 if constexpr (with_gradient)
-                  {
-                    dx1[p][v] = sum3(n[1], d0 + 3 * p, v);
-                    dy1[p][v] = sum3(dn[1], v0 + 3 * p, v);
-                  }
+                  d0[b][v] = dn[0][0] * r0 + dn[0][1] * r1 + dn[0][2] * r2;
               }
+          }
+        for (unsigned int v = 0; v < P; ++v)
+          {
+            pv[v] = sum3(n[1], v0, v);
+            if constexpr (with_gradient)
+              {
+                pdx[v] = sum3(n[1], d0, v);
+                pdy[v] = sum3(dn[1], v0, v);
+              }
+          }
+      };
+      if constexpr (dim == 2)
+        plane(0, val, grad[0], grad[1]);
+      else
+        {
+          // then direction 2 over the 3 planes
+          Pair v1[3][P], dx1[3][P], dy1[3][P];
+          for (unsigned int k = 0; k < 3; ++k)
+            plane(k, v1[k], dx1[k], dy1[k]);
           for (unsigned int v = 0; v < P; ++v)
             {
               val[v] = sum3(n[2], v1, v);
