@@ -342,6 +342,15 @@ namespace talus
   } // namespace
 
   double
+  thread_cpu_seconds()
+  {
+    timespec t{};
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) != 0)
+      return 0.0;
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  }
+
+  double
   seconds_since_process_start()
   {
     std::ifstream in("/proc/self/stat");

@@ -99,6 +99,9 @@ namespace talus
   {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
+  /// CPU time of the calling thread [s] (a phase's cost on a shared machine,
+  /// where the wall clock also counts the waits for a core).
+  double thread_cpu_seconds();
 
   /// main() of a tool: `return talus::run_tool(argc, argv, description);`
   /// Command line: [--help] [--print-parameters] [--check] [tool options] FILE.prm.

@@ -110,7 +110,8 @@ namespace talus::implicit_mpm
   double
   Solver<dim>::assemble(const bool with_tangent, const dealii::Tensor<1, dim> &g)
   {
-    const auto                            start = Clock::now();
+    const auto                            start     = Clock::now();
+    const double                          start_cpu = thread_cpu_seconds();
     transfer::PointFailure                failure;
     transfer::UpdatedLagrangianForce<dim> force;
     force.materials      = &prm.materials;
@@ -216,6 +217,7 @@ namespace talus::implicit_mpm
           tangent.compress(dealii::VectorOperation::add);
       }
     seconds_assembly += seconds_since(start);
+    cpu_seconds_assembly += thread_cpu_seconds() - start_cpu;
     ++n_assemblies;
     if (!any_force_plate() || plates_held)
       return residual.l2_norm();

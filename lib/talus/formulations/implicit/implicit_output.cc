@@ -271,6 +271,8 @@ namespace talus::implicit_mpm
     log() << "  breakdown [s]: assembly " << seconds_assembly << " (" << n_assemblies << "), linear solve "
           << seconds_solve << " (" << n_solves << "), convective phase " << seconds_commit << ", output " << t.output
           << std::endl;
+    log() << "  assembly CPU time [s]: " << cpu_seconds_assembly
+          << " (this thread's CPU clock; the wall time above also counts waits for a core)" << std::endl;
     if (any_force_plate())
       log() << "  rigid plates: the Newton solves " << seconds_plates_solve
             << " s (1 + number of force plates right-hand sides each, within the linear solve above), the products "

@@ -590,6 +590,7 @@ namespace talus::implicit_mpm
     // totals for the summary
     unsigned long long total_iterations = 0, total_linear_iterations = 0;
     double             seconds_assembly = 0, seconds_solve = 0, seconds_commit = 0;
+    double             cpu_seconds_assembly = 0; ///< the assemblies' CPU time (thread_cpu_seconds)
     unsigned int       n_assemblies = 0, n_solves = 0;
   };
 } // namespace talus::implicit_mpm
