@@ -66,6 +66,8 @@ namespace talus::transfer
     // scratch per cell
     std::vector<unsigned int> local, free_rows, fixed_rows, inhomogeneous, order;
     std::vector<int>          column;
+    /// position of each local column in the row being filled (-1: not in it)
+    std::vector<long> position_in_row;
     /// Epetra local row and column index of each partitioner-local DoF, looked
     /// up at its first use in this assembly (-2: not yet, -1: not in the map):
     /// a map's LID is a hash look-up, and a DoF comes up in every cell of its
@@ -193,20 +195,48 @@ namespace talus::transfer
         column[i] = cached_lid(col_lid, col_map, local[i], dofs[i]);
 
       // (1) matrix rows of the free DoFs, free columns only (deal.II:
-      // resolve_matrix_row, zero entries elided)
+      // resolve_matrix_row, zero entries elided). The rows of one node's
+      // components have the same column list (a space couples all components
+      // of two nodes): the positions of the cell's columns found in one row
+      // serve the next ones after a check of each used position (idx[q] is
+      // the column), instead of a new stamp of the whole row.
+      position_in_row.resize(m);
+      bool have_positions = false;
       for (const unsigned int r : free_rows)
         {
           const double *row = Al + r * stride;
           const int     lr  = row_of(r);
           if (lr >= 0)
             {
-              open_row(lr);
+              int     n   = 0;
+              int    *idx = nullptr;
+              double *val = nullptr;
+              E->ExtractMyRowView(lr, n, val, idx);
+              bool reuse = have_positions;
+              for (unsigned int k = 0; reuse && k < free_rows.size(); ++k)
+                {
+                  const unsigned int c = free_rows[k];
+                  const long         q = position_in_row[c];
+                  reuse                = q >= 0 ? (q < n && idx[q] == column[c]) : row[c] == 0.0;
+                }
+              if (reuse)
+                row_values = val;
+              else
+                {
+                  open_row(lr);
+                  for (const unsigned int c : free_rows)
+                    position_in_row[c] = position(column[c]);
+                  have_positions = true;
+                }
               for (const unsigned int c : free_rows)
                 {
                   const double a = row[c];
                   if (a == 0.0)
                     continue;
-                  add_in_open_row(column[c], a, dofs[r], dofs[c]);
+                  const long q = position_in_row[c];
+                  if (q < 0)
+                    outside_pattern(dofs[r], dofs[c]);
+                  row_values[q] += a;
                 }
               wrote = true;
             }
