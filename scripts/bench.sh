@@ -153,7 +153,7 @@ parallel_figures block_3d parameter_files/bench/block_spreading_3d.prm
 parallel_figures corner_2d parameter_files/bench/corner_collapse_2d.prm 50
 
 # ---- implicit family (issue 13): time per step, per Newton iteration, assembly
-# ns per point, linear-solve time and iterations, a 2D (KLU) and a 3D (CG + ML AMG)
+# ns per point (wall and CPU: docs/implicit.md, "Assembly cost"), linear-solve time and iterations, a 2D (KLU) and a 3D (CG + ML AMG)
 # scene, and the 3D block in mixed u-p by GMRES with the block preconditioner
 # (issue 39 item 5: 110,592 points without a direct factorisation)
 for PRM in parameter_files/bench/implicit_cantilever_2d.prm parameter_files/bench/implicit_block_3d.prm \
