@@ -229,42 +229,38 @@ namespace talus::materials
     tau = kirchhoff_stress(b);
     if (!dtau_ddF)
       return;
-    // d tau / d dF in closed form, with G = dF b_n (b = G dF^T):
-    //   d b_ij / d dF_kl = delta_ik G_jl + G_il delta_jk,
-    //   b^-1 : d b / d dF_kl = 2 (b^-1 G)_kl = 2 dF^-T_kl, so d ln J / d dF_kl = dF^-1_lk.
-    const dealii::Tensor<2, 3> G  = dF * dealii::Tensor<2, 3>(b_n);
-    const dealii::Tensor<2, 3> Fi = invert(dF);
-    dealii::Tensor<4, 3>      &D  = *dtau_ddF;
-    D                             = 0;
-    // coupled, tau = lambda ln J I + mu (b - I):
-    //   D_ijkl = lambda delta_ij dF^-1_lk + mu (delta_ik G_jl + G_il delta_jk)
-    // split, tau = K (J^2 - 1)/2 I + g dev b, g = mu J^-2/3 (d g / d dF_kl = -2/3 g dF^-1_lk):
-    //   D_ijkl = K J^2 delta_ij dF^-1_lk - 2/3 g dev(b)_ij dF^-1_lk
-    //            + g (delta_ik G_jl + G_il delta_jk - 2/3 delta_ij G_kl)
-    double     vol = lambda, shear = mu;
-    Stress     db;
-    const bool split = energy_form != Energy::coupled;
-    if (split)
+    // A = d tau / d b (symmetric in k,l), then the chain rule through b = dF b_n dF^T.
+    const double         J    = std::sqrt(determinant(b));
+    const Stress         binv = invert(b);
+    dealii::Tensor<4, 3> A;
+    if (energy_form == Energy::coupled)
       {
-        const double J2 = determinant(b);
-        vol             = bulk_modulus() * J2;
-        shear           = mu * std::pow(J2, -1.0 / 3.0);
-        db              = deviator(b);
+        // tau = lambda ln J I + mu (b - I):  A = lambda/2 I (x) b^-1 + mu I_sym
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = 0; j < 3; ++j)
+            for (unsigned int k = 0; k < 3; ++k)
+              for (unsigned int l = 0; l < 3; ++l)
+                A[i][j][k][l] =
+                  0.5 * lambda * (i == j) * binv[k][l] + mu * 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
       }
-    for (unsigned int i = 0; i < 3; ++i)
-      for (unsigned int k = 0; k < 3; ++k)
-        for (unsigned int l = 0; l < 3; ++l)
-          {
-            D[i][i][k][l] += vol * Fi[l][k];
-            D[i][k][k][l] += shear * G[i][l]; // G_il delta_jk (j = k)
-            D[k][i][k][l] += shear * G[i][l]; // delta_ik G_jl (i -> k, j -> i)
-          }
-    if (split)
-      for (unsigned int i = 0; i < 3; ++i)
-        for (unsigned int j = 0; j < 3; ++j)
-          for (unsigned int k = 0; k < 3; ++k)
-            for (unsigned int l = 0; l < 3; ++l)
-              D[i][j][k][l] -= 2.0 / 3.0 * ((i == j) * shear * G[k][l] + shear * db[i][j] * Fi[l][k]);
+    else
+      {
+        // tau = K (J^2-1)/2 I + mu J^-2/3 dev b:
+        // A = K J^2/2 I (x) b^-1 + mu J^-2/3 [ I_dev - 1/3 dev(b) (x) b^-1 ]
+        const double K  = bulk_modulus();
+        const double g  = mu * std::pow(J, -2.0 / 3.0);
+        const Stress db = deviator(b);
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = 0; j < 3; ++j)
+            for (unsigned int k = 0; k < 3; ++k)
+              for (unsigned int l = 0; l < 3; ++l)
+                {
+                  const double Is = 0.5 * ((i == k) * (j == l) + (i == l) * (j == k));
+                  A[i][j][k][l]   = 0.5 * K * J * J * (i == j) * binv[k][l] +
+                                  g * (Is - (i == j) * (k == l) / 3.0 - db[i][j] * binv[k][l] / 3.0);
+                }
+      }
+    *dtau_ddF = fs::chain_trial_b(A, dF, b_n);
   }
 
   void
