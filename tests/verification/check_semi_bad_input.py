@@ -51,6 +51,10 @@ cases = [
                                    ("body 1/phase", "water"), ("body 1/upper corner", "0.075, 1.05"),
                                    ("body 1/lower corner", "0, 1")], "one set needs every body"),
     ("bad point sets", [("semi implicit/point sets", "one")], "point sets"),
+    ("smoothing fraction above 1", [("semi implicit/pressure smoothing fraction", "1.5")],
+     "semi implicit/pressure smoothing fraction: is '1.5'; allowed: a number in [0, 1] or automatic"),
+    ("smoothing fraction not a number", [("semi implicit/pressure smoothing fraction", "auto")],
+     "semi implicit/pressure smoothing fraction: is 'auto'; allowed"),
     # the shared loads (issue 37, docs/boundary-conditions.md; the per-body
     # 'surface load' entries they replace are gone): a region upside down
     ("traction region upside down", [("loads/number of tractions", "1"), ("loads/traction 0/apply to", "region"),

@@ -389,3 +389,11 @@ add_test(NAME verification.semi_implicit_terzaghi_low_k
                  1e-6 5 1e-4 0.02)
 set_tests_properties(verification.semi_implicit_terzaghi_low_k PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600)
+# the same with 'pressure smoothing fraction = automatic' (beta = c_v dt / h^2 =
+# 6.4e-5 here): within the same 2 % (measured 1.41 %)
+add_test(NAME verification.semi_implicit_terzaghi_low_k_automatic
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_semi_terzaghi_low_k.py ${TALUS_TOOLS_DIR}/talus-semi-implicit
+                 ${TALUS_PRM_DIR}/work_precision/scenes/terzaghi_semi_implicit.prm
+                 ${_w}/semi_implicit_terzaghi_low_k_automatic 1e-6 5 automatic 0.02)
+set_tests_properties(verification.semi_implicit_terzaghi_low_k_automatic PROPERTIES LABELS "fast"
+                     ENVIRONMENT "${_env}" TIMEOUT 600)

@@ -73,8 +73,11 @@ namespace talus::semi_implicit
     /// share of the smoothed value in a water point's pore pressure per step (1: Eq. 77,
     /// the point's value replaced; below 1 the point keeps 1 - this of its own value)
     double smoothing_fraction = 1.0;
-    double flip_fraction      = 1.0; ///< 1: pure FLIP (the paper); the rest PIC
-    double patch_size         = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
+    /// 'pressure smoothing fraction = automatic': per material and step
+    /// min(1, c_v dt / h_min^2) (smoothing_fractions_of_materials)
+    bool   automatic_smoothing_fraction = false;
+    double flip_fraction                = 1.0; ///< 1: pure FLIP (the paper); the rest PIC
+    double patch_size                   = 1.5; ///< side of the modified F-bar patches in cells (Eq. 83)
     /// single: the water is carried on the soil points (its points move with the
     /// soil's velocity, so they stay on them); double: its own points
     bool single_point = false;
@@ -105,6 +108,16 @@ namespace talus::semi_implicit
   /// h / sqrt(E_c / ((1 - n) rho_s)) (the skeleton alone, the fastest wave).
   template <int dim>
   double soil_critical_time_step(const Parameters<dim> &p, double h_min);
+
+  /// Per material: the share of the smoothed pore pressure in a step dt
+  /// ('pressure smoothing fraction'): the number given, or (automatic)
+  /// min(1, c_v dt / h_min^2) with the consolidation coefficient
+  /// c_v = k E_c / (rho_w g) of the material's skeleton (k: `conductivity`, the
+  /// initialisation's during the App. B.4 stage); 1 for a material no body seeds
+  /// as soil (free water: nothing consolidates).
+  template <int dim>
+  std::vector<double> smoothing_fractions_of_materials(const Parameters<dim> &p, double dt, double h_min,
+                                                       bool initial_stage);
 
   /// x with 4 significant digits (the numbers in messages).
   std::string number_text(const double x);

@@ -97,7 +97,7 @@ namespace talus::semi_implicit
                                                double    *P   = it->get_properties().data();
                                                const bool wet = P[fs.water_mass] > 0;
                                                if (wet && prm.pressure_smoothing)
-                                                 smooth_pressure(s, pn, P[fs.pressure]);
+                                                 smooth_pressure(s, pn, P, P[fs.pressure]);
                                                double gp[dim];
                                                s.gradient(pn, gp);
                                                s.scatter_vector(gps, P[L::volume], gp);

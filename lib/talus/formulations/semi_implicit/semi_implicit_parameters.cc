@@ -78,14 +78,17 @@ namespace talus::semi_implicit
                         "p_I = sum N m (p + grad p . (x_I - x_p)) / sum N m, exact for linear fields "
                         "(docs/semi-implicit.md). none: the pressure changes only by the interpolated "
                         "increments (p += sum N dp).");
-      prm.declare_entry("pressure smoothing fraction", "1", Double(0, 1),
+      prm.declare_entry("pressure smoothing fraction", "1", dealii::Patterns::Anything(),
                         "The share beta of the smoothed value in a water point's pore pressure at each step: "
                         "p <- (1 - beta) p + beta sum N p_I, then p += sum N dp. 1 (the paper's Eq. 77): the "
                         "point's value is replaced every step. The map-remap keeps linear fields and flattens "
                         "curvature a little at every application, so its effect grows with the number of "
                         "steps, not with time: where a consolidation needs millions of steps (low k) a "
                         "smaller share keeps the profile (docs/semi-implicit.md, 'The smoothing at low k'). "
-                        "Ignored with pressure smoothing = none.");
+                        "automatic: per material and step min(1, c_v dt / h_min^2), c_v = k E_c / (rho_w g) "
+                        "the skeleton's consolidation coefficient (the share of a grid cell's own diffusion "
+                        "time that the step is). A number in [0, 1] or automatic. Ignored with pressure "
+                        "smoothing = none.");
       prm.declare_entry("flip fraction", "1", Double(0, 1),
                         "Point velocity update: this fraction of FLIP (v_p + sum N (v^{t+1} - v^t)), the rest "
                         "PIC (sum N v^{t+1}). 1 = pure FLIP as in the paper.");
@@ -216,9 +219,21 @@ namespace talus::semi_implicit
       p.kozeny_carman             = prm.get_bool("kozeny carman");
       p.pressure_smoothing        = prm.get("pressure smoothing") != "none";
       p.linear_smoothing          = prm.get("pressure smoothing") == "linear";
-      p.smoothing_fraction        = prm.get_double("pressure smoothing fraction");
-      p.flip_fraction             = prm.get_double("flip fraction");
-      p.rigid_skeleton            = prm.get_bool("rigid skeleton");
+      {
+        const std::string text         = prm.get("pressure smoothing fraction");
+        p.automatic_smoothing_fraction = text == "automatic";
+        if (!p.automatic_smoothing_fraction)
+          {
+            char  *end = nullptr;
+            double x   = std::strtod(text.c_str(), &end);
+            require(!text.empty() && end != text.c_str() && *end == '\0' && x >= 0 && x <= 1,
+                    "semi implicit/pressure smoothing fraction",
+                    "is '" + text + "'; allowed: a number in [0, 1] or automatic");
+            p.smoothing_fraction = x;
+          }
+      }
+      p.flip_fraction  = prm.get_double("flip fraction");
+      p.rigid_skeleton = prm.get_bool("rigid skeleton");
       // rigid plates (issue 37): a rigid skeleton holds every soil node, so no
       // plate can move it (a physical impossibility, not a missing feature)
       if (p.grid_mesh == nullptr) // (a grid file is refused below)
@@ -440,6 +455,25 @@ namespace talus::semi_implicit
     return dt;
   }
 
+  template <int dim>
+  std::vector<double>
+  smoothing_fractions_of_materials(const Parameters<dim> &p, const double dt, const double h_min,
+                                   const bool initial_stage)
+  {
+    std::vector<double> beta(p.materials.size(), p.automatic_smoothing_fraction ? 1.0 : p.smoothing_fraction);
+    if (!p.automatic_smoothing_fraction)
+      return beta;
+    for (unsigned int b = 0; b < p.bodies.size(); ++b)
+      if (p.phase_of_body[b] != Phase::water)
+        for (const unsigned int m : p.materials_of_body[b])
+          {
+            const double k   = initial_stage ? p.initialisation_conductivity : p.soil_of_material[m].conductivity;
+            const double c_v = k * p.materials[m]->constrained_modulus() / (p.water_density * p.unit_weight_gravity);
+            beta[m]          = std::min(1.0, c_v * dt / (h_min * h_min));
+          }
+    return beta;
+  }
+
   void
   check_parameters(dealii::ParameterHandler &prm, const std::string &)
   {
@@ -448,6 +482,8 @@ namespace talus::semi_implicit
 
   // the Solver's instantiations: semi_implicit_setup.cc and the other parts'
   TALUS_INSTANTIATE_PARAMETERS();
-  template double soil_critical_time_step<2>(const Parameters<2> &, double);
-  template double soil_critical_time_step<3>(const Parameters<3> &, double);
+  template double              soil_critical_time_step<2>(const Parameters<2> &, double);
+  template double              soil_critical_time_step<3>(const Parameters<3> &, double);
+  template std::vector<double> smoothing_fractions_of_materials<2>(const Parameters<2> &, double, double, bool);
+  template std::vector<double> smoothing_fractions_of_materials<3>(const Parameters<3> &, double, double, bool);
 } // namespace talus::semi_implicit

@@ -309,12 +309,13 @@ namespace talus::semi_implicit
         v[d] = flip * (v[d] + a[d] - b[d]) + (1 - flip) * a[d];
     }
     /// (77) a water point's pore pressure from the nodal p^t: replaced (the paper),
-    /// or blended by `pressure smoothing fraction`
+    /// or blended by the step's `pressure smoothing fraction` of its material
+    /// (`P`: the point's properties)
     template <class Stencil>
     void
-    smooth_pressure(const Stencil &s, const double *p_node, double &p) const
+    smooth_pressure(const Stencil &s, const double *p_node, const double *P, double &p) const
     {
-      const double beta = prm.smoothing_fraction;
+      const double beta = smoothing_fraction_of_material[static_cast<unsigned int>(P[L::material])];
       p                 = beta == 1.0 ? s.value(p_node) : (1 - beta) * p + beta * s.value(p_node);
     }
     /// (7c) a water point's pore pressure p += dp (as an increment: p_I^t + dp_I
@@ -499,6 +500,8 @@ namespace talus::semi_implicit
     unsigned long long solver_iterations = 0, n_solves = 0;
     double             seconds_solve    = 0; ///< CG + AMG set-ups
     double             dt_soil_critical = 0;
+    /// per material: the share of the smoothed pore pressure in this step (begin_step)
+    std::vector<double> smoothing_fraction_of_material;
     // wall-clock phases of the step (a few clock reads per step; the solve is
     // seconds_solve): P2N, nodal updates, Poisson set-up and assembly, N2P
     // (FLIP + MUSL remap), soil update and stress (with F-bar), water move

@@ -245,6 +245,8 @@ namespace talus::semi_implicit
          {&Ms, &Ps, &Mn, &Mk, &Fs, &Ww, &Pw0, &Ww0, &Mwp, &Mw, &Gpw, &Gps, &Mwg, &gs, &gw, &wet, &dry, &near_wet})
       *v = 0;
     bloads.begin_step(time, h); // the loads' time factors over [t, t + h]
+    smoothing_fraction_of_material =
+      smoothing_fractions_of_materials(prm, h, grid.min_cell_size(), this_step.initial_stage);
     // the displacement-controlled plates' velocities over the step (those of
     // force control follow from the plates' balance at its end)
     const unsigned int   n_plates = prm.rigid_plates.size();
@@ -414,7 +416,10 @@ namespace talus::semi_implicit
       transfer::scatter_weak_gradient<dim, K>(grid, water, stencils<K>(water), pn, L::volume, gpw,
                                               [&](It &it, const Stencil &s) {
                                                 if (prm.pressure_smoothing)
-                                                  smooth_pressure(s, pn, it->get_properties()[fw.pressure]);
+                                                  {
+                                                    double *P = it->get_properties().data();
+                                                    smooth_pressure(s, pn, P, P[fw.pressure]);
+                                                  }
                                               });
       transfer::scatter_weak_gradient<dim, K>(grid, soil, stencils<K>(soil), pn, L::volume, gps);
     }
