@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
 #include <random>
 
@@ -279,6 +280,149 @@ TEST(ExplicitTransfer, MemoryOrderRebuild3D)
 TEST(ExplicitTransfer, BSplineMemoryOrderRebuild3D)
 {
   memory_order<3>(Shape::quadratic_bspline);
+}
+
+/// The rebuild itself, against its definition: run with rebuilds switched off
+/// until the storage is scattered, (optionally) remove every 7th point so that
+/// the pool has free slots, then restore_memory_order(). The walk afterwards
+/// must be the walk before with the cell groups in active-cell order (each
+/// cell's points in their old order), every point's location, reference
+/// location, id and properties bit for bit the same, and the slots increasing
+/// along the walk (free slots stay free: the pool keeps its size).
+template <int dim>
+void
+rebuild_in_place(const bool with_free_slots)
+{
+  const auto                p = sliding_scene<dim>(Shape::linear, false);
+  explicit_mpm::Solver<dim> s(p, MPI_COMM_WORLD);
+  s.setup();
+  s.points.relocator().resort_fraction = 1e30; // never
+  for (int i = 0; i < 30; ++i)
+    s.step(s.time_step());
+  auto &handler = s.points.handler;
+  if (with_free_slots)
+    {
+      // remove from the back of each cell's points (deal.II moves a cell's last
+      // point into the hole a removal leaves)
+      std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> doomed;
+      for (auto it = handler.begin(); it != handler.end(); ++it)
+        if (it->get_id() % 7 == 3)
+          doomed.push_back(it);
+      for (auto k = doomed.size(); k-- > 0;)
+        handler.remove_particle(doomed[k]);
+    }
+  struct Row
+  {
+    unsigned int        cell;
+    std::vector<double> bits; // location, reference location, id, properties
+  };
+  auto walk = [&]() {
+    std::vector<Row> rows;
+    for (const auto &pt : handler)
+      {
+        Row r{pt.get_surrounding_cell()->active_cell_index(), {}};
+        for (unsigned int d = 0; d < dim; ++d)
+          r.bits.push_back(pt.get_location()[d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          r.bits.push_back(pt.get_reference_location()[d]);
+        r.bits.push_back(static_cast<double>(pt.get_id()));
+        r.bits.insert(r.bits.end(), pt.get_properties().begin(), pt.get_properties().end());
+        rows.push_back(r);
+      }
+    return rows;
+  };
+  auto expected = walk();
+  std::stable_sort(expected.begin(), expected.end(), [](const Row &a, const Row &b) { return a.cell < b.cell; });
+  // the storage must be scattered before, or the test shows nothing
+  unsigned int descents = 0, last = 0, k = 0;
+  for (const auto &pt : handler)
+    {
+      descents += k++ > 0 && pt.get_local_index() < last;
+      last = pt.get_local_index();
+    }
+  EXPECT_GT(dealii::Utilities::MPI::sum(descents, MPI_COMM_WORLD), 10u) << "the storage was not scattered";
+  const auto slots_before = handler.get_property_pool().n_slots();
+
+  s.points.relocator().restore_memory_order();
+
+  const auto got = walk();
+  ASSERT_EQ(got.size(), expected.size());
+  bool same = true;
+  for (std::size_t i = 0; i < got.size(); ++i)
+    same = same && got[i].cell == expected[i].cell &&
+           std::memcmp(got[i].bits.data(), expected[i].bits.data(), got[i].bits.size() * sizeof(double)) == 0;
+  EXPECT_TRUE(same) << "the rebuild must keep every point's cell, place in its cell and data bit for bit";
+  bool ascending = true;
+  k              = 0;
+  for (const auto &pt : handler)
+    {
+      ascending = ascending && (k++ == 0 || pt.get_local_index() > last);
+      last      = pt.get_local_index();
+    }
+  EXPECT_TRUE(ascending) << "the walk must read the slots in increasing order";
+  EXPECT_EQ(handler.get_property_pool().n_slots(), slots_before);
+  EXPECT_EQ(handler.n_locally_owned_particles(), got.size());
+}
+TEST(ExplicitTransfer, MemoryOrderRebuildInPlace2D)
+{
+  rebuild_in_place<2>(false);
+}
+TEST(ExplicitTransfer, MemoryOrderRebuildInPlace3D)
+{
+  rebuild_in_place<3>(false);
+}
+TEST(ExplicitTransfer, MemoryOrderRebuildInPlaceFreeSlots3D)
+{
+  rebuild_in_place<3>(true);
+}
+
+/// The grid's caches hold only what the points use: on a grid much larger than
+/// the body, after set-up and steps in which points change cell, only the cells
+/// holding points and their vertex neighbours have a filled cache entry, and
+/// only cells that points left have a neighbour list. The fields of an entry
+/// filled on first read equal the triangulation's.
+TEST(ExplicitTransfer, GridCachesOnlyNearPoints3D)
+{
+  auto p = scene<3>(Shape::linear);
+  for (unsigned int d = 0; d < 3; ++d)
+    p.grid_cells[d] = 24;
+  p.bodies[0].radius = 0.15;
+  explicit_mpm::Solver<3> s(p, MPI_COMM_WORLD);
+  s.setup();
+  for (int i = 0; i < 20; ++i)
+    s.step(s.time_step());
+  const auto &grid = s.grid;
+  EXPECT_GT(dealii::Utilities::MPI::sum(s.points.relocation_stats.moved_locally, MPI_COMM_WORLD), 0u)
+    << "points must change cell";
+  // every cell within one cell of a point may be filled, no other
+  std::vector<char> near(grid.cells.size(), 0);
+  for (const auto &pt : s.points.handler)
+    {
+      const unsigned int *nb = grid.neighbours_of(pt.get_surrounding_cell()->active_cell_index());
+      for (unsigned int k = 1; k <= nb[0]; ++k)
+        near[nb[k]] = 1;
+    }
+  std::size_t n_near = 0;
+  for (const char x : near)
+    n_near += x;
+  EXPECT_LE(grid.cells.n_filled(), 2 * n_near) << "cache entries filled far from the points";
+  EXPECT_LT(grid.cells.n_filled(), grid.cells.size() / 4);
+  EXPECT_LT(grid.n_neighbour_lists(), grid.cells.size() / 4);
+  // a lazily filled entry holds the triangulation's box and owner
+  for (unsigned int c = 0; c < grid.cells.size(); c += 97)
+    {
+      double      lower[3], h[3];
+      const bool  owned = grid.owned_cell_box(c, lower, h);
+      const auto &cc    = grid.cells[c];
+      EXPECT_EQ(owned, cc.locally_owned);
+      if (owned)
+        for (unsigned int d = 0; d < 3; ++d)
+          {
+            EXPECT_EQ(cc.lower[d], lower[d]);
+            EXPECT_EQ(cc.h[d], h[d]);
+            EXPECT_EQ(cc.lower[d], grid.cell_iterator(c)->vertex(0)[d]);
+          }
+    }
 }
 
 TEST(ExplicitTransfer, RelocationKeepsParticles2D)

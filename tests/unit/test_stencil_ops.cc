@@ -119,7 +119,7 @@ namespace
     // component of every owned grid DoF
     std::vector<unsigned int> comp(M.locally_owned_size() + grid.partitioner->n_ghost_indices(), 0);
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
-      if (grid.cell_iterators[c] != grid.tria.end())
+      if (grid.cell_iterator(c) != grid.tria.end())
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
           for (unsigned int d = 0; d < dim; ++d)
             comp[grid.cells[c].dofs[v * dim + d]] = d;
@@ -138,7 +138,7 @@ namespace
     grid.reinit_vector(V);
     grid.reinit_vector(S);
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
-      if (grid.cell_iterators[c] != grid.tria.end())
+      if (grid.cell_iterator(c) != grid.tria.end())
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
           {
             double x[dim];

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sys/mman.h>
+#include <type_traits>
 #include <map>
 #include <set>
 
@@ -131,88 +133,183 @@ namespace talus
     dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant_dofs);
     partitioner = std::make_shared<dealii::Utilities::MPI::Partitioner>(owned_dofs, relevant_dofs, comm);
 
+    // the cache entries are filled on first read (CellCaches::fill); here only
+    // the level and index of every cell, and the check that every cell is a box
     constexpr unsigned int nv = CellCache<dim>::n_vertices;
-    cells.assign(tria.n_active_cells(), CellCache<dim>());
-    cell_iterators.assign(tria.n_active_cells(), tria.end());
-    std::vector<dealii::types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
-    double                                       min_h = std::numeric_limits<double>::max();
-    for (const auto &cell : dof_handler.active_cell_iterators())
+    cells.reset(*this, tria.n_active_cells());
+    level_index.assign(tria.n_active_cells(), artificial);
+    double min_h = std::numeric_limits<double>::max();
+    for (const auto &cell : tria.active_cell_iterators())
       {
         if (cell->is_artificial())
           continue;
         const unsigned int c = cell->active_cell_index();
-        cell_iterators[c]    = cell;
-        auto &cc             = cells[c];
-        cc.locally_owned     = cell->is_locally_owned();
-        const auto p0        = cell->vertex(0);
+        AssertThrow(cell->level() < 31 && std::uint32_t(cell->index()) <= index_mask,
+                    dealii::ExcMessage("grid: more than 30 levels or 2^27 cells on a level"));
+        level_index[c]   = (std::uint32_t(cell->level()) << index_bits) | std::uint32_t(cell->index());
+        const auto p0    = cell->vertex(0);
+        const bool owned = cell->is_locally_owned();
+        double     h[dim];
         for (unsigned int d = 0; d < dim; ++d)
           {
-            cc.lower[d] = p0[d];
-            cc.h[d]     = cell->vertex(nv - 1)[d] - p0[d];
-            cc.inv_h[d] = 1.0 / cc.h[d];
-            if (cc.locally_owned)
-              min_h = std::min(min_h, cc.h[d]);
+            h[d] = cell->vertex(nv - 1)[d] - p0[d];
+            if (owned)
+              min_h = std::min(min_h, h[d]);
           }
         // every vertex must sit at its box corner
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)
             {
-              const double expected = p0[d] + (((v >> d) & 1u) ? cc.h[d] : 0.0);
-              if (std::abs(cell->vertex(v)[d] - expected) > 1e-10 * std::abs(cc.h[d]) || !(cc.h[d] > 0))
+              const double expected = p0[d] + (((v >> d) & 1u) ? h[d] : 0.0);
+              if (std::abs(cell->vertex(v)[d] - expected) > 1e-10 * std::abs(h[d]) || !(h[d] > 0))
                 throw InputError("grid: cell " + cell->id().to_string() + " at " + std::to_string(p0[0]) +
                                  ",... is not an axis-aligned box with lexicographic "
                                  "vertex order; the MPM background grid must consist of axis-aligned quads/hexes");
             }
-        cell->get_dof_indices(dof_indices);
-        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
-          {
-            const auto [comp, base] = fe.system_to_component_index(i);
-            const unsigned int v    = base; // Q1: base index == vertex
-            cc.dofs[v * dim + comp] = partitioner->global_to_local(dof_indices[i]);
-          }
       }
     global_min_h = dealii::Utilities::MPI::min(min_h, comm);
 
-    // Vertex neighbours of every non-artificial cell (itself first): on a grid
-    // without hanging nodes these are the cells reached by at most one face
-    // step along each axis. (GridTools::vertex_to_cell_map with its std::sets
-    // took ~40 s on a 786k-cell grid; this takes well under a second.)
-    neighbours.clear();
-    std::vector<unsigned int> nb;
-    for (unsigned int c = 0; c < cells.size(); ++c)
-      {
-        if (cell_iterators[c] == tria.end())
-          continue;
-        std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> set = {cell_iterators[c]};
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const std::size_t n = set.size();
-            for (std::size_t k = 0; k < n; ++k)
-              for (const unsigned int f : {2 * d, 2 * d + 1})
-                {
-                  if (set[k]->at_boundary(f))
-                    continue;
-                  const auto nbc = set[k]->neighbor(f);
-                  if (nbc->has_children() || nbc->is_artificial())
-                    continue;
-                  set.push_back(nbc);
-                }
-          }
-        cells[c].neighbours_begin = neighbours.size();
-        nb.clear();
-        for (const auto &x : set)
-          {
-            const unsigned int i = x->active_cell_index();
-            if (std::find(nb.begin(), nb.end(), i) == nb.end())
-              nb.push_back(i);
-          }
-        neighbours.insert(neighbours.end(), nb.begin(), nb.end());
-        cells[c].neighbours_end = neighbours.size();
-      }
+    // the vertex neighbour lists are built on first use (neighbours_of)
+    neighbour_chunks.clear();
+    chunk_used = 0;
+    n_lists    = 0;
 
     // a rebuilt grid (repartition, restart) keeps a requested B-spline stencil valid
     if (!patch_of_cell.empty())
       setup_bspline_patches();
+  }
+
+  template <int dim>
+  void
+  CellCaches<dim>::reset(const BackgroundGrid<dim> &grid, const std::size_t n_cells)
+  {
+    static_assert(std::is_trivially_copyable_v<CellCache<dim>>, "entries start as zero bytes");
+    release();
+    // an anonymous mapping: zero pages that become resident one by one when an
+    // entry on them is first filled (calloc would do the same only when it
+    // happens to take fresh memory from the system, not recycled heap)
+    const std::size_t bytes = std::max<std::size_t>(n_cells, 1) * sizeof(CellCache<dim>);
+    void *p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    if (p == MAP_FAILED)
+      throw std::bad_alloc();
+    entries          = static_cast<CellCache<dim> *>(p);
+    n                = n_cells;
+    owner            = &grid;
+    n_filled_entries = 0;
+  }
+
+  template <int dim>
+  void
+  CellCaches<dim>::release()
+  {
+    if (entries != nullptr)
+      munmap(entries, std::max<std::size_t>(n, 1) * sizeof(CellCache<dim>));
+    entries = nullptr;
+    n       = 0;
+  }
+
+  template <int dim>
+  void
+  CellCaches<dim>::fill(const unsigned int c) const
+  {
+    CellCache<dim> &cc = entries[c];
+    owner->fill_cache(c, cc);
+    cc.filled = true;
+    ++n_filled_entries;
+  }
+
+  template <int dim>
+  void
+  BackgroundGrid<dim>::fill_cache(const unsigned int c, CellCache<dim> &cc) const
+  {
+    const std::uint32_t li = level_index[c];
+    if (li == artificial)
+      return; // zeros
+    constexpr unsigned int                                       nv = CellCache<dim>::n_vertices;
+    const typename dealii::DoFHandler<dim>::active_cell_iterator cell(&tria, static_cast<int>(li >> index_bits),
+                                                                      static_cast<int>(li & index_mask), &dof_handler);
+    cc.locally_owned = cell->is_locally_owned();
+    const auto p0    = cell->vertex(0);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        cc.lower[d] = p0[d];
+        cc.h[d]     = cell->vertex(nv - 1)[d] - p0[d];
+        cc.inv_h[d] = 1.0 / cc.h[d];
+      }
+    std::vector<dealii::types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
+    cell->get_dof_indices(dof_indices);
+    for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+      {
+        const auto [comp, base] = fe.system_to_component_index(i);
+        const unsigned int v    = base; // Q1: base index == vertex
+        cc.dofs[v * dim + comp] = partitioner->global_to_local(dof_indices[i]);
+      }
+  }
+
+  template <int dim>
+  bool
+  BackgroundGrid<dim>::owned_cell_box(const unsigned int c, double (&lower)[dim], double (&h)[dim]) const
+  {
+    const auto cell = cell_iterator(c);
+    if (cell == tria.end() || !cell->is_locally_owned())
+      return false;
+    constexpr unsigned int nv = CellCache<dim>::n_vertices;
+    const auto             p0 = cell->vertex(0);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lower[d] = p0[d];
+        h[d]     = cell->vertex(nv - 1)[d] - p0[d];
+      }
+    return true;
+  }
+
+  template <int dim>
+  const unsigned int *
+  BackgroundGrid<dim>::build_neighbours(const unsigned int c) const
+  {
+    // the cells reached from c by at most one face step along each axis, in the
+    // order x, then y, then z (GridTools::vertex_to_cell_map with its std::sets
+    // took ~40 s on a 786k-cell grid for all cells at once)
+    AssertThrow(cell_iterator(c) != tria.end(), dealii::ExcMessage("neighbours of an artificial cell"));
+    std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> set = {cell_iterator(c)};
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        const std::size_t n = set.size();
+        for (std::size_t k = 0; k < n; ++k)
+          for (const unsigned int f : {2 * d, 2 * d + 1})
+            {
+              if (set[k]->at_boundary(f))
+                continue;
+              const auto nbc = set[k]->neighbor(f);
+              if (nbc->has_children() || nbc->is_artificial())
+                continue;
+              set.push_back(nbc);
+            }
+      }
+    unsigned int nb[64];
+    unsigned int count = 0;
+    for (const auto &x : set)
+      {
+        const unsigned int i = x->active_cell_index();
+        if (std::find(nb, nb + count, i) == nb + count)
+          {
+            AssertThrow(count < 64, dealii::ExcInternalError());
+            nb[count++] = i;
+          }
+      }
+    constexpr std::size_t chunk_size = 1u << 16; // entries: 256 KB
+    if (neighbour_chunks.empty() || chunk_used + count + 1 > chunk_size)
+      {
+        neighbour_chunks.emplace_back(new unsigned int[chunk_size]);
+        chunk_used = 0;
+      }
+    unsigned int *list = neighbour_chunks.back().get() + chunk_used;
+    chunk_used += count + 1;
+    list[0] = count;
+    std::copy(nb, nb + count, list + 1);
+    cells[c].neighbours = list;
+    ++n_lists;
+    return list;
   }
 
   template <int dim>
@@ -274,7 +371,7 @@ namespace talus
     std::vector<std::array<unsigned int, dim>> index(cells.size());
     bool                                       on_lattice = true;
     for (unsigned int c = 0; c < cells.size(); ++c)
-      if (cell_iterators[c] != tria.end())
+      if (cell_iterator(c) != tria.end())
         for (unsigned int d = 0; d < dim; ++d)
           {
             const double r = (cells[c].lower[d] - box.lower[d]) * box.inv_h[d];
@@ -296,9 +393,10 @@ namespace talus
         for (unsigned int d = 0; d < dim; ++d)
           p.i_cell[d] = index[c][d];
         // the patch nodes are the vertices of the cell and its vertex neighbours
-        for (unsigned int k = cells[c].neighbours_begin; k < cells[c].neighbours_end; ++k)
+        const unsigned int *nbs = neighbours_of(c);
+        for (unsigned int k = 1; k <= nbs[0]; ++k)
           {
-            const unsigned int n = neighbours[k];
+            const unsigned int n = nbs[k];
             for (unsigned int v = 0; v < nv; ++v)
               {
                 unsigned int slot = 0, m = 1;
@@ -325,7 +423,7 @@ namespace talus
               }
             if (inside != (p.dofs[slot * dim] != invalid))
               throw std::logic_error("BackgroundGrid::setup_bspline_patches: patch node of cell " +
-                                     cell_iterators[c]->id().to_string() +
+                                     cell_iterator(c)->id().to_string() +
                                      (inside ? " missing from the ghost layer" : " outside the grid"));
           }
         p.full = true;
@@ -384,10 +482,10 @@ namespace talus
   unsigned int
   BackgroundGrid<dim>::find_cell_near(const unsigned int c, const dealii::Point<dim> &x, dealii::Point<dim> &xi) const
   {
-    const auto &cc = cells[c];
-    for (unsigned int k = cc.neighbours_begin; k < cc.neighbours_end; ++k)
+    const unsigned int *nbs = neighbours_of(c);
+    for (unsigned int k = 1; k <= nbs[0]; ++k)
       {
-        const unsigned int n  = neighbours[k];
+        const unsigned int n  = nbs[k];
         const auto        &nc = cells[n];
         bool               in = true;
         for (unsigned int d = 0; d < dim; ++d)
@@ -426,6 +524,8 @@ namespace talus
     setup();
   }
 
+  template class CellCaches<2>;
+  template class CellCaches<3>;
   template class BackgroundGrid<2>;
   template class BackgroundGrid<3>;
 } // namespace talus

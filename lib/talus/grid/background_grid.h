@@ -12,6 +12,7 @@
 #include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/lac/la_parallel_vector.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -40,6 +41,9 @@ namespace talus
   };
 
   template <int dim>
+  class BackgroundGrid;
+
+  template <int dim>
   struct CellCache
   {
     static constexpr unsigned int n_vertices = 1u << dim;
@@ -48,9 +52,105 @@ namespace talus
     double                        inv_h[dim];
     /// Local (owned + ghost) index of DoF (vertex v, component c) at [v*dim + c].
     unsigned int dofs[n_vertices * dim];
-    /// Range of this cell's vertex neighbours in BackgroundGrid::neighbours.
-    unsigned int neighbours_begin = 0, neighbours_end = 0;
-    bool         locally_owned = false;
+    /// This cell's vertex neighbours (itself first), built on first use
+    /// (BackgroundGrid::neighbours_of): [0] their count, then their active
+    /// cell indices; nullptr until then.
+    mutable const unsigned int *neighbours    = nullptr;
+    bool                        locally_owned = false;
+    /// Set when the entry is filled (CellCaches); an artificial cell's entry
+    /// is filled with zeros.
+    bool filled = false;
+  };
+
+  /// The cell caches of all active cells, indexed by active_cell_index(), each
+  /// filled from the triangulation and the DoFHandler when first read. The
+  /// entries sit in one anonymous mapping (mmap) that the kernel backs page
+  /// by page on first write, so a grid much larger than its points holds in
+  /// memory only the pages of the cells the points (and their neighbours)
+  /// have used: on the 3D bench, whose grid is 4.8 x the block's box, about
+  /// a fifth of the 184 bytes per cell (docs/scaling.md). All-zero bytes are an
+  /// entry's unfilled state. An entry never moves: references stay valid
+  /// until the next BackgroundGrid::setup().
+  template <int dim>
+  class CellCaches
+  {
+  public:
+    CellCaches()                              = default;
+    CellCaches(const CellCaches &)            = delete;
+    CellCaches &operator=(const CellCaches &) = delete;
+    ~CellCaches() { release(); }
+
+    const CellCache<dim> &
+    operator[](const unsigned int c) const
+    {
+      const CellCache<dim> &e = entries[c];
+      if (__builtin_expect(!e.filled, 0))
+        fill(c);
+      return e;
+    }
+    std::size_t
+    size() const
+    {
+      return n;
+    }
+    /// Entries filled so far (memory accounting, tests).
+    std::size_t
+    n_filled() const
+    {
+      return n_filled_entries;
+    }
+
+    class const_iterator
+    {
+    public:
+      const_iterator(const CellCaches *a, const unsigned int i)
+          : array(a)
+          , index(i)
+      {
+      }
+      const CellCache<dim> &
+      operator*() const
+      {
+        return (*array)[index];
+      }
+      const_iterator &
+      operator++()
+      {
+        ++index;
+        return *this;
+      }
+      bool
+      operator!=(const const_iterator &o) const
+      {
+        return index != o.index;
+      }
+
+    private:
+      const CellCaches *array;
+      unsigned int      index;
+    };
+    /// Iterating over all entries fills all of them.
+    const_iterator
+    begin() const
+    {
+      return {this, 0};
+    }
+    const_iterator
+    end() const
+    {
+      return {this, static_cast<unsigned int>(n)};
+    }
+
+  private:
+    friend class BackgroundGrid<dim>;
+    void                   reset(const BackgroundGrid<dim> &grid, std::size_t n_cells);
+    void                   release();
+    [[gnu::noinline]] void fill(unsigned int c) const;
+
+    CellCache<dim>            *entries          = nullptr;
+    std::size_t                n                = 0;
+    const BackgroundGrid<dim> *owner            = nullptr;
+    mutable std::size_t        n_filled_entries = 0;
   };
 
   /// Stencil data of the quadratic B-spline kernel (shape/bspline2.h) for one
@@ -116,6 +216,12 @@ namespace talus
       v.reinit(partitioner);
     }
 
+    /// Whether cell c is locally owned, and (if so) its box: the lower corner
+    /// and the edge lengths, the values its cache entry holds, read from the
+    /// triangulation without filling the entry (a loop over all cells, such as
+    /// the seeding, would otherwise fill the caches of cells no point uses).
+    bool owned_cell_box(unsigned int c, double (&lower)[dim], double (&h)[dim]) const;
+
     /// Index of the cell (owned, containing x) among cell `c` and its vertex
     /// neighbours; on success also writes the reference coordinates. Returns
     /// numbers::invalid_unsigned_int if x is in none of them or the containing
@@ -176,10 +282,39 @@ namespace talus
     dealii::IndexSet                                           owned_dofs, relevant_dofs;
     std::shared_ptr<const dealii::Utilities::MPI::Partitioner> partitioner;
 
-    /// Indexed by active_cell_index().
-    std::vector<CellCache<dim>>                                            cells;
-    std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_iterators;
-    std::vector<unsigned int>                                              neighbours;
+    /// Indexed by active_cell_index(), filled on first read.
+    CellCaches<dim> cells;
+
+    /// The triangulation's iterator of cell c (active_cell_index), tria.end()
+    /// for an artificial cell. Made from its level and index on the level,
+    /// packed in 4 bytes per cell (a vector of iterators cost 16).
+    typename dealii::Triangulation<dim>::active_cell_iterator
+    cell_iterator(const unsigned int c) const
+    {
+      const std::uint32_t li = level_index[c];
+      return li == artificial ? tria.end()
+                              : typename dealii::Triangulation<dim>::active_cell_iterator(
+                                  &tria, static_cast<int>(li >> index_bits), static_cast<int>(li & index_mask));
+    }
+
+    /// The vertex neighbours of non-artificial cell c, itself first (on a grid
+    /// without hanging nodes the cells reached by at most one face step along
+    /// each axis): [0] their count, [1..] their active cell indices. Built on
+    /// first use and kept until the next setup(): only the cells whose points
+    /// leave them (and the B-spline patches) ask, so a grid much larger than
+    /// its points does not hold the lists of all its cells (3^dim indices each).
+    const unsigned int *
+    neighbours_of(const unsigned int c) const
+    {
+      const unsigned int *nb = cells[c].neighbours;
+      return nb != nullptr ? nb : build_neighbours(c);
+    }
+    /// Number of cells whose neighbour lists are built (memory accounting, tests).
+    std::size_t
+    n_neighbour_lists() const
+    {
+      return n_lists;
+    }
 
     /// Filled by setup_bspline_patches(): the box, one patch per locally owned
     /// cell, and per active cell the index of its patch (invalid if not owned).
@@ -188,6 +323,22 @@ namespace talus
     std::vector<unsigned int>      patch_of_cell;
 
   private:
-    double global_min_h = 0;
+    friend class CellCaches<dim>;
+    /// Per active cell: its level (top 5 bits) and index on the level (27 bits);
+    /// `artificial` for an artificial cell.
+    static constexpr unsigned int  index_bits = 27;
+    static constexpr std::uint32_t index_mask = (std::uint32_t(1) << index_bits) - 1;
+    static constexpr std::uint32_t artificial = ~std::uint32_t(0);
+    std::vector<std::uint32_t>     level_index;
+    /// Fill cell c's cache entry (CellCaches::fill).
+    void fill_cache(unsigned int c, CellCache<dim> &cc) const;
+
+    double                                global_min_h = 0;
+    [[gnu::noinline]] const unsigned int *build_neighbours(const unsigned int c) const;
+    /// Storage of the neighbour lists: fixed-size chunks, so that a list once
+    /// built never moves (CellCache::neighbours points into it) and growing
+    /// never copies what is there.
+    mutable std::vector<std::unique_ptr<unsigned int[]>> neighbour_chunks;
+    mutable std::size_t                                  chunk_used = 0, n_lists = 0;
   };
 } // namespace talus

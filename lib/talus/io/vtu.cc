@@ -56,113 +56,143 @@ namespace talus::io
       return first == 1;
     }
 
-    /// A block of the appended data: its XML attributes and its bytes.
+    /// A block of the appended data: its XML attributes, the bytes per point
+    /// and its offset in the appended data (its byte count, then its bytes).
     struct Block
     {
       std::string   attributes; ///< type, Name, NumberOfComponents
-      const char   *data;
-      std::uint64_t bytes;
+      std::uint64_t bytes_per_point;
+      std::uint64_t offset = 0;
     };
-
-    template <typename T>
-    Block
-    block_of(const std::string &attributes, const std::vector<T> &v)
-    {
-      return {attributes, reinterpret_cast<const char *>(v.data()), std::uint64_t(v.size() * sizeof(T))};
-    }
   } // namespace
 
   std::string
-  write_points_vtu(const std::vector<float> &points, const std::vector<VtuPointArray> &arrays, const double time,
-                   const std::string &directory, const std::string &base, const unsigned int counter, MPI_Comm comm)
+  write_points_vtu(const std::uint64_t n, const std::vector<VtuPointArray> &arrays, const VtuChunkFill &fill,
+                   const double time, const std::string &directory, const std::string &base, const unsigned int counter,
+                   MPI_Comm comm, const std::uint64_t chunk)
   {
-    const unsigned int  rank   = dealii::Utilities::MPI::this_mpi_process(comm);
-    const unsigned int  n_rank = dealii::Utilities::MPI::n_mpi_processes(comm);
-    const std::string   stem   = base + "_" + dealii::Utilities::int_to_string(counter, 4);
-    const std::uint64_t n      = points.size() / 3;
-    if (points.size() != 3 * n)
-      throw std::logic_error("write_points_vtu: the coordinates are not 3 per point");
+    const unsigned int rank   = dealii::Utilities::MPI::this_mpi_process(comm);
+    const unsigned int n_rank = dealii::Utilities::MPI::n_mpi_processes(comm);
+    const std::string  stem   = base + "_" + dealii::Utilities::int_to_string(counter, 4);
+    if (chunk == 0)
+      throw std::logic_error("write_points_vtu: chunk of zero points");
     const auto type_of = [](const VtuPointArray &a) { return a.integer ? "UInt64" : "Float32"; };
-    for (const auto &a : arrays)
-      if ((a.integer ? a.u64.size() : a.f32.size()) != n * a.n_components)
-        throw std::logic_error("write_points_vtu: array '" + a.name + "' does not hold " +
-                               std::to_string(a.n_components) + " values per point");
 
     // one vertex cell per point: connectivity i, offsets i + 1, type 1 (VTK_VERTEX);
     // Int32 unless a piece has 2^31 points or more
-    const bool                small = n < std::uint64_t(std::numeric_limits<std::int32_t>::max());
-    std::vector<std::int32_t> conn32, off32;
-    std::vector<std::int64_t> conn64, off64;
-    if (small)
-      {
-        conn32.resize(n);
-        off32.resize(n);
-        for (std::uint64_t i = 0; i < n; ++i)
-          {
-            conn32[i] = std::int32_t(i);
-            off32[i]  = std::int32_t(i + 1);
-          }
-      }
-    else
-      {
-        conn64.resize(n);
-        off64.resize(n);
-        for (std::uint64_t i = 0; i < n; ++i)
-          {
-            conn64[i] = std::int64_t(i);
-            off64[i]  = std::int64_t(i + 1);
-          }
-      }
-    const std::vector<std::uint8_t> types(n, 1);
+    const bool small = n < std::uint64_t(std::numeric_limits<std::int32_t>::max());
 
-    std::vector<Block> point_data;
+    // the blocks in file order: the point data, the points, the cells
+    std::vector<Block> blocks;
     for (const auto &a : arrays)
-      {
-        const std::string attr = std::string("type=\"") + type_of(a) + "\" Name=\"" + a.name +
-                                 "\" NumberOfComponents=\"" + std::to_string(a.n_components) + "\"";
-        point_data.push_back(a.integer ? block_of(attr, a.u64) : block_of(attr, a.f32));
-      }
-    const Block pts  = block_of("type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\"", points);
-    const Block conn = small ? block_of("type=\"Int32\" Name=\"connectivity\"", conn32)
-                             : block_of("type=\"Int64\" Name=\"connectivity\"", conn64);
-    const Block off =
-      small ? block_of("type=\"Int32\" Name=\"offsets\"", off32) : block_of("type=\"Int64\" Name=\"offsets\"", off64);
-    const Block typ = block_of("type=\"UInt8\" Name=\"types\"", types);
+      blocks.push_back({std::string("type=\"") + type_of(a) + "\" Name=\"" + a.name + "\" NumberOfComponents=\"" +
+                          std::to_string(a.n_components) + "\"",
+                        a.n_components * (a.integer ? sizeof(std::uint64_t) : sizeof(float))});
+    const std::size_t pts = blocks.size();
+    blocks.push_back({"type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\"", 3 * sizeof(float)});
+    const std::size_t conn = blocks.size();
+    blocks.push_back({small ? "type=\"Int32\" Name=\"connectivity\"" : "type=\"Int64\" Name=\"connectivity\"",
+                      small ? sizeof(std::int32_t) : sizeof(std::int64_t)});
+    blocks.push_back({small ? "type=\"Int32\" Name=\"offsets\"" : "type=\"Int64\" Name=\"offsets\"",
+                      small ? sizeof(std::int32_t) : sizeof(std::int64_t)});
+    blocks.push_back({"type=\"UInt8\" Name=\"types\"", sizeof(std::uint8_t)});
 
     const char *const  order = host_is_little_endian() ? "LittleEndian" : "BigEndian";
     std::ostringstream xml;
     std::uint64_t      offset = 0;
-    std::vector<Block> all;
-    const auto         entry = [&](const Block &b) {
+    const auto         entry  = [&](Block &b) {
       xml << "        <DataArray " << b.attributes << " format=\"appended\" offset=\"" << offset << "\"/>\n";
-      offset += sizeof(std::uint64_t) + b.bytes;
-      all.push_back(b);
+      b.offset = offset;
+      offset += sizeof(std::uint64_t) + n * b.bytes_per_point;
     };
     xml << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"" << order
         << "\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n"
         << "      <DataArray type=\"Float64\" Name=\"TIME\" NumberOfTuples=\"1\" format=\"ascii\">"
         << std::setprecision(17) << time << "</DataArray>\n    </FieldData>\n"
         << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n << "\">\n      <PointData>\n";
-    for (const auto &b : point_data)
-      entry(b);
+    for (std::size_t k = 0; k < pts; ++k)
+      entry(blocks[k]);
     xml << "      </PointData>\n      <Points>\n";
-    entry(pts);
+    entry(blocks[pts]);
     xml << "      </Points>\n      <Cells>\n";
-    entry(conn);
-    entry(off);
-    entry(typ);
+    for (std::size_t k = conn; k < blocks.size(); ++k)
+      entry(blocks[k]);
     xml << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n_";
     {
       AtomicFile f(directory + "/" + stem + "." + std::to_string(rank) + ".vtu");
       auto      &s    = f.stream();
       const auto head = xml.str();
       s.write(head.data(), std::streamsize(head.size()));
-      // each block: its byte count, then its bytes in one write
-      for (const auto &b : all)
+      const std::streamoff data_start = std::streamoff(head.size());
+      // each block: its byte count, then its bytes, written chunk by chunk at their place
+      for (const Block &b : blocks)
         {
-          s.write(reinterpret_cast<const char *>(&b.bytes), sizeof(b.bytes));
-          s.write(b.data, std::streamsize(b.bytes));
+          const std::uint64_t bytes = n * b.bytes_per_point;
+          s.seekp(data_start + std::streamoff(b.offset));
+          s.write(reinterpret_cast<const char *>(&bytes), sizeof(bytes));
         }
+      std::vector<VtuPointArray> buffers(arrays.size());
+      for (std::size_t k = 0; k < arrays.size(); ++k)
+        {
+          buffers[k].name         = arrays[k].name;
+          buffers[k].n_components = arrays[k].n_components;
+          buffers[k].integer      = arrays[k].integer;
+        }
+      std::vector<float>        points;
+      std::vector<std::int32_t> i32;
+      std::vector<std::int64_t> i64;
+      std::vector<std::uint8_t> types;
+      const auto put = [&](const Block &b, const std::uint64_t first, const void *data, const std::uint64_t count) {
+        s.seekp(data_start + std::streamoff(b.offset + sizeof(std::uint64_t) + first * b.bytes_per_point));
+        s.write(static_cast<const char *>(data), std::streamsize(count * b.bytes_per_point));
+      };
+      for (std::uint64_t first = 0; first < n; first += chunk)
+        {
+          const std::uint64_t count = std::min(chunk, n - first);
+          points.assign(3 * count, 0.0f);
+          for (auto &a : buffers)
+            {
+              if (a.integer)
+                a.u64.assign(count * a.n_components, 0);
+              else
+                a.f32.assign(count * a.n_components, 0.0f);
+            }
+          fill(first, count, points, buffers);
+          for (std::size_t k = 0; k < buffers.size(); ++k)
+            {
+              const auto &a = buffers[k];
+              if ((a.integer ? a.u64.size() : a.f32.size()) != count * a.n_components)
+                throw std::logic_error("write_points_vtu: array '" + a.name + "' does not hold " +
+                                       std::to_string(a.n_components) + " values per point");
+              put(blocks[k], first, a.integer ? static_cast<const void *>(a.u64.data()) : a.f32.data(), count);
+            }
+          if (points.size() != 3 * count)
+            throw std::logic_error("write_points_vtu: the coordinates are not 3 per point");
+          put(blocks[pts], first, points.data(), count);
+          if (small)
+            {
+              i32.resize(count);
+              for (std::uint64_t i = 0; i < count; ++i)
+                i32[i] = std::int32_t(first + i);
+              put(blocks[conn], first, i32.data(), count);
+              for (std::uint64_t i = 0; i < count; ++i)
+                i32[i] = std::int32_t(first + i + 1);
+              put(blocks[conn + 1], first, i32.data(), count);
+            }
+          else
+            {
+              i64.resize(count);
+              for (std::uint64_t i = 0; i < count; ++i)
+                i64[i] = std::int64_t(first + i);
+              put(blocks[conn], first, i64.data(), count);
+              for (std::uint64_t i = 0; i < count; ++i)
+                i64[i] = std::int64_t(first + i + 1);
+              put(blocks[conn + 1], first, i64.data(), count);
+            }
+          types.assign(count, 1);
+          put(blocks[conn + 2], first, types.data(), count);
+        }
+      s.seekp(data_start + std::streamoff(offset));
       s << "\n  </AppendedData>\n</VTKFile>\n";
       f.commit();
     }
@@ -172,8 +202,8 @@ namespace talus::io
         auto      &s = f.stream();
         s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"" << order
           << "\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n    <PPointData>\n";
-        for (const auto &b : point_data)
-          s << "      <PDataArray " << b.attributes << "/>\n";
+        for (std::size_t k = 0; k < pts; ++k)
+          s << "      <PDataArray " << blocks[k].attributes << "/>\n";
         s << "    </PPointData>\n    <PPoints>\n      <PDataArray type=\"Float32\" NumberOfComponents=\"3\"/>\n"
           << "    </PPoints>\n";
         for (unsigned int r = 0; r < n_rank; ++r)

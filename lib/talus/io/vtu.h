@@ -11,6 +11,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,13 +41,25 @@ namespace talus::io
     std::vector<std::uint64_t> u64;
   };
 
-  /// This rank's points (3 coordinates per point, Float32) and arrays, written
-  /// as <directory>/<base>_<counter>.<rank>.vtu (raw appended data, the time as
-  /// FieldData TIME) and, by rank 0, the record <base>_<counter>.pvtu. Every
-  /// rank passes the same array names, components and types; a rank without
-  /// points writes a valid empty piece. Collective (every rank must call it;
-  /// no data is exchanged). Returns the PVTU file name.
-  std::string write_points_vtu(const std::vector<float> &points, const std::vector<VtuPointArray> &arrays, double time,
-                               const std::string &directory, const std::string &base, unsigned int counter,
-                               MPI_Comm comm);
+  /// Fills the buffers of one chunk of points: fill(first, count, points,
+  /// arrays) writes the coordinates (3 per point) of points first ...
+  /// first + count - 1 into `points` (3 x count floats) and their values into
+  /// the arrays (count x n_components each, f32 or u64 as declared). Called for
+  /// consecutive chunks in point order.
+  using VtuChunkFill = std::function<void(std::uint64_t first, std::uint64_t count, std::vector<float> &points,
+                                          std::vector<VtuPointArray> &arrays)>;
+
+  /// This rank's n points (3 coordinates per point, Float32) and the arrays
+  /// declared by `arrays` (name, components, type; their data are ignored),
+  /// written as <directory>/<base>_<counter>.<rank>.vtu (raw appended data, the
+  /// time as FieldData TIME) and, by rank 0, the record <base>_<counter>.pvtu.
+  /// The values come from `fill`, `chunk` points at a time, each chunk written
+  /// to its place in every array's block: the memory held is one chunk
+  /// (~93 bytes per 3D point), not the whole snapshot. Every rank passes the
+  /// same array names, components and types; a rank without points writes a
+  /// valid empty piece. Collective (every rank must call it; no data is
+  /// exchanged). Returns the PVTU file name.
+  std::string write_points_vtu(std::uint64_t n, const std::vector<VtuPointArray> &arrays, const VtuChunkFill &fill,
+                               double time, const std::string &directory, const std::string &base, unsigned int counter,
+                               MPI_Comm comm, std::uint64_t chunk = 65536);
 } // namespace talus::io

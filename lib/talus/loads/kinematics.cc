@@ -135,7 +135,7 @@ namespace talus::loads
                   }
                 else
                   {
-                    const auto &cell = grid.cell_iterators[c];
+                    const auto &cell = grid.cell_iterator(c);
                     for (unsigned int f = 0; f < dealii::GeometryInfo<dim>::faces_per_cell && !hit; ++f)
                       if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == pv.boundary)
                         for (unsigned int i = 0; i < dealii::GeometryInfo<dim>::vertices_per_face; ++i)

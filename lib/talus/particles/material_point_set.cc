@@ -99,7 +99,7 @@ namespace talus
     const unsigned int n_props      = handler.n_properties_per_particle();
     auto               insert_group = [&](const unsigned int k) {
       for (const auto &q : points[k])
-        handler.insert_particle(q.x, q.xi, q.id, grid.cell_iterators[cell_order[k]],
+        handler.insert_particle(q.x, q.xi, q.id, grid.cell_iterator(cell_order[k]),
                                               dealii::ArrayView<const double>(q.properties, n_props));
     };
     for (std::size_t k = 0; k < cell_order.size(); ++k)
@@ -114,7 +114,7 @@ namespace talus
     std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> in_cell;
     for (std::size_t k = 0; k < cell_order.size(); ++k)
       {
-        const auto range = handler.particles_in_cell(grid.cell_iterators[cell_order[k]]);
+        const auto range = handler.particles_in_cell(grid.cell_iterator(cell_order[k]));
         in_cell.clear();
         for (auto it = range.begin(); it != range.end(); ++it)
           in_cell.push_back(it);

@@ -241,8 +241,11 @@ namespace talus
 
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
       {
-        const auto &cc = grid.cells[c];
-        if (!cc.locally_owned)
+        struct
+        {
+          double lower[dim], h[dim];
+        } cc;
+        if (!grid.owned_cell_box(c, cc.lower, cc.h))
           continue;
         double cell_volume = 1.0;
         for (unsigned int d = 0; d < dim; ++d)
@@ -297,7 +300,7 @@ namespace talus
         for (unsigned int d = 0; d < dim; ++d)
           props[layout.velocity + d] = v[d];
         result.volume_per_body[p.body] += p.volume;
-        particles.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
+        particles.insert_particle(p.x, p.xi, offset + i, grid.cell_iterator(p.cell),
                                   dealii::ArrayView<const double>(props.data(), props.size()));
       }
     particles.update_cached_numbers();
@@ -482,7 +485,7 @@ namespace talus
         if (!t.stress.empty())
           for (unsigned int s = 0; s < t.n_stress(); ++s)
             props[layout.stress + s] = t.stress[i * t.n_stress() + s];
-        particles.insert_particle(x, xi, first_id + k, grid.cell_iterators[cell_of[k]],
+        particles.insert_particle(x, xi, first_id + k, grid.cell_iterator(cell_of[k]),
                                   dealii::ArrayView<const double>(props.data(), props.size()));
       }
     particles.update_cached_numbers();
@@ -546,7 +549,7 @@ namespace talus
             cell_changes.push_back({pending[k].cell, false});
             if (moved && !pending[k].added)
               moved(n, xi, props.data());
-            particles.insert_particle(x, xi, id, grid.cell_iterators[n],
+            particles.insert_particle(x, xi, id, grid.cell_iterator(n),
                                       dealii::ArrayView<const double>(props.data(), n_props));
             cell_changes.push_back({n, true});
             ++n_local_moves;
@@ -554,7 +557,7 @@ namespace talus
           }
         // a neighbour cell of another rank: send the point to its owner
         // (point to point, no collective sort)
-        const auto &cell = grid.cell_iterators[n];
+        const auto &cell = grid.cell_iterator(n);
         auto       &buf  = outgoing[cell->subdomain_id()];
         for (const unsigned int w : cell->id().template to_binary<dim>())
           buf.push_back(w);
@@ -603,7 +606,7 @@ namespace talus
         if (moved)
           moved(m.cell, m.xi, props.data() + m.prop_offset);
         cell_changes.push_back({m.cell, true});
-        particles.insert_particle(m.x, m.xi, m.id, grid.cell_iterators[m.cell],
+        particles.insert_particle(m.x, m.xi, m.id, grid.cell_iterator(m.cell),
                                   dealii::ArrayView<const double>(props.data() + m.prop_offset, n_props));
       }
     stats.moved_locally += n_local_moves + n_sent;
@@ -646,45 +649,167 @@ namespace talus
   {
     // Why not deal.II's sort: sort_particles_into_subdomains_and_cells() locates
     // every point again through the mapping and walks all active cells; it cost
-    // about 400 ns per point on the 3D bench, this about a quarter of that.
+    // about 400 ns per point on the 3D bench. Why not a copy of all points,
+    // clear_particles() and insertion in order (the rebuild until 2026-12-07): the
+    // copy (184 bytes per 3D point) sat beside deal.II's pool and set the peak
+    // memory of the bench.
+    //
+    // In place instead: deal.II 9.4's pool hands the slot freed last to the next
+    // insertion (PropertyPool::register_particle takes the back of its free list),
+    // so removing the points that hold slots a, b (in that order) and inserting
+    // two points at once gives the first one b and the second a. Going through
+    // the cell groups in active-cell order, each group's target slots are the next
+    // n occupied slots; the group's points and the points of other cells that
+    // hold those slots are copied out (a few points), removed (the holders of the
+    // targets from the last to the first, then the group's points outside the
+    // targets), and inserted again: the others first (they take the slots the
+    // group leaves), then the group in its old order (they take the targets in
+    // increasing order). The set of occupied slots never changes, so a pool
+    // with free slots (points sent away or lost) keeps them as gaps.
+    using Handle               = typename dealii::Particles::PropertyPool<dim>::Handle;
+    auto              &pool    = particles.get_property_pool();
     const unsigned int n_props = particles.n_properties_per_particle();
+    const unsigned int invalid = dealii::numbers::invalid_unsigned_int;
+    const std::size_t  n_slots = pool.n_slots();
+
+    // per slot: the cell of its point (invalid: a free slot) and the slot the
+    // point goes to; the cell groups in walk order
+    std::vector<unsigned int> cell_of(n_slots, invalid);
+    std::vector<Handle>       dest(n_slots, invalid);
     struct Group
     {
-      unsigned int cell;
-      std::size_t  first, count;
+      unsigned int cell, count;
+      std::size_t  offset; ///< index of its first target among the occupied slots
     };
-    std::vector<Group>                         groups;
-    std::vector<dealii::Point<dim>>            x, xi;
-    std::vector<dealii::types::particle_index> id;
-    std::vector<double>                        p;
-    const std::size_t                          n = particles.n_locally_owned_particles();
-    x.reserve(n);
-    xi.reserve(n);
-    id.reserve(n);
-    p.reserve(n * n_props);
+    std::vector<Group> groups;
+    std::size_t        n_particles = 0;
     for (auto it = particles.begin(); it != particles.end(); ++it)
       {
         const unsigned int c = it->get_surrounding_cell()->active_cell_index();
         if (groups.empty() || groups.back().cell != c)
-          groups.push_back({c, x.size(), 0});
+          groups.push_back({c, 0, 0});
         ++groups.back().count;
-        x.push_back(it->get_location());
-        xi.push_back(it->get_reference_location());
-        id.push_back(it->get_id());
-        const auto P = it->get_properties();
-        p.insert(p.end(), P.begin(), P.end());
+        cell_of[it->get_local_index()] = c;
+        ++n_particles;
       }
+    // the occupied slots in increasing order (without free slots: 0, 1, 2, ...)
+    std::vector<Handle> occupied;
+    if (n_particles != n_slots)
+      for (std::size_t s = 0; s < n_slots; ++s)
+        if (cell_of[s] != invalid)
+          occupied.push_back(s);
+    const auto target = [&](const std::size_t k) -> Handle { return occupied.empty() ? Handle(k) : occupied[k]; };
     // deal.II's update_cached_numbers() keeps the cell groups in active-cell
-    // order, so inserting in that order makes the walks read memory forwards
-    std::sort(groups.begin(), groups.end(), [](const Group &a, const Group &b) { return a.cell < b.cell; });
-    particles.clear_particles();
-    particles.reserve(x.size());
-    for (const Group &g : groups)
+    // order, so the targets go to the groups in that order
+    std::vector<unsigned int> order(groups.size());
+    for (unsigned int g = 0; g < groups.size(); ++g)
+      order[g] = g;
+    std::sort(order.begin(), order.end(),
+              [&](const unsigned int a, const unsigned int b) { return groups[a].cell < groups[b].cell; });
+    std::size_t k = 0;
+    for (const unsigned int g : order)
       {
-        const auto &cell = grid.cell_iterators[g.cell];
-        for (std::size_t k = g.first; k < g.first + g.count; ++k)
-          particles.insert_particle(x[k], xi[k], id[k], cell,
-                                    dealii::ArrayView<const double>(p.data() + k * n_props, n_props));
+        groups[g].offset = k;
+        k += groups[g].count;
+      }
+    {
+      auto it = particles.begin();
+      for (const Group &g : groups)
+        for (unsigned int j = 0; j < g.count; ++j, ++it)
+          dest[it->get_local_index()] = target(g.offset + j);
+    }
+
+    // scratch for the points of one group and the others that hold its targets
+    struct Held
+    {
+      Handle                        slot, dest;
+      unsigned int                  cell;
+      dealii::Point<dim>            x, xi;
+      dealii::types::particle_index id;
+    };
+    std::vector<Held>   mine, others;
+    std::vector<double> mine_p, others_p;
+    const auto          copy_out = [&](std::vector<Held> &to, std::vector<double> &to_p, const Handle s) {
+      to.push_back({s, dest[s], cell_of[s], pool.get_location(s), pool.get_reference_location(s), pool.get_id(s)});
+      const auto P = pool.get_properties(s);
+      to_p.insert(to_p.end(), P.begin(), P.end());
+    };
+    const auto remove = [&](const unsigned int c, const Handle s) {
+      const auto range = particles.particles_in_cell(grid.cell_iterator(c));
+      for (auto it = range.begin(); it != range.end(); ++it)
+        if (it->get_local_index() == s)
+          {
+            particles.remove_particle(it);
+            return;
+          }
+      throw std::logic_error("Relocator::restore_memory_order: slot not found in its cell");
+    };
+    const auto insert = [&](const Held &h, const double *P) {
+      const auto   it = particles.insert_particle(h.x, h.xi, h.id, grid.cell_iterator(h.cell),
+                                                  dealii::ArrayView<const double>(P, n_props));
+      const Handle s  = it->get_local_index();
+      cell_of[s]      = h.cell;
+      dest[s]         = h.dest;
+      return s;
+    };
+
+    for (const unsigned int g : order)
+      {
+        const Group &G     = groups[g];
+        const Handle first = target(G.offset), last = target(G.offset + G.count - 1);
+        // the group's points by target (their old order in the cell)
+        mine.clear();
+        mine_p.clear();
+        bool in_place = true;
+        {
+          unsigned int j = 0;
+          for (const auto &pt : particles.particles_in_cell(grid.cell_iterator(G.cell)))
+            {
+              const Handle s = pt.get_local_index();
+              in_place       = in_place && s == target(G.offset + j) && dest[s] == s;
+              mine.push_back({s, dest[s], G.cell, {}, {}, 0});
+              ++j;
+            }
+        }
+        if (in_place)
+          continue;
+        std::sort(mine.begin(), mine.end(), [](const Held &a, const Held &b) { return a.dest < b.dest; });
+        for (Held &h : mine)
+          {
+            const Handle s = h.slot;
+            h.x            = pool.get_location(s);
+            h.xi           = pool.get_reference_location(s);
+            h.id           = pool.get_id(s);
+            const auto P   = pool.get_properties(s);
+            mine_p.insert(mine_p.end(), P.begin(), P.end());
+          }
+        // the points of other cells on the targets
+        others.clear();
+        others_p.clear();
+        for (unsigned int j = 0; j < G.count; ++j)
+          {
+            const Handle t = target(G.offset + j);
+            if (cell_of[t] != G.cell)
+              copy_out(others, others_p, t);
+          }
+        // removals: the holders of the targets from the last one to the first,
+        // then the group's points outside the targets
+        for (unsigned int j = G.count; j-- > 0;)
+          {
+            const Handle t = target(G.offset + j);
+            remove(cell_of[t], t);
+          }
+        for (const Held &h : mine)
+          if (h.slot < first || h.slot > last)
+            remove(G.cell, h.slot);
+        // insertions: the others take the slots the group left, the group its targets
+        for (std::size_t i = 0; i < others.size(); ++i)
+          insert(others[i], others_p.data() + i * n_props);
+        // (a lone group with free slots: removing all its points emptied the pool,
+        // which then starts again at slot 0: memory order too)
+        for (std::size_t j = 0; j < mine.size(); ++j)
+          if (insert(mine[j], mine_p.data() + j * n_props) != mine[j].dest && groups.size() > 1)
+            throw std::logic_error("Relocator::restore_memory_order: deal.II's pool did not hand out the freed slot");
       }
     particles.update_cached_numbers();
   }

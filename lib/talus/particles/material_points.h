@@ -306,17 +306,19 @@ namespace talus
       return moved_since_sort;
     }
 
-  private:
-    /// Rebuild the handler's storage in memory order: every point is copied out
-    /// with its cell groups taken in active-cell order, the handler is cleared
-    /// (deal.II 9.4's pool then hands out slots 0, 1, 2, ... again) and the
-    /// points are inserted back into their cells in that order. Each point keeps
-    /// its cell, location, reference location, id and properties bit for bit:
+    /// Rebuild the handler's storage in memory order: afterwards the walk
+    /// (cell groups in active-cell order) reads the pool's occupied slots in
+    /// increasing order. Each point keeps its cell, its place among its cell's
+    /// points, its location, reference location, id and properties bit for bit:
     /// unlike deal.II's sort_particles_into_subdomains_and_cells() there is no
     /// point location, no mapping and no communication except one collective
-    /// update of the handler's counts. Collective.
+    /// update of the handler's counts. In place: the points are moved slot by
+    /// slot through deal.II's free list (a few points copied at a time, no copy
+    /// of all points beside the pool); a pool with free slots keeps them as gaps.
+    /// Collective.
     void restore_memory_order();
 
+  private:
     struct Pending
     {
       typename dealii::Particles::ParticleHandler<dim>::particle_iterator it;

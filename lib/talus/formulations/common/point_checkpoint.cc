@@ -266,7 +266,7 @@ namespace talus
         std::vector<std::vector<typename MaterialPointSet<dim>::SavedPoint>> groups;
         for (std::size_t i = 0; i < ids.size(); ++i)
           {
-            if (cells[i] >= grid.cell_iterators.size() || !grid.cell_iterators[cells[i]]->is_locally_owned())
+            if (cells[i] >= grid.cells.size() || !grid.cell_iterator(cells[i])->is_locally_owned())
               throw InputError(where + ": particle " + std::to_string(ids[i]) +
                                " refers to a cell this rank does not own (grid partition differs)");
             if (i == 0 || cells[i] != cells[i - 1])

@@ -24,7 +24,6 @@ namespace talus
     std::vector<io::VtuPointArray> arrays(1);
     arrays[0].name    = "id";
     arrays[0].integer = true;
-    arrays[0].u64.reserve(n);
     std::vector<std::pair<unsigned int, unsigned int>> slot(names.size()); // property -> (array, component)
     for (unsigned int k = 0; k < names.size();)
       {
@@ -36,35 +35,38 @@ namespace talus
         io::VtuPointArray a;
         a.name         = names[k];
         a.n_components = interp[k] == component_is_part_of_vector ? 3 : 1;
-        a.f32.assign(n * a.n_components, 0.0f);
         for (unsigned int c = 0; c < size; ++c)
           slot[k + c] = {static_cast<unsigned int>(arrays.size()), c};
         arrays.push_back(std::move(a));
         k += size;
       }
-    // property k of point i goes to first[k][i * stride[k]]
+    // one pass over the points, a chunk at a time (the writer holds one chunk,
+    // not the whole snapshot: docs/scaling.md, "Peak memory")
+    auto                      it = set.handler.begin();
     std::vector<float *>      first(slot.size());
     std::vector<unsigned int> stride(slot.size());
-    for (unsigned int k = 0; k < slot.size(); ++k)
-      {
-        auto &a   = arrays[slot[k].first];
-        first[k]  = a.f32.data() + slot[k].second;
-        stride[k] = a.n_components;
-      }
-    std::vector<float> points(3 * n, 0.0f);
-    std::size_t        i = 0;
-    for (const auto &pt : set.handler)
-      {
-        arrays[0].u64.push_back(pt.get_id());
-        const auto x = pt.get_location();
-        for (unsigned int d = 0; d < dim; ++d)
-          points[3 * i + d] = static_cast<float>(x[d]);
-        const auto P = pt.get_properties();
-        for (unsigned int k = 0; k < first.size(); ++k)
-          first[k][i * stride[k]] = static_cast<float>(P[k]);
-        ++i;
-      }
-    const std::string file = io::write_points_vtu(points, arrays, time, directory, name, counter, comm);
+    const auto                fill = [&](const std::uint64_t, const std::uint64_t count, std::vector<float> &points,
+                          std::vector<io::VtuPointArray> &buffers) {
+      // property k of point i goes to first[k][i * stride[k]]
+      for (unsigned int k = 0; k < slot.size(); ++k)
+        {
+          auto &a   = buffers[slot[k].first];
+          first[k]  = a.f32.data() + slot[k].second;
+          stride[k] = a.n_components;
+        }
+      auto &ids = buffers[0].u64;
+      for (std::uint64_t i = 0; i < count; ++i, ++it)
+        {
+          ids[i]       = it->get_id();
+          const auto x = it->get_location();
+          for (unsigned int d = 0; d < dim; ++d)
+            points[3 * i + d] = static_cast<float>(x[d]);
+          const auto P = it->get_properties();
+          for (unsigned int k = 0; k < first.size(); ++k)
+            first[k][i * stride[k]] = static_cast<float>(P[k]);
+        }
+    };
+    const std::string file = io::write_points_vtu(n, arrays, fill, time, directory, name, counter, comm);
     records.emplace_back(time, file);
     if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       io::write_pvd(directory + "/" + name + ".pvd", records);

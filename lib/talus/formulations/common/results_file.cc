@@ -169,7 +169,7 @@ namespace talus
         std::vector<double>        X, m, u, vel, sig;
         for (unsigned int c = 0; c < grid.cells.size(); ++c)
           {
-            if (grid.cell_iterators[c] == grid.tria.end())
+            if (grid.cell_iterator(c) == grid.tria.end())
               continue;
             const auto &cc = grid.cells[c];
             for (unsigned int v = 0; v < nv; ++v)
@@ -181,7 +181,7 @@ namespace talus
                 const double mi = w[0].local_element(i0), Vi = w[0].local_element(cc.dofs[v * dim + 1]);
                 for (unsigned int d = 0; d < dim; ++d)
                   {
-                    X.push_back(grid.cell_iterators[c]->vertex(v)[d]);
+                    X.push_back(grid.cell_iterator(c)->vertex(v)[d]);
                     const unsigned int i = cc.dofs[v * dim + d];
                     u.push_back(mi > 0 ? w[1].local_element(i) / mi : 0.0);
                     vel.push_back(mi > 0 ? w[2].local_element(i) / mi : 0.0);

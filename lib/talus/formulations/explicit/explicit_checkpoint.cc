@@ -57,7 +57,7 @@ namespace talus::explicit_mpm
       std::vector<unsigned char>               seen(n_owned, 0);
       for (unsigned int c = 0; c < grid.cells.size(); ++c)
         {
-          if (grid.cell_iterators[c] == grid.tria.end()) // artificial: not cached
+          if (grid.cell_iterator(c) == grid.tria.end()) // artificial: not cached
             continue;
           for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
             for (unsigned int d = 0; d < dim; ++d)
@@ -66,7 +66,7 @@ namespace talus::explicit_mpm
                 if (i >= n_owned || seen[i])
                   continue;
                 seen[i]      = 1;
-                const auto x = grid.cell_iterators[c]->vertex(v);
+                const auto x = grid.cell_iterator(c)->vertex(v);
                 for (unsigned int e = 0; e < dim; ++e)
                   keys[i][e] = x[e];
                 keys[i][dim] = d;

@@ -28,10 +28,10 @@ namespace talus::explicit_mpm
     const auto &grid = s.grid;
     vertices.assign(grid.cells.size() * nv * dim, 0.0);
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
-      if (grid.cell_iterators[c] != grid.tria.end())
+      if (grid.cell_iterator(c) != grid.tria.end())
         for (unsigned int v = 0; v < nv; ++v)
           for (unsigned int d = 0; d < dim; ++d)
-            vertices[(c * nv + v) * dim + d] = grid.cell_iterators[c]->vertex(v)[d];
+            vertices[(c * nv + v) * dim + d] = grid.cell_iterator(c)->vertex(v)[d];
   }
 
   template <int dim>
@@ -108,7 +108,7 @@ namespace talus::explicit_mpm
             Kernel::evaluate(cell, xi, e);
             const double det = e.det;
             if (!(det > 0))
-              throw InputError("grid: cell " + grid.cell_iterators[c]->id().to_string() +
+              throw InputError("grid: cell " + grid.cell_iterator(c)->id().to_string() +
                                " is inverted or degenerate (det J = " + std::to_string(det) +
                                " at a Gauss point); numerics/integration = fem | ul-fem needs valid cells");
             Kernel::position(cell, e, x);
@@ -136,7 +136,7 @@ namespace talus::explicit_mpm
         for (unsigned int d = 0; d < dim; ++d)
           props[L::velocity + d] = v[d];
         result.volume_per_body[p.body] += p.volume;
-        s.points.handler.insert_particle(p.x, p.xi, offset + i, grid.cell_iterators[p.cell],
+        s.points.handler.insert_particle(p.x, p.xi, offset + i, grid.cell_iterator(p.cell),
                                          dealii::ArrayView<const double>(props.data(), props.size()));
       }
     s.points.handler.update_cached_numbers();

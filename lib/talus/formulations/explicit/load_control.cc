@@ -217,7 +217,7 @@ namespace talus::loads
         const auto &cc = s.grid.cells[c];
         if (!(cc.h[0] > 0) || current->friction_ids.empty())
           continue;
-        const auto &cell = s.grid.cell_iterators[c];
+        const auto &cell = s.grid.cell_iterator(c);
         for (unsigned int f = 0; f < dealii::GeometryInfo<dim>::faces_per_cell; ++f)
           {
             if (!cell->face(f)->at_boundary())

@@ -68,7 +68,7 @@ namespace talus
       {
         if (!grid.cells[c].locally_owned || !covered(c))
           continue;
-        const auto &cell = grid.cell_iterators[c];
+        const auto &cell = grid.cell_iterator(c);
         for (unsigned int f = 0; f < 2 * dim; ++f)
           {
             if (cell->at_boundary(f))

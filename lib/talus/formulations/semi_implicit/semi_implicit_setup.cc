@@ -38,7 +38,7 @@ namespace talus::semi_implicit
     component.assign(nl, 0);
     node_x.assign(nl, dealii::Point<dim>());
     for (unsigned int c = 0; c < grid.cells.size(); ++c)
-      if (grid.cell_iterators[c] != grid.tria.end()) // artificial cells carry no DoFs (their cache is zero)
+      if (grid.cell_iterator(c) != grid.tria.end()) // artificial cells carry no DoFs (their cache is zero)
         for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
           for (unsigned int d = 0; d < dim; ++d)
             {
