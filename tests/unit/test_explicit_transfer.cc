@@ -394,6 +394,16 @@ TEST(ExplicitTransfer, GridCachesOnlyNearPoints3D)
   const auto &grid = s.grid;
   EXPECT_GT(dealii::Utilities::MPI::sum(s.points.relocation_stats.moved_locally, MPI_COMM_WORLD), 0u)
     << "points must change cell";
+  // the walks and the kernels read the entries of the cells with points
+  // unchecked (CellCaches::filled_entry): all of them are filled, on 2 ranks
+  // also those of cells that got points from the other rank
+  bool all_filled = true;
+  for (const auto &pt : s.points.handler)
+    all_filled = all_filled && grid.cells.is_filled(pt.get_surrounding_cell()->active_cell_index());
+  for (const auto &ac : s.points.active_cells())
+    all_filled = all_filled && grid.cells.is_filled(ac.cell);
+  EXPECT_TRUE(all_filled) << "a cell with points has no filled cache entry";
+  EXPECT_TRUE(s.check_incremental_state().second);
   // every cell within one cell of a point may be filled, no other
   std::vector<char> near(grid.cells.size(), 0);
   for (const auto &pt : s.points.handler)

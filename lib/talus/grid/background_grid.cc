@@ -236,7 +236,8 @@ namespace talus
         cc.h[d]     = cell->vertex(nv - 1)[d] - p0[d];
         cc.inv_h[d] = 1.0 / cc.h[d];
       }
-    std::vector<dealii::types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
+    static thread_local std::vector<dealii::types::global_dof_index> dof_indices; // no allocation per entry
+    dof_indices.resize(fe.n_dofs_per_cell());
     cell->get_dof_indices(dof_indices);
     for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
       {
@@ -270,12 +271,20 @@ namespace talus
     // the cells reached from c by at most one face step along each axis, in the
     // order x, then y, then z (GridTools::vertex_to_cell_map with its std::sets
     // took ~40 s on a 786k-cell grid for all cells at once)
+    // Each step along an axis adds at most two cells per cell found so far: at
+    // most 3^dim cells. All on c's level: the cells of a lattice, each reached
+    // once; else (hanging nodes) a coarser cell may be reached twice.
     AssertThrow(cell_iterator(c) != tria.end(), dealii::ExcMessage("neighbours of an artificial cell"));
-    std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> set = {cell_iterator(c)};
+    constexpr unsigned int                                    max_set = dim == 2 ? 9 : 27;
+    typename dealii::Triangulation<dim>::active_cell_iterator set[max_set];
+    unsigned int                                              n_set = 0;
+    set[n_set++]                                                    = cell_iterator(c);
+    const int level                                                 = set[0]->level();
+    bool      one_level                                             = true;
     for (unsigned int d = 0; d < dim; ++d)
       {
-        const std::size_t n = set.size();
-        for (std::size_t k = 0; k < n; ++k)
+        const unsigned int n = n_set;
+        for (unsigned int k = 0; k < n; ++k)
           for (const unsigned int f : {2 * d, 2 * d + 1})
             {
               if (set[k]->at_boundary(f))
@@ -283,20 +292,21 @@ namespace talus
               const auto nbc = set[k]->neighbor(f);
               if (nbc->has_children() || nbc->is_artificial())
                 continue;
-              set.push_back(nbc);
+              one_level    = one_level && nbc->level() == level;
+              set[n_set++] = nbc;
             }
       }
-    unsigned int nb[64];
+    unsigned int nb[max_set];
     unsigned int count = 0;
-    for (const auto &x : set)
+    for (unsigned int k = 0; k < n_set; ++k)
       {
-        const unsigned int i = x->active_cell_index();
-        if (std::find(nb, nb + count, i) == nb + count)
-          {
-            AssertThrow(count < 64, dealii::ExcInternalError());
-            nb[count++] = i;
-          }
+        const unsigned int i = set[k]->active_cell_index();
+        if (one_level || std::find(nb, nb + count, i) == nb + count)
+          nb[count++] = i;
       }
+    // find_cell_near reads the entries of the listed cells unchecked
+    for (unsigned int k = 0; k < count; ++k)
+      cells.ensure_filled(nb[k]);
     constexpr std::size_t chunk_size = 1u << 16; // entries: 256 KB
     if (neighbour_chunks.empty() || chunk_used + count + 1 > chunk_size)
       {
@@ -486,15 +496,18 @@ namespace talus
     for (unsigned int k = 1; k <= nbs[0]; ++k)
       {
         const unsigned int n  = nbs[k];
-        const auto        &nc = cells[n];
-        bool               in = true;
-        for (unsigned int d = 0; d < dim; ++d)
+        const auto        &nc = cells.filled_entry(n); // build_neighbours filled them
+        // the first axis outside ends the test (xi is only meaningful for the
+        // cell returned: the callers do not read it when none is found)
+        unsigned int d = 0;
+        for (; d < dim; ++d)
           {
             const double r = (x[d] - nc.lower[d]) * nc.inv_h[d];
-            in             = in && (r >= 0.0) && (r <= 1.0);
-            xi[d]          = r;
+            if (!((r >= 0.0) && (r <= 1.0)))
+              break;
+            xi[d] = r;
           }
-        if (in)
+        if (d == dim)
           return n;
       }
     return dealii::numbers::invalid_unsigned_int;

@@ -88,6 +88,36 @@ namespace talus
         fill(c);
       return e;
     }
+    /// The entry of cell c, which must be filled already, without the check of
+    /// operator[]. The entries of the cells that hold points are filled:
+    /// MaterialPointSet::collect_active_cells and update_active_cells fill the
+    /// entries of the cells of the set's walk, the relocation the entry of
+    /// every cell it puts a point in, before anything walks them; building a
+    /// cell's neighbour list fills the entries of the cells in it (the cells
+    /// find_cell_near returns). So the walks, the kernels' cell() and
+    /// find_cell_near read entries this way: the check, inlined into the hot
+    /// loops, changed GCC's inlining of the update pass (+19 instructions per
+    /// point-step on the bench, docs/scaling.md). Checked in debug builds.
+    const CellCache<dim> &
+    filled_entry(const unsigned int c) const
+    {
+      Assert(entries[c].filled,
+             dealii::ExcMessage("CellCaches::filled_entry: the entry of cell " + std::to_string(c) + " is not filled"));
+      return entries[c];
+    }
+    /// Fill cell c's entry if it is not (operator[] without the read).
+    void
+    ensure_filled(const unsigned int c) const
+    {
+      if (!entries[c].filled)
+        fill(c);
+    }
+    /// Whether cell c's entry is filled (checks, tests).
+    bool
+    is_filled(const unsigned int c) const
+    {
+      return entries[c].filled;
+    }
     std::size_t
     size() const
     {
@@ -299,10 +329,11 @@ namespace talus
 
     /// The vertex neighbours of non-artificial cell c, itself first (on a grid
     /// without hanging nodes the cells reached by at most one face step along
-    /// each axis): [0] their count, [1..] their active cell indices. Built on
-    /// first use and kept until the next setup(): only the cells whose points
-    /// leave them (and the B-spline patches) ask, so a grid much larger than
-    /// its points does not hold the lists of all its cells (3^dim indices each).
+    /// each axis): [0] their count, [1..] their active cell indices (their cache
+    /// entries filled). Built on first use and kept until the next setup():
+    /// only the cells whose points leave them (and the B-spline patches) ask,
+    /// so a grid much larger than its points does not hold the lists of all its
+    /// cells (3^dim indices each).
     const unsigned int *
     neighbours_of(const unsigned int c) const
     {

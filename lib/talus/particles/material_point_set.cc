@@ -30,6 +30,7 @@ namespace talus
         for (; it != handler.end() && it->get_surrounding_cell() == cell; ++it)
           ++n;
         cells.push_back({cell->active_cell_index(), n});
+        grid.cells.ensure_filled(cells.back().cell); // the walks read it unchecked
       }
     count_in_cell.assign(grid.cells.size(), 0);
     cell_erased.assign(grid.cells.size(), 0);
@@ -63,7 +64,10 @@ namespace talus
             cell_erased[change.cell] = 1;
         }
       else if (count[change.cell]++ == 0)
-        cells.push_back({change.cell, 0});
+        {
+          cells.push_back({change.cell, 0});
+          grid.cells.ensure_filled(change.cell); // filled by the relocation already
+        }
     std::size_t out = 0;
     for (std::size_t i = 0; i < cells.size(); ++i)
       {
@@ -130,8 +134,12 @@ namespace talus
   MaterialPointSet<dim>::check_active_cells()
   {
     const auto kept = cells;
+    // every cell of the walk has its cache entry filled (the walks read it unchecked)
+    bool filled = true;
+    for (const auto &ac : kept)
+      filled = filled && grid.cells.is_filled(ac.cell);
     collect_active_cells();
-    bool same = kept.size() == cells.size();
+    bool same = filled && kept.size() == cells.size();
     for (std::size_t i = 0; same && i < kept.size(); ++i)
       same = kept[i].cell == cells[i].cell && kept[i].n_particles == cells[i].n_particles;
     return same;

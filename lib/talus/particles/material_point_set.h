@@ -59,7 +59,8 @@ namespace talus
     }
 
     /// Rebuild the cell list from the storage (after seeding, a deal.II sort,
-    /// a restart).
+    /// a restart). Fills the grid's cache entries of the listed cells (the
+    /// walks and the kernels read them unchecked: CellCaches::filled_entry).
     void collect_active_cells();
 
     /// From inside a walk: the point at `it` left cell `c` (location updated)
@@ -113,7 +114,8 @@ namespace talus
     void insert_in_order(const std::vector<unsigned int> &cells, const std::vector<std::vector<SavedPoint>> &points);
 
     /// For tests: whether the incrementally kept cell list equals one read
-    /// from the storage (the list is rebuilt from storage in any case).
+    /// from the storage and the grid's cache entries of its cells are filled
+    /// (the list is rebuilt from storage in any case).
     bool check_active_cells();
 
   private:

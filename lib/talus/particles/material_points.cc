@@ -540,7 +540,7 @@ namespace talus
             continue;
           }
         const auto p = it->get_properties();
-        if (grid.cells[n].locally_owned)
+        if (grid.cells[n].locally_owned) // (checked: fills the entry of a cell that gets a point)
           {
             // remove, then insert at once: the pool gives the freed slot back
             const auto id = it->get_id();
@@ -603,6 +603,7 @@ namespace talus
       }
     for (const auto &m : moves)
       {
+        grid.cells.ensure_filled(m.cell); // a cell with points: read unchecked from now on
         if (moved)
           moved(m.cell, m.xi, props.data() + m.prop_offset);
         cell_changes.push_back({m.cell, true});
@@ -666,6 +667,10 @@ namespace talus
     // group leaves), then the group in its old order (they take the targets in
     // increasing order). The set of occupied slots never changes, so a pool
     // with free slots (points sent away or lost) keeps them as gaps.
+    //
+    // The bookkeeping runs on plain arrays: one pass over the points, the
+    // group's own removals through a mirror of its handle vector (no search),
+    // the copies through one scratch buffer (docs/scaling.md, "in-place rebuild").
     using Handle               = typename dealii::Particles::PropertyPool<dim>::Handle;
     auto              &pool    = particles.get_property_pool();
     const unsigned int n_props = particles.n_properties_per_particle();
@@ -673,7 +678,9 @@ namespace talus
     const std::size_t  n_slots = pool.n_slots();
 
     // per slot: the cell of its point (invalid: a free slot) and the slot the
-    // point goes to; the cell groups in walk order
+    // point goes to; the cell groups in walk order. Filled in one pass: first
+    // the point's group and its place in the group, then (below) turned into
+    // the group's cell and the target.
     std::vector<unsigned int> cell_of(n_slots, invalid);
     std::vector<Handle>       dest(n_slots, invalid);
     struct Group
@@ -688,8 +695,9 @@ namespace talus
         const unsigned int c = it->get_surrounding_cell()->active_cell_index();
         if (groups.empty() || groups.back().cell != c)
           groups.push_back({c, 0, 0});
-        ++groups.back().count;
-        cell_of[it->get_local_index()] = c;
+        const Handle s = it->get_local_index();
+        cell_of[s]     = static_cast<unsigned int>(groups.size() - 1);
+        dest[s]        = groups.back().count++;
         ++n_particles;
       }
     // the occupied slots in increasing order (without free slots: 0, 1, 2, ...)
@@ -706,18 +714,21 @@ namespace talus
       order[g] = g;
     std::sort(order.begin(), order.end(),
               [&](const unsigned int a, const unsigned int b) { return groups[a].cell < groups[b].cell; });
-    std::size_t k = 0;
-    for (const unsigned int g : order)
-      {
-        groups[g].offset = k;
-        k += groups[g].count;
-      }
     {
-      auto it = particles.begin();
-      for (const Group &g : groups)
-        for (unsigned int j = 0; j < g.count; ++j, ++it)
-          dest[it->get_local_index()] = target(g.offset + j);
+      std::size_t k = 0;
+      for (const unsigned int g : order)
+        {
+          groups[g].offset = k;
+          k += groups[g].count;
+        }
     }
+    for (std::size_t s = 0; s < n_slots; ++s)
+      if (cell_of[s] != invalid)
+        {
+          const Group &g = groups[cell_of[s]];
+          cell_of[s]     = g.cell;
+          dest[s]        = target(g.offset + dest[s]);
+        }
 
     // scratch for the points of one group and the others that hold its targets
     struct Held
@@ -729,12 +740,17 @@ namespace talus
     };
     std::vector<Held>   mine, others;
     std::vector<double> mine_p, others_p;
-    const auto          copy_out = [&](std::vector<Held> &to, std::vector<double> &to_p, const Handle s) {
-      to.push_back({s, dest[s], cell_of[s], pool.get_location(s), pool.get_reference_location(s), pool.get_id(s)});
-      const auto P = pool.get_properties(s);
-      to_p.insert(to_p.end(), P.begin(), P.end());
+    std::vector<Handle> mirror; // the group's handle vector, as deal.II holds it
+    const auto          copy_data = [&](Held &h, std::vector<double> &to_p, const std::size_t i) {
+      const Handle s = h.slot;
+      h.x            = pool.get_location(s);
+      h.xi           = pool.get_reference_location(s);
+      h.id           = pool.get_id(s);
+      const auto P   = pool.get_properties(s);
+      std::copy(P.begin(), P.end(), to_p.begin() + i * n_props);
     };
-    const auto remove = [&](const unsigned int c, const Handle s) {
+    // a point of another cell: found by its slot among the cell's points
+    const auto remove_other = [&](const unsigned int c, const Handle s) {
       const auto range = particles.particles_in_cell(grid.cell_iterator(c));
       for (auto it = range.begin(); it != range.end(); ++it)
         if (it->get_local_index() == s)
@@ -759,49 +775,62 @@ namespace talus
         const Handle first = target(G.offset), last = target(G.offset + G.count - 1);
         // the group's points by target (their old order in the cell)
         mine.clear();
-        mine_p.clear();
-        bool in_place = true;
+        mirror.clear();
+        bool       in_place = true;
+        const auto range    = particles.particles_in_cell(grid.cell_iterator(G.cell));
+        const auto begin    = range.begin(); // stays valid while the cell has points
         {
           unsigned int j = 0;
-          for (const auto &pt : particles.particles_in_cell(grid.cell_iterator(G.cell)))
+          for (auto it = begin; it != range.end(); ++it, ++j)
             {
-              const Handle s = pt.get_local_index();
+              const Handle s = it->get_local_index();
               in_place       = in_place && s == target(G.offset + j) && dest[s] == s;
               mine.push_back({s, dest[s], G.cell, {}, {}, 0});
-              ++j;
+              mirror.push_back(s);
             }
         }
         if (in_place)
           continue;
-        std::sort(mine.begin(), mine.end(), [](const Held &a, const Held &b) { return a.dest < b.dest; });
-        for (Held &h : mine)
-          {
-            const Handle s = h.slot;
-            h.x            = pool.get_location(s);
-            h.xi           = pool.get_reference_location(s);
-            h.id           = pool.get_id(s);
-            const auto P   = pool.get_properties(s);
-            mine_p.insert(mine_p.end(), P.begin(), P.end());
-          }
+        if (!std::is_sorted(mine.begin(), mine.end(), [](const Held &a, const Held &b) { return a.dest < b.dest; }))
+          std::sort(mine.begin(), mine.end(), [](const Held &a, const Held &b) { return a.dest < b.dest; });
+        mine_p.resize(mine.size() * n_props);
+        for (std::size_t i = 0; i < mine.size(); ++i)
+          copy_data(mine[i], mine_p, i);
         // the points of other cells on the targets
         others.clear();
-        others_p.clear();
         for (unsigned int j = 0; j < G.count; ++j)
           {
             const Handle t = target(G.offset + j);
             if (cell_of[t] != G.cell)
-              copy_out(others, others_p, t);
+              others.push_back({t, dest[t], cell_of[t], {}, {}, 0});
           }
+        others_p.resize(others.size() * n_props);
+        for (std::size_t i = 0; i < others.size(); ++i)
+          copy_data(others[i], others_p, i);
         // removals: the holders of the targets from the last one to the first,
-        // then the group's points outside the targets
+        // then the group's points outside the targets (the group's own through
+        // the mirror: deal.II moves a cell's last handle into the hole)
+        const auto remove_mine = [&](const Handle s) {
+          const std::size_t pos = std::find(mirror.begin(), mirror.end(), s) - mirror.begin();
+          AssertThrow(pos < mirror.size(), dealii::ExcInternalError());
+          auto it = begin;
+          for (std::size_t i = 0; i < pos; ++i)
+            ++it;
+          particles.remove_particle(it);
+          mirror[pos] = mirror.back();
+          mirror.pop_back();
+        };
         for (unsigned int j = G.count; j-- > 0;)
           {
             const Handle t = target(G.offset + j);
-            remove(cell_of[t], t);
+            if (cell_of[t] == G.cell)
+              remove_mine(t);
+            else
+              remove_other(cell_of[t], t);
           }
         for (const Held &h : mine)
           if (h.slot < first || h.slot > last)
-            remove(G.cell, h.slot);
+            remove_mine(h.slot);
         // insertions: the others take the slots the group left, the group its targets
         for (std::size_t i = 0; i < others.size(); ++i)
           insert(others[i], others_p.data() + i * n_props);

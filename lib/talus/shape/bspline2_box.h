@@ -48,7 +48,7 @@ namespace talus::shape
     cell(const BackgroundGrid<dim> &grid, const unsigned int c)
     {
       const auto &p = grid.patch(c);
-      return {&grid.cells[c], &p, &grid.box, p.dofs};
+      return {&grid.cells.filled_entry(c), &p, &grid.box, p.dofs};
     }
 
     using Eval   = typename W::Eval;

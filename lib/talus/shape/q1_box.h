@@ -4,7 +4,9 @@
 //   K::n_nodes                      nodes of a cell's stencil (the nodal data a
 //                                   cell's points read and write)
 //   K::Cell    K::cell(grid, c)     the stencil (local DoF index of node n,
-//                                   component d at dofs[n * dim + d]) and geometry
+//                                   component d at dofs[n * dim + d]) and geometry;
+//                                   c's cache entry must be filled (a cell with
+//                                   points: CellCaches::filled_entry)
 //   K::Values  K::values(cell, xi)  shape values at a point (interpolation, P2G)
 //   K::Eval    K::evaluate(cell,xi) values and what gradients need
 //   K::Field   gather(cell, V, s)   s * the nodal vector V on the stencil, prepared
@@ -39,7 +41,7 @@ namespace talus::shape
     static inline Cell
     cell(const BackgroundGrid<dim> &grid, const unsigned int c)
     {
-      const auto &cc = grid.cells[c];
+      const auto &cc = grid.cells.filled_entry(c);
       return {&cc, cc.dofs};
     }
 

@@ -39,7 +39,7 @@ namespace talus::transfer
                     typename dealii::Particles::ParticleHandler<dim>::particle_iterator &it,
                     const dealii::Point<dim> &x, dealii::Point<dim> &xi, unsigned int &add_to, const bool caller_adds)
   {
-    const auto &cc     = grid.cells[c];
+    const auto &cc     = grid.cells.filled_entry(c); // a cell with points
     bool        inside = true;
     for (unsigned int d = 0; d < dim; ++d)
       {

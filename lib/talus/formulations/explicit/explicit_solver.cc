@@ -230,10 +230,15 @@ namespace talus::explicit_mpm
               for (unsigned int d = 0; d < dim; ++d)
                 add(dofs[n * dim + d]);
         }
-    else
+    else // a vertex's dim DoFs: all or none owned, all or none new (as for the patches)
       for (const auto &ac : points.active_cells())
-        for (const unsigned int i : grid.cells[ac.cell].dofs)
-          add(i);
+        {
+          const unsigned int *dofs = grid.cells.filled_entry(ac.cell).dofs;
+          for (unsigned int v = 0; v < CellCache<dim>::n_vertices; ++v)
+            if (dofs[v * dim] < n_owned && !dof_marker[dofs[v * dim]])
+              for (unsigned int d = 0; d < dim; ++d)
+                add(dofs[v * dim + d]);
+        }
     for (const auto &range : grid.partitioner->import_indices())
       for (unsigned int i = range.first; i < range.second; ++i)
         if (!dof_marker[i])
