@@ -130,8 +130,9 @@ SCENES = [
           [10, 20]),
     Scene("terzaghi_k1e-7", "consolidation",
           "Terzaghi's consolidation at k = 1e-7 m/s (scenes/terzaghi.inc; T_v = 0.2 at t = 1962 s)",
-          "as at k = 1e-3; h = 1/N, N = 5, 10, 20 (0.78, 1.57, 3.14 million steps); talus-semi-implicit only: "
-          "the other families' cost estimates are in the next section",
+          "as at k = 1e-3; h = 1/N, N = 5, 10, 20 (0.78, 1.57, 3.14 million steps); talus-semi-implicit, double "
+          "and single point; talus-explicit's 2-phase family (days to weeks of loop time per run) and the other option sets are "
+          "estimated in the next section",
           [Family("terzaghi_k1e-7_semi_implicit_double_dt80", "talus-semi-implicit",
                   "double point, dt = h/80 s, smoothing of Eq. 77 every step", None, 0.1,
                   why="a documented defect, no order: the map-remap of the pore pressure at every one of "
@@ -141,14 +142,21 @@ SCENES = [
                   "double point, dt = h/80 s, pressure smoothing fraction 1e-5", None, 0.02,
                   why="as the k = 1e-3 column at the same N (1.42 % at N = 5): the blend keeps the "
                   "smoothing's relaxation of the modes the grid does not see without its cumulative "
-                  "flattening")],
+                  "flattening"),
+           Family("terzaghi_k1e-7_semi_implicit_single_dt80_beta", "talus-semi-implicit",
+                  "single point, dt = h/80 s, pressure smoothing fraction 1e-5", None, 0.02,
+                  why="as the double-point family with the same blend (1.41 % at N = 5, 2026-12-07): the water "
+                  "riding on the soil points changes the pressure's positions, not the smoothing's "
+                  "cumulative effect")],
           None,
           note="Run to T_v = 0.2, not estimated: at this k the step of talus-semi-implicit is still bound to the "
           "skeleton's wave (h / 80 s), so the run takes 1e4 times the steps of the k = 1e-3 column, and the "
           "paper's smoothing, harmless over 157 steps, is applied a million times. The flattening grows with the "
           "number of steps: at N = 5 and T_v = 0.2 the error was (2026-12-07) 1.42 / 5.71 / 8.31 / 8.72 / 8.76 % at "
           "k = 1e-3 ... 1e-7 (one decade each). `verification.semi_implicit_terzaghi_low_k` checks the "
-          "blended smoothing at k = 1e-6 in ctest."),
+          "blended smoothing at k = 1e-6 in ctest. The single-point family was run beside the campaign and two test "
+          "suites (2026-12-07): its loop times are 2-3 x those of a free core, and its N = 20 run was paused for "
+          "10 min to let a test suite through (about 18 min of CPU time for its 2689 s of loop)."),
 ]
 
 # Terzaghi at k = 1e-7 m/s: the same scene and families, too slow to run to T_v = 0.2
