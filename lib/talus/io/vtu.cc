@@ -10,6 +10,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 namespace talus::io
@@ -169,26 +170,21 @@ namespace talus::io
           if (points.size() != 3 * count)
             throw std::logic_error("write_points_vtu: the coordinates are not 3 per point");
           put(blocks[pts], first, points.data(), count);
+          // connectivity (point k is vertex k) and offsets (k + 1), in the file's integer width
+          const auto put_ids = [&](auto &ids) {
+            using Id = typename std::decay_t<decltype(ids)>::value_type;
+            ids.resize(count);
+            for (const unsigned int shift : {0u, 1u})
+              {
+                for (std::uint64_t i = 0; i < count; ++i)
+                  ids[i] = Id(first + i + shift);
+                put(blocks[conn + shift], first, ids.data(), count);
+              }
+          };
           if (small)
-            {
-              i32.resize(count);
-              for (std::uint64_t i = 0; i < count; ++i)
-                i32[i] = std::int32_t(first + i);
-              put(blocks[conn], first, i32.data(), count);
-              for (std::uint64_t i = 0; i < count; ++i)
-                i32[i] = std::int32_t(first + i + 1);
-              put(blocks[conn + 1], first, i32.data(), count);
-            }
+            put_ids(i32);
           else
-            {
-              i64.resize(count);
-              for (std::uint64_t i = 0; i < count; ++i)
-                i64[i] = std::int64_t(first + i);
-              put(blocks[conn], first, i64.data(), count);
-              for (std::uint64_t i = 0; i < count; ++i)
-                i64[i] = std::int64_t(first + i + 1);
-              put(blocks[conn + 1], first, i64.data(), count);
-            }
+            put_ids(i64);
           types.assign(count, 1);
           put(blocks[conn + 2], first, types.data(), count);
         }
