@@ -11,7 +11,9 @@
    (the points of each disk stay on their side of the symmetry line x + y = 1 at
    every sampled time), momentum conserved to round-off, the disks separate
    (velocities reversed, gap > 2 cells at the end), 1 and 2 ranks agree to 1e-10.
-Usage: check_contact.py TOOL SLIDING_PRM DISKS_PRM WORKDIR
+With a last argument `f-bar`, every run also sets numerics/volumetric stabilisation = f-bar
+(each body maps and remaps its own dJ, docs/explicit.md "F-bar with contact"): the same checks.
+Usage: check_contact.py TOOL SLIDING_PRM DISKS_PRM WORKDIR [f-bar]
 """
 import math
 import sys
@@ -19,13 +21,19 @@ import sys
 import talus_verify as tv
 
 tool, sliding_prm, disks_prm, work = sys.argv[1:5]
+STABILISATION = sys.argv[5] if len(sys.argv) > 5 else "none"
+
+
+def scene(path):
+    return tv.prm_set(open(path).read(), "numerics/volumetric stabilisation", STABILISATION)
+
 g = 9.81
 B, m_block = 0.2, 2000 * 0.2 * 0.1  # block width [m], mass per unit thickness [kg/m]
 
 
 def sliding(theta_deg, mu, adhesion, name):
     th = math.radians(theta_deg)
-    text = open(sliding_prm).read()
+    text = scene(sliding_prm)
     text = tv.prm_set(text, "gravity/acceleration", f"{g * math.sin(th)!r}, {-g * math.cos(th)!r}")
     text = tv.prm_set(text, "contact/pairs", f"0, 1, {mu}, {adhesion}")
     text = tv.prm_set(text, "output/directory", name)
@@ -48,7 +56,7 @@ for theta, mu, adh in [(10, 0.3, 0), (30, 0.0, 3000)]:
              f"frictionless {free * t[-1] ** 2:.3f} m)")
 
 # ---------------------------------------------------------------- disks
-base = tv.prm_set(open(disks_prm).read(), "contact/pairs", "0, 1, 0, 0")
+base = tv.prm_set(scene(disks_prm), "contact/pairs", "0, 1, 0, 0")
 scale = 2 * 1000 * math.pi * 0.2 ** 2 * 0.1 * math.sqrt(2)
 gaps = []
 for T in [1.0, 1.25, 1.5, 1.75, 2.0, 3.0]:

@@ -89,6 +89,13 @@ add_test(NAME verification.explicit_contact
                  ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
                  ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact)
 set_tests_properties(verification.explicit_contact PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+# the same with numerics/volumetric stabilisation = f-bar (each body its own map and remap of dJ)
+add_test(NAME verification.explicit_contact_fbar
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                 ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_fbar f-bar)
+set_tests_properties(verification.explicit_contact_fbar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900
+                     PROCESSORS 2)
 # contact with quadratic B-splines (issue 38): the sliding block (acceleration within 1 %),
 # the disks (momentum, energy, no interpenetration), 1 vs 2 ranks (1e-10), restart (bitwise)
 foreach(_part slide disks ranks restart)
@@ -100,6 +107,19 @@ foreach(_part slide disks ranks restart)
                        TIMEOUT 900)
 endforeach()
 set_tests_properties(verification.explicit_contact_bspline_ranks verification.explicit_contact_bspline_restart
+                     PROPERTIES PROCESSORS 2)
+# the same four with numerics/volumetric stabilisation = f-bar (each body maps and remaps its
+# own dJ; docs/explicit.md "F-bar with contact"): the same bounds
+foreach(_part slide disks ranks restart)
+  add_test(NAME verification.explicit_contact_bspline_fbar_${_part}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_fbar_${_part} ${_part}
+                   f-bar)
+  set_tests_properties(verification.explicit_contact_bspline_fbar_${_part} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 900)
+endforeach()
+set_tests_properties(verification.explicit_contact_bspline_fbar_ranks verification.explicit_contact_bspline_fbar_restart
                      PROPERTIES PROCESSORS 2)
 
 # checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),

@@ -43,6 +43,44 @@ namespace talus::transfer
     return dF;
   }
 
+  /// det(I + g) - 1 of a displacement-gradient increment g (in 2D the in-plane
+  /// block) as the sum of g's invariants: no cancellation against the 1. The
+  /// rate-form F-bar (explicit family) works with dJ - 1, because a stiff body at
+  /// rest has |g| ~ 1e-9, where det(I + g) - 1 keeps only ~7 digits and the
+  /// stress E (dJbar - dJ) takes that round-off (1 vs 2 ranks differed by 1e-9
+  /// of the stress in a contact scene before this).
+  template <int dim>
+  inline double
+  volume_increment_minus_one(const double (&g)[dim][dim])
+  {
+    if constexpr (dim == 2)
+      return g[0][0] + g[1][1] + (g[0][0] * g[1][1] - g[0][1] * g[1][0]);
+    else
+      {
+        const double minors = g[0][0] * g[1][1] - g[0][1] * g[1][0] + g[0][0] * g[2][2] - g[0][2] * g[2][0] +
+                              g[1][1] * g[2][2] - g[1][2] * g[2][1];
+        const double det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1]) -
+                           g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0]) +
+                           g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
+        return g[0][0] + g[1][1] + g[2][2] + minors + det;
+      }
+  }
+
+  /// The rate-form Eq. 79: dF-bar - I of a displacement-gradient increment g,
+  /// given e = dJ - 1 and e_bar = dJbar - 1: (a - 1) I + a g with a = ((1 +
+  /// e_bar) / (1 + e))^(1/dim), a - 1 by log1p / expm1 (exact digits for small
+  /// e, e_bar; the same value as stabilised_increment(I + g, 1 + e_bar) - I).
+  template <int dim>
+  inline void
+  stabilised_gradient_increment(const double (&g)[dim][dim], const double e, const double e_bar,
+                                double (&g_bar)[dim][dim])
+  {
+    const double a_minus_one = std::expm1((std::log1p(e_bar) - std::log1p(e)) / dim);
+    for (unsigned int i = 0; i < dim; ++i)
+      for (unsigned int j = 0; j < dim; ++j)
+        g_bar[i][j] = (1 + a_minus_one) * g[i][j] + (i == j ? a_minus_one : 0.0);
+  }
+
   /// dF-bar = (dJbar / dJ)^(1/dim) dF (Eq. 79; in 2D the in-plane block, the
   /// paper's dof = 2): the increment a soil point's model sees with either F-bar.
   template <int dim>

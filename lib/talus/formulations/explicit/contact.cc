@@ -14,9 +14,10 @@ namespace talus::explicit_mpm
 {
   template <int dim>
   Contact<dim>::Contact(const BackgroundGrid<dim> &g, const NumericsOptions &o, const unsigned int nb,
-                        const bool bspline)
+                        const bool bspline, const bool fbar)
       : grid(g)
       , n_bodies(nb)
+      , fbar(fbar)
       , bspline(bspline)
   {
     fields.resize(n_bodies);
@@ -53,6 +54,8 @@ namespace talus::explicit_mpm
         grid.reinit_vector(f.force);
         grid.reinit_vector(f.momentum);
         grid.reinit_vector(f.gradient);
+        if (fbar)
+          grid.reinit_vector(f.volume_increment);
       }
     node_marker.clear();
     nodes.clear();

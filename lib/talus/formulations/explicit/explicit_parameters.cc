@@ -152,10 +152,6 @@ namespace talus::explicit_mpm
                 "strain smoothing" + why +
                   "both replace the volumetric strain increment: choose one); allowed: none, or volumetric "
                   "stabilisation = none");
-        require(!p.numerics.contact(), "contact/pairs",
-                "contact" + why +
-                  "the map and remap of dJ use the combined velocity field, while a body in contact "
-                  "deforms with its own; docs/explicit.md); allowed: empty, or volumetric stabilisation = none");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/volumetric stabilisation",
                 "f-bar is available in the 1-phase step only (coupled 2-phase materials and body tractions run "
                 "the 2-phase step); allowed: none, or 1-phase materials");

@@ -131,7 +131,7 @@ namespace talus::explicit_mpm
             "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
             "2-phase materials or tractions); use integration = mpm, strain smoothing = none, no contact pairs");
     if (prm.numerics.contact())
-      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline());
+      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline(), prm.numerics.fbar);
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
       smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
@@ -447,7 +447,7 @@ namespace talus::explicit_mpm
       const StrainSmoothing<dim>                                    *smoothing;
       const bool                                                     need_strain_energy;
       PointProbes<dim>                                              &probes;
-      /// F-bar: offset of the point's dJbar (0: off; Solver::volume_averages_with)
+      /// F-bar: offset of the point's dJbar - 1 (0: off; Solver::volume_averages_with)
       const unsigned int fbar = 0;
 
       diagnostics::PointSums<dim> sums = {};
@@ -488,7 +488,8 @@ namespace talus::explicit_mpm
 
       /// The strain and spin increments the model sees: those of grad du, or
       /// with F-bar those of dF-bar - I, dF-bar = (dJbar / dJ)^(1/dim) dF (seed
-      /// 002 Eq. 79, in plane in 2D: d_eps_zz stays 0)
+      /// 002 Eq. 79, in plane in 2D: d_eps_zz stays 0), from dJ - 1 and the
+      /// point's dJbar - 1 without cancellation (transfer/fbar.h)
       inline void
       increments_of(const double (&gu)[dim][dim], const double *P, materials::Strain &d_eps, materials::Spin &d_omega)
       {
@@ -497,19 +498,15 @@ namespace talus::explicit_mpm
             materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
             return;
           }
-        const dealii::Tensor<2, 3> dF = transfer::increment_tensor<dim>(gu, 1.0);
-        const double               dJ = dealii::determinant(dF);
-        if (!(dJ > 0) || !(P[fbar] > 0)) // flagged by the stability check (the volume turns non-positive)
+        const double e = transfer::volume_increment_minus_one<dim>(gu); // dJ - 1
+        if (!(e > -1) || !(P[fbar] > -1)) // flagged by the stability check (the volume turns non-positive)
           {
             materials::strain_and_spin_increments<dim>(gu, d_eps, d_omega);
             bad = true;
             return;
           }
-        const dealii::Tensor<2, 3> f = transfer::stabilised_increment<dim>(dF, P[fbar]);
-        double                     g[dim][dim];
-        for (unsigned int i = 0; i < dim; ++i)
-          for (unsigned int j = 0; j < dim; ++j)
-            g[i][j] = f[i][j] - (i == j ? 1.0 : 0.0);
+        double g[dim][dim];
+        transfer::stabilised_gradient_increment<dim>(gu, e, P[fbar], g);
         materials::strain_and_spin_increments<dim>(g, d_eps, d_omega);
       }
 
@@ -699,30 +696,57 @@ namespace talus::explicit_mpm
   void
   Solver<dim>::volume_averages_with(K, const double h)
   {
-    // the map: sum N m dJ at the nodes (the scalar slot: component 0), dJ of the
-    // increment the update pass will use (h x the nodal velocity, at x^t)
+    // the map: sum N m (dJ - 1) at the nodes (the scalar slot: component 0), dJ
+    // of the increment the update pass will use (h x the nodal velocity, at x^t;
+    // dJ - 1 without cancellation, transfer/fbar.h). With
+    // contact every body maps and remaps on its own, like its update pass: dJ
+    // from its corrected velocities v~_b, over its own lumped mass (a body in
+    // contact deforms with its own field, docs/explicit.md "F-bar with contact")
     using Stencil = transfer::PointStencil<dim, K>;
     using It      = transfer::PointIterator<dim>;
     using L       = PropertyLayout<dim>;
-    zero_on_active(nodal_dj);
-    const double *V  = nodal_p.begin();
-    double       *mj = nodal_dj.begin();
+    struct Field
+    {
+      Vector       *dj;
+      const double *v; ///< nodal velocities
+      const double *m; ///< lumped masses
+    };
+    std::vector<Field> fields;
+    if (contact)
+      for (auto &f : contact->fields)
+        fields.push_back({&f.volume_increment, f.momentum.begin(), f.mass.begin()});
+    else
+      fields.push_back({&nodal_dj, nodal_p.begin(), nodal_mass.begin()});
+    const auto field_of = [&](const double *P) -> const Field & {
+      return contact ? fields[static_cast<unsigned int>(P[L::body])] : fields[0];
+    };
+    for (const Field &f : fields)
+      zero_on_active(*f.dj);
     transfer::for_each_point_stencil<dim, K>(grid, points, [&](unsigned int, It &it, const Stencil &s) {
       const double *P = it->get_properties().data();
+      const Field  &f = field_of(P);
       double        gv[dim][dim];
-      s.vector_gradient(V, gv);
-      s.scatter(mj, P[L::mass] * dealii::determinant(transfer::increment_tensor<dim>(gv, h)));
+      s.vector_gradient(f.v, gv);
+      for (unsigned int i = 0; i < dim; ++i)
+        for (unsigned int j = 0; j < dim; ++j)
+          gv[i][j] *= h;
+      s.scatter(f.dj->begin(), P[L::mass] * transfer::volume_increment_minus_one<dim>(gv));
     });
-    nodal_dj.compress(dealii::VectorOperation::add);
-    // dJ_I = sum N m dJ / sum N m (the lumped mass of this step; every node a
-    // point's N reaches carries mass, so a uniform dJ comes back exactly)
-    const double *M = nodal_mass.begin();
-    for (const unsigned int i : active_dofs)
-      mj[i] = M[i] > 0 ? mj[i] / M[i] : 0.0;
-    nodal_dj.update_ghost_values();
-    // the remap: dJbar = sum N dJ_I at the point
-    transfer::for_each_point_stencil<dim, K>(
-      grid, points, [&](unsigned int, It &it, const Stencil &s) { it->get_properties()[fbar_offset] = s.value(mj); });
+    // dJ_I - 1 = sum N m (dJ - 1) / sum N m (the lumped mass of this step; every
+    // node a point's N reaches carries mass, so a uniform dJ comes back exactly)
+    for (const Field &f : fields)
+      {
+        f.dj->compress(dealii::VectorOperation::add);
+        double *mj = f.dj->begin();
+        for (const unsigned int i : active_dofs)
+          mj[i] = f.m[i] > 0 ? mj[i] / f.m[i] : 0.0;
+        f.dj->update_ghost_values();
+      }
+    // the remap: dJbar - 1 = sum N (dJ_I - 1) at the point
+    transfer::for_each_point_stencil<dim, K>(grid, points, [&](unsigned int, It &it, const Stencil &s) {
+      double *P      = it->get_properties().data();
+      P[fbar_offset] = s.value(field_of(P).dj->begin());
+    });
   }
 
   template <int dim>

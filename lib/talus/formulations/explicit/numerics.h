@@ -150,7 +150,8 @@ namespace talus::explicit_mpm
   class Contact
   {
   public:
-    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies, bool bspline);
+    /// `fbar`: every body also gets its own F-bar map (BodyFields::volume_increment)
+    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies, bool bspline, bool fbar);
 
     /// After a repartition: the per-body nodal fields re-sized for the new DoF
     /// numbering (every step fills them from the points: P2G, contact law), the
@@ -189,6 +190,9 @@ namespace talus::explicit_mpm
       Vector force;    ///< internal + gravity force; after correct_accelerations: a~_b
       Vector momentum; ///< momentum; after correct_velocities: v~_b
       Vector gradient; ///< outward normal of the body (minus the gradient of its mass field)
+      /// F-bar: sum N m dJ of the body's points, then dJ_I (sized only in f-bar
+      /// runs: Solver::volume_averages_with)
+      Vector volume_increment;
     };
     std::vector<BodyFields> fields;
 
@@ -196,6 +200,7 @@ namespace talus::explicit_mpm
     friend void                p2g_extended<dim>(Solver<dim> &s);
     const BackgroundGrid<dim> &grid;
     unsigned int               n_bodies;
+    bool                       fbar;
     /// quadratic B-splines: normals from the points (p2g), nodes from the cells' patches
     bool bspline;
     /// quadratic B-splines: a node is a contact node only where at least two
