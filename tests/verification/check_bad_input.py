@@ -65,6 +65,15 @@ cases.update({
     "unknown velocity transfer": (tv.prm_set(base, "numerics/velocity transfer", "pic"),
                                   ["velocity transfer", "pic", "flip|apic"]),
 })
+# APIC with contact runs (each body its own v^L_b), but not with a prescribed velocity of a body
+# (its re-projection of v_p, C_p uses the combined field): the sliding block of the contact checks
+sliding = open(os.path.join(os.path.dirname(prm_path), "block_sliding_contact.prm")).read()
+sliding = tv.prm_set_args(sliding, ["output/directory=must_not_exist", "numerics/shape function=quadratic bspline",
+                                    "numerics/velocity transfer=apic", "contact/pairs=0, 1, 0.3, 0",
+                                    "loads/number of velocity conditions=1", "loads/velocity 0/apply to=body",
+                                    "loads/velocity 0/body=1", "loads/velocity 0/velocity=0, 0"])
+cases["apic with contact and a body velocity"] = (sliding, ["loads/velocity k/apply to", "apply to = body",
+                                                            "velocity transfer = apic", "APIC with contact"])
 # numerics/volumetric stabilisation (issue 38): modified f-bar has no b_e to scale in the rate
 # update; f-bar with the passes that replace the volume change themselves
 fbar = tv.prm_set(base, "numerics/volumetric stabilisation", "f-bar")

@@ -21,10 +21,11 @@ ranks    The disks and the sliding block (mu = 0.3) on 1 and 2 ranks: particles_
 restart  The disks with checkpoints every 0.5 s, stopped at 1.2 s (in the collision) and
          restarted: particles_final.csv and series.csv byte for byte those of the
          uninterrupted run, on 1 rank and on 2 ranks.
-With a last argument `f-bar`, every run also sets numerics/volumetric stabilisation = f-bar
-(each body maps and remaps its own dJ, docs/explicit.md "F-bar with contact"): the same checks
-and bounds.
-Usage: check_contact_bspline.py TOOL SLIDING_PRM DISKS_PRM WORKDIR slide|disks|ranks|restart [f-bar]
+A last argument, a '+'-separated option set, switches more on in every run, with the same checks
+and bounds: `f-bar` (numerics/volumetric stabilisation = f-bar: each body maps and remaps its own
+dJ, docs/explicit.md "F-bar with contact"), `apic` (numerics/velocity transfer = apic: each body's
+v_p, C_p from its own corrected v^L_b, "APIC with contact").
+Usage: check_contact_bspline.py TOOL SLIDING_PRM DISKS_PRM WORKDIR slide|disks|ranks|restart [f-bar|apic|apic+f-bar]
 """
 import math
 import os
@@ -34,7 +35,16 @@ import sys
 import talus_verify as tv
 
 tool, sliding_prm, disks_prm, work, part = sys.argv[1:6]
-STABILISATION = sys.argv[6] if len(sys.argv) > 6 else "none"
+OPTIONS = sys.argv[6].split("+") if len(sys.argv) > 6 else []
+if any(o not in ("f-bar", "apic") for o in OPTIONS):
+    tv.fail(f"unknown option set '{sys.argv[6]}' (allowed: f-bar, apic, apic+f-bar)")
+
+
+def with_options(text):
+    text = tv.prm_set(text, "numerics/shape function", BSPLINE)
+    text = tv.prm_set(text, "numerics/volumetric stabilisation", "f-bar" if "f-bar" in OPTIONS else "none")
+    return tv.prm_set(text, "numerics/velocity transfer", "apic" if "apic" in OPTIONS else "flip")
+
 shutil.rmtree(work, ignore_errors=True)  # no checkpoint of an earlier run may be restarted from
 os.makedirs(work)
 g = 9.81
@@ -44,8 +54,7 @@ BSPLINE = "quadratic bspline"
 def sliding_text(theta_deg, mu, name):
     th = math.radians(theta_deg)
     text = open(sliding_prm).read()
-    text = tv.prm_set(text, "numerics/shape function", BSPLINE)
-    text = tv.prm_set(text, "numerics/volumetric stabilisation", STABILISATION)
+    text = with_options(text)
     text = tv.prm_set(text, "gravity/acceleration", f"{g * math.sin(th)!r}, {-g * math.cos(th)!r}")
     text = tv.prm_set(text, "contact/pairs", f"0, 1, {mu}, 0")
     text = tv.prm_set(text, "output/vtu interval", "0")
@@ -54,8 +63,7 @@ def sliding_text(theta_deg, mu, name):
 
 def disks_text(name, end=None):
     text = open(disks_prm).read()
-    text = tv.prm_set(text, "numerics/shape function", BSPLINE)
-    text = tv.prm_set(text, "numerics/volumetric stabilisation", STABILISATION)
+    text = with_options(text)
     text = tv.prm_set(text, "contact/pairs", "0, 1, 0, 0")
     text = tv.prm_set(text, "output/vtu interval", "0")
     text = tv.prm_set(text, "output/series interval", "0.01")

@@ -121,6 +121,28 @@ foreach(_part slide disks ranks restart)
 endforeach()
 set_tests_properties(verification.explicit_contact_bspline_fbar_ranks verification.explicit_contact_bspline_fbar_restart
                      PROPERTIES PROCESSORS 2)
+# and with numerics/velocity transfer = apic (each body's v_p, C_p from its own v^L_b;
+# docs/explicit.md "APIC with contact"), alone (the four parts) and with f-bar (slide, disks)
+foreach(_part slide disks ranks restart)
+  add_test(NAME verification.explicit_contact_bspline_apic_${_part}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_apic_${_part} ${_part}
+                   apic)
+  set_tests_properties(verification.explicit_contact_bspline_apic_${_part} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 900)
+endforeach()
+set_tests_properties(verification.explicit_contact_bspline_apic_ranks verification.explicit_contact_bspline_apic_restart
+                     PROPERTIES PROCESSORS 2)
+foreach(_part slide disks)
+  add_test(NAME verification.explicit_contact_bspline_apic_fbar_${_part}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_apic_fbar_${_part}
+                   ${_part} apic+f-bar)
+  set_tests_properties(verification.explicit_contact_bspline_apic_fbar_${_part} PROPERTIES LABELS "fast"
+                       ENVIRONMENT "${_env}" TIMEOUT 900)
+endforeach()
 
 # checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
 # 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints

@@ -1,6 +1,7 @@
 // talus — contact between bodies (seed 000 §6.2): the predictor-corrector
 // algorithm of Bardenhagen et al. with Coulomb friction and adhesion.
 #include <talus/base/errors.h>
+#include <talus/formulations/explicit/affine_ops.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/shape/with_kernel.h>
@@ -14,10 +15,11 @@ namespace talus::explicit_mpm
 {
   template <int dim>
   Contact<dim>::Contact(const BackgroundGrid<dim> &g, const NumericsOptions &o, const unsigned int nb,
-                        const bool bspline, const bool fbar)
+                        const bool bspline, const bool fbar, const unsigned int affine)
       : grid(g)
       , n_bodies(nb)
       , fbar(fbar)
+      , affine(affine)
       , bspline(bspline)
   {
     fields.resize(n_bodies);
@@ -175,7 +177,10 @@ namespace talus::explicit_mpm
           a.volume.clear();
         }
       a.mass_force.add(e, m, t);
-      a.momentum.add(e, m, P + L::velocity);
+      if (affine) // APIC: m (v_p + C_p (x_i - x_p))
+        transfer::add_affine_momentum<dim, K>(cell, e, m, P + L::velocity, P + affine, a.momentum.lp);
+      else
+        a.momentum.add(e, m, P + L::velocity);
       a.volume.add(e, V, ones);
       if (bspline)
         {
@@ -487,18 +492,27 @@ namespace talus::explicit_mpm
             vb[b][d] = m_all[b] > 0 ? v0[b][d] + dt * fields[b].force.begin()[dofs[d]] / m_all[b] : 0.0;
         mb = m_all;
         correct_node(dofs, s.constrained, mb, vb, dt);
-        // corrected acceleration, stored in the force vector
+        // corrected acceleration, stored in the force vector (APIC: and v^L_b
+        // in the momentum vector)
         for (unsigned int b = 0; b < n_bodies; ++b)
           {
             double *A = fields[b].force.begin();
+            double *V = fields[b].momentum.begin();
             for (unsigned int d = 0; d < dim; ++d)
-              A[dofs[d]] = (m_all[b] > 0 && !s.constrained[dofs[d]]) ? (vb[b][d] - v0[b][d]) / dt : 0.0;
+              {
+                const bool free = m_all[b] > 0 && !s.constrained[dofs[d]];
+                A[dofs[d]]      = free ? (vb[b][d] - v0[b][d]) / dt : 0.0;
+                if (affine)
+                  V[dofs[d]] = free ? vb[b][d] : 0.0;
+              }
           }
       }
     for (auto &f : fields)
       {
         f.force.update_ghost_values();
         f.mass.update_ghost_values();
+        if (affine)
+          f.momentum.update_ghost_values();
       }
   }
 

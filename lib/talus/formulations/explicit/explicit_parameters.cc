@@ -181,13 +181,24 @@ namespace talus::explicit_mpm
                 std::string(p.numerics.integration_name()) + cells + "mpm, or velocity transfer = flip");
         require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
                 "strain smoothing" + cells + "none, or velocity transfer = flip");
-        // contact and the coupled 2-phase step keep their own (FLIP) velocity transfer
+        // the coupled 2-phase step keeps its own (FLIP) velocity transfer
         const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
-                                "FLIP velocity update: per-body velocity fields, the liquid's momentum); allowed: ";
-        require(!p.numerics.contact(), "contact/pairs", "contact" + why + "empty, or velocity transfer = flip");
+                                "FLIP velocity update: the liquid's momentum); allowed: ";
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/velocity transfer",
                 "coupled 2-phase materials and body tractions" + why +
                   "1-phase materials, or velocity transfer = flip");
+        // contact: each body's v^L_b (Contact::correct_accelerations); a body
+        // velocity condition re-projects v_p, C_p of all points from the combined v^L
+        if (p.numerics.contact())
+          for (unsigned int k = 0; k < p.loads.stages.size(); ++k)
+            for (const auto &v : p.loads.stages[k].velocities)
+              require(v.target != loads::PrescribedVelocity<dim>::Target::body,
+                      (p.loads.staged ? "stage " + std::to_string(k) + "/loads" : std::string("loads")) +
+                        "/velocity k/apply to",
+                      "a prescribed velocity of a body ('apply to = body') is not available with contact and "
+                      "numerics/velocity transfer = apic: its APIC projection of v_p, C_p uses the combined "
+                      "velocity field, not each body's (docs/explicit.md, \"APIC with contact\"); allowed: "
+                      "'apply to = boundary | region', no contact pairs, or velocity transfer = flip");
       }
     if (p.bspline())
       {

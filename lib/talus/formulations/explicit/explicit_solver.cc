@@ -131,7 +131,8 @@ namespace talus::explicit_mpm
             "MPM-MIXED, strain smoothing and contact are available in the 1-phase step only (not with coupled "
             "2-phase materials or tractions); use integration = mpm, strain smoothing = none, no contact pairs");
     if (prm.numerics.contact())
-      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline(), prm.numerics.fbar);
+      contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline(), prm.numerics.fbar,
+                                               affine_offset);
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
       smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
 
@@ -463,11 +464,12 @@ namespace talus::explicit_mpm
         const materials::Material    *material;
       };
 
-      inline void
-      increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, const double *P,
-                 double (&gu)[dim][dim], double (&dx)[dim])
+      /// the displacement increments the point moves with: du of the combined
+      /// field, or with contact its body's own (§6.2), gathered once per cell and body
+      inline const typename K::Field &
+      displacement_field(const typename K::Cell &cell, const typename K::Field &du, const double *P)
       {
-        if constexpr (with_contact) // the body's own nodal velocities (§6.2), gathered once per cell and body
+        if constexpr (with_contact)
           {
             const unsigned int b = static_cast<unsigned int>(P[L::body]);
             if (body_du.empty())
@@ -480,10 +482,16 @@ namespace talus::explicit_mpm
                 contact->template body_increments<K>(cell, b, h, body_du[b]);
                 body_cell[b] = cell.dofs;
               }
-            transfer::default_increments<dim, K>(cell, ev, body_du[b], gu, dx);
-            return;
+            return body_du[b];
           }
-        transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
+        return du;
+      }
+
+      inline void
+      increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, const double *P,
+                 double (&gu)[dim][dim], double (&dx)[dim])
+      {
+        transfer::default_increments<dim, K>(cell, ev, displacement_field(cell, du, P), gu, dx);
       }
 
       /// The strain and spin increments the model sees: those of grad du, or
@@ -609,8 +617,9 @@ namespace talus::explicit_mpm
     /// The same physics with the APIC G2P of the velocity (formulations/explicit/affine_ops.h):
     /// v_p and C_p from the nodal velocity of the update pass (v^L), instead of
     /// the FLIP increment of the separate G2P/P2G pass.
-    template <int dim, class K>
-    struct ApicPointUpdate : ExplicitPointUpdate<dim, K, false>
+    /// With contact, each point from its body's own v^L_b (Contact::correct_accelerations).
+    template <int dim, class K, bool with_contact>
+    struct ApicPointUpdate : ExplicitPointUpdate<dim, K, with_contact>
     {
       using L             = PropertyLayout<dim>;
       unsigned int affine = 0;
@@ -618,8 +627,9 @@ namespace talus::explicit_mpm
       increments(const typename K::Cell &cell, const typename K::Eval &ev, const typename K::Field &du, double *P,
                  double (&gu)[dim][dim], double (&dx)[dim])
       {
-        transfer::default_increments<dim, K>(cell, ev, du, gu, dx);
-        transfer::apic_point_velocity<dim, K>(cell, ev, du, this->h, gu, dx, P + L::velocity, P + affine);
+        const typename K::Field &v = this->displacement_field(cell, du, P);
+        transfer::default_increments<dim, K>(cell, ev, v, gu, dx);
+        transfer::apic_point_velocity<dim, K>(cell, ev, v, this->h, gu, dx, P + L::velocity, P + affine);
       }
     };
   } // namespace
@@ -677,18 +687,31 @@ namespace talus::explicit_mpm
   Solver<dim>::g2p_update_apic_with(K, const double h)
   {
     probes.clear_values();
-    ApicPointUpdate<dim, K> physics{
-      {prm.materials, points.layout.history, h, gravity, nullptr, nullptr, need_strain_energy, probes, fbar_offset},
-      affine_offset};
-    // as g2p_update_with: the update pass with the next step's mass and force fused
-    zero_on_active(nodal_mass);
-    zero_on_active(nodal_a);
-    transfer::UpdateAndMove<dim, K, ApicPointUpdate<dim, K>> update{grid, points, nodal_p.begin(), h, physics};
-    transfer::ScatterMassForce<dim, K>                       p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-    transfer::Fused                                          fused{update, p2g};
-    transfer::for_each_active_cell(points, fused);
-    local_sums = physics.sums;
-    local_bad  = physics.bad;
+    const auto run = [&](auto with_contact) {
+      using Physics = ApicPointUpdate<dim, K, decltype(with_contact)::value>;
+      Physics physics{{prm.materials, points.layout.history, h, gravity, contact.get(), nullptr, need_strain_energy,
+                       probes, fbar_offset},
+                      affine_offset};
+      // as g2p_update_with: the update pass with the next step's mass and force fused
+      // (with contact a full P2G follows, per body)
+      zero_on_active(nodal_mass);
+      zero_on_active(nodal_a);
+      transfer::UpdateAndMove<dim, K, Physics> update{grid, points, nodal_p.begin(), h, physics};
+      if (prm.numerics.extended_p2g())
+        transfer::for_each_active_cell(points, update);
+      else
+        {
+          transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
+          transfer::Fused                    fused{update, p2g};
+          transfer::for_each_active_cell(points, fused);
+        }
+      local_sums = physics.sums;
+      local_bad  = physics.bad;
+    };
+    if (contact)
+      run(std::true_type());
+    else
+      run(std::false_type());
   }
 
   template <int dim>
@@ -794,7 +817,8 @@ namespace talus::explicit_mpm
     t0 = Clock::now();
     if (affine_offset)
       {
-        // APIC (contact, FEM, 2-phase, smoothing are refused with it)
+        // APIC (FEM, 2-phase, smoothing are refused with it; with contact the
+        // update pass takes each body's v^L_b of correct_accelerations)
         apic_nodal_velocity(h);
         const bool body = control && control->has_particle_conditions();
         if (body) // v_p, C_p from v^L, the prescribed ones set, then v = p / m

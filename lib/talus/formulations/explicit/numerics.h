@@ -150,8 +150,10 @@ namespace talus::explicit_mpm
   class Contact
   {
   public:
-    /// `fbar`: every body also gets its own F-bar map (BodyFields::volume_increment)
-    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies, bool bspline, bool fbar);
+    /// `fbar`: every body also gets its own F-bar map (BodyFields::volume_increment);
+    /// `affine`: APIC, the offset of C_p (0: FLIP)
+    Contact(const BackgroundGrid<dim> &grid, const NumericsOptions &o, unsigned int n_bodies, bool bspline, bool fbar,
+            unsigned int affine);
 
     /// After a repartition: the per-body nodal fields re-sized for the new DoF
     /// numbering (every step fills them from the points: P2G, contact law), the
@@ -163,7 +165,10 @@ namespace talus::explicit_mpm
     /// kernel. (MPM-MIXED with contact: p2g_extended, linear only.)
     void p2g(Solver<dim> &s);
     /// Lagrangian phase: after nodal_acceleration(), the corrected per-body
-    /// accelerations a~_b = (v~_b - v_b^t) / dt (Eq. 6.21).
+    /// accelerations a~_b = (v~_b - v_b^t) / dt (Eq. 6.21). APIC: the body's
+    /// momentum vector then holds its corrected v^L_b = v~_b^t + dt a~_b, from
+    /// which the update pass takes v_p, C_p and the displacement (the contact law
+    /// acts once, on v^L; there is no convective phase).
     void correct_accelerations(Solver<dim> &s, double dt);
     /// G2P of the particle velocities with the per-body accelerations and P2G
     /// of the momentum per body and combined (replaces the solver's pass).
@@ -188,7 +193,8 @@ namespace talus::explicit_mpm
       Vector mass;     ///< lumped mass (every component of a node holds it)
       Vector volume;   ///< lumped volume sum V_p N_i (for the adhesion area; every component)
       Vector force;    ///< internal + gravity force; after correct_accelerations: a~_b
-      Vector momentum; ///< momentum; after correct_velocities: v~_b
+      Vector momentum; ///< momentum (APIC: with the affine term); after correct_velocities (APIC:
+                       ///< correct_accelerations): v~_b
       Vector gradient; ///< outward normal of the body (minus the gradient of its mass field)
       /// F-bar: sum N m dJ of the body's points, then dJ_I (sized only in f-bar
       /// runs: Solver::volume_averages_with)
@@ -201,6 +207,7 @@ namespace talus::explicit_mpm
     const BackgroundGrid<dim> &grid;
     unsigned int               n_bodies;
     bool                       fbar;
+    unsigned int               affine;
     /// quadratic B-splines: normals from the points (p2g), nodes from the cells' patches
     bool bspline;
     /// quadratic B-splines: a node is a contact node only where at least two
