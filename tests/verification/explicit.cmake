@@ -97,52 +97,28 @@ add_test(NAME verification.explicit_contact_fbar
 set_tests_properties(verification.explicit_contact_fbar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900
                      PROCESSORS 2)
 # contact with quadratic B-splines (issue 38): the sliding block (acceleration within 1 %),
-# the disks (momentum, energy, no interpenetration), 1 vs 2 ranks (1e-10), restart (bitwise)
-foreach(_part slide disks ranks restart)
-  add_test(NAME verification.explicit_contact_bspline_${_part}
-           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
-                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
-                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_${_part} ${_part})
-  set_tests_properties(verification.explicit_contact_bspline_${_part} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
-                       TIMEOUT 900)
-endforeach()
-set_tests_properties(verification.explicit_contact_bspline_ranks verification.explicit_contact_bspline_restart
-                     PROPERTIES PROCESSORS 2)
-# the same four with numerics/volumetric stabilisation = f-bar (each body maps and remaps its
-# own dJ; docs/explicit.md "F-bar with contact"): the same bounds
-foreach(_part slide disks ranks restart)
-  add_test(NAME verification.explicit_contact_bspline_fbar_${_part}
-           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
-                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
-                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_fbar_${_part} ${_part}
-                   f-bar)
-  set_tests_properties(verification.explicit_contact_bspline_fbar_${_part} PROPERTIES LABELS "fast"
-                       ENVIRONMENT "${_env}" TIMEOUT 900)
-endforeach()
-set_tests_properties(verification.explicit_contact_bspline_fbar_ranks verification.explicit_contact_bspline_fbar_restart
-                     PROPERTIES PROCESSORS 2)
-# and with numerics/velocity transfer = apic (each body's v_p, C_p from its own v^L_b;
-# docs/explicit.md "APIC with contact"), alone (the four parts) and with f-bar (slide, disks)
-foreach(_part slide disks ranks restart)
-  add_test(NAME verification.explicit_contact_bspline_apic_${_part}
-           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
-                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
-                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_apic_${_part} ${_part}
-                   apic)
-  set_tests_properties(verification.explicit_contact_bspline_apic_${_part} PROPERTIES LABELS "fast"
-                       ENVIRONMENT "${_env}" TIMEOUT 900)
-endforeach()
-set_tests_properties(verification.explicit_contact_bspline_apic_ranks verification.explicit_contact_bspline_apic_restart
-                     PROPERTIES PROCESSORS 2)
-foreach(_part slide disks)
-  add_test(NAME verification.explicit_contact_bspline_apic_fbar_${_part}
-           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
-                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
-                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline_apic_fbar_${_part}
-                   ${_part} apic+f-bar)
-  set_tests_properties(verification.explicit_contact_bspline_apic_fbar_${_part} PROPERTIES LABELS "fast"
-                       ENVIRONMENT "${_env}" TIMEOUT 900)
-endforeach()
+# the disks (momentum, energy, no interpenetration), 1 vs 2 ranks (1e-10), restart (bitwise);
+# the same bounds with f-bar (each body maps and remaps its own dJ; docs/explicit.md "F-bar with
+# contact"), with apic (each body's v_p, C_p from its own v^L_b: "APIC with contact") and both.
+# talus_contact_bspline(SUFFIX OPTIONS PART...): OPTIONS the script's option set ("" for none)
+function(talus_contact_bspline suffix options)
+  foreach(_part ${ARGN})
+    set(_name verification.explicit_contact_bspline${suffix}_${_part})
+    add_test(NAME ${_name}
+             COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_bspline.py ${TALUS_TOOLS_DIR}/talus-explicit
+                     ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                     ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_bspline${suffix}_${_part}
+                     ${_part} ${options})
+    set_tests_properties(${_name} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900)
+    if(_part STREQUAL "ranks" OR _part STREQUAL "restart")
+      set_tests_properties(${_name} PROPERTIES PROCESSORS 2)
+    endif()
+  endforeach()
+endfunction()
+talus_contact_bspline("" "" slide disks ranks restart)
+talus_contact_bspline(_fbar f-bar slide disks ranks restart)
+talus_contact_bspline(_apic apic slide disks ranks restart)
+talus_contact_bspline(_apic_fbar apic+f-bar slide disks)
 
 # checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
 # 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints

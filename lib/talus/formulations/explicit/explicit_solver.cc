@@ -642,21 +642,30 @@ namespace talus::explicit_mpm
   }
 
   template <int dim>
-  template <class K>
+  template <class K, bool apic>
   void
   Solver<dim>::g2p_update_with(K, const double h)
   {
     probes.clear_values();
     const auto run = [&](auto with_contact) {
-      using Physics = ExplicitPointUpdate<dim, K, decltype(with_contact)::value>;
-      Physics physics{prm.materials,   points.layout.history, h,      gravity,    contact.get(),
-                      smoothing.get(), need_strain_energy,    probes, fbar_offset};
+      constexpr bool contact_on = decltype(with_contact)::value;
+      using Point               = ExplicitPointUpdate<dim, K, contact_on>;
+      // APIC: v_p, C_p from v^L in the same pass (strain smoothing is refused with it)
+      using Physics = std::conditional_t<apic, ApicPointUpdate<dim, K, contact_on>, Point>;
+      const Point point{prm.materials,   points.layout.history, h,      gravity,    contact.get(),
+                        smoothing.get(), need_strain_energy,    probes, fbar_offset};
+      Physics     physics = [&]() -> Physics {
+        if constexpr (apic)
+          return Physics{point, affine_offset};
+        else
+          return point;
+      }();
       // the mass and force of the next step are accumulated here, at the updated
       // state, for every particle that stays in its cell (seed 000 §4.3.7 step 1 of
       // the next cycle fused into this pass) and for every particle that entered
       // an owned neighbour cell (into that cell); particles received from other
       // ranks are added by the relocation, and any deal.II sort falls back to a
-      // full P2G pass.
+      // full P2G pass (with contact or MPM-MIXED: always, per body).
       // Every non-zero entry of the mass/force vectors belongs to a cell that
       // holds particles now (writes go only to cells that hold particles after
       // the relocation), so clearing the active DoFs clears everything, and the
@@ -665,39 +674,6 @@ namespace talus::explicit_mpm
       zero_on_active(nodal_a);
       transfer::UpdateAndMove<dim, K, Physics> update{grid, points, nodal_p.begin(), h, physics};
       if (prm.numerics.extended_p2g()) // a full P2G pass follows
-        transfer::for_each_active_cell(points, update);
-      else
-        {
-          transfer::ScatterMassForce<dim, K> p2g{grid, gravity, nodal_mass.begin(), nodal_a.begin()};
-          transfer::Fused                    fused{update, p2g};
-          transfer::for_each_active_cell(points, fused);
-        }
-      local_sums = physics.sums;
-      local_bad  = physics.bad;
-    };
-    if (contact)
-      run(std::true_type());
-    else
-      run(std::false_type());
-  }
-
-  template <int dim>
-  template <class K>
-  void
-  Solver<dim>::g2p_update_apic_with(K, const double h)
-  {
-    probes.clear_values();
-    const auto run = [&](auto with_contact) {
-      using Physics = ApicPointUpdate<dim, K, decltype(with_contact)::value>;
-      Physics physics{{prm.materials, points.layout.history, h, gravity, contact.get(), nullptr, need_strain_energy,
-                       probes, fbar_offset},
-                      affine_offset};
-      // as g2p_update_with: the update pass with the next step's mass and force fused
-      // (with contact a full P2G follows, per body)
-      zero_on_active(nodal_mass);
-      zero_on_active(nodal_a);
-      transfer::UpdateAndMove<dim, K, Physics> update{grid, points, nodal_p.begin(), h, physics};
-      if (prm.numerics.extended_p2g())
         transfer::for_each_active_cell(points, update);
       else
         {
@@ -830,7 +806,7 @@ namespace talus::explicit_mpm
         if (body) // the update pass of the FLIP step: v_p, C_p are set already
           g2p_update(h);
         else
-          with_kernel([&](auto kernel) { g2p_update_apic_with(kernel, h); });
+          with_kernel([&](auto kernel) { g2p_update_with<decltype(kernel), true>(kernel, h); });
         timings.g2p += seconds_since(t0);
         t0 = Clock::now();
         relocate();

@@ -241,14 +241,13 @@ namespace talus::explicit_mpm
     void g2p_velocity_p2g_momentum(const double dt);
     void nodal_velocity();
     void g2p_update(const double dt);
-    template <class Kernel>
+    /// The update pass (FLIP, or with `apic` the APIC G2P of v_p, C_p fused in)
+    template <class Kernel, bool apic = false>
     void g2p_update_with(Kernel, const double dt);
     /// The 1-phase step with velocity transfer = apic (after the nodal
-    /// acceleration): affine P2G of p^t, v^L = p^t / m + h a, APIC G2P fused
-    /// into the update pass.
+    /// acceleration): affine P2G of p^t, v^L = p^t / m + h a, then the update
+    /// pass with the APIC G2P (g2p_update_with<K, true>).
     void apic_nodal_velocity(const double dt);
-    template <class Kernel>
-    void g2p_update_apic_with(Kernel, const double dt);
     /// APIC with body velocity conditions (after apic_nodal_velocity): the
     /// APIC G2P of v_p and C_p from v^L, the conditioned points set to their
     /// prescribed velocity (C_p rows 0), the affine P2G of all points and
