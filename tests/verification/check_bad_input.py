@@ -59,8 +59,6 @@ cases.update({
     "apic with mpm-mixed": (tv.prm_set(apic_bs, "numerics/integration", "mpm-mixed"),
                             ["numerics/integration", "velocity transfer = apic"]),
     "apic with fem": (tv.prm_set(apic_bs, "numerics/integration", "fem"), ["numerics/integration", "velocity transfer = apic"]),
-    "apic with strain smoothing": (tv.prm_set(apic_bs, "numerics/strain smoothing", "cell"),
-                                   ["numerics/strain smoothing", "velocity transfer = apic"]),
     "apic with linear shape functions": (apic, ["numerics/velocity transfer", "quadratic bspline"]),
     "unknown velocity transfer": (tv.prm_set(base, "numerics/velocity transfer", "pic"),
                                   ["velocity transfer", "pic", "flip|apic"]),

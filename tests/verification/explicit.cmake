@@ -132,6 +132,16 @@ talus_verification(explicit_strain_smoothing check_smoothing.py verification/foo
 # and the B-spline footing settlement with and without it
 talus_verification(explicit_fbar_strip check_fbar_strip.py verification/strip_bending_incompressible.prm)
 set_tests_properties(verification.explicit_fbar_strip PROPERTIES PROCESSORS 2)
+# the same cases with strain smoothing (cell, nodal) as the device: with quadratic B-splines the
+# cell mean of the B-spline field's divergence (docs/explicit.md "Strain smoothing on B-splines")
+foreach(_kind cell nodal)
+  add_test(NAME verification.explicit_smoothing_strip_${_kind}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_fbar_strip.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/strip_bending_incompressible.prm ${_w}/smoothing_strip_${_kind}
+                   ${_kind})
+  set_tests_properties(verification.explicit_smoothing_strip_${_kind} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 900 PROCESSORS 2)
+endforeach()
 
 # issue 6: talus-convergence (bar without cell crossing: order >= 1.8; translating bar
 # with cell crossing: the predicted loss of convergence; bad input)

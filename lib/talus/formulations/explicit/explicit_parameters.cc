@@ -174,13 +174,12 @@ namespace talus::explicit_mpm
                 "docs/shape-functions.md, \"APIC\"); allowed: velocity transfer = flip, or quadratic bspline");
         // the cell-integrated passes: they integrate on the cells with linear
         // shape functions by definition, and APIC needs quadratic B-splines
+        // (strain smoothing takes the B-spline field's cell averages: allowed)
         const std::string cells = " is not available with numerics/velocity transfer = apic: APIC needs quadratic "
                                   "B-splines, and this pass integrates on the cells with linear shape functions "
                                   "(docs/shape-functions.md, \"APIC\"); allowed: ";
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
                 std::string(p.numerics.integration_name()) + cells + "mpm, or velocity transfer = flip");
-        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
-                "strain smoothing" + cells + "none, or velocity transfer = flip");
         // the coupled 2-phase step keeps its own (FLIP) velocity transfer
         const std::string why = " is not available with numerics/velocity transfer = apic (its passes keep the "
                                 "FLIP velocity update: the liquid's momentum); allowed: ";
@@ -202,14 +201,14 @@ namespace talus::explicit_mpm
       }
     if (p.bspline())
       {
-        // the passes that are not kernel templates (MPM-MIXED, FEM/UL-FEM, strain
-        // smoothing) walk with Q1
-        const std::string why = " is not available with numerics/shape function = quadratic bspline yet "
-                                "(its particle passes use linear shape functions); allowed: ";
+        // MPM-MIXED and FEM/UL-FEM integrate on the cells of the Q1 element by
+        // definition (cell stresses, its Gauss points); strain smoothing takes
+        // the cell averages of the B-spline field (StrainSmoothing)
         require(p.numerics.integration == NumericsOptions::Integration::mpm, "numerics/integration",
-                std::string(p.numerics.integration_name()) + why + "mpm");
-        require(p.numerics.smoothing == NumericsOptions::Smoothing::none, "numerics/strain smoothing",
-                "strain smoothing" + why + "none");
+                std::string(p.numerics.integration_name()) +
+                  " is not available with numerics/shape function = quadratic bspline: it integrates on the cells "
+                  "with the linear element by definition (cell stresses, Gauss points of the Q1 cell; "
+                  "docs/shape-functions.md); allowed: mpm");
         // contact (contact/pairs) is a kernel template (contact.cc; normals from
         // the B-spline mass gradient, docs/explicit.md "Contact between bodies").
         // The loads are kernel templates: the nodal momentum p^t (ScatterMomentum),

@@ -134,7 +134,7 @@ namespace talus::explicit_mpm
       contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline(), prm.numerics.fbar,
                                                affine_offset);
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
-      smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing);
+      smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing, prm.bspline());
 
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
@@ -650,7 +650,7 @@ namespace talus::explicit_mpm
     const auto run = [&](auto with_contact) {
       constexpr bool contact_on = decltype(with_contact)::value;
       using Point               = ExplicitPointUpdate<dim, K, contact_on>;
-      // APIC: v_p, C_p from v^L in the same pass (strain smoothing is refused with it)
+      // APIC: v_p, C_p from v^L in the same pass
       using Physics = std::conditional_t<apic, ApicPointUpdate<dim, K, contact_on>, Point>;
       const Point point{prm.materials,   points.layout.history, h,      gravity,    contact.get(),
                         smoothing.get(), need_strain_energy,    probes, fbar_offset};
@@ -793,12 +793,14 @@ namespace talus::explicit_mpm
     t0 = Clock::now();
     if (affine_offset)
       {
-        // APIC (FEM, 2-phase, smoothing are refused with it; with contact the
+        // APIC (FEM, MPM-MIXED and 2-phase are refused with it; with contact the
         // update pass takes each body's v^L_b of correct_accelerations)
         apic_nodal_velocity(h);
         const bool body = control && control->has_particle_conditions();
         if (body) // v_p, C_p from v^L, the prescribed ones set, then v = p / m
           apic_body_velocities();
+        if (smoothing) // from the nodal velocity the update pass moves with
+          smoothing->compute(*this, h);
         if (fbar_offset)
           with_kernel([&](auto kernel) { volume_averages_with(kernel, h); });
         timings.grid += seconds_since(t0);

@@ -4,8 +4,10 @@
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/mixed_integration.h>
 #include <talus/formulations/explicit/numerics.h>
-#include <talus/transfer/cell_walk.h>
+#include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1.h>
+#include <talus/transfer/cell_walk.h>
+#include <talus/transfer/point_ops.h>
 
 #include <deal.II/base/utilities.h>
 
@@ -305,8 +307,10 @@ namespace talus::explicit_mpm
 
   // ================================================================ smoothing
   template <int dim>
-  StrainSmoothing<dim>::StrainSmoothing(const BackgroundGrid<dim> &grid, const NumericsOptions::Smoothing k)
+  StrainSmoothing<dim>::StrainSmoothing(const BackgroundGrid<dim> &grid, const NumericsOptions::Smoothing k,
+                                        const bool bspline)
       : kind(k)
+      , bspline(bspline)
   {
     cell_value.assign(grid.cells.size(), 0.0);
     if (kind == NumericsOptions::Smoothing::nodal)
@@ -329,6 +333,8 @@ namespace talus::explicit_mpm
     using F                   = shape::Q1Factorised<dim>;
     constexpr unsigned int nv = F::nv;
     const double *const    Vn = s.nodal_p.begin();
+    if (bspline)
+      bspline_cell_values(s, dt);
     // element value: the volumetric strain increment of the Q1 field at the cell
     // centre, which is its cell average (the divergence of a Q1 field is linear
     // in each coordinate)
@@ -341,19 +347,20 @@ namespace talus::explicit_mpm
       F::weights(centre, N, w);
     }
     for (const auto &ac : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[ac.cell];
-        double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
-        for (unsigned int v = 0; v < nv; ++v)
+      if (!bspline)
+        {
+          const auto &cc = s.grid.cells[ac.cell];
+          double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
+          for (unsigned int v = 0; v < nv; ++v)
+            for (unsigned int d = 0; d < dim; ++d)
+              du[v][d] = dt * Vn[cc.dofs[v * dim + d]];
+          F::differences(du, D);
+          F::gradient(D, w, cc.inv_h, gu);
+          double tr = 0;
           for (unsigned int d = 0; d < dim; ++d)
-            du[v][d] = dt * Vn[cc.dofs[v * dim + d]];
-        F::differences(du, D);
-        F::gradient(D, w, cc.inv_h, gu);
-        double tr = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          tr += gu[d][d];
-        cell_value[ac.cell] = tr;
-      }
+            tr += gu[d][d];
+          cell_value[ac.cell] = tr;
+        }
     if (kind == NumericsOptions::Smoothing::cell)
       return;
     // Eq. 6.35: nodal value = sum over the surrounding active cells of
@@ -382,6 +389,40 @@ namespace talus::explicit_mpm
         for (unsigned int v = 0; v < nv; ++v)
           sum += X[cc.dofs[v * dim + 0]] / X[cc.dofs[v * dim + 1]];
         cell_value[ac.cell] = sum / nv;
+      }
+  }
+
+  template <int dim>
+  void
+  StrainSmoothing<dim>::bspline_cell_values(const Solver<dim> &s, const double dt)
+  {
+    // the cell average of tr grad du of the quadratic B-spline field: its pieces
+    // break at the cell centre, so 2 Gauss points on each half per direction
+    // (exact: on a piece the divergence is at most quadratic in each coordinate)
+    using K                  = shape::BSpline2Box<dim>;
+    const double       g     = 0.25 / std::sqrt(3.0);
+    const double       x1[4] = {0.25 - g, 0.25 + g, 0.75 - g, 0.75 + g};
+    const double      *Vn    = s.nodal_p.begin();
+    constexpr unsigned n     = dim == 2 ? 16 : 64;
+    typename K::Field  du;
+    for (const auto &ac : s.points.active_cells())
+      {
+        const typename K::Cell cell = K::cell(s.grid, ac.cell);
+        K::gather(cell, Vn, dt, du, true);
+        double tr = 0;
+        for (unsigned int q = 0; q < n; ++q)
+          {
+            dealii::Point<dim> xi;
+            for (unsigned int d = 0, r = q; d < dim; ++d, r /= 4)
+              xi[d] = x1[r % 4];
+            typename K::Eval e;
+            K::evaluate(cell, xi, e);
+            double gu[dim][dim], dx[dim];
+            transfer::default_increments<dim, K>(cell, e, du, gu, dx);
+            for (unsigned int d = 0; d < dim; ++d)
+              tr += gu[d][d];
+          }
+        cell_value[ac.cell] = tr / n;
       }
   }
 

@@ -113,7 +113,9 @@ namespace talus::explicit_mpm
   class StrainSmoothing
   {
   public:
-    StrainSmoothing(const BackgroundGrid<dim> &grid, NumericsOptions::Smoothing kind);
+    /// `bspline`: the cell values are the cell averages of the quadratic
+    /// B-spline field's divergence (else the Q1 field's, at the cell centre)
+    StrainSmoothing(const BackgroundGrid<dim> &grid, NumericsOptions::Smoothing kind, bool bspline);
     /// From the nodal velocities of the solver (nodal_p after nodal_velocity()).
     void compute(const Solver<dim> &s, double dt);
     /// After a repartition: the cell values and the nodal vector re-sized for
@@ -134,8 +136,10 @@ namespace talus::explicit_mpm
 
   private:
     NumericsOptions::Smoothing kind;
+    bool                       bspline;
     std::vector<double>        cell_value; ///< by active cell index
-    Vector                     nodal;      ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
+    void                       bspline_cell_values(const Solver<dim> &s, double dt);
+    Vector                     nodal; ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
   };
 
   /// Contact between bodies (§6.2). Every body gets its own nodal mass, volume,
