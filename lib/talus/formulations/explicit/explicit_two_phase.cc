@@ -8,7 +8,6 @@
 #include <talus/shape/q1_box.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/move_point.h>
-#include <talus/transfer/pressure_relaxation.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -222,15 +221,6 @@ namespace talus::explicit_mpm
                       "Alias of the top-level 'damping/local damping' (seed 000 §6.3; in the 2-phase step "
                       "each phase is damped with its own unbalanced force, Eqs. 6.24-6.28), 0 <= alpha < 1; "
                       "0 = off. Giving both with different values is an error.");
-    prm.declare_entry("pressure relaxation", "0.25", Double(0, 10),
-                      "Quadratic B-splines only (linear shape functions ignore it): at each step every "
-                      "point pore pressure of a coupled material is blended towards its node map-remap "
-                      "(liquid-mass-weighted lumped projection to the nodes, interpolated back) with the "
-                      "share min(1, C c_v dt / h^2), C this number, c_v = k M / (rho_L g) the "
-                      "consolidation coefficient (M = 1 / (1 / E_c + n / K_L)), h the smallest cell edge: "
-                      "the point-pressure patterns the nodal liquid force does not see decay at the rate "
-                      "Darcy flow dissipates a grid-scale pattern (docs/shape-functions.md, \"2-phase on "
-                      "B-splines\"). A number in [0, 10]; 0 = off (Terzaghi's error is then 6.6 %).");
     prm.leave_subsection();
   }
 
@@ -243,8 +233,7 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
     require(p.free_surface_factor < 1, "liquid/free surface factor", "must be < 1 (0 = off)");
     prm.enter_subsection("two phase");
-    p.local_damping       = prm.get_double("local damping");
-    p.pressure_relaxation = prm.get_double("pressure relaxation");
+    p.local_damping = prm.get_double("local damping");
     prm.leave_subsection();
     require(p.local_damping < 1, "two phase/local damping", "must satisfy 0 <= alpha < 1");
   }
@@ -324,7 +313,6 @@ namespace talus::explicit_mpm
       : s(solver)
   {
     coupled = s.prm.liquid.any_coupled();
-    relax   = coupled && s.prm.bspline() && s.prm.liquid.pressure_relaxation > 0;
   }
 
   template <int dim>
@@ -357,45 +345,6 @@ namespace talus::explicit_mpm
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid, &a_liquid})
         s.grid.reinit_vector(*v);
-    if (relax)
-      s.grid.reinit_vector(p_node);
-  }
-
-  // The share of the relaxed pore pressure in the step h for each coupled
-  // material: min(1, C c_v h / h_min^2) (transfer/pressure_relaxation.h, the
-  // rule of the semi-implicit 'automatic' smoothing with C), c_v = k M / (rho_L g)
-  // with the storage modulus M = 1 / (1 / E_c + n / K_L) of the skeleton and the
-  // liquid (the diffusivity of the pore pressure in the storage equation; E_c
-  // for an incompressible liquid).
-  template <int dim>
-  void
-  TwoPhase<dim>::relaxation_fractions(const double h)
-  {
-    const auto  &pl    = s.prm.liquid.pore_liquid;
-    const double h_min = s.grid.min_cell_size();
-    relax_share.assign(pl.size(), 0.0);
-    for (unsigned int m = 0; m < pl.size(); ++m)
-      if (pl[m].drainage == Drainage::coupled)
-        {
-          const double k = pl[m].intrinsic_permeability * pl[m].density * pl[m].gravity / pl[m].viscosity;
-          const double M =
-            1.0 / (1.0 / s.prm.materials[m]->constrained_modulus() + pl[m].porosity / pl[m].bulk_modulus);
-          const double c_v = transfer::consolidation_coefficient(k, M, pl[m].density, pl[m].gravity);
-          relax_share[m]   = transfer::pressure_smoothing_fraction(c_v, h, h_min, s.prm.liquid.pressure_relaxation);
-        }
-  }
-
-  // p_I = sum N mL p / sum N mL on the scalar slot of each node (the sums of
-  // particles_to_nodes; mL = n rho_L V, the denominator is Mbar_L), with ghosts.
-  template <int dim>
-  void
-  TwoPhase<dim>::pressure_map()
-  {
-    const double *const mLn_ = m_liquid_n.begin();
-    double *const       PN   = p_node.begin();
-    for (const unsigned int i : s.active_dofs)
-      PN[i] = mLn_[i] > 0 ? PN[i] / mLn_[i] : 0.0;
-    p_node.update_ghost_values();
   }
 
   template <int dim>
@@ -459,11 +408,7 @@ namespace talus::explicit_mpm
   {
     auto *const control = s.control.get();
     const auto  t0      = std::chrono::steady_clock::now();
-    if (relax)
-      relaxation_fractions(h);
     particles_to_nodes<K>(); // 1
-    if (relax)
-      pressure_map();
     // loads: tractions on the mixture, nodal v^t (the solid momentum of this
     // P2G), friction lift; convergence ratios of both phases
     if (control)
@@ -520,15 +465,12 @@ namespace talus::explicit_mpm
     double *const mLt_ = coupled ? m_liquid.begin() : nullptr, *const mLn_ = coupled ? m_liquid_n.begin() : nullptr;
     double *const Q_ = coupled ? drag.begin() : nullptr, *const FL_ = coupled ? f_liquid.begin() : nullptr;
     double *const PL_ = coupled ? p_liquid.begin() : nullptr;
-    double *const PN  = relax ? p_node.begin() : nullptr; // sum N mL p (pressure_map)
     s.zero_on_active(MSv);
     s.zero_on_active(FSv);
     s.zero_on_active(PSv);
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         s.zero_on_active(*v);
-    if (relax)
-      s.zero_on_active(p_node);
     // traction point forces (loads/traction, at t) scattered in this pass
     double *const T = control ? control->begin_traction_scatter(s) : nullptr;
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
@@ -583,17 +525,12 @@ namespace talus::explicit_mpm
                 PL_[i] += mL * N[v] * P[liquid_velocity + d];
               }
           }
-      if (cp && PN) // the scalar slot of each node
-        for (unsigned int v = 0; v < nv; ++v)
-          PN[kc.dofs[slot[v] * dim]] += mL * N[v] * p;
     });
     for (Vector *v : {&MSv, &FSv, &PSv})
       v->compress(dealii::VectorOperation::add);
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         v->compress(dealii::VectorOperation::add);
-    if (relax)
-      p_node.compress(dealii::VectorOperation::add);
     if (control)
       control->end_traction_scatter();
   }
@@ -790,7 +727,6 @@ namespace talus::explicit_mpm
     auto *const                 control = s.control.get();
     const double *const         PS      = s.nodal_p.begin();
     const double *const         PL_     = coupled ? p_liquid.begin() : nullptr;
-    const double *const         PN      = relax ? p_node.begin() : nullptr; // pressure_map
     diagnostics::PointSums<dim> sums;
     bool                        bad    = false;
     double                      work   = 0; // of the tractions over this step
@@ -828,14 +764,7 @@ namespace talus::explicit_mpm
       m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
       L::set_stress(sigma, P);
       const double dvS = trace(d_eps);
-      if (cp && PN) // the relaxation towards the node map-remap, before the increment
-        {
-          double ps = 0;
-          for (unsigned int v = 0; v < nv; ++v)
-            ps += N[v] * PN[kc.dofs[slot[v] * dim]];
-          P[pore_pressure] = transfer::blend_pressure(P[pore_pressure], ps, relax_share[mat]);
-        }
-      const double mL = cp ? pore_liquid_update(P, pl[mat], dvS, div_uL, sums, bad) : 0.0;
+      const double mL  = cp ? pore_liquid_update(P, pl[mat], dvS, div_uL, sums, bad) : 0.0;
       P[L::volume] *= (1.0 + dvS); // Eq. 4.118
       if (P[L::volume] > cell_volume)
         P[L::volume] = cell_volume;
