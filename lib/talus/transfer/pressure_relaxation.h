@@ -1,11 +1,11 @@
 // talus — the relaxation of point pore pressures towards their node map-remap:
-// the rule for the share of the smoothed value per step and the blend. Used by
+// the rule for the share of the smoothed value per step and the blend, shared by
 // the semi-implicit family ('semi implicit/pressure smoothing fraction',
-// docs/semi-implicit.md "The smoothing at low k"); the explicit 2-phase step on
-// quadratic B-splines was measured with it (C != 1, docs/shape-functions.md
-// "2-phase on B-splines: why still refused"). A family makes its own nodal map
-// (its nodal vectors, fused into its own passes) and chooses the modulus of its
-// consolidation coefficient; the rule and the blend live here only.
+// docs/semi-implicit.md "The smoothing at low k") and the explicit 2-phase step
+// on quadratic B-splines ('two phase/pressure relaxation', docs/shape-functions.md
+// "2-phase on B-splines"). A family makes its own nodal map (its nodal vectors,
+// fused into its own passes) and chooses the modulus of its consolidation
+// coefficient; the rule and the blend live here only.
 #pragma once
 
 #include <algorithm>
