@@ -215,17 +215,9 @@ namespace talus::explicit_mpm
         // the traction point forces and the momentum of prescribed point
         // velocities (ScatterPointVectors); wall friction acts on the wall nodes'
         // sums, whichever kernel made them. The 2-phase step is a kernel template
-        // too, but with B-splines its point pore pressures carry patterns the
-        // nodal liquid force does not see; the smoothings tried fail either
-        // Terzaghi or the hydrostatic column (docs/shape-functions.md, "2-phase on
-        // B-splines: why still refused").
-        require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/shape function",
-                "coupled 2-phase materials and their body tractions are not available with numerics/shape "
-                "function = quadratic bspline: the point pore pressures carry patterns the nodal liquid force "
-                "does not see, which never dissipate (Terzaghi: 6.6 % L2 error against 0.5 % with linear shape "
-                "functions), and the smoothings tried fail Terzaghi or the hydrostatic column "
-                "(docs/shape-functions.md, \"2-phase on B-splines: why still refused\"); allowed: linear, or "
-                "1-phase materials");
+        // too; with B-splines it relaxes the point pore pressures towards their
+        // node map-remap ('two phase/pressure relaxation', docs/shape-functions.md,
+        // "2-phase on B-splines").
         require(!p.grid_mesh, "grid/source",
                 "a grid file with quadratic B-splines: they need a uniform box grid; allowed: box");
         for (unsigned int d = 0; d < dim; ++d)

@@ -1,4 +1,5 @@
 #include <talus/base/errors.h>
+#include <talus/base/tool.h>
 #include <talus/formulations/explicit/explicit_solver.h>
 #include <talus/formulations/explicit/explicit_two_phase.h>
 #include <talus/formulations/explicit/load_control.h>
@@ -8,6 +9,7 @@
 #include <talus/shape/q1_box.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/move_point.h>
+#include <talus/transfer/pressure_relaxation.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -221,6 +223,16 @@ namespace talus::explicit_mpm
                       "Alias of the top-level 'damping/local damping' (seed 000 §6.3; in the 2-phase step "
                       "each phase is damped with its own unbalanced force, Eqs. 6.24-6.28), 0 <= alpha < 1; "
                       "0 = off. Giving both with different values is an error.");
+    prm.declare_entry("pressure relaxation", "1", Double(0, 10),
+                      "Quadratic B-splines only (linear shape functions ignore it): at each step the pore "
+                      "pressure of every point of a coupled material is blended towards its node map-remap "
+                      "(liquid-mass-weighted lumped map to the nodes, interpolated back) with the share "
+                      "min(1, C c_v dt / h^2), C this number, c_v = k / (rho_L g (1/E_c + n/K_L)) the "
+                      "consolidation coefficient, h the smallest cell edge: the point-pressure patterns the "
+                      "nodal liquid force does not see decay at the rate Darcy flow dissipates a pattern of "
+                      "the grid scale (C = 1: the rule of the semi-implicit 'pressure smoothing fraction = "
+                      "automatic'). 0 = off: Terzaghi's column then keeps a pattern in its top point rows "
+                      "(docs/shape-functions.md, \"2-phase on B-splines\"). A number in [0, 10].");
     prm.leave_subsection();
   }
 
@@ -233,7 +245,8 @@ namespace talus::explicit_mpm
     prm.leave_subsection();
     require(p.free_surface_factor < 1, "liquid/free surface factor", "must be < 1 (0 = off)");
     prm.enter_subsection("two phase");
-    p.local_damping = prm.get_double("local damping");
+    p.local_damping       = prm.get_double("local damping");
+    p.pressure_relaxation = prm.get_double("pressure relaxation");
     prm.leave_subsection();
     require(p.local_damping < 1, "two phase/local damping", "must satisfy 0 <= alpha < 1");
   }
@@ -313,6 +326,18 @@ namespace talus::explicit_mpm
       : s(solver)
   {
     coupled = s.prm.liquid.any_coupled();
+    relax   = coupled && s.prm.bspline() && s.prm.liquid.pressure_relaxation > 0;
+    // with B-splines a drained free surface needs 3 point rows per cell for the
+    // node of the grid cell above it (one point row in its support with 2)
+    if (coupled && s.prm.bspline())
+      for (unsigned int b = 0; b < s.prm.bodies.size(); ++b)
+        if (s.prm.liquid.pore_liquid[s.prm.bodies[b].material_id].drainage == Drainage::coupled &&
+            s.prm.bodies[b].particles_per_direction < 3)
+          log() << "  warning: body " << b << " (coupled 2-phase) has " << s.prm.bodies[b].particles_per_direction
+                << " particles per direction with quadratic B-splines: the pore pressure of the point rows next "
+                   "to a drained free surface is measured off by up to 0.15 q in Terzaghi's column (L2 2.7 % "
+                   "at T_v = 0.05 against 0.5 % with 3; docs/shape-functions.md, \"2-phase on B-splines\"); "
+                   "use 3 or more\n";
   }
 
   template <int dim>
@@ -345,6 +370,45 @@ namespace talus::explicit_mpm
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid, &a_liquid})
         s.grid.reinit_vector(*v);
+    if (relax)
+      s.grid.reinit_vector(p_node);
+  }
+
+  // The share of the relaxed pore pressure in the step h for each coupled
+  // material: min(1, C c_v h / h_min^2) (transfer/pressure_relaxation.h, the
+  // rule of the semi-implicit 'automatic' smoothing with C), c_v = k M / (rho_L g)
+  // with the storage modulus M = 1 / (1 / E_c + n / K_L) of the skeleton and the
+  // liquid (the diffusivity of the pore pressure in the storage equation; E_c
+  // for an incompressible liquid).
+  template <int dim>
+  void
+  TwoPhase<dim>::relaxation_fractions(const double h)
+  {
+    const auto  &pl    = s.prm.liquid.pore_liquid;
+    const double h_min = s.grid.min_cell_size();
+    relax_share.assign(pl.size(), 0.0);
+    for (unsigned int m = 0; m < pl.size(); ++m)
+      if (pl[m].drainage == Drainage::coupled)
+        {
+          const double k = pl[m].intrinsic_permeability * pl[m].density * pl[m].gravity / pl[m].viscosity;
+          const double M =
+            1.0 / (1.0 / s.prm.materials[m]->constrained_modulus() + pl[m].porosity / pl[m].bulk_modulus);
+          const double c_v = transfer::consolidation_coefficient(k, M, pl[m].density, pl[m].gravity);
+          relax_share[m]   = transfer::pressure_smoothing_fraction(c_v, h, h_min, s.prm.liquid.pressure_relaxation);
+        }
+  }
+
+  // p_I = sum N mL p / sum N mL on the scalar slot of each node (the sums of
+  // particles_to_nodes; mL = n rho_L V, the denominator is Mbar_L), with ghosts.
+  template <int dim>
+  void
+  TwoPhase<dim>::pressure_map()
+  {
+    const double *const mLn_ = m_liquid_n.begin();
+    double *const       PN   = p_node.begin();
+    for (const unsigned int i : s.active_dofs)
+      PN[i] = mLn_[i] > 0 ? PN[i] / mLn_[i] : 0.0;
+    p_node.update_ghost_values();
   }
 
   template <int dim>
@@ -408,7 +472,11 @@ namespace talus::explicit_mpm
   {
     auto *const control = s.control.get();
     const auto  t0      = std::chrono::steady_clock::now();
+    if (relax)
+      relaxation_fractions(h);
     particles_to_nodes<K>(); // 1
+    if (relax)
+      pressure_map();
     // loads: tractions on the mixture, nodal v^t (the solid momentum of this
     // P2G), friction lift; convergence ratios of both phases
     if (control)
@@ -465,12 +533,15 @@ namespace talus::explicit_mpm
     double *const mLt_ = coupled ? m_liquid.begin() : nullptr, *const mLn_ = coupled ? m_liquid_n.begin() : nullptr;
     double *const Q_ = coupled ? drag.begin() : nullptr, *const FL_ = coupled ? f_liquid.begin() : nullptr;
     double *const PL_ = coupled ? p_liquid.begin() : nullptr;
+    double *const PN  = relax ? p_node.begin() : nullptr; // sum N mL p (pressure_map)
     s.zero_on_active(MSv);
     s.zero_on_active(FSv);
     s.zero_on_active(PSv);
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         s.zero_on_active(*v);
+    if (relax)
+      s.zero_on_active(p_node);
     // traction point forces (loads/traction, at t) scattered in this pass
     double *const T = control ? control->begin_traction_scatter(s) : nullptr;
     transfer::for_each_point(s.points, [&](const unsigned int c, transfer::PointIterator<dim> &pt) {
@@ -525,12 +596,17 @@ namespace talus::explicit_mpm
                 PL_[i] += mL * N[v] * P[liquid_velocity + d];
               }
           }
+      if (cp && PN) // the scalar slot of each node
+        for (unsigned int v = 0; v < nv; ++v)
+          PN[kc.dofs[slot[v] * dim]] += mL * N[v] * p;
     });
     for (Vector *v : {&MSv, &FSv, &PSv})
       v->compress(dealii::VectorOperation::add);
     if (coupled)
       for (Vector *v : {&m_liquid, &m_liquid_n, &drag, &f_liquid, &p_liquid})
         v->compress(dealii::VectorOperation::add);
+    if (relax)
+      p_node.compress(dealii::VectorOperation::add);
     if (control)
       control->end_traction_scatter();
   }
@@ -727,6 +803,7 @@ namespace talus::explicit_mpm
     auto *const                 control = s.control.get();
     const double *const         PS      = s.nodal_p.begin();
     const double *const         PL_     = coupled ? p_liquid.begin() : nullptr;
+    const double *const         PN      = relax ? p_node.begin() : nullptr; // pressure_map
     diagnostics::PointSums<dim> sums;
     bool                        bad    = false;
     double                      work   = 0; // of the tractions over this step
@@ -764,7 +841,14 @@ namespace talus::explicit_mpm
       m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + s.points.layout.history, m.n_history()));
       L::set_stress(sigma, P);
       const double dvS = trace(d_eps);
-      const double mL  = cp ? pore_liquid_update(P, pl[mat], dvS, div_uL, sums, bad) : 0.0;
+      if (cp && PN) // the relaxation towards the node map-remap, before the increment
+        {
+          double ps = 0;
+          for (unsigned int v = 0; v < nv; ++v)
+            ps += N[v] * PN[kc.dofs[slot[v] * dim]];
+          P[pore_pressure] = transfer::blend_pressure(P[pore_pressure], ps, relax_share[mat]);
+        }
+      const double mL = cp ? pore_liquid_update(P, pl[mat], dvS, div_uL, sums, bad) : 0.0;
       P[L::volume] *= (1.0 + dvS); // Eq. 4.118
       if (P[L::volume] > cell_volume)
         P[L::volume] = cell_volume;

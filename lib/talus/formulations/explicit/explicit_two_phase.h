@@ -47,8 +47,13 @@ namespace talus::explicit_mpm
     std::vector<BodyTraction<dim>> tractions;               ///< per body
     double                         free_surface_factor = 0; ///< F_FreeSurf of Eq. 6.40; 0: off
     double                         local_damping = 0; ///< 'two phase/local damping' (alias of damping/local damping)
-    bool                           any_coupled() const;
-    bool                           any_traction() const;
+    /// 'two phase/pressure relaxation' C: with quadratic B-splines each step blends
+    /// the point pore pressures towards their node map-remap with the share
+    /// min(1, C c_v dt / h^2) (transfer/pressure_relaxation.h); 0 = off. Linear
+    /// shape functions ignore it.
+    double pressure_relaxation = 1.0;
+    bool   any_coupled() const;
+    bool   any_traction() const;
   };
 
   /// .prm declarations: inside a "body k" subsection, and the top-level
@@ -126,7 +131,12 @@ namespace talus::explicit_mpm
     template <class K>
     void g2p_update(const double dt);
     // pieces of the phases
-    void   update_ghosts(Vector &solid, Vector &liquid);
+    void update_ghosts(Vector &solid, Vector &liquid);
+    /// the shares of the relaxed pore pressure of the step h, per material
+    void relaxation_fractions(const double h);
+    /// the node map of the pore pressure p_I = sum N mL p / sum N mL (the sums of
+    /// particles_to_nodes), on the scalar slot of each node, with its ghosts
+    void   pressure_map();
     double pore_liquid_update(double *P, const PoreLiquid &pl, const double dvS, const double div_uL,
                               diagnostics::PointSums<dim> &sums, bool &bad) const;
 
@@ -134,6 +144,11 @@ namespace talus::explicit_mpm
     // lumped nodal quantities: liquid mass without / with porosity, drag,
     // liquid force and momentum (solid: the solver's nodal_mass, nodal_a, nodal_p)
     Vector m_liquid, m_liquid_n, drag, f_liquid, p_liquid, a_liquid;
+    /// the pore-pressure relaxation (quadratic B-splines, pressure_relaxation > 0):
+    /// on, the node map of the pore pressure, the share per material in this step
+    bool                relax = false;
+    Vector              p_node;
+    std::vector<double> relax_share;
   };
 
   /// Liquid free-surface detection (§6.8): nodal density of the non-empty

@@ -15,6 +15,7 @@
 #include <talus/materials/material.h>
 #include <talus/materials/pore_liquid.h>
 #include <talus/particles/material_points.h>
+#include <talus/transfer/pressure_relaxation.h>
 
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/utilities.h>
@@ -468,8 +469,9 @@ namespace talus::semi_implicit
         for (const unsigned int m : p.materials_of_body[b])
           {
             const double k   = initial_stage ? p.initialisation_conductivity : p.soil_of_material[m].conductivity;
-            const double c_v = k * p.materials[m]->constrained_modulus() / (p.water_density * p.unit_weight_gravity);
-            beta[m]          = std::min(1.0, c_v * dt / (h_min * h_min));
+            const double c_v = transfer::consolidation_coefficient(k, p.materials[m]->constrained_modulus(),
+                                                                   p.water_density, p.unit_weight_gravity);
+            beta[m]          = transfer::pressure_smoothing_fraction(c_v, dt, h_min);
           }
     return beta;
   }

@@ -18,6 +18,7 @@
 #include <talus/formulations/common/simulation.h>
 #include <talus/formulations/semi_implicit/boundary_loads.h>
 #include <talus/transfer/fbar.h>
+#include <talus/transfer/pressure_relaxation.h>
 #include <talus/formulations/semi_implicit/semi_implicit.h>
 #include <talus/grid/background_grid.h>
 #include <talus/grid/nodal_space.h>
@@ -316,7 +317,7 @@ namespace talus::semi_implicit
     smooth_pressure(const Stencil &s, const double *p_node, const double *P, double &p) const
     {
       const double beta = smoothing_fraction_of_material[static_cast<unsigned int>(P[L::material])];
-      p                 = beta == 1.0 ? s.value(p_node) : (1 - beta) * p + beta * s.value(p_node);
+      p                 = transfer::blend_pressure(p, s.value(p_node), beta);
     }
     /// (7c) a water point's pore pressure p += dp (as an increment: p_I^t + dp_I
     /// interpolated differs by the remap) and its gradient grad p^t + grad dp;
