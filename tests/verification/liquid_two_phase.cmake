@@ -26,9 +26,9 @@ talus_liquid_case(two_phase_terzaghi_fast fast check_terzaghi.py verification/te
 talus_liquid_case(two_phase_terzaghi verify check_terzaghi.py verification/terzaghi_consolidation.prm)
 # coupled 2-phase on quadratic B-splines (issue 38; docs/shape-functions.md, "2-phase on B-splines"):
 # Terzaghi within 2 % (3 x 41 cells, 3 x 3 points per cell) and 1 vs 2 ranks (1e-10) on its column;
-# the hydrostatic column (3 x 34 cells, 3 x 3 points per cell) at rest, and its restart bitwise on 1
-# and 2 ranks (the Terzaghi column's body traction is reassigned at a restart from the current point
-# volumes, an ulp off: docs/shape-functions.md)
+# the hydrostatic column (3 x 34 cells, 3 x 3 points per cell) at rest; the restart bitwise on 1 and
+# 2 ranks of both columns (Terzaghi's: its traction point forces come from the checkpoint, not from a
+# new assignment at the restart's volumes, which was an ulp off)
 set(_tz_bspline "numerics/shape function=quadratic bspline" "grid/upper corner=0.075, 1.025" "grid/cells=3, 41"
                 "body 0/upper corner=0.075, 1" "body 0/particles per direction=3")
 set(_hy_bspline "numerics/shape function=quadratic bspline" "grid/upper corner=0.09375, 1.0625" "grid/cells=3, 34"
@@ -38,6 +38,9 @@ talus_liquid_case(two_phase_hydrostatic_bspline fast check_hydrostatic.py verifi
                   two-phase ${_hy_bspline})
 talus_liquid_case(two_phase_bspline_np1_np2 fast check_two_phase_ranks.py verification/terzaghi_consolidation.prm
                   ${_tz_bspline})
+talus_liquid_case(two_phase_terzaghi_bspline_restart fast check_two_phase_restart.py
+                  verification/terzaghi_consolidation.prm ${_tz_bspline})
+set_tests_properties(verification.two_phase_terzaghi_bspline_restart PROPERTIES PROCESSORS 2)
 talus_liquid_case(two_phase_bspline_restart fast check_two_phase_restart.py verification/hydrostatic_2phase.prm
                   ${_hy_bspline})
 set_tests_properties(verification.two_phase_bspline_np1_np2 verification.two_phase_bspline_restart PROPERTIES

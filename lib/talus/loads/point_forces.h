@@ -66,6 +66,13 @@ namespace talus::loads
       factor = std::move(f);
     }
 
+    /// A restart within a stage: the points' force slots come from the checkpoint
+    /// (what assign() gave at the stage's start); only the switch is set again.
+    void
+    resume(const std::vector<Traction<dim>> &tractions)
+    {
+      have_tractions = !tractions.empty();
+    }
     /// Whether the tractions of the last assign() were not empty.
     bool
     any() const

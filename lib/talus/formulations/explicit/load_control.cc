@@ -154,7 +154,16 @@ namespace talus::loads
       settle_time = std::max(settle_time, plate.function.settle_time() - stage_t0);
 
     if (settings.max_tractions > 0)
-      assign_tractions(s);
+      {
+        // a restart: the checkpointed points carry the forces of the stage's
+        // assignment; assigning anew from the current volumes gave other shares
+        // (1 ulp off in a consolidating layer, more where the loaded points'
+        // volumes change unevenly), so the restart was not bitwise
+        if (resume)
+          forces.resume(current->tractions);
+        else
+          assign_tractions(s);
+      }
     build_node_lists(s);
     if (!resume)
       s.initial_energies = s.energies(); // baseline of the stability check (restored on restart)
