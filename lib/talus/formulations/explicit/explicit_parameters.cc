@@ -153,8 +153,10 @@ namespace talus::explicit_mpm
                   "both replace the volumetric strain increment: choose one); allowed: none, or volumetric "
                   "stabilisation = none");
         require(!p.liquid.any_coupled() && !p.liquid.any_traction(), "numerics/volumetric stabilisation",
-                "f-bar is available in the 1-phase step only (coupled 2-phase materials and body tractions run "
-                "the 2-phase step); allowed: none, or 1-phase materials");
+                "f-bar is not available with coupled 2-phase materials (and body tractions, which run the 2-phase "
+                "step): the storage equation turns any change of the skeleton's volume increment into pore "
+                "pressure at K_L / n, and the node average of the skeleton's dJ alone put Terzaghi 500 % off "
+                "(docs/explicit.md, \"F-bar and the 2-phase step\"); allowed: none, or 1-phase materials");
       }
     if (p.numerics.apic())
       {
