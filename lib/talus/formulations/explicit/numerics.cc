@@ -332,35 +332,10 @@ namespace talus::explicit_mpm
   {
     using F                   = shape::Q1Factorised<dim>;
     constexpr unsigned int nv = F::nv;
-    const double *const    Vn = s.nodal_p.begin();
     if (bspline)
       bspline_cell_values(s, dt);
-    // element value: the volumetric strain increment of the Q1 field at the cell
-    // centre, which is its cell average (the divergence of a Q1 field is linear
-    // in each coordinate)
-    double w[dim][F::npairs];
-    {
-      double             N[nv];
-      dealii::Point<dim> centre;
-      for (unsigned int d = 0; d < dim; ++d)
-        centre[d] = 0.5;
-      F::weights(centre, N, w);
-    }
-    for (const auto &ac : s.points.active_cells())
-      if (!bspline)
-        {
-          const auto &cc = s.grid.cells[ac.cell];
-          double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
-          for (unsigned int v = 0; v < nv; ++v)
-            for (unsigned int d = 0; d < dim; ++d)
-              du[v][d] = dt * Vn[cc.dofs[v * dim + d]];
-          F::differences(du, D);
-          F::gradient(D, w, cc.inv_h, gu);
-          double tr = 0;
-          for (unsigned int d = 0; d < dim; ++d)
-            tr += gu[d][d];
-          cell_value[ac.cell] = tr;
-        }
+    else
+      q1_cell_values(s, dt);
     if (kind == NumericsOptions::Smoothing::cell)
       return;
     // Eq. 6.35: nodal value = sum over the surrounding active cells of
@@ -389,6 +364,40 @@ namespace talus::explicit_mpm
         for (unsigned int v = 0; v < nv; ++v)
           sum += X[cc.dofs[v * dim + 0]] / X[cc.dofs[v * dim + 1]];
         cell_value[ac.cell] = sum / nv;
+      }
+  }
+
+  template <int dim>
+  void
+  StrainSmoothing<dim>::q1_cell_values(const Solver<dim> &s, const double dt)
+  {
+    // element value: the volumetric strain increment of the Q1 field at the cell
+    // centre, which is its cell average (the divergence of a Q1 field is linear
+    // in each coordinate)
+    using F                   = shape::Q1Factorised<dim>;
+    constexpr unsigned int nv = F::nv;
+    const double *const    Vn = s.nodal_p.begin();
+    double                 w[dim][F::npairs];
+    {
+      double             N[nv];
+      dealii::Point<dim> centre;
+      for (unsigned int d = 0; d < dim; ++d)
+        centre[d] = 0.5;
+      F::weights(centre, N, w);
+    }
+    for (const auto &ac : s.points.active_cells())
+      {
+        const auto &cc = s.grid.cells[ac.cell];
+        double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
+        for (unsigned int v = 0; v < nv; ++v)
+          for (unsigned int d = 0; d < dim; ++d)
+            du[v][d] = dt * Vn[cc.dofs[v * dim + d]];
+        F::differences(du, D);
+        F::gradient(D, w, cc.inv_h, gu);
+        double tr = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          tr += gu[d][d];
+        cell_value[ac.cell] = tr;
       }
   }
 

@@ -138,8 +138,10 @@ namespace talus::explicit_mpm
     NumericsOptions::Smoothing kind;
     bool                       bspline;
     std::vector<double>        cell_value; ///< by active cell index
-    void                       bspline_cell_values(const Solver<dim> &s, double dt);
-    Vector                     nodal; ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
+    /// the element values (volumetric increment per active cell) of either kernel
+    void   q1_cell_values(const Solver<dim> &s, double dt);
+    void   bspline_cell_values(const Solver<dim> &s, double dt);
+    Vector nodal; ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
   };
 
   /// Contact between bodies (§6.2). Every body gets its own nodal mass, volume,
