@@ -12,8 +12,10 @@
    every sampled time), momentum conserved to round-off, the disks separate
    (velocities reversed, gap > 2 cells at the end), 1 and 2 ranks agree to 1e-10.
 With a last argument `f-bar`, every run also sets numerics/volumetric stabilisation = f-bar
-(each body maps and remaps its own dJ, docs/explicit.md "F-bar with contact"): the same checks.
-Usage: check_contact.py TOOL SLIDING_PRM DISKS_PRM WORKDIR [f-bar]
+(each body maps and remaps its own dJ, docs/explicit.md "F-bar with contact"); with `cell` or
+`nodal`, numerics/strain smoothing (each body's cell values from its own velocities, "Strain
+smoothing with contact"): the same checks.
+Usage: check_contact.py TOOL SLIDING_PRM DISKS_PRM WORKDIR [f-bar|cell|nodal]
 """
 import math
 import sys
@@ -21,11 +23,18 @@ import sys
 import talus_verify as tv
 
 tool, sliding_prm, disks_prm, work = sys.argv[1:5]
-STABILISATION = sys.argv[5] if len(sys.argv) > 5 else "none"
+DEVICE = sys.argv[5] if len(sys.argv) > 5 else "none"
+if DEVICE not in ("none", "f-bar", "cell", "nodal"):
+    sys.exit(f"check_contact.py: unknown device '{DEVICE}' (none, f-bar, cell, nodal)")
 
 
 def scene(path):
-    return tv.prm_set(open(path).read(), "numerics/volumetric stabilisation", STABILISATION)
+    text = open(path).read()
+    if DEVICE == "f-bar":
+        return tv.prm_set(text, "numerics/volumetric stabilisation", "f-bar")
+    if DEVICE in ("cell", "nodal"):
+        return tv.prm_set(text, "numerics/strain smoothing", DEVICE)
+    return text
 
 g = 9.81
 B, m_block = 0.2, 2000 * 0.2 * 0.1  # block width [m], mass per unit thickness [kg/m]

@@ -24,8 +24,10 @@ restart  The disks with checkpoints every 0.5 s, stopped at 1.2 s (in the collis
 A last argument, a '+'-separated option set, switches more on in every run, with the same checks
 and bounds: `f-bar` (numerics/volumetric stabilisation = f-bar: each body maps and remaps its own
 dJ, docs/explicit.md "F-bar with contact"), `apic` (numerics/velocity transfer = apic: each body's
-v_p, C_p from its own corrected v^L_b, "APIC with contact").
-Usage: check_contact_bspline.py TOOL SLIDING_PRM DISKS_PRM WORKDIR slide|disks|ranks|restart [f-bar|apic|apic+f-bar]
+v_p, C_p from its own corrected v^L_b, "APIC with contact"), `cell` or `nodal` (numerics/strain
+smoothing: each body's cell values from its own velocities, "Strain smoothing with contact").
+Usage: check_contact_bspline.py TOOL SLIDING_PRM DISKS_PRM WORKDIR slide|disks|ranks|restart [OPTIONS]
+       OPTIONS: f-bar, apic, cell, nodal joined by '+' (f-bar excludes cell and nodal)
 """
 import math
 import os
@@ -36,13 +38,15 @@ import talus_verify as tv
 
 tool, sliding_prm, disks_prm, work, part = sys.argv[1:6]
 OPTIONS = sys.argv[6].split("+") if len(sys.argv) > 6 else []
-if any(o not in ("f-bar", "apic") for o in OPTIONS):
-    tv.fail(f"unknown option set '{sys.argv[6]}' (allowed: f-bar, apic, apic+f-bar)")
+if any(o not in ("f-bar", "apic", "cell", "nodal") for o in OPTIONS):
+    tv.fail(f"unknown option set '{sys.argv[6]}' (allowed: f-bar, apic, cell, nodal joined by '+')")
+SMOOTHING = "cell" if "cell" in OPTIONS else "nodal" if "nodal" in OPTIONS else "none"
 
 
 def with_options(text):
     text = tv.prm_set(text, "numerics/shape function", BSPLINE)
     text = tv.prm_set(text, "numerics/volumetric stabilisation", "f-bar" if "f-bar" in OPTIONS else "none")
+    text = tv.prm_set(text, "numerics/strain smoothing", SMOOTHING)
     return tv.prm_set(text, "numerics/velocity transfer", "apic" if "apic" in OPTIONS else "flip")
 
 shutil.rmtree(work, ignore_errors=True)  # no checkpoint of an earlier run may be restarted from

@@ -96,6 +96,16 @@ add_test(NAME verification.explicit_contact_fbar
                  ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_fbar f-bar)
 set_tests_properties(verification.explicit_contact_fbar PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900
                      PROCESSORS 2)
+# the same with numerics/strain smoothing = cell | nodal (each body its own cell values from its
+# corrected velocities, the force with the transposed mean stress: docs/explicit.md "Strain smoothing")
+foreach(_kind cell nodal)
+  add_test(NAME verification.explicit_contact_smoothing_${_kind}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm
+                   ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/contact_smoothing_${_kind} ${_kind})
+  set_tests_properties(verification.explicit_contact_smoothing_${_kind} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                       TIMEOUT 900 PROCESSORS 2)
+endforeach()
 # contact with quadratic B-splines (issue 38): the sliding block (acceleration within 1 %),
 # the disks (momentum, energy, no interpenetration), 1 vs 2 ranks (1e-10), restart (bitwise);
 # the same bounds with f-bar (each body maps and remaps its own dJ; docs/explicit.md "F-bar with
@@ -119,6 +129,9 @@ talus_contact_bspline("" "" slide disks ranks restart)
 talus_contact_bspline(_fbar f-bar slide disks ranks restart)
 talus_contact_bspline(_apic apic slide disks ranks restart)
 talus_contact_bspline(_apic_fbar apic+f-bar slide disks)
+talus_contact_bspline(_cell cell slide disks ranks restart)
+talus_contact_bspline(_nodal nodal slide disks ranks)
+talus_contact_bspline(_apic_cell apic+cell slide disks)
 
 # checkpoint/restart: SIGKILL at a random moment + restart (bitwise), 1 -> 2 ranks (1e-10),
 # 2 -> 2 ranks (bitwise), corrupt / foreign / missing checkpoints
@@ -127,6 +140,14 @@ set_tests_properties(verification.explicit_checkpoint_restart PROPERTIES PROCESS
 
 # chapter 6 numerics (issue 5): strain smoothing against volumetric locking (§6.7.1)
 talus_verification(explicit_strain_smoothing check_smoothing.py verification/footing_incompressible.prm)
+# strain smoothing consistent with the force (issue 38): a block crossing cells on a frictionless
+# floor (u(t) and energy within 1 %) and the disks in one field (energy within +3 %), both kernels
+add_test(NAME verification.explicit_smoothing_consistency
+         COMMAND ${Python3_EXECUTABLE} ${_v}/check_smoothing_consistency.py ${TALUS_TOOLS_DIR}/talus-explicit
+                 ${TALUS_PRM_DIR}/verification/block_sliding_floor.prm
+                 ${TALUS_PRM_DIR}/verification/disks_collision.prm ${_w}/smoothing_consistency)
+set_tests_properties(verification.explicit_smoothing_consistency PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
+                     TIMEOUT 900)
 # issue 38: F-bar (numerics/volumetric stabilisation, transfer/fbar.h) on linear and
 # quadratic B-spline kernels: a strip's flexural period against Rayleigh-Lamb at nu = 0.49,
 # and the B-spline footing settlement with and without it

@@ -157,7 +157,7 @@ namespace talus::explicit_mpm
       all.clear();
       touched.clear();
     };
-    const auto at_point = [&](const unsigned int, auto &pt) {
+    const auto at_point = [&](const unsigned int c, auto &pt) {
       const double            *P  = pt->get_properties().data();
       const dealii::Point<dim> xi = pt->get_reference_location();
       typename K::Eval         e;
@@ -165,9 +165,11 @@ namespace talus::explicit_mpm
       const double m = P[L::mass], V = P[L::volume];
       double       t[dim][dim];
       minus_V_sigma<dim>(P, V, t);
-      all.add(e, m, t);
       const unsigned int b = static_cast<unsigned int>(P[L::body]);
-      auto              &a = acc[b];
+      if (s.smoothing) // the body's cell mean stress (StrainSmoothing)
+        s.smoothing->force_stress_correction(c, b, P, V, t);
+      all.add(e, m, t);
+      auto &a = acc[b];
       if (!in_cell[b])
         {
           in_cell[b] = 1;

@@ -134,7 +134,8 @@ namespace talus::explicit_mpm
       contact = std::make_unique<Contact<dim>>(grid, prm.numerics, prm.bodies.size(), prm.bspline(), prm.numerics.fbar,
                                                affine_offset);
     if (prm.numerics.smoothing != NumericsOptions::Smoothing::none)
-      smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing, prm.bspline());
+      smoothing = std::make_unique<StrainSmoothing<dim>>(grid, prm.numerics.smoothing, prm.bspline(),
+                                                         contact ? prm.bodies.size() : 1);
 
     const bool restored = restore_if_asked(prm, [this] { return restore_checkpoint(); });
     if (!restored)
@@ -525,8 +526,8 @@ namespace talus::explicit_mpm
         materials::Strain d_eps;
         materials::Spin   d_omega;
         increments_of(gu, P, d_eps, d_omega);
-        if (smoothing) // §6.7.1: smoothed volumetric part
-          smoothing->apply(c, d_eps);
+        if (smoothing) // §6.7.1: smoothed volumetric part (with contact: of the point's body)
+          smoothing->apply(c, smoothing->field_of(P), d_eps);
         const materials::Material &m     = *materials[static_cast<unsigned int>(P[L::material])];
         auto                       sigma = L::get_stress(P);
         m.update_stress(d_eps, d_omega, h, sigma, dealii::ArrayView<double>(P + history, m.n_history()));
@@ -568,7 +569,7 @@ namespace talus::explicit_mpm
               }
             increments_of(points[k].gu, points[k].P, r.d_eps, r.d_omega);
             if (smoothing) // §6.7.1: smoothed volumetric part
-              smoothing->apply(c, r.d_eps);
+              smoothing->apply(c, smoothing->field_of(points[k].P), r.d_eps);
             r.sigma   = L::get_stress(points[k].P);
             r.history = points[k].P + history;
           }

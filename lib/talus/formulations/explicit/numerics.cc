@@ -6,8 +6,10 @@
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/shape/bspline2_box.h>
 #include <talus/shape/q1.h>
+#include <talus/shape/with_kernel.h>
 #include <talus/transfer/cell_walk.h>
 #include <talus/transfer/point_ops.h>
+#include <talus/transfer/stencil_ops.h>
 
 #include <deal.II/base/utilities.h>
 
@@ -170,6 +172,16 @@ namespace talus::explicit_mpm
       for (const unsigned int i : active_dofs)
         x[i] = 0.0;
     }
+    /// the volume Omega of a grid cell (its cache entry)
+    template <class Cache>
+    inline double
+    cell_volume(const Cache &cc)
+    {
+      double v = 1.0;
+      for (const double h : cc.h)
+        v *= h;
+      return v;
+    }
   } // namespace
 
   template <int dim>
@@ -184,9 +196,40 @@ namespace talus::explicit_mpm
     const bool             linear_stress = s.prm.numerics.mixed_linear;
     Contact<dim>          *contact       = s.contact.get();
     const auto             g             = s.gravity; // of the running stage
+    if (s.smoothing)                                  // the cells and the force's mean stresses of this step
+      s.smoothing->collect(s);
+    if (!mixed && contact)
+      {
+        contact->p2g(s); // contact: on the run's kernel (contact.cc)
+        return;
+      }
     if (!mixed)
       {
-        contact->p2g(s); // contact alone: on the run's kernel (contact.cc)
+        // strain smoothing alone: the solver's P2G with the force's mean stress
+        // of each point's cell (StrainSmoothing::force_stress_correction)
+        zero_on(s.nodal_mass, s.active_dofs);
+        zero_on(s.nodal_a, s.active_dofs);
+        shape::with_kernel<dim>(s.prm.bspline(), [&](auto kernel) {
+          using K = decltype(kernel);
+          typename K::Cell      cell;
+          typename K::MassForce sums;
+          transfer::for_each_active_cell(
+            s.points,
+            [&](const unsigned int c) {
+              cell = K::cell(s.grid, c);
+              sums.clear();
+            },
+            [&](const unsigned int c, auto &pt) {
+              const double    *P = pt->get_properties().data();
+              typename K::Eval e;
+              K::evaluate(cell, pt->get_reference_location(), e);
+              double t[dim][dim];
+              minus_V_sigma<dim>(P, P[L::volume], t);
+              s.smoothing->force_stress_correction(c, 0, P, P[L::volume], t);
+              sums.add(e, P[L::mass], t);
+            },
+            [&](unsigned int) { sums.scatter(cell, g, s.nodal_mass.begin(), s.nodal_a.begin()); });
+        });
         return;
       }
 
@@ -308,131 +351,167 @@ namespace talus::explicit_mpm
   // ================================================================ smoothing
   template <int dim>
   StrainSmoothing<dim>::StrainSmoothing(const BackgroundGrid<dim> &grid, const NumericsOptions::Smoothing k,
-                                        const bool bspline)
+                                        const bool bspline, const unsigned int n_fields)
       : kind(k)
       , bspline(bspline)
+      , n_fields(n_fields)
+      , cells(n_fields)
   {
-    cell_value.assign(grid.cells.size(), 0.0);
-    if (kind == NumericsOptions::Smoothing::nodal)
-      grid.reinit_vector(nodal);
+    grid_changed(grid);
   }
 
   template <int dim>
   void
   StrainSmoothing<dim>::grid_changed(const BackgroundGrid<dim> &grid)
   {
-    cell_value.assign(grid.cells.size(), 0.0);
+    n_cells             = grid.cells.size();
+    const std::size_t n = std::size_t(n_fields) * n_cells;
+    cell_value.assign(n, 0.0);
+    cell_weight.assign(n, 0.0);
+    force_mean.assign(n, 0.0);
+    scale.assign(n_cells, 0.0);
+    for (auto &list : cells)
+      list.clear();
     if (kind == NumericsOptions::Smoothing::nodal)
       grid.reinit_vector(nodal);
   }
 
   template <int dim>
   void
-  StrainSmoothing<dim>::compute(const Solver<dim> &s, const double dt)
+  StrainSmoothing<dim>::collect(Solver<dim> &s)
   {
+    // per field and cell: W = sum V_p, the cell list, and the force's mean
+    // stress, first the cell's own sum V_p s_p / W (s_p: the mean in-plane
+    // normal stress, the part of sigma the smoothed strain works on)
+    using L = PropertyLayout<dim>;
+    for (unsigned int f = 0; f < n_fields; ++f)
+      {
+        for (const unsigned int c : cells[f])
+          cell_weight[std::size_t(f) * n_cells + c] = force_mean[std::size_t(f) * n_cells + c] = 0.0;
+        cells[f].clear();
+      }
+    const auto at_point = [&](const unsigned int c, auto &pt) {
+      const double     *P = pt->get_properties().data();
+      const std::size_t i = std::size_t(field_of(P)) * n_cells + c;
+      if (cell_weight[i] == 0.0) // volumes are positive: the field's first point in c
+        cells[field_of(P)].push_back(c);
+      double m = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        m += P[L::stress + d];
+      cell_weight[i] += P[L::volume];
+      force_mean[i] += P[L::volume] * m / dim;
+    };
+    transfer::for_each_point(s.points, at_point);
+    for (unsigned int f = 0; f < n_fields; ++f)
+      {
+        if (kind == NumericsOptions::Smoothing::nodal)
+          nodal_average_transposed(s, f); // from the sums S_c = W_c s_c
+        else
+          for (const unsigned int c : cells[f])
+            force_mean[std::size_t(f) * n_cells + c] /= cell_weight[std::size_t(f) * n_cells + c];
+      }
+  }
+
+  template <int dim>
+  void
+  StrainSmoothing<dim>::compute(Solver<dim> &s, const double dt)
+  {
+    shape::with_kernel<dim>(bspline, [&](auto kernel) { point_means(kernel, s, dt); });
+    if (kind == NumericsOptions::Smoothing::nodal)
+      for (unsigned int f = 0; f < n_fields; ++f)
+        nodal_average(s, f);
+  }
+
+  template <int dim>
+  template <class K>
+  void
+  StrainSmoothing<dim>::point_means(K, Solver<dim> &s, const double dt)
+  {
+    // The element value of a cell is the volume-weighted mean of its points'
+    // volumetric strain increments, sum V_p dt div v(x_p) / sum V_p: the
+    // projection onto cell constants with the quadrature the force uses. The
+    // value at the cell centre is that only for a filled, symmetric cell: a
+    // block sliding across cells with 2 x 2 points gained 5 x its energy with
+    // it (docs/explicit.md "Strain smoothing"). Every field from its own
+    // velocities: the combined nodal velocity, or with contact each body's
+    // corrected v~_b, with which the update pass moves that body.
+    using L = PropertyLayout<dim>;
+    std::vector<const double *> velocity(n_fields);
+    for (unsigned int f = 0; f < n_fields; ++f)
+      {
+        velocity[f] = s.contact ? s.contact->fields[f].momentum.begin() : s.nodal_p.begin();
+        for (const unsigned int c : cells[f])
+          cell_value[std::size_t(f) * n_cells + c] = 0.0;
+      }
+    transfer::for_each_point_stencil<dim, K>(
+      s.grid, s.points,
+      [&](const unsigned int c, transfer::PointIterator<dim> &it, const transfer::PointStencil<dim, K> &st) {
+        const double      *P = it->get_properties().data();
+        const unsigned int f = field_of(P);
+        cell_value[std::size_t(f) * n_cells + c] += P[L::volume] * dt * st.divergence(velocity[f]);
+      });
+    for (unsigned int f = 0; f < n_fields; ++f)
+      for (const unsigned int c : cells[f])
+        cell_value[std::size_t(f) * n_cells + c] /= cell_weight[std::size_t(f) * n_cells + c];
+  }
+
+  template <int dim>
+  void
+  StrainSmoothing<dim>::through_vertices(const Solver<dim> &s, const unsigned int field, double *a, const bool share,
+                                         const double *scale)
+  {
+    // at every vertex i of the field's cells: X0_i = sum_{c at i} a_c w_c,
+    // X1_i = sum_{c at i} Omega_c (one distributed vector, deal.II's exchange);
+    // then a_c = scale_c sum_{i of c} X0_i / X1_i (no scale: 1 / nv, the mean)
     using F                   = shape::Q1Factorised<dim>;
     constexpr unsigned int nv = F::nv;
-    if (bspline)
-      bspline_cell_values(s, dt);
-    else
-      q1_cell_values(s, dt);
-    if (kind == NumericsOptions::Smoothing::cell)
-      return;
-    // Eq. 6.35: nodal value = sum over the surrounding active cells of
-    // eps_el Omega_el / sum Omega_el (component 0 / component 1 of the vector)
     zero_on(nodal, s.active_dofs);
     double *const X = nodal.begin();
-    for (const auto &ac : s.points.active_cells())
+    for (const unsigned int c : cells[field])
       {
-        const auto &cc     = s.grid.cells[ac.cell];
-        double      volume = 1.0;
-        for (unsigned int d = 0; d < dim; ++d)
-          volume *= cc.h[d];
+        const auto  &cc    = s.grid.cells[c];
+        const double Omega = cell_volume(cc);
+        const double ac    = share ? a[c] / nv : a[c] * Omega;
         for (unsigned int v = 0; v < nv; ++v)
           {
-            X[cc.dofs[v * dim + 0]] += cell_value[ac.cell] * volume;
-            X[cc.dofs[v * dim + 1]] += volume;
+            X[cc.dofs[v * dim + 0]] += ac;
+            X[cc.dofs[v * dim + 1]] += Omega;
           }
       }
     nodal.compress(dealii::VectorOperation::add);
     nodal.update_ghost_values();
-    // Eq. 6.36: the cell's value is the mean of its nodal values
-    for (const auto &ac : s.points.active_cells())
+    for (const unsigned int c : cells[field])
       {
-        const auto &cc  = s.grid.cells[ac.cell];
+        const auto &cc  = s.grid.cells[c];
         double      sum = 0;
         for (unsigned int v = 0; v < nv; ++v)
           sum += X[cc.dofs[v * dim + 0]] / X[cc.dofs[v * dim + 1]];
-        cell_value[ac.cell] = sum / nv;
+        a[c] = (scale ? scale[c] : 1.0 / nv) * sum;
       }
   }
 
   template <int dim>
   void
-  StrainSmoothing<dim>::q1_cell_values(const Solver<dim> &s, const double dt)
+  StrainSmoothing<dim>::nodal_average(const Solver<dim> &s, const unsigned int field)
   {
-    // element value: the volumetric strain increment of the Q1 field at the cell
-    // centre, which is its cell average (the divergence of a Q1 field is linear
-    // in each coordinate)
-    using F                   = shape::Q1Factorised<dim>;
-    constexpr unsigned int nv = F::nv;
-    const double *const    Vn = s.nodal_p.begin();
-    double                 w[dim][F::npairs];
-    {
-      double             N[nv];
-      dealii::Point<dim> centre;
-      for (unsigned int d = 0; d < dim; ++d)
-        centre[d] = 0.5;
-      F::weights(centre, N, w);
-    }
-    for (const auto &ac : s.points.active_cells())
-      {
-        const auto &cc = s.grid.cells[ac.cell];
-        double      du[nv][dim], D[dim][F::npairs][dim], gu[dim][dim];
-        for (unsigned int v = 0; v < nv; ++v)
-          for (unsigned int d = 0; d < dim; ++d)
-            du[v][d] = dt * Vn[cc.dofs[v * dim + d]];
-        F::differences(du, D);
-        F::gradient(D, w, cc.inv_h, gu);
-        double tr = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          tr += gu[d][d];
-        cell_value[ac.cell] = tr;
-      }
+    // Eq. 6.35: nodal value = sum over the surrounding cells with points of
+    // eps_el Omega_el / sum Omega_el; Eq. 6.36: the cell's value is the mean
+    // of its nodal values
+    through_vertices(s, field, cell_value.data() + std::size_t(field) * n_cells, false, nullptr);
   }
 
   template <int dim>
   void
-  StrainSmoothing<dim>::bspline_cell_values(const Solver<dim> &s, const double dt)
+  StrainSmoothing<dim>::nodal_average_transposed(const Solver<dim> &s, const unsigned int field)
   {
-    // the cell average of tr grad du of the quadratic B-spline field: its pieces
-    // break at the cell centre, so 2 Gauss points on each half per direction
-    // (exact: on a piece the divergence is at most quadratic in each coordinate)
-    using K                  = shape::BSpline2Box<dim>;
-    const double       g     = 0.25 / std::sqrt(3.0);
-    const double       x1[4] = {0.25 - g, 0.25 + g, 0.75 - g, 0.75 + g};
-    const double      *Vn    = s.nodal_p.begin();
-    constexpr unsigned n     = dim == 2 ? 16 : 64;
-    typename K::Field  du;
-    for (const auto &ac : s.points.active_cells())
-      {
-        const typename K::Cell cell = K::cell(s.grid, ac.cell);
-        K::gather(cell, Vn, dt, du, true);
-        double tr = 0;
-        for (unsigned int q = 0; q < n; ++q)
-          {
-            dealii::Point<dim> xi;
-            for (unsigned int d = 0, r = q; d < dim; ++d, r /= 4)
-              xi[d] = x1[r % 4];
-            typename K::Eval e;
-            K::evaluate(cell, xi, e);
-            double gu[dim][dim], dx[dim];
-            transfer::default_increments<dim, K>(cell, e, du, gu, dx);
-            for (unsigned int d = 0; d < dim; ++d)
-              tr += gu[d][d];
-          }
-        cell_value[ac.cell] = tr / n;
-      }
+    // The work of the smoothed strain, sum_c S_c e~_c with S_c = sum_p V_p s_p
+    // and e~ = nodal_average(e), equals sum_p V_p e_p s~_c(p) with
+    // s~_c = Omega_c / W_c sum_{i of c} q_i / sum Omega_i, q_i = sum_{c at i} S_c / nv
+    // (the transpose of Eqs. 6.35-6.36 under the point quadrature)
+    const std::size_t offset = std::size_t(field) * n_cells;
+    for (const unsigned int c : cells[field])
+      scale[c] = cell_volume(s.grid.cells[c]) / cell_weight[offset + c];
+    through_vertices(s, field, force_mean.data() + offset, true, scale.data()); // in: S_c, out: s~_c
   }
 
   template void p2g_extended<2>(Solver<2> &);

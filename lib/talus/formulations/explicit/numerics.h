@@ -91,7 +91,7 @@ namespace talus::explicit_mpm
     bool
     extended_p2g() const
     {
-      return integration == Integration::mpm_mixed || contact();
+      return integration == Integration::mpm_mixed || contact() || smoothing != Smoothing::none;
     }
   };
 
@@ -107,29 +107,62 @@ namespace talus::explicit_mpm
   void p2g_extended(Solver<dim> &s);
 
   /// Strain smoothing (§6.7.1): after the nodal velocities are known, a volumetric
-  /// strain increment per active cell; the update pass replaces each point's
-  /// volumetric part by it.
+  /// strain increment per cell with points; the update pass replaces each point's
+  /// volumetric part by it. Kept variationally consistent: the element value
+  /// is the volume-weighted mean of the cell's points (the projection with the
+  /// quadrature the force uses), and the internal force of the same step takes
+  /// the transpose, each point's mean in-plane stress replaced by its cell's
+  /// (cell) or by the nodal smoothing's transpose (nodal): the smoothed strain
+  /// does the work the force does (docs/explicit.md "Strain smoothing").
+  /// With contact every body is a field of its own (its corrected velocities,
+  /// the cells of its points).
   template <int dim>
   class StrainSmoothing
   {
   public:
-    /// `bspline`: the cell values are the cell averages of the quadratic
-    /// B-spline field's divergence (else the Q1 field's, at the cell centre)
-    StrainSmoothing(const BackgroundGrid<dim> &grid, NumericsOptions::Smoothing kind, bool bspline);
-    /// From the nodal velocities of the solver (nodal_p after nodal_velocity()).
-    void compute(const Solver<dim> &s, double dt);
-    /// After a repartition: the cell values and the nodal vector re-sized for
-    /// the new local mesh (both are recomputed every step from the nodal
-    /// velocities, so nothing has to travel).
-    void grid_changed(const BackgroundGrid<dim> &grid);
-    /// Replace the volumetric part of d_eps (in-plane trace in 2D) by the cell value.
+    /// `n_fields`: 1, or with contact the number of bodies
+    StrainSmoothing(const BackgroundGrid<dim> &grid, NumericsOptions::Smoothing kind, bool bspline,
+                    unsigned int n_fields);
+    /// At the start of the step's P2G (the points where they stay for the
+    /// step): every field's cells, point volumes per cell and the mean
+    /// stresses the force takes (force_stress_correction).
+    void collect(Solver<dim> &s);
+    /// The P2G's -V sigma of a point of `field` in `cell` with mean in-plane
+    /// stress replaced by the cell's (t = -V sigma on entry).
     inline void
-    apply(const unsigned int cell, materials::Strain &d_eps) const
+    force_stress_correction(const unsigned int cell, const unsigned int field, const double *P, const double V,
+                            double (&t)[dim][dim]) const
+    {
+      using L  = PropertyLayout<dim>;
+      double m = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        m += P[L::stress + d];
+      const double c = V * (m / dim - force_mean[field * n_cells + cell]);
+      for (unsigned int d = 0; d < dim; ++d)
+        t[d][d] += c;
+    }
+    /// From the nodal velocities the update pass moves with: the solver's
+    /// nodal_p after nodal_velocity(), or with contact every body's v~_b
+    /// (Contact::BodyFields::momentum after the contact law). After collect().
+    void compute(Solver<dim> &s, double dt);
+    /// After a repartition: the per-cell arrays and the nodal vector re-sized
+    /// for the new local mesh (all recomputed every step, nothing travels).
+    void grid_changed(const BackgroundGrid<dim> &grid);
+    /// The field of a point: 0, or with contact its body.
+    inline unsigned int
+    field_of(const double *P) const
+    {
+      return n_fields > 1 ? static_cast<unsigned int>(P[PropertyLayout<dim>::body]) : 0;
+    }
+    /// Replace the volumetric part of d_eps (in-plane trace in 2D) by the value
+    /// of the cell for the point's field.
+    inline void
+    apply(const unsigned int cell, const unsigned int field, materials::Strain &d_eps) const
     {
       double tr = 0;
       for (unsigned int d = 0; d < dim; ++d)
         tr += d_eps[d][d];
-      const double c = (cell_value[cell] - tr) / dim;
+      const double c = (cell_value[field * n_cells + cell] - tr) / dim;
       for (unsigned int d = 0; d < dim; ++d)
         d_eps[d][d] += c;
     }
@@ -137,11 +170,26 @@ namespace talus::explicit_mpm
   private:
     NumericsOptions::Smoothing kind;
     bool                       bspline;
-    std::vector<double>        cell_value; ///< by active cell index
-    /// the element values (volumetric increment per active cell) of either kernel
-    void   q1_cell_values(const Solver<dim> &s, double dt);
-    void   bspline_cell_values(const Solver<dim> &s, double dt);
-    Vector nodal; ///< component 0: sum eps_el Omega_el, 1: sum Omega_el
+    unsigned int               n_fields, n_cells = 0;
+    /// per field and cell (index field * n_cells + cell): the element values,
+    /// sum V_p of the field's points, and the mean stress the force takes
+    std::vector<double> cell_value, cell_weight, force_mean;
+    /// per cell: nodal_average_transposed's factor Omega_c / W_c
+    std::vector<double> scale;
+    /// per field: the cells that hold its points in this step
+    std::vector<std::vector<unsigned int>> cells;
+    /// the element values: the volume-weighted means over each cell's points
+    template <class K>
+    void point_means(K, Solver<dim> &s, double dt);
+    /// Eqs. 6.35-6.36 for one field over its cells
+    void nodal_average(const Solver<dim> &s, unsigned int field);
+    /// the transpose of nodal_average for the force's mean stresses
+    void nodal_average_transposed(const Solver<dim> &s, unsigned int field);
+    /// both through the vertices of the field's cells: a_c <- scale_c sum_{i of c}
+    /// X0_i / X1_i (no scale: 1 / nv), X0_i = sum_{c at i} (share ? a_c / nv : a_c Omega_c),
+    /// X1_i = sum Omega_c
+    void   through_vertices(const Solver<dim> &s, unsigned int field, double *a, bool share, const double *scale);
+    Vector nodal; ///< two scalar slots per node (components 0 and 1)
   };
 
   /// Contact between bodies (§6.2). Every body gets its own nodal mass, volume,
