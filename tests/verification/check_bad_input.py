@@ -72,6 +72,19 @@ sliding = tv.prm_set_args(sliding, ["output/directory=must_not_exist", "numerics
                                     "loads/velocity 0/body=1", "loads/velocity 0/velocity=0, 0"])
 cases["apic with contact and a body velocity"] = (sliding, ["loads/velocity k/apply to", "apply to = body",
                                                             "velocity transfer = apic", "APIC with contact"])
+# contact moves every body with its own nodal fields: a rigid plate's balance sums the combined field
+plate = tv.prm_set_args(open(os.path.join(os.path.dirname(prm_path), "block_sliding_contact.prm")).read(),
+                        ["output/directory=must_not_exist", "boundary conditions/number of rigid plates=1"])
+plate = plate.replace("subsection boundary conditions\n", """subsection boundary conditions
+  subsection rigid plate 0
+    set apply to    = boundary
+    set boundary id = 3
+    set direction   = y
+    set total force = -1e3
+  end
+""", 1)
+cases["rigid plate with contact"] = (plate, ["boundary conditions/rigid plate 0", "contact pairs",
+                                             "Contact and nodal loads"])
 # numerics/volumetric stabilisation (issue 38): modified f-bar has no b_e to scale in the rate
 # update; f-bar with the passes that replace the volume change themselves
 fbar = tv.prm_set(base, "numerics/volumetric stabilisation", "f-bar")

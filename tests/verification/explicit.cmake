@@ -106,6 +106,20 @@ foreach(_kind cell nodal)
   set_tests_properties(verification.explicit_contact_smoothing_${_kind} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                        TIMEOUT 900 PROCESSORS 2)
 endforeach()
+# contact with the loads that act on nodes (each body's field gets damping, mass scaling, friction
+# walls, prescribed nodal velocities: docs/explicit.md "Contact and nodal loads"), both kernels
+foreach(_kernel linear bspline)
+  set(_name verification.explicit_contact_loads)
+  set(_kname linear)
+  if(_kernel STREQUAL "bspline")
+    set(_name verification.explicit_contact_loads_bspline)
+    set(_kname "quadratic bspline")
+  endif()
+  add_test(NAME ${_name}
+           COMMAND ${Python3_EXECUTABLE} ${_v}/check_contact_loads.py ${TALUS_TOOLS_DIR}/talus-explicit
+                   ${TALUS_PRM_DIR}/verification/block_sliding_contact.prm ${_w}/contact_loads_${_kernel} ${_kname})
+  set_tests_properties(${_name} PROPERTIES LABELS "fast" ENVIRONMENT "${_env}" TIMEOUT 900 PROCESSORS 2)
+endforeach()
 # contact with quadratic B-splines (issue 38): the sliding block (acceleration within 1 %),
 # the disks (momentum, energy, no interpenetration), 1 vs 2 ranks (1e-10), restart (bitwise);
 # the same bounds with f-bar (each body maps and remaps its own dJ; docs/explicit.md "F-bar with

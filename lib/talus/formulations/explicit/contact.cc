@@ -3,6 +3,7 @@
 #include <talus/base/errors.h>
 #include <talus/formulations/explicit/affine_ops.h>
 #include <talus/formulations/explicit/explicit_solver.h>
+#include <talus/formulations/explicit/load_control.h>
 #include <talus/formulations/explicit/numerics.h>
 #include <talus/shape/with_kernel.h>
 #include <talus/transfer/cell_walk.h>
@@ -472,6 +473,23 @@ namespace talus::explicit_mpm
     if (bspline && !capacity_ready)
       compute_capacity(shape::BSpline2Box<dim>());
     contact_nodes = corrected_nodes = 0;
+    // every body's acceleration F_b / m_b with the loads' share of the body
+    // (damping, mass scaling, friction walls, prescribed nodes: the rules of
+    // the combined field, docs/explicit.md "Contact and nodal loads"); the
+    // force vector holds the acceleration from here on
+    wall_state.resize(n_bodies);
+    for (unsigned int b = 0; b < n_bodies; ++b)
+      {
+        auto         &f = fields[b];
+        double       *A = f.force.begin();
+        const double *M = f.mass.begin();
+        if (s.control)
+          s.control->body_forces(s, A, M, f.momentum.begin());
+        for (const unsigned int i : s.active_dofs)
+          A[i] = (M[i] > 0 && !s.constrained[i]) ? A[i] / M[i] : 0.0;
+        if (s.control)
+          s.control->body_accelerations(s, A, M, f.momentum.begin(), wall_state[b]);
+      }
     std::vector<double>                  mb(n_bodies);
     std::vector<std::array<double, dim>> vb(n_bodies), v0(n_bodies);
     for (const auto &dofs : nodes)
@@ -491,7 +509,7 @@ namespace talus::explicit_mpm
         correct_node(dofs, s.constrained, mb, v0, dt);
         for (unsigned int b = 0; b < n_bodies; ++b)
           for (unsigned int d = 0; d < dim; ++d)
-            vb[b][d] = m_all[b] > 0 ? v0[b][d] + dt * fields[b].force.begin()[dofs[d]] / m_all[b] : 0.0;
+            vb[b][d] = m_all[b] > 0 ? v0[b][d] + dt * fields[b].force.begin()[dofs[d]] : 0.0;
         mb = m_all;
         correct_node(dofs, s.constrained, mb, vb, dt);
         // corrected acceleration, stored in the force vector (APIC: and v^L_b
@@ -587,6 +605,17 @@ namespace talus::explicit_mpm
   void
   Contact<dim>::correct_velocities(Solver<dim> &s, const double h)
   {
+    // v_b = p_b / m_b with the walls' and prescribed nodes' conditions
+    // (LoadControl::body_velocities, by the states of correct_accelerations)
+    for (unsigned int b = 0; b < n_bodies; ++b)
+      {
+        double       *V = fields[b].momentum.begin();
+        const double *M = fields[b].mass.begin();
+        for (const unsigned int i : s.active_dofs)
+          V[i] = M[i] > 0 ? V[i] / M[i] : 0.0;
+        if (s.control)
+          s.control->body_velocities(s, V, wall_state[b]);
+      }
     std::vector<double>                  mb(n_bodies);
     std::vector<std::array<double, dim>> vb(n_bodies);
     for (const auto &dofs : nodes)
@@ -595,7 +624,7 @@ namespace talus::explicit_mpm
           {
             mb[b] = fields[b].mass.begin()[dofs[0]];
             for (unsigned int d = 0; d < dim; ++d)
-              vb[b][d] = mb[b] > 0 ? fields[b].momentum.begin()[dofs[d]] / mb[b] : 0.0;
+              vb[b][d] = mb[b] > 0 ? fields[b].momentum.begin()[dofs[d]] : 0.0;
           }
         // the points' velocities keep the Lagrangian-phase values: applying
         // this correction to them too was measured to add energy (disks +38 %)

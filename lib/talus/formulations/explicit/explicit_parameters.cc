@@ -201,6 +201,14 @@ namespace talus::explicit_mpm
                       "velocity field, not each body's (docs/explicit.md, \"APIC with contact\"); allowed: "
                       "'apply to = boundary | region', no contact pairs, or velocity transfer = flip");
       }
+    // contact moves every body with its own nodal fields; the loads' rules
+    // reach them through LoadControl::body_forces / body_accelerations /
+    // body_velocities, a rigid plate's balance does not (it sums the combined
+    // field's nodes): a plate on a body in contact would act on nothing
+    require(!p.numerics.contact() || p.rigid_plates.empty(), "boundary conditions/rigid plate 0",
+            "a rigid plate is not available with contact pairs: every body moves with its own nodal fields and "
+            "the plate's balance acts on the combined field only (docs/explicit.md, \"Contact and nodal "
+            "loads\"); allowed: no rigid plate, or no contact pairs");
     if (p.bspline())
       {
         // MPM-MIXED and FEM/UL-FEM integrate on the cells of the Q1 element by

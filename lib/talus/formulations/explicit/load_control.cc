@@ -1,6 +1,7 @@
 #include <talus/base/errors.h>
 #include <talus/base/tool.h>
 #include <talus/formulations/explicit/load_control.h>
+#include <talus/formulations/explicit/numerics.h>
 #include <talus/formulations/explicit/with_kernel.h>
 #include <talus/formulations/common/initial_stress.h>
 #include <talus/loads/rigid_plate_nodes.h>
@@ -257,7 +258,6 @@ namespace talus::loads
                     n.side           = (f % 2) ? +1 : -1;
                     n.area           = 0;
                     n.h              = cc.h[axis];
-                    n.state          = 0;
                     n.liquid_stopped = false;
                     it               = node_of.emplace(key, friction_nodes.size()).first;
                     friction_nodes.push_back(n);
@@ -269,6 +269,7 @@ namespace talus::loads
     for (const auto &n : friction_nodes)
       for (unsigned int d = 0; d < dim; ++d)
         excluded[n.dofs[d]] = 1;
+    wall_state.assign(friction_nodes.size(), 0);
     any_friction = dealii::Utilities::MPI::logical_or(!friction_nodes.empty(), s.comm);
     if (any_friction && lift.size() == 0)
       s.grid.reinit_vector(lift);
@@ -455,24 +456,23 @@ namespace talus::loads
             }
         evaluate_convergence(s, v);
       }
-    // local damping (Eq. 6.23) with the nodal velocity at t
+    damp_and_scale(s, F, M, vt.begin());
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::damp_and_scale(const Solver &s, double *F, const double *M, const double *P) const
+  {
+    // local damping (Eq. 6.23) with the nodal velocity at t (sign(p) = sign(v))
     if (current->damping > 0)
-      {
-        const double *Pm = vt.begin();
-        const double  a  = current->damping;
-        for (const unsigned int i : s.active_dofs)
-          if (M[i] > 0)
-            F[i] += local_damping_force(a, F[i], Pm[i]); // sign(p) = sign(v)
-      }
+      for (const unsigned int i : s.active_dofs)
+        if (M[i] > 0)
+          F[i] += local_damping_force(current->damping, F[i], P[i]);
     // mass-proportional (Rayleigh alpha) damping: -alpha_v m_i v_i = -alpha_v p_i
     if (current->viscous_damping > 0)
-      {
-        const double *Pm = vt.begin();
-        const double  a  = current->viscous_damping;
-        for (const unsigned int i : s.active_dofs)
-          if (M[i] > 0)
-            F[i] -= a * Pm[i];
-      }
+      for (const unsigned int i : s.active_dofs)
+        if (M[i] > 0)
+          F[i] -= current->viscous_damping * P[i];
     // mass scaling (Eq. 6.31): inertia beta m, forces unchanged
     if (current->mass_scaling != 1.0)
       {
@@ -480,6 +480,13 @@ namespace talus::loads
         for (const unsigned int i : s.active_dofs)
           F[i] *= inv;
       }
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::body_forces(const Solver &s, double *F, const double *M, const double *P) const
+  {
+    damp_and_scale(s, F, M, P);
   }
 
   template <int dim>
@@ -579,56 +586,7 @@ namespace talus::loads
     const double *const M    = s.nodal_mass.begin();
     const double *const Pm   = vt.begin();
     const double        beta = current->mass_scaling;
-    // frictional contact with a rigid fixed boundary: seed 000 Eqs. 6.4-6.21
-    // with the other body at rest (v = 0): predicted v* = v^t + dt a; if it
-    // moves into the wall, the normal component is removed and the tangential
-    // one is reduced by mu |v*_n| + a A dt / m (stick if that stops it).
-    const double mu = current->friction_coefficient, adh = current->adhesion;
-    for (auto &n : friction_nodes)
-      {
-        const double m = M[n.dofs[0]];
-        n.state        = 0;
-        if (!(m > 0))
-          continue;
-        double v0[dim], vs[dim];
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const bool fixed = s.constrained[n.dofs[d]];
-            v0[d]            = fixed ? 0.0 : Pm[n.dofs[d]] / m;
-            vs[d]            = fixed ? 0.0 : v0[d] + h * A[n.dofs[d]];
-          }
-        const double vn = n.side * vs[n.axis];
-        if (!(vn > 0))
-          continue; // separating: no correction
-        // the material at this node has moved away from the wall (a gap): free.
-        // Without this test the node blocks every motion towards the wall even
-        // after the material lifted off, so velocity noise is rectified into a
-        // drift away from the wall (a block sliding on the floor rose 3.8 mm).
-        if (lift.local_element(n.dofs[n.axis]) > lift_tolerance * n.h)
-          continue;
-        vs[n.axis] = 0;
-        double vt2 = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          vt2 += vs[d] * vs[d];
-        const double vtan   = std::sqrt(vt2);
-        const double budget = mu * vn + adh * n.area * h / (beta * m);
-        if (vtan <= budget)
-          {
-            n.state = 1; // stick
-            for (unsigned int d = 0; d < dim; ++d)
-              vs[d] = 0;
-          }
-        else
-          {
-            n.state         = 2; // slip
-            const double fr = 1.0 - budget / vtan;
-            for (unsigned int d = 0; d < dim; ++d)
-              vs[d] *= fr;
-          }
-        for (unsigned int d = 0; d < dim; ++d)
-          if (!s.constrained[n.dofs[d]])
-            A[n.dofs[d]] = (vs[d] - v0[d]) / h;
-      }
+    wall_law(s, A, M, Pm, wall_state.data());
     // 2-phase: the pore liquid (nodal momentum at t, acceleration, mass Mbar_L)
     const bool    cp  = s.two_phase && s.two_phase->coupled;
     double *const AL  = cp ? s.two_phase->a_liquid.begin() : nullptr;
@@ -656,9 +614,7 @@ namespace talus::loads
     for (const auto &p : prescribed_dofs)
       {
         const double m    = M[p.dof];
-        const auto  &pv   = current->velocities[p.condition];
-        const double t    = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
-        const double vbar = pv.velocity[p.component] * pv.function.value(t);
+        const double vbar = prescribed_value(s, p);
         if (cp && mLn[p.dof] > 0)
           {
             const double anew = (vbar - PL[p.dof] / mLn[p.dof]) / h;
@@ -780,27 +736,15 @@ namespace talus::loads
   LoadControl<dim>::nodal_velocities(Solver &s)
   {
     double *const V = s.nodal_p.begin();
-    for (const auto &n : friction_nodes)
-      if (n.state != 0)
-        {
-          if (n.side * V[n.dofs[n.axis]] > 0)
-            V[n.dofs[n.axis]] = 0; // no penetration
-          if (n.state == 1)
-            for (unsigned int d = 0; d < dim; ++d)
-              V[n.dofs[d]] = 0; // stick
-        }
+    wall_and_prescribed_velocities(s, V, wall_state.data());
     // 2-phase: the liquid's nodal velocities (after the division by Mbar_L)
     double *const VL = (s.two_phase && s.two_phase->coupled) ? s.two_phase->p_liquid.begin() : nullptr;
     if (VL)
-      for (const auto &n : friction_nodes)
-        if (n.liquid_stopped && n.side * VL[n.dofs[n.axis]] > 0)
-          VL[n.dofs[n.axis]] = 0; // no flow into the wall
-    for (const auto &p : prescribed_dofs)
       {
-        const auto  &pv = current->velocities[p.condition];
-        const double t  = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
-        V[p.dof]        = pv.velocity[p.component] * pv.function.value(t);
-        if (VL)
+        for (const auto &n : friction_nodes)
+          if (n.liquid_stopped && n.side * VL[n.dofs[n.axis]] > 0)
+            VL[n.dofs[n.axis]] = 0; // no flow into the wall
+        for (const auto &p : prescribed_dofs)
           VL[p.dof] = V[p.dof];
       }
     for (const auto &p : plate_dofs)
@@ -812,6 +756,110 @@ namespace talus::loads
           if (VL && on_axis && !pl.permeable && s.two_phase->m_liquid_n.local_element(p.dof) > 0)
             VL[p.dof] = V[p.dof];
         }
+  }
+
+  template <int dim>
+  double
+  LoadControl<dim>::prescribed_value(const Solver &s, const PrescribedNodeDof &p) const
+  {
+    const auto  &pv = current->velocities[p.condition];
+    const double t  = (p.condition < current->n_global_velocities ? s.time : s.time - stage_t0) + h;
+    return pv.velocity[p.component] * pv.function.value(t);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::wall_law(const Solver &s, double *A, const double *M, const double *P, unsigned char *state) const
+  {
+    // frictional contact with a rigid fixed boundary: seed 000 Eqs. 6.4-6.21
+    // with the other body at rest (v = 0): predicted v* = v^t + dt a; if it
+    // moves into the wall, the normal component is removed and the tangential
+    // one is reduced by mu |v*_n| + a A dt / m (stick if that stops it).
+    const double mu = current->friction_coefficient, adh = current->adhesion;
+    const double beta = current->mass_scaling;
+    for (unsigned int k = 0; k < friction_nodes.size(); ++k)
+      {
+        const auto  &n = friction_nodes[k];
+        const double m = M[n.dofs[0]];
+        state[k]       = 0;
+        if (!(m > 0))
+          continue;
+        double v0[dim], vs[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const bool fixed = s.constrained[n.dofs[d]];
+            v0[d]            = fixed ? 0.0 : P[n.dofs[d]] / m;
+            vs[d]            = fixed ? 0.0 : v0[d] + h * A[n.dofs[d]];
+          }
+        const double vn = n.side * vs[n.axis];
+        if (!(vn > 0))
+          continue; // separating: no correction
+        // the material at this node has moved away from the wall (a gap): free.
+        // Without this test the node blocks every motion towards the wall even
+        // after the material lifted off, so velocity noise is rectified into a
+        // drift away from the wall (a block sliding on the floor rose 3.8 mm).
+        if (lift.local_element(n.dofs[n.axis]) > lift_tolerance * n.h)
+          continue;
+        vs[n.axis] = 0;
+        double vt2 = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          vt2 += vs[d] * vs[d];
+        const double vtan   = std::sqrt(vt2);
+        const double budget = mu * vn + adh * n.area * h / (beta * m);
+        if (vtan <= budget)
+          {
+            state[k] = 1; // stick
+            for (unsigned int d = 0; d < dim; ++d)
+              vs[d] = 0;
+          }
+        else
+          {
+            state[k]        = 2; // slip
+            const double fr = 1.0 - budget / vtan;
+            for (unsigned int d = 0; d < dim; ++d)
+              vs[d] *= fr;
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          if (!s.constrained[n.dofs[d]])
+            A[n.dofs[d]] = (vs[d] - v0[d]) / h;
+      }
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::wall_and_prescribed_velocities(const Solver &s, double *V, const unsigned char *state) const
+  {
+    for (unsigned int k = 0; k < friction_nodes.size(); ++k)
+      if (state[k] != 0)
+        {
+          const auto &n = friction_nodes[k];
+          if (n.side * V[n.dofs[n.axis]] > 0)
+            V[n.dofs[n.axis]] = 0; // no penetration
+          if (state[k] == 1)
+            for (unsigned int d = 0; d < dim; ++d)
+              V[n.dofs[d]] = 0; // stick
+        }
+    for (const auto &p : prescribed_dofs)
+      V[p.dof] = prescribed_value(s, p);
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::body_accelerations(const Solver &s, double *A, const double *M, const double *P,
+                                       std::vector<unsigned char> &wall) const
+  {
+    wall.assign(friction_nodes.size(), 0);
+    wall_law(s, A, M, P, wall.data());
+    for (const auto &p : prescribed_dofs)
+      if (M[p.dof] > 0)
+        A[p.dof] = (prescribed_value(s, p) - P[p.dof] / M[p.dof]) / h;
+  }
+
+  template <int dim>
+  void
+  LoadControl<dim>::body_velocities(const Solver &s, double *V, const std::vector<unsigned char> &wall) const
+  {
+    wall_and_prescribed_velocities(s, V, wall.data());
   }
 
   // ---------------------------------------------------------------- rigid plates

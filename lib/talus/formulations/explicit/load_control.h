@@ -168,6 +168,19 @@ namespace talus::loads
     }
     void nodal_velocities(Solver &s);
 
+    /// Contact (every body moves with its own nodal fields, explicit_mpm::Contact):
+    /// the loads' share of one body's field, by the rules of the combined field
+    /// with the body's mass M and momentum at t P. Damping and mass scaling on
+    /// its force F (as nodal_forces).
+    void body_forces(const Solver &s, double *F, const double *M, const double *P) const;
+    /// Friction walls and prescribed nodal velocities on its acceleration
+    /// A = F / M (as nodal_accelerations); `wall`: the state of every friction
+    /// node (0 free, 1 stick, 2 slip) for body_velocities.
+    void body_accelerations(const Solver &s, double *A, const double *M, const double *P,
+                            std::vector<unsigned char> &wall) const;
+    /// The same conditions on its velocities V of the convective phase (as nodal_velocities).
+    void body_velocities(const Solver &s, double *V, const std::vector<unsigned char> &wall) const;
+
     /// Rigid plates, at setup (fresh or restored run, before any output): the
     /// plate state, the checks that need the grid (InputError naming 'boundary
     /// conditions/rigid plate k': a plate holding no grid node, a plate whose
@@ -231,15 +244,16 @@ namespace talus::loads
 
     struct FrictionNode
     {
-      unsigned int  dofs[dim];
-      unsigned int  axis;
-      int           side;
-      double        area;
-      double        h;              ///< cell size normal to the wall
-      unsigned char state;          ///< 0 free/separating, 1 stick, 2 slip
-      bool          liquid_stopped; ///< 2-phase: liquid normal velocity into the wall removed
+      unsigned int dofs[dim];
+      unsigned int axis;
+      int          side;
+      double       area;
+      double       h;              ///< cell size normal to the wall
+      bool         liquid_stopped; ///< 2-phase: liquid normal velocity into the wall removed
     };
     std::vector<FrictionNode> friction_nodes;
+    /// per friction node, of the combined field: 0 free/separating, 1 stick, 2 slip
+    std::vector<unsigned char> wall_state;
     /// Per grid cell: bit f set if face f lies on a friction boundary.
     std::vector<unsigned char> friction_faces;
     /// Per DoF (the normal component of a friction node): the smallest
@@ -286,9 +300,19 @@ namespace talus::loads
     static constexpr unsigned int plate_sum_size = 5 + 2 * dim;
     std::vector<double>           plate_sum; ///< per plate, summed over the ranks
 
-    void assign_tractions(Solver &s);
-    void update_factors(const Solver &s);
-    void build_node_lists(Solver &s);
+    /// local and viscous damping, then mass scaling, on the force F of a field
+    /// (mass M, momentum at t P)
+    void damp_and_scale(const Solver &s, double *F, const double *M, const double *P) const;
+    /// the friction-wall law on a field's predicted velocity P / M + h A: A
+    /// corrected, the node states into `state`
+    void wall_law(const Solver &s, double *A, const double *M, const double *P, unsigned char *state) const;
+    /// the walls' and the prescribed nodes' conditions on a field's velocities
+    void wall_and_prescribed_velocities(const Solver &s, double *V, const unsigned char *state) const;
+    /// the value at t + h of a prescribed DoF
+    double prescribed_value(const Solver &s, const PrescribedNodeDof &p) const;
+    void   assign_tractions(Solver &s);
+    void   update_factors(const Solver &s);
+    void   build_node_lists(Solver &s);
     /// `lift` of the friction nodes from the points next to friction walls.
     void friction_lift(Solver &s);
     void set_time_step(Solver &s);

@@ -282,6 +282,9 @@ namespace talus::explicit_mpm
     /// owned active nodes: local DoF indices of their dim components
     std::vector<std::array<unsigned int, dim>> nodes;
     std::vector<unsigned char>                 node_marker;
+    /// per body: the friction-wall node states of its field in this step
+    /// (LoadControl::body_accelerations, read by body_velocities)
+    std::vector<std::vector<unsigned char>> wall_state;
     template <class K>
     void p2g_with(K, Solver<dim> &s);
     template <class K>
