@@ -1,6 +1,6 @@
 """Contact with the loads that act on nodes (issue 38): every body moves with its own nodal
 fields, so damping, mass scaling, friction walls, prescribed nodal velocities and body
-velocity conditions must reach each body's field (LoadControl::body_forces,
+velocity conditions must reach each body's field (LoadControl::damp_and_scale,
 body_accelerations, body_velocities; docs/explicit.md "Contact and nodal loads").
 
 The scene of check_contact.py (block_sliding_contact.prm: a block on a stiff base under

@@ -484,7 +484,7 @@ namespace talus::explicit_mpm
         double       *A = f.force.begin();
         const double *M = f.mass.begin();
         if (s.control)
-          s.control->body_forces(s, A, M, f.momentum.begin());
+          s.control->damp_and_scale(s, A, M, f.momentum.begin());
         for (const unsigned int i : s.active_dofs)
           A[i] = (M[i] > 0 && !s.constrained[i]) ? A[i] / M[i] : 0.0;
         if (s.control)

@@ -202,7 +202,7 @@ namespace talus::explicit_mpm
                       "'apply to = boundary | region', no contact pairs, or velocity transfer = flip");
       }
     // contact moves every body with its own nodal fields; the loads' rules
-    // reach them through LoadControl::body_forces / body_accelerations /
+    // reach them through LoadControl::damp_and_scale / body_accelerations /
     // body_velocities, a rigid plate's balance does not (it sums the combined
     // field's nodes): a plate on a body in contact would act on nothing
     require(!p.numerics.contact() || p.rigid_plates.empty(), "boundary conditions/rigid plate 0",

@@ -484,13 +484,6 @@ namespace talus::loads
 
   template <int dim>
   void
-  LoadControl<dim>::body_forces(const Solver &s, double *F, const double *M, const double *P) const
-  {
-    damp_and_scale(s, F, M, P);
-  }
-
-  template <int dim>
-  void
   LoadControl<dim>::evaluate_convergence(const Solver &s, double (&v)[4])
   {
     const auto &conv = current->convergence;

@@ -170,9 +170,9 @@ namespace talus::loads
 
     /// Contact (every body moves with its own nodal fields, explicit_mpm::Contact):
     /// the loads' share of one body's field, by the rules of the combined field
-    /// with the body's mass M and momentum at t P. Damping and mass scaling on
-    /// its force F (as nodal_forces).
-    void body_forces(const Solver &s, double *F, const double *M, const double *P) const;
+    /// with the body's mass M and momentum at t P. Local and viscous damping,
+    /// then mass scaling, on its force F (the last part of nodal_forces).
+    void damp_and_scale(const Solver &s, double *F, const double *M, const double *P) const;
     /// Friction walls and prescribed nodal velocities on its acceleration
     /// A = F / M (as nodal_accelerations); `wall`: the state of every friction
     /// node (0 free, 1 stick, 2 slip) for body_velocities.
@@ -300,9 +300,6 @@ namespace talus::loads
     static constexpr unsigned int plate_sum_size = 5 + 2 * dim;
     std::vector<double>           plate_sum; ///< per plate, summed over the ranks
 
-    /// local and viscous damping, then mass scaling, on the force F of a field
-    /// (mass M, momentum at t P)
-    void damp_and_scale(const Solver &s, double *F, const double *M, const double *P) const;
     /// the friction-wall law on a field's predicted velocity P / M + h A: A
     /// corrected, the node states into `state`
     void wall_law(const Solver &s, double *A, const double *M, const double *P, unsigned char *state) const;
