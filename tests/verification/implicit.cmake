@@ -542,7 +542,7 @@ endforeach()
 add_test(NAME verification.implicit_strip_footing_prandtl
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_prandtl.prm ${_w}/implicit_strip_footing_prandtl
-                 --tol=0.05 --u-settlement=0.04 --ranks=3)
+                 --tol=0.05 --u-settlement=0.04 --ranks=3 --ranks-klu)
 set_tests_properties(verification.implicit_strip_footing_prandtl PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 900 PROCESSORS 2)
 add_test(NAME verification.implicit_strip_footing_prandtl_full
@@ -582,7 +582,7 @@ set_tests_properties(verification.implicit_strip_footing_negligible_mass PROPERT
 add_test(NAME verification.implicit_strip_footing_points
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points
-                 --points --settlement=0.06 --window=0.02,0.06 --tol=0.03 --ranks=10)
+                 --points --settlement=0.06 --window=0.02,0.06 --tol=0.03 --ranks=10 --ranks-klu)
 set_tests_properties(verification.implicit_strip_footing_points PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
 # the footing on the points with 'implicit/carry start imbalance = true' (docs/implicit.md, "Load steps:
@@ -601,7 +601,7 @@ set_tests_properties(verification.implicit_strip_footing_points_carry PROPERTIES
 add_test(NAME verification.implicit_strip_footing_points_bspline
          COMMAND ${Python3_EXECUTABLE} ${_v}/check_strip_footing_prandtl.py ${TALUS_TOOLS_DIR}
                  ${TALUS_PRM_DIR}/implicit/strip_footing_points.prm ${_w}/implicit_strip_footing_points_bspline
-                 --points --settlement=0.06 --window=0.02,0.06 --tol=0.03 --ranks=10
+                 --points --settlement=0.06 --window=0.02,0.06 --tol=0.03 --ranks=10 --ranks-klu
                  "--set=numerics/shape function=quadratic bspline")
 set_tests_properties(verification.implicit_strip_footing_points_bspline PROPERTIES LABELS "fast" ENVIRONMENT "${_env}"
                      TIMEOUT 600 PROCESSORS 2)
