@@ -41,47 +41,65 @@ namespace talus::transfer
     }
   };
 
+  /// The stress a point's force takes as it is: no adjustment of -V sigma.
+  struct PointStressAsIs
+  {
+    static constexpr bool active = false;
+    template <int dim>
+    inline void
+    operator()(unsigned int, const double *, double, double (&)[dim][dim]) const
+    {
+    }
+  };
+
   /// P2G of lumped mass and internal + gravity force (seed 000 Eqs. 4.32, 4.34,
   /// 4.41) at the points' current reference locations, added to M and F.
-  template <int dim, class K>
+  /// `Adjust` (if active): adjust(c, P, V, t) changes a point's t = -V sigma in
+  /// cell c before it is scattered (strain smoothing's transposed mean stress).
+  template <int dim, class K, class Adjust = PointStressAsIs>
   struct ScatterMassForce : CellSums<dim, K, typename K::MassForce>
   {
     using Base = CellSums<dim, K, typename K::MassForce>;
     using Base::cell;
     using Base::grid;
     using Base::sums;
-    ScatterMassForce(const BackgroundGrid<dim> &grid, const dealii::Tensor<1, dim> &g, double *M, double *F)
+    ScatterMassForce(const BackgroundGrid<dim> &grid, const dealii::Tensor<1, dim> &g, double *M, double *F,
+                     const Adjust &adjust = Adjust())
         : Base(grid)
         , g(g)
         , M(M)
         , F(F)
+        , adjust(adjust)
     {
     }
     const dealii::Tensor<1, dim> g;
     double *const                M;
     double *const                F;
-    /// one point with properties P at reference location xi
+    const Adjust                 adjust;
+    /// one point of cell c with properties P at reference location xi
     inline void
-    add(const dealii::Point<dim> &xi, const double *P)
+    add(const unsigned int c, const dealii::Point<dim> &xi, const double *P)
     {
       using L = PropertyLayout<dim>;
       typename K::Eval e;
       K::evaluate(cell, xi, e);
       double t[dim][dim];
       minus_V_sigma<dim>(P, P[L::volume], t);
+      if constexpr (Adjust::active)
+        adjust(c, P, P[L::volume], t);
       sums.add(e, P[L::mass], t);
     }
     inline bool
-    point(const unsigned int, PointIterator<dim> &it)
+    point(const unsigned int c, PointIterator<dim> &it)
     {
-      add(it->get_reference_location(), it->get_properties().data());
+      add(c, it->get_reference_location(), it->get_properties().data());
       return true;
     }
     /// the same with the reference location known (a fused op after a move)
     inline bool
-    point_at(const unsigned int, PointIterator<dim> &it, const dealii::Point<dim> &xi)
+    point_at(const unsigned int c, PointIterator<dim> &it, const dealii::Point<dim> &xi)
     {
-      add(xi, it->get_properties().data());
+      add(c, xi, it->get_properties().data());
       return true;
     }
     inline void
@@ -106,6 +124,8 @@ namespace talus::transfer
       K::evaluate(one, xi, e);
       double t[dim][dim];
       minus_V_sigma<dim>(P, P[L::volume], t);
+      if constexpr (Adjust::active)
+        adjust(c, P, P[L::volume], t);
       K::scatter_point(one, e, P[L::mass], t, g, M, F);
     }
   };

@@ -172,6 +172,20 @@ namespace talus::explicit_mpm
       for (const unsigned int i : active_dofs)
         x[i] = 0.0;
     }
+    /// ScatterMassForce's adjustment with strain smoothing: the point's mean
+    /// stress replaced by its cell's (one field: no contact)
+    template <int dim>
+    struct SmoothedMeanStress
+    {
+      static constexpr bool       active = true;
+      const StrainSmoothing<dim> *smoothing;
+      inline void
+      operator()(const unsigned int c, const double *P, const double V, double (&t)[dim][dim]) const
+      {
+        smoothing->force_stress_correction(c, 0, P, V, t);
+      }
+    };
+
     /// the volume Omega of a grid cell (its cache entry)
     template <class Cache>
     inline double
@@ -209,26 +223,11 @@ namespace talus::explicit_mpm
         // of each point's cell (StrainSmoothing::force_stress_correction)
         zero_on(s.nodal_mass, s.active_dofs);
         zero_on(s.nodal_a, s.active_dofs);
+        const SmoothedMeanStress<dim> adjust{s.smoothing.get()};
         shape::with_kernel<dim>(s.prm.bspline(), [&](auto kernel) {
-          using K = decltype(kernel);
-          typename K::Cell      cell;
-          typename K::MassForce sums;
-          transfer::for_each_active_cell(
-            s.points,
-            [&](const unsigned int c) {
-              cell = K::cell(s.grid, c);
-              sums.clear();
-            },
-            [&](const unsigned int c, auto &pt) {
-              const double    *P = pt->get_properties().data();
-              typename K::Eval e;
-              K::evaluate(cell, pt->get_reference_location(), e);
-              double t[dim][dim];
-              minus_V_sigma<dim>(P, P[L::volume], t);
-              s.smoothing->force_stress_correction(c, 0, P, P[L::volume], t);
-              sums.add(e, P[L::mass], t);
-            },
-            [&](unsigned int) { sums.scatter(cell, g, s.nodal_mass.begin(), s.nodal_a.begin()); });
+          transfer::ScatterMassForce<dim, decltype(kernel), SmoothedMeanStress<dim>> p2g{
+            s.grid, g, s.nodal_mass.begin(), s.nodal_a.begin(), adjust};
+          transfer::for_each_active_cell(s.points, p2g);
         });
         return;
       }
@@ -293,18 +292,16 @@ namespace talus::explicit_mpm
         }
     };
     const auto end_cell = [&](const unsigned int c) {
-      const auto &cc          = s.grid.cells[c];
-      double      cell_volume = 1.0;
-      for (unsigned int d = 0; d < dim; ++d)
-        cell_volume *= cc.h[d];
+      const auto  &cc    = s.grid.cells[c];
+      const double Omega = cell_volume(cc);
       // §6.6: a filled cell (Eq. 6.33) is integrated at its 2^dim Gauss points
       // with a stress field linear in the cell, fitted to its points (mean =
       // Eq. 6.32; see mixed_integration.h for why not constant on Q1 cells).
       // With contact, only single-body cells are mixed-integrated (the body's
       // force must equal the cell's).
-      const bool use_mixed = mixed && stress_fit.sV > fill * cell_volume && (!contact || touched.size() <= 1);
+      const bool use_mixed = mixed && stress_fit.sV > fill * Omega && (!contact || touched.size() <= 1);
       if (use_mixed)
-        stress_fit.moments(cell_volume, linear_stress, T);
+        stress_fit.moments(Omega, linear_stress, T);
       double f[nv][dim];
       for (unsigned int v = 0; v < nv; ++v)
         for (unsigned int d = 0; d < dim; ++d)
